@@ -1,0 +1,269 @@
+#include "cli_commands.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <set>
+
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_format.h"
+#include "geodex/geodesic_solver.h"
+#include "geodex/mesh_io.h"
+#include "geodex/samples.h"
+#include "geodex/surface_point.h"
+#include "geodex/triangle_mesh.h"
+
+namespace geodex::cli {
+namespace {
+
+double MsSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+}
+
+int Fail(int code, const std::string& message) {
+  std::fprintf(stderr, "geodex: %s\n", message.c_str());
+  return code;
+}
+
+// Reads a mesh file, or a built-in sample ("sample:terrain").
+absl::StatusOr<MeshData> LoadMeshData(const std::string& path) {
+  if (path.rfind("sample:", 0) == 0) return MakeSampleMesh(path);
+  absl::StatusOr<MeshData> data = ReadMeshFile(path);
+  if (!data.ok()) return data.status();
+  return data;
+}
+
+struct LoadedMesh {
+  MeshData data;
+  TriangleMesh mesh;
+  double load_ms, build_ms;
+};
+
+absl::StatusOr<LoadedMesh> LoadMesh(const std::string& path, const MeshBuildOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  absl::StatusOr<MeshData> data = LoadMeshData(path);
+  if (!data.ok()) return data.status();
+  const double load_ms = MsSince(t0);
+  const auto t1 = std::chrono::steady_clock::now();
+  absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(*data, options);
+  if (!mesh.ok()) {
+    return absl::Status(mesh.status().code(), path + ": " + std::string(mesh.status().message()));
+  }
+  return LoadedMesh{std::move(*data), std::move(*mesh), load_ms, MsSince(t1)};
+}
+
+bool GetDouble(const Args& args, const std::string& key, double* out, std::string* error) {
+  auto it = args.options.find(key);
+  if (it == args.options.end()) return true;
+  if (!absl::SimpleAtod(it->second, out) || std::isnan(*out)) {
+    *error = absl::StrFormat("--%s: '%s' is not a number", key, it->second);
+    return false;
+  }
+  return true;
+}
+
+bool GetUint(const Args& args, const std::string& key, uint64_t* out, std::string* error) {
+  auto it = args.options.find(key);
+  if (it == args.options.end()) return true;
+  if (!absl::SimpleAtoi(it->second, out)) {
+    *error = absl::StrFormat("--%s: '%s' is not a non-negative integer", key, it->second);
+    return false;
+  }
+  return true;
+}
+
+bool CheckKnown(const Args& args, const std::set<std::string>& known, std::string* error) {
+  for (const auto& [key, value] : args.options) {
+    if (!known.count(key)) {
+      *error = absl::StrFormat("unknown option --%s (see geodex --help)", key);
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+bool ParseArgs(int argc, char** argv, int first, const std::vector<std::string>& boolean_flags,
+               Args* out, std::string* error) {
+  const std::set<std::string> booleans(boolean_flags.begin(), boolean_flags.end());
+  for (int i = first; i < argc; ++i) {
+    std::string a = argv[i];
+    if (a.rfind("--", 0) != 0 || a == "--") {
+      out->positional.push_back(a);
+      continue;
+    }
+    a = a.substr(2);
+    const size_t eq = a.find('=');
+    if (eq != std::string::npos) {
+      out->options[a.substr(0, eq)] = a.substr(eq + 1);
+    } else if (booleans.count(a)) {
+      out->options[a] = "";
+    } else if (i + 1 < argc) {
+      out->options[a] = argv[++i];
+    } else {
+      *error = absl::StrFormat("option --%s needs a value", a);
+      return false;
+    }
+  }
+  return true;
+}
+
+int RunInfo(const Args& args) {
+  std::string error;
+  if (!CheckKnown(args, {"format", "strict"}, &error)) return Fail(kExitUsage, error);
+  if (args.positional.size() != 1) return Fail(kExitUsage, "usage: geodex info MESH [--format json]");
+  const std::string format = args.options.count("format") ? args.options.at("format") : "text";
+  if (format != "text" && format != "json") {
+    return Fail(kExitUsage, "--format must be text or json");
+  }
+  MeshBuildOptions options;
+  options.strict = args.options.count("strict") > 0;
+  absl::StatusOr<LoadedMesh> loaded = LoadMesh(args.positional[0], options);
+  if (!loaded.ok()) return Fail(kExitInput, std::string(loaded.status().message()));
+  const TriangleMesh& mesh = loaded->mesh;
+  const MeshReport& r = mesh.report();
+  const std::vector<std::pair<std::string, std::string>> rows = {
+      {"vertices", absl::StrFormat("%d", r.file_vertices)},
+      {"faces", absl::StrFormat("%d", r.file_faces)},
+      {"boundary_edges", absl::StrFormat("%d", r.boundary_edges)},
+      {"boundary_loops", absl::StrFormat("%d", r.boundary_loops)},
+      {"components", absl::StrFormat("%d", r.components)},
+      {"isolated_vertices", absl::StrFormat("%d", r.isolated_vertices)},
+      {"non_manifold_edges", absl::StrFormat("%d", r.non_manifold_edges)},
+      {"non_manifold_vertices", absl::StrFormat("%d", r.non_manifold_vertices)},
+      {"degenerate_faces", absl::StrFormat("%d", r.degenerate_faces)},
+      {"flipped_faces", absl::StrFormat("%d", r.flipped_faces)},
+      {"orientation_cuts", absl::StrFormat("%d", r.orientation_cuts)},
+      {"saddle_vertices", absl::StrFormat("%d", r.saddle_vertices)},
+      {"boundary_vertices", absl::StrFormat("%d", r.boundary_vertices)},
+      {"internal_vertices", absl::StrFormat("%d", mesh.vertex_count())},
+      {"mean_edge_length", absl::StrFormat("%.17g", mesh.MeanEdgeLength())},
+      {"max_edge_length", absl::StrFormat("%.17g", mesh.MaxEdgeLength())},
+      {"bbox_min", absl::StrFormat("%.17g %.17g %.17g", mesh.BoundsMin()[0], mesh.BoundsMin()[1],
+                                   mesh.BoundsMin()[2])},
+      {"bbox_max", absl::StrFormat("%.17g %.17g %.17g", mesh.BoundsMax()[0], mesh.BoundsMax()[1],
+                                   mesh.BoundsMax()[2])},
+      {"bytes", absl::StrFormat("%d", mesh.MemoryBytes())},
+      {"load_ms", absl::StrFormat("%.3f", loaded->load_ms)},
+      {"build_ms", absl::StrFormat("%.3f", loaded->build_ms)},
+  };
+  if (format == "text") {
+    for (const auto& [k, v] : rows) std::printf("%s: %s\n", k.c_str(), v.c_str());
+  } else {
+    std::string json = "{";
+    for (size_t i = 0; i < rows.size(); ++i) {
+      const bool quoted = rows[i].first.rfind("bbox_", 0) == 0;
+      json += absl::StrFormat("%s\"%s\": %s%s%s", i ? ", " : "", rows[i].first, quoted ? "\"" : "",
+                              rows[i].second, quoted ? "\"" : "");
+    }
+    std::printf("%s}\n", json.c_str());
+  }
+  return kExitOk;
+}
+
+int RunDistances(const Args& args) {
+  std::string error;
+  if (!CheckKnown(args, {"sources", "method", "lambda", "lambda-scale", "max-distance",
+                         "max-windows", "stats", "output", "no-filter", "no-one-split"},
+                  &error)) {
+    return Fail(kExitUsage, error);
+  }
+  if (args.positional.size() != 1 || !args.options.count("sources")) {
+    return Fail(kExitUsage, "usage: geodex distances MESH --sources SPEC [options]");
+  }
+  GeodesicOptions options;
+  const std::string method = args.options.count("method") ? args.options.at("method") : "ich";
+  if (method == "ich") {
+    options.method = Method::kIch;
+  } else if (method == "dijkstra") {
+    options.method = Method::kDijkstra;
+  } else {
+    return Fail(kExitUsage, "--method must be ich or dijkstra");
+  }
+  if (!GetDouble(args, "lambda", &options.lambda, &error) ||
+      !GetDouble(args, "max-distance", &options.max_distance, &error) ||
+      !GetUint(args, "max-windows", &options.max_windows, &error)) {
+    return Fail(kExitUsage, error);
+  }
+  if (!(options.lambda >= 0 && options.lambda <= 1)) {
+    return Fail(kExitUsage, absl::StrFormat("--lambda must be in [0, 1], got %g", options.lambda));
+  }
+  if (!(options.max_distance > 0)) {
+    return Fail(kExitUsage, "--max-distance must be positive");
+  }
+  if (args.options.count("lambda-scale")) {
+    const std::string& s = args.options.at("lambda-scale");
+    if (s == "max") {
+      options.lambda_scale = LambdaScale::kMaxEdge;
+    } else if (s == "mean") {
+      options.lambda_scale = LambdaScale::kMeanEdge;
+    } else {
+      return Fail(kExitUsage, "--lambda-scale must be max or mean");
+    }
+  }
+  options.use_filter = !args.options.count("no-filter");
+  options.use_one_angle_one_split = !args.options.count("no-one-split");
+
+  absl::StatusOr<std::vector<SurfacePoint>> sources = ParseSurfacePoints(args.options.at("sources"));
+  if (!sources.ok()) return Fail(kExitUsage, "--sources: " + std::string(sources.status().message()));
+  absl::StatusOr<LoadedMesh> loaded = LoadMesh(args.positional[0], MeshBuildOptions{});
+  if (!loaded.ok()) return Fail(kExitInput, std::string(loaded.status().message()));
+  for (const SurfacePoint& p : *sources) {
+    if (absl::Status s = ValidateSurfacePoint(loaded->mesh, p); !s.ok()) {
+      return Fail(kExitUsage, "--sources: " + std::string(s.message()));
+    }
+  }
+  absl::StatusOr<DistanceField> field = ComputeDistanceField(loaded->mesh, *sources, options);
+  if (!field.ok()) {
+    const int code = field.status().code() == absl::StatusCode::kInvalidArgument ? kExitUsage
+                                                                                  : kExitSolveFailed;
+    return Fail(code, std::string(field.status().message()));
+  }
+  const auto t_out = std::chrono::steady_clock::now();
+  std::string text;
+  text.reserve(field->distance.size() * 24);
+  char buf[64];
+  for (double d : field->distance) {
+    const int n = std::snprintf(buf, sizeof(buf), "%.17g\n", d);
+    text.append(buf, n);
+  }
+  if (args.options.count("output")) {
+    const std::string& path = args.options.at("output");
+    std::ofstream out(path, std::ios::binary);
+    out << text;
+    out.close();
+    if (!out) return Fail(kExitInput, absl::StrFormat("cannot write %s", path));
+  } else {
+    std::fwrite(text.data(), 1, text.size(), stdout);
+  }
+  if (args.options.count("stats")) {
+    const SolveStats& s = field->stats;
+    std::fprintf(
+        stderr,
+        "{\"method\": \"%s\", \"vertices\": %u, \"faces\": %u, \"sources\": %zu, "
+        "\"windows_created\": %llu, \"windows_filtered_at_creation\": %llu, "
+        "\"windows_filtered_at_pop\": %llu, \"windows_filtered_overfilter\": %llu, "
+        "\"children_skipped_one_split\": %llu, \"windows_deleted_one_split\": %llu, "
+        "\"windows_processed\": %llu, \"pseudo_sources\": %llu, \"edge_relaxations\": %llu, "
+        "\"max_level\": %u, \"peak_live_windows\": %llu, \"peak_bytes\": %llu, "
+        "\"mesh_bytes\": %llu, \"load_ms\": %.3f, \"build_ms\": %.3f, \"solve_ms\": %.3f, "
+        "\"output_ms\": %.3f}\n",
+        method.c_str(), loaded->mesh.file_vertex_count(), loaded->mesh.face_count(),
+        sources->size(), (unsigned long long)s.windows_created,
+        (unsigned long long)s.windows_filtered_at_creation,
+        (unsigned long long)s.windows_filtered_at_pop,
+        (unsigned long long)s.windows_filtered_overfilter,
+        (unsigned long long)s.children_skipped_one_split,
+        (unsigned long long)s.windows_deleted_one_split, (unsigned long long)s.windows_processed,
+        (unsigned long long)s.pseudo_sources, (unsigned long long)s.edge_relaxations, s.max_level,
+        (unsigned long long)s.peak_live_windows, (unsigned long long)s.peak_bytes,
+        (unsigned long long)loaded->mesh.MemoryBytes(), loaded->load_ms, loaded->build_ms,
+        s.solve_ms, MsSince(t_out));
+  }
+  return kExitOk;
+}
+
+}  // namespace geodex::cli

@@ -1,0 +1,60 @@
+// geodex: the command line. Thin: parses the command and hands over to cli_commands.cc.
+
+#include <cstdio>
+#include <cstring>
+#include <string>
+
+#include "cli_commands.h"
+
+namespace {
+
+constexpr char kUsage[] = R"(geodex - exact geodesic distances on triangle meshes (improved Chen-Han)
+
+usage: geodex COMMAND MESH [options]
+
+MESH is a mesh file (OFF, OBJ, PLY, STL, optionally .gz) or a built-in sample:
+sample:terrain, sample:torus, sample:sphere.
+
+commands:
+  info MESH [--format text|json] [--strict]
+      One 'key: value' line per property (vertices, faces, boundary_loops, components,
+      isolated_vertices, non_manifold_edges, non_manifold_vertices, degenerate_faces,
+      saddle_vertices, bytes, ...). Reports on any readable mesh, valid or messy.
+  distances MESH --sources SPEC [--method ich|dijkstra] [--lambda L] [--lambda-scale max|mean]
+                 [--max-distance D] [--max-windows N] [--stats] [--output FILE]
+      One distance per vertex in the file's vertex order (%.17g; 'inf' if unreachable).
+      --stats prints one JSON object with counters and times (*_ms) on stderr.
+      --no-filter / --no-one-split switch off Lemma 2 / Lemma 1 (slower; same answer).
+
+SPEC: comma-separated points: 17 (vertex), e:V1:V2:T (the point (1-T)*V1 + T*V2 on an edge),
+      f:FACE:B0:B1:B2 (barycentric in the face's vertex order as in the file).
+
+exit codes: 0 ok; 1 the computation failed (cancelled, budget); 2 bad command line or argument;
+            3 the mesh could not be read or is invalid.
+)";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace geodex::cli;
+  if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h") ||
+      !std::strcmp(argv[1], "help")) {
+    std::fputs(kUsage, argc < 2 ? stderr : stdout);
+    return argc < 2 ? kExitUsage : kExitOk;
+  }
+  if (!std::strcmp(argv[1], "--version")) {
+    std::puts("geodex 0.1.0");
+    return kExitOk;
+  }
+  const std::string command = argv[1];
+  Args args;
+  std::string error;
+  if (!ParseArgs(argc, argv, 2, {"stats", "strict", "no-filter", "no-one-split"}, &args, &error)) {
+    std::fprintf(stderr, "geodex: %s\n", error.c_str());
+    return kExitUsage;
+  }
+  if (command == "info") return RunInfo(args);
+  if (command == "distances") return RunDistances(args);
+  std::fprintf(stderr, "geodex: unknown command '%s' (see geodex --help)\n", command.c_str());
+  return kExitUsage;
+}

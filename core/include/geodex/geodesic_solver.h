@@ -1,0 +1,47 @@
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "geodex/cancel.h"
+#include "geodex/distance_field.h"
+#include "geodex/surface_point.h"
+#include "geodex/triangle_mesh.h"
+
+namespace geodex {
+
+enum class Method {
+  kIch,       // exact: improved Chen-Han (Xin & Wang 2009/2010)
+  kDijkstra,  // shortest paths along mesh edges (an upper bound; the baseline)
+};
+
+enum class LambdaScale {
+  kMaxEdge,   // epsilon = lambda * longest edge: lambda = 1 reproduces Dijkstra (Theorem 8)
+  kMeanEdge,  // epsilon = lambda * mean edge length, the paper's practical suggestion
+};
+
+struct GeodesicOptions {
+  Method method = Method::kIch;
+  // Precision knob of section 7: 0 = exact ICH; larger values over-filter (faster, less exact).
+  double lambda = 0;
+  LambdaScale lambda_scale = LambdaScale::kMaxEdge;
+  // Vertices farther than this stay +inf; propagation stops there.
+  double max_distance = std::numeric_limits<double>::infinity();
+  // 0 = unlimited. Stops the solve with ResourceExhausted once this many windows were created.
+  uint64_t max_windows = 0;
+  const CancelToken* cancel = nullptr;
+  // Ablation switches for tests and benchmarks; both are exact either way.
+  bool use_filter = true;            // Lemma 2, the filter theorem
+  bool use_one_angle_one_split = true;  // Lemma 1, Chen & Han
+};
+
+// Distances from every vertex to the nearest of `sources`, with the nearest source's index.
+// Errors: InvalidArgument for an empty source list or a bad source (named), Cancelled,
+// ResourceExhausted (window budget).
+absl::StatusOr<DistanceField> ComputeDistanceField(const TriangleMesh& mesh,
+                                                   const std::vector<SurfacePoint>& sources,
+                                                   const GeodesicOptions& options = {});
+
+}  // namespace geodex

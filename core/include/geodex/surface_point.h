@@ -1,0 +1,59 @@
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
+
+namespace geodex {
+
+class TriangleMesh;
+
+// A point on the surface, named in the file's terms (file vertex ids, file face ids and the
+// file's corner order), so it means the same thing to every client.
+struct SurfacePoint {
+  enum class Kind : uint8_t { kVertex, kEdge, kFace };
+  Kind kind = Kind::kVertex;
+  uint32_t vertex = 0;                 // kVertex
+  uint32_t edge_from = 0, edge_to = 0; // kEdge: the point (1 - t) * from + t * to
+  double t = 0;
+  uint32_t face = 0;                   // kFace: barycentric in the file's corner order
+  std::array<double, 3> bary{};
+
+  static SurfacePoint AtVertex(uint32_t v) {
+    SurfacePoint p;
+    p.kind = Kind::kVertex;
+    p.vertex = v;
+    return p;
+  }
+  static SurfacePoint OnEdge(uint32_t from, uint32_t to, double t) {
+    SurfacePoint p;
+    p.kind = Kind::kEdge;
+    p.edge_from = from;
+    p.edge_to = to;
+    p.t = t;
+    return p;
+  }
+  static SurfacePoint InFace(uint32_t f, double b0, double b1, double b2) {
+    SurfacePoint p;
+    p.kind = Kind::kFace;
+    p.face = f;
+    p.bary = {b0, b1, b2};
+    return p;
+  }
+};
+
+// Parses a comma list: `17` (vertex), `e:V1:V2:T`, `f:FACE:B0:B1:B2`. Checks the syntax only; the
+// mesh checks ranges (see ValidateSurfacePoint). Errors name the offending item.
+absl::StatusOr<std::vector<SurfacePoint>> ParseSurfacePoints(absl::string_view spec);
+
+// Range and consistency checks against a mesh: unknown vertex or face, an edge that does not
+// exist, T outside [0,1], negative barycentrics or ones that do not sum to 1 (within 1e-9).
+absl::Status ValidateSurfacePoint(const TriangleMesh& mesh, const SurfacePoint& p);
+
+std::string SurfacePointToString(const SurfacePoint& p);
+
+}  // namespace geodex

@@ -1,0 +1,148 @@
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "geodex/mesh_data.h"
+
+namespace geodex {
+
+inline constexpr uint32_t kNoIndex = std::numeric_limits<uint32_t>::max();
+
+// How TriangleMesh::Build treats messy input.
+struct MeshBuildOptions {
+  // Reject non-manifold edges/vertices and inconsistent orientation instead of repairing them
+  // (cutting at non-manifold junctions, re-orienting per component).
+  bool strict = false;
+};
+
+// What Build found in the file (all counts refer to the file's vertices and faces).
+struct MeshReport {
+  uint64_t file_vertices = 0;
+  uint64_t file_faces = 0;
+  uint64_t boundary_edges = 0;
+  uint64_t boundary_loops = 0;
+  uint64_t components = 0;          // connected components of faces (isolated vertices excluded)
+  uint64_t isolated_vertices = 0;   // vertices referenced by no face
+  uint64_t non_manifold_edges = 0;  // edges shared by more than two faces (cut)
+  uint64_t non_manifold_vertices = 0;  // file vertices split into several internal copies
+  uint64_t degenerate_faces = 0;       // zero-area faces (no window crosses them)
+  uint64_t flipped_faces = 0;          // faces re-oriented to agree with their component
+  uint64_t orientation_cuts = 0;       // edges cut because no consistent orientation exists
+  uint64_t saddle_vertices = 0;        // interior vertices with angle sum >= 2*pi (within round-off)
+  uint64_t boundary_vertices = 0;
+};
+
+// An immutable triangle mesh with everything the geodesic engine reads precomputed.
+//
+// Internal vertex ids: 0..file_vertex_count()-1 are the file's vertices; a file vertex that is
+// non-manifold (several fans of faces meet only at it) keeps its id for its first fan and gets a
+// new internal id >= file_vertex_count() per further fan, so that paths never cross such
+// junctions. FileVertex() maps back. Faces keep the file's order; a face may have its 2nd and 3rd
+// corners swapped (FaceFlipped) so that each component is consistently oriented.
+//
+// Half-edge h = 3*f + k runs from corner k to corner (k+1)%3 of face f; its frame puts the start at
+// (0,0), the end at (length,0) and the opposite corner at (opp_x, opp_y) with opp_y > 0.
+//
+// Positions are recentred on the bounding-box centre (large georeferenced coordinates keep their
+// precision); Center() restores file coordinates.
+class TriangleMesh {
+ public:
+  // Validates and builds. Errors (InvalidArgument, naming the face/vertex): empty mesh, face index
+  // out of range, a face repeating a vertex, NaN/Inf coordinates; in strict mode also non-manifold
+  // or inconsistently oriented input.
+  static absl::StatusOr<TriangleMesh> Build(const MeshData& data, const MeshBuildOptions& options = {});
+
+  TriangleMesh(TriangleMesh&&) = default;
+  TriangleMesh& operator=(TriangleMesh&&) = default;
+
+  // --- sizes and mapping ---
+  uint32_t vertex_count() const { return static_cast<uint32_t>(vertex_flags_.size()); }
+  uint32_t face_count() const { return static_cast<uint32_t>(faces_.size() / 3); }
+  uint32_t file_vertex_count() const { return file_vertex_count_; }
+  uint32_t FileVertex(uint32_t v) const {
+    return v < file_vertex_count_ ? v : copy_of_[v - file_vertex_count_];
+  }
+  // Internal copies (beyond the file vertex itself) of file vertex v; empty for manifold vertices.
+  const std::vector<uint32_t>& copy_of() const { return copy_of_; }
+
+  // --- geometry ---
+  const std::array<double, 3>& Center() const { return center_; }
+  std::array<double, 3> Position(uint32_t v) const {
+    return {positions_[3 * v], positions_[3 * v + 1], positions_[3 * v + 2]};
+  }
+  const double* positions() const { return positions_.data(); }  // recentred, 3 per vertex
+  uint32_t FaceVertex(uint32_t f, int k) const { return faces_[3 * f + k]; }
+  const uint32_t* faces() const { return faces_.data(); }
+  bool FaceFlipped(uint32_t f) const { return face_flags_[f] & kFaceFlipped; }
+  bool FaceDegenerate(uint32_t f) const { return face_flags_[f] & kFaceDegenerate; }
+
+  // --- half-edges (the engine's inner loop reads only these) ---
+  static uint32_t FaceOf(uint32_t h) { return h / 3; }
+  static uint32_t Next(uint32_t h) { return h - h % 3 + (h % 3 + 1) % 3; }
+  static uint32_t Prev(uint32_t h) { return h - h % 3 + (h % 3 + 2) % 3; }
+  uint32_t Twin(uint32_t h) const { return twin_[h]; }  // kNoIndex on a boundary
+  uint32_t From(uint32_t h) const { return faces_[h]; }
+  uint32_t To(uint32_t h) const { return faces_[Next(h)]; }
+  uint32_t Opposite(uint32_t h) const { return faces_[Prev(h)]; }
+  double Length(uint32_t h) const { return length_[h]; }
+  double OppX(uint32_t h) const { return opp_x_[h]; }
+  double OppY(uint32_t h) const { return opp_y_[h]; }
+  double CornerAngle(uint32_t corner) const { return corner_angle_[corner]; }
+
+  // --- vertices ---
+  double AngleSum(uint32_t v) const { return angle_sum_[v]; }
+  bool IsSaddle(uint32_t v) const { return vertex_flags_[v] & kSaddle; }
+  bool IsBoundary(uint32_t v) const { return vertex_flags_[v] & kBoundary; }
+  bool IsIsolated(uint32_t v) const { return vertex_flags_[v] & kIsolated; }
+  // Paths may bend here: saddle, boundary, or touching a degenerate face (ICH pseudo-source).
+  bool IsPseudoSourceCandidate(uint32_t v) const { return vertex_flags_[v] & kPseudoSource; }
+  uint32_t Component(uint32_t v) const { return component_[v]; }
+  // Corners (3*f+k) at vertex v, in no particular order.
+  const uint32_t* CornersBegin(uint32_t v) const { return &vertex_corners_[corner_offsets_[v]]; }
+  const uint32_t* CornersEnd(uint32_t v) const { return &vertex_corners_[corner_offsets_[v + 1]]; }
+  // Edge neighbours (unique) with edge lengths, including edges of degenerate faces.
+  uint32_t NeighborBegin(uint32_t v) const { return neighbor_offsets_[v]; }
+  uint32_t NeighborEnd(uint32_t v) const { return neighbor_offsets_[v + 1]; }
+  uint32_t NeighborVertex(uint32_t i) const { return neighbors_[i]; }
+  double NeighborLength(uint32_t i) const { return neighbor_length_[i]; }
+
+  // --- summary ---
+  const MeshReport& report() const { return report_; }
+  const std::array<double, 3>& BoundsMin() const { return bounds_min_; }  // file coordinates
+  const std::array<double, 3>& BoundsMax() const { return bounds_max_; }
+  double MeanEdgeLength() const { return mean_edge_length_; }
+  double MaxEdgeLength() const { return max_edge_length_; }
+  uint64_t MemoryBytes() const;
+
+ private:
+  TriangleMesh() = default;
+
+  enum : uint8_t { kFaceFlipped = 1, kFaceDegenerate = 2 };
+  enum : uint8_t { kSaddle = 1, kBoundary = 2, kIsolated = 4, kPseudoSource = 8 };
+
+  friend class MeshBuilder;
+
+  uint32_t file_vertex_count_ = 0;
+  std::array<double, 3> center_{};
+  std::array<double, 3> bounds_min_{}, bounds_max_{};
+  std::vector<double> positions_;
+  std::vector<uint32_t> faces_;
+  std::vector<uint8_t> face_flags_;
+  std::vector<uint32_t> copy_of_;
+  std::vector<uint32_t> twin_;
+  std::vector<double> length_, opp_x_, opp_y_, corner_angle_;
+  std::vector<double> angle_sum_;
+  std::vector<uint8_t> vertex_flags_;
+  std::vector<uint32_t> component_;
+  std::vector<uint32_t> corner_offsets_, vertex_corners_;
+  std::vector<uint32_t> neighbor_offsets_, neighbors_;
+  std::vector<double> neighbor_length_;
+  double mean_edge_length_ = 0, max_edge_length_ = 0;
+  MeshReport report_;
+};
+
+}  // namespace geodex

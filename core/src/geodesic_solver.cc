@@ -1,0 +1,224 @@
+#include "geodex/geodesic_solver.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "absl/strings/str_format.h"
+#include "dijkstra.h"
+#include "ich/ich_solver.h"
+
+namespace geodex {
+namespace {
+
+// Barycentrics (and edge parameters) this close to 0 or 1 snap to the face's edge or vertex, so a
+// point "on" an edge behaves exactly like the edge point.
+constexpr double kSnap = 1e-12;
+
+// Corner c of face f in the frame of half-edge 3f.
+void CornerInFaceFrame(const TriangleMesh& mesh, uint32_t f, int c, double* x, double* y) {
+  const uint32_t h = 3 * f;
+  if (c == 0) {
+    *x = 0, *y = 0;
+  } else if (c == 1) {
+    *x = mesh.Length(h), *y = 0;
+  } else {
+    *x = mesh.OppX(h), *y = mesh.OppY(h);
+  }
+}
+
+void InternalCopies(const TriangleMesh& mesh, uint32_t file_vertex, std::vector<uint32_t>* out) {
+  out->clear();
+  out->push_back(file_vertex);
+  const std::vector<uint32_t>& copies = mesh.copy_of();
+  for (uint32_t i = 0; i < copies.size(); ++i) {
+    if (copies[i] == file_vertex) out->push_back(mesh.file_vertex_count() + i);
+  }
+}
+
+class SourceResolver {
+ public:
+  explicit SourceResolver(const TriangleMesh& mesh) : mesh_(mesh) {}
+
+  absl::Status Add(const SurfacePoint& p, uint32_t label) {
+    if (absl::Status s = ValidateSurfacePoint(mesh_, p); !s.ok()) return s;
+    switch (p.kind) {
+      case SurfacePoint::Kind::kVertex:
+        return AddVertex(p.vertex, label);
+      case SurfacePoint::Kind::kEdge:
+        return AddEdgePoint(p, p.edge_from, p.edge_to, p.t, label);
+      case SurfacePoint::Kind::kFace:
+        return AddFacePoint(p, label);
+    }
+    return absl::OkStatus();
+  }
+
+  const std::vector<ich::ResolvedSource>& sources() const { return sources_; }
+
+ private:
+  absl::Status AddVertex(uint32_t file_vertex, uint32_t label) {
+    InternalCopies(mesh_, file_vertex, &copies_);
+    for (uint32_t v : copies_) {
+      ich::ResolvedSource s;
+      s.is_vertex = true;
+      s.vertex = v;
+      s.label = label;
+      sources_.push_back(s);
+    }
+    return absl::OkStatus();
+  }
+
+  absl::Status AddEdgePoint(const SurfacePoint& p, uint32_t a, uint32_t b, double t,
+                            uint32_t label) {
+    if (t <= kSnap) return AddVertex(a, label);
+    if (t >= 1 - kSnap) return AddVertex(b, label);
+    bool found = false, placed = false;
+    InternalCopies(mesh_, a, &copies_);
+    for (uint32_t va : copies_) {
+      for (const uint32_t* c = mesh_.CornersBegin(va); c != mesh_.CornersEnd(va); ++c) {
+        // Corner c starts half-edge c (a -> next); half-edge Prev(c) ends at a.
+        const uint32_t candidates[2] = {*c, TriangleMesh::Prev(*c)};
+        for (const uint32_t h : candidates) {
+          const bool forward = mesh_.FileVertex(mesh_.From(h)) == a &&
+                               mesh_.FileVertex(mesh_.To(h)) == b;
+          const bool backward = mesh_.FileVertex(mesh_.From(h)) == b &&
+                                mesh_.FileVertex(mesh_.To(h)) == a;
+          if (!forward && !backward) continue;
+          found = true;
+          const uint32_t f = TriangleMesh::FaceOf(h);
+          if (mesh_.FaceDegenerate(f)) continue;
+          const double x = (forward ? t : 1 - t) * mesh_.Length(h);
+          const int k = static_cast<int>(h % 3);
+          double x0, y0, x1, y1;
+          CornerInFaceFrame(mesh_, f, k, &x0, &y0);
+          CornerInFaceFrame(mesh_, f, (k + 1) % 3, &x1, &y1);
+          const double len = mesh_.Length(h);
+          PlaceInFace(f, x0 + (x1 - x0) * x / len, y0 + (y1 - y0) * x / len, label);
+          placed = true;
+        }
+      }
+    }
+    if (!found) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "point %s: the mesh has no edge between vertices %d and %d", SurfacePointToString(p), a,
+          b));
+    }
+    if (!placed) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "point %s: the edge %d-%d belongs only to degenerate (zero-area) faces",
+          SurfacePointToString(p), a, b));
+    }
+    return absl::OkStatus();
+  }
+
+  absl::Status AddFacePoint(const SurfacePoint& p, uint32_t label) {
+    const uint32_t f = p.face;
+    double bary[3] = {std::max(0.0, p.bary[0]), std::max(0.0, p.bary[1]),
+                      std::max(0.0, p.bary[2])};
+    const double sum = bary[0] + bary[1] + bary[2];
+    for (double& b : bary) b = b / sum < kSnap ? 0 : b / sum;
+    // File corners of the face (internal order may have corners 1 and 2 swapped).
+    uint32_t file_corner[3];
+    for (int k = 0; k < 3; ++k) file_corner[k] = mesh_.FileVertex(mesh_.FaceVertex(f, k));
+    if (mesh_.FaceFlipped(f)) std::swap(file_corner[1], file_corner[2]);
+    const int zeros = (bary[0] == 0) + (bary[1] == 0) + (bary[2] == 0);
+    if (zeros == 2) {
+      for (int k = 0; k < 3; ++k) {
+        if (bary[k] != 0) return AddVertex(file_corner[k], label);
+      }
+    }
+    if (zeros == 1) {
+      const int z = bary[0] == 0 ? 0 : (bary[1] == 0 ? 1 : 2);
+      const int i = (z + 1) % 3, j = (z + 2) % 3;
+      return AddEdgePoint(p, file_corner[i], file_corner[j], bary[j] / (bary[i] + bary[j]),
+                          label);
+    }
+    if (mesh_.FaceDegenerate(f)) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "point %s: face %d is degenerate (zero area)", SurfacePointToString(p), f));
+    }
+    // Internal barycentrics follow the internal corner order.
+    double ib[3] = {bary[0], bary[1], bary[2]};
+    if (mesh_.FaceFlipped(f)) std::swap(ib[1], ib[2]);
+    double x1, y1, x2, y2;
+    CornerInFaceFrame(mesh_, f, 1, &x1, &y1);
+    CornerInFaceFrame(mesh_, f, 2, &x2, &y2);
+    PlaceInFace(f, ib[1] * x1 + ib[2] * x2, ib[1] * y1 + ib[2] * y2, label);
+    return absl::OkStatus();
+  }
+
+  void PlaceInFace(uint32_t f, double px, double py, uint32_t label) {
+    ich::ResolvedSource s;
+    s.is_vertex = false;
+    s.face = f;
+    s.px = px;
+    s.py = py;
+    s.label = label;
+    sources_.push_back(s);
+  }
+
+  const TriangleMesh& mesh_;
+  std::vector<ich::ResolvedSource> sources_;
+  std::vector<uint32_t> copies_;
+};
+
+std::vector<VertexSeed> SeedsForDijkstra(const TriangleMesh& mesh,
+                                         const std::vector<ich::ResolvedSource>& sources) {
+  std::vector<VertexSeed> seeds;
+  for (const ich::ResolvedSource& s : sources) {
+    if (s.is_vertex) {
+      seeds.push_back({s.vertex, 0.0, s.label});
+      continue;
+    }
+    for (int k = 0; k < 3; ++k) {
+      double x, y;
+      CornerInFaceFrame(mesh, s.face, k, &x, &y);
+      seeds.push_back({mesh.FaceVertex(s.face, k), std::hypot(s.px - x, s.py - y), s.label});
+    }
+  }
+  return seeds;
+}
+
+}  // namespace
+
+absl::StatusOr<DistanceField> ComputeDistanceField(const TriangleMesh& mesh,
+                                                   const std::vector<SurfacePoint>& sources,
+                                                   const GeodesicOptions& options) {
+  if (sources.empty()) return absl::InvalidArgumentError("no sources given");
+  if (!(options.lambda >= 0 && options.lambda <= 1)) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("lambda = %g is outside [0, 1]", options.lambda));
+  }
+  if (!(options.max_distance > 0)) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("max_distance = %g must be positive", options.max_distance));
+  }
+  SourceResolver resolver(mesh);
+  for (uint32_t i = 0; i < sources.size(); ++i) {
+    if (absl::Status s = resolver.Add(sources[i], i); !s.ok()) return s;
+  }
+  DistanceField field;
+  if (options.method == Method::kDijkstra) {
+    if (absl::Status s = RunDijkstra(mesh, SeedsForDijkstra(mesh, resolver.sources()), options,
+                                     &field);
+        !s.ok()) {
+      return s;
+    }
+  } else {
+    ich::IchSolver solver(mesh, options);
+    if (absl::Status s = solver.Solve(resolver.sources(), &field); !s.ok()) return s;
+  }
+  // File order: a split vertex takes the best of its copies.
+  const uint32_t nf = mesh.file_vertex_count();
+  field.distance.assign(field.internal_distance.begin(), field.internal_distance.begin() + nf);
+  field.source.assign(field.internal_source.begin(), field.internal_source.begin() + nf);
+  for (uint32_t v = nf; v < mesh.vertex_count(); ++v) {
+    const uint32_t fv = mesh.FileVertex(v);
+    if (field.internal_distance[v] < field.distance[fv]) {
+      field.distance[fv] = field.internal_distance[v];
+      field.source[fv] = field.internal_source[v];
+    }
+  }
+  return field;
+}
+
+}  // namespace geodex

@@ -1,0 +1,508 @@
+#include "ich/ich_solver.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "absl/strings/str_format.h"
+
+namespace geodex::ich {
+namespace {
+
+// Numerical policy (docs/numerics.md): every tolerance is relative to the geometry at hand.
+// Filter ties keep the window: it is killed only when worse by more than this fraction of the
+// distances compared (so a vertex distance set by the window's own parent never kills it).
+constexpr double kFilterRelTol = 1e-12;
+// The opposite vertex counts as seen by a window when its ray crosses within this fraction of the
+// edge length of the interval (generous: a spurious second child is harmless, a missed one is not).
+constexpr double kCoverRelTol = 1e-10;
+// Windows narrower than this fraction of their edge carry no path that a neighbouring window or
+// an endpoint vertex does not also carry.
+constexpr double kTinyWindowRel = 1e-13;
+// An image closer than this (relative to the edge) to the edge's line sends rays along the edge,
+// never into the face.
+constexpr double kGrazingRel = 1e-13;
+// Lemma 1 treats distances or crossing points this close as ties and then keeps both children.
+constexpr double kSplitTieRel = 1e-12;
+// Cancellation is polled every this many dequeued windows.
+constexpr uint32_t kCancelPollInterval = 1024;
+
+inline double Hypot(double x, double y) { return std::sqrt(x * x + y * y); }
+
+// Where the ray from image (ix, iy) through edge point (b, 0) meets the segment from p to p + w,
+// as a parameter in [0, 1] (clamped: the caller knows the ray hits that segment).
+inline double RayHitParam(double ix, double iy, double b, double px, double py, double wx,
+                          double wy) {
+  const double dx = b - ix, dy = -iy;
+  const double denom = wx * dy - wy * dx;
+  const double numer = (ix - px) * dy - (iy - py) * dx;
+  // I + s D = P + t W, crossed with D: (I - P) x D = t (W x D), with a x b = a.x b.y - a.y b.x.
+  double t = denom != 0 ? numer / denom : 0.0;
+  if (!(t > 0)) t = 0;  // also catches NaN
+  if (t > 1) t = 1;
+  return t;
+}
+
+}  // namespace
+
+IchSolver::IchSolver(const TriangleMesh& mesh, const GeodesicOptions& options)
+    : mesh_(mesh), options_(options) {
+  if (options.lambda > 0) {
+    const double scale = options.lambda_scale == LambdaScale::kMaxEdge ? mesh.MaxEdgeLength()
+                                                                       : mesh.MeanEdgeLength();
+    epsilon_ = options.lambda * scale;
+  }
+}
+
+void IchSolver::Push(uint32_t id, double key) {
+  queue_.push_back({key, id, pool_[id].generation});
+  std::push_heap(queue_.begin(), queue_.end(), QueueGreater());
+}
+
+void IchSolver::SeedVertex(uint32_t v, uint32_t label) {
+  if (dist_[v] <= 0) return;  // the same vertex given twice: the first label wins
+  dist_[v] = 0;
+  label_[v] = label;
+  origin_[v] = VertexOrigin{kNoIndex, v, 0, 0};
+  const uint32_t id = pool_.Allocate();
+  Window& w = pool_[id];
+  w.kind = WindowKind::kPseudoSource;
+  w.side = WindowSide::kInitial;
+  w.element = v;
+  w.sigma = 0;
+  w.b0 = w.b1 = w.ix = w.iy = 0;
+  w.pseudo_source = v;
+  w.source = label;
+  w.level = 0;
+  ++stats_.pseudo_sources;
+  Push(id, 0);
+}
+
+void IchSolver::SeedFacePoint(const ResolvedSource& s) {
+  // A point source is a pseudo-source at a point: its face's vertices are reached straight, and
+  // windows leave through the face's three edges. On an edge of the face, the matching window would
+  // graze; the caller seeds the neighbouring face too.
+  const uint32_t f = s.face;
+  // Corner positions in the frame of half-edge 3f.
+  const double cx[3] = {0, mesh_.Length(3 * f), mesh_.OppX(3 * f)};
+  const double cy[3] = {0, 0, mesh_.OppY(3 * f)};
+  // A root window so the seed's children have a parent (kept for the tree's sake).
+  const uint32_t root = pool_.Allocate();
+  {
+    Window& w = pool_[root];
+    w.kind = WindowKind::kPseudoSource;
+    w.side = WindowSide::kInitial;
+    w.element = kNoIndex;
+    w.sigma = 0;
+    w.b0 = w.b1 = w.ix = w.iy = 0;
+    w.pseudo_source = kNoIndex;
+    w.source = s.label;
+    w.level = 0;
+    w.state = WindowState::kProcessed;
+  }
+  for (int k = 0; k < 3; ++k) {
+    const uint32_t h = 3 * f + k;
+    const int k1 = (k + 1) % 3;
+    const double len = mesh_.Length(h);
+    const double ux = (cx[k1] - cx[k]) / len, uy = (cy[k1] - cy[k]) / len;
+    // The point in h's frame (+y towards the face).
+    const double qx = (s.px - cx[k]) * ux + (s.py - cy[k]) * uy;
+    const double qy = -(s.px - cx[k]) * uy + (s.py - cy[k]) * ux;
+    UpdateVertex(mesh_.From(h), Hypot(qx, qy), root, h, qx, qy);
+    const uint32_t t = mesh_.Twin(h);
+    if (t == kNoIndex) continue;
+    // In the twin's frame the point lies behind the edge: (len - x, -y).
+    MakeInterval(root, t, 0, len, len - qx, -qy, WindowSide::kInitial, kNoIndex, 0, s.label);
+  }
+  ReleaseIfDone(root);
+}
+
+void IchSolver::UpdateVertex(uint32_t v, double d, uint32_t parent, uint32_t half_edge, double ix,
+                             double iy) {
+  if (!(d < dist_[v])) return;
+  const Window& p = pool_[parent];
+  dist_[v] = d;
+  label_[v] = p.source;
+  origin_[v] = VertexOrigin{half_edge, p.kind == WindowKind::kPseudoSource ? p.element
+                                                                            : p.pseudo_source,
+                            ix, iy};
+  // Paths bend only at saddle and boundary vertices (P4); with lambda > 0 every vertex also passes
+  // its distance along its edges, so it gets a (relax-only) pseudo-source window too.
+  if (mesh_.IsPseudoSourceCandidate(v) || epsilon_ > 0) {
+    if (d > options_.max_distance) return;
+    const uint32_t id = pool_.Allocate();
+    const Window& pp = pool_[parent];  // re-read: Allocate may have moved the pool
+    Window& w = pool_[id];
+    w.kind = WindowKind::kPseudoSource;
+    w.side = WindowSide::kInitial;
+    w.element = v;
+    w.sigma = d;
+    w.b0 = w.b1 = w.ix = w.iy = 0;
+    w.pseudo_source = v;
+    w.source = pp.source;
+    w.level = pp.level + 1;
+    stats_.max_level = std::max(stats_.max_level, w.level);
+    pool_.AddChild(parent, id);
+    ++stats_.pseudo_sources;
+    Push(id, d);
+  }
+}
+
+void IchSolver::RelaxNeighbors(uint32_t v, double d, uint32_t source) {
+  for (uint32_t i = mesh_.NeighborBegin(v); i < mesh_.NeighborEnd(v); ++i) {
+    const uint32_t u = mesh_.NeighborVertex(i);
+    const double du = d + mesh_.NeighborLength(i);
+    if (!(du < dist_[u])) continue;
+    ++stats_.edge_relaxations;
+    dist_[u] = du;
+    label_[u] = source;
+    origin_[u] = VertexOrigin{kNoIndex, v, 0, 0};
+    if ((mesh_.IsPseudoSourceCandidate(u) || epsilon_ > 0) && du <= options_.max_distance) {
+      // The neighbour becomes a pseudo-source of its own (a root: it does not depend on any
+      // interval window's survival).
+      const uint32_t id = pool_.Allocate();
+      Window& w = pool_[id];
+      w.kind = WindowKind::kPseudoSource;
+      w.side = WindowSide::kInitial;
+      w.element = u;
+      w.sigma = du;
+      w.b0 = w.b1 = w.ix = w.iy = 0;
+      w.pseudo_source = u;
+      w.source = source;
+      w.level = 0;
+      ++stats_.pseudo_sources;
+      Push(id, du);
+    }
+  }
+}
+
+bool IchSolver::IsFiltered(uint32_t he, double b0, double b1, double ix, double iy, double sigma,
+                           WindowSide side, double epsilon) const {
+  const double len = mesh_.Length(he);
+  const double d_a = sigma + Hypot(b0 - ix, iy);  // through the window at interval end A (b0)
+  const double d_b = sigma + Hypot(b1 - ix, iy);  // at interval end B (b1)
+  const uint32_t v_start = mesh_.From(he), v_end = mesh_.To(he);
+  // Each edge endpoint is paired with the interval end FARTHER from it: along the edge,
+  // sigma + |I p| - |v p| is monotone, so that end bounds the whole interval (docs/numerics.md).
+  const double r1 = dist_[v_start] + b1;
+  const double r2 = dist_[v_end] + (len - b0);
+  if (epsilon > 0) {
+    // Section 7's over-filtering (>=, with the margin): lambda = 1 filters every interval window.
+    if (d_b + epsilon >= r1 * (1 - kFilterRelTol)) return true;
+    if (d_a + epsilon >= r2 * (1 - kFilterRelTol)) return true;
+  } else {
+    if (d_b > r1 + kFilterRelTol * d_b) return true;
+    if (d_a > r2 + kFilterRelTol * d_a) return true;
+  }
+  if (side == WindowSide::kInitial) return false;  // third vertex = the pseudo-source itself
+  // The third vertex of the face the window came through (opposite the twin), paired with the
+  // interval end nearer the vertex this edge shares with the parent's edge: the start for a left
+  // child, the end for a right child. Rays through the parent's edge make
+  // sigma + |I p| - |v3 p| non-decreasing away from that shared vertex.
+  const uint32_t tw = mesh_.Twin(he);
+  const double tx = len - mesh_.OppX(tw), ty = -mesh_.OppY(tw);
+  const double d_third = dist_[mesh_.Opposite(tw)];
+  if (side == WindowSide::kLeft) {
+    const double r3 = d_third + Hypot(b0 - tx, ty);
+    return d_a > r3 + kFilterRelTol * d_a;
+  }
+  const double r3 = d_third + Hypot(b1 - tx, ty);
+  return d_b > r3 + kFilterRelTol * d_b;
+}
+
+void IchSolver::MakeInterval(uint32_t parent, uint32_t he, double b0, double b1, double ix,
+                             double iy, WindowSide side, uint32_t pseudo_source, double sigma,
+                             uint32_t source) {
+  const double len = mesh_.Length(he);
+  if (mesh_.FaceDegenerate(TriangleMesh::FaceOf(he))) return;  // no window crosses a zero-area face
+  if (b1 - b0 <= kTinyWindowRel * len) return;
+  if (iy > -kGrazingRel * len) return;
+  ++stats_.windows_created;
+  if (options_.use_filter) {
+    if (IsFiltered(he, b0, b1, ix, iy, sigma, side, 0)) {
+      ++stats_.windows_filtered_at_creation;
+      return;
+    }
+    if (epsilon_ > 0 && IsFiltered(he, b0, b1, ix, iy, sigma, side, epsilon_)) {
+      ++stats_.windows_filtered_overfilter;
+      return;
+    }
+  }
+  // Smallest distance any point of the interval can get through this window: the queue key.
+  double key;
+  if (ix < b0) {
+    key = sigma + Hypot(b0 - ix, iy);
+  } else if (ix > b1) {
+    key = sigma + Hypot(b1 - ix, iy);
+  } else {
+    key = sigma - iy;
+  }
+  if (key > options_.max_distance) return;
+  const uint32_t id = pool_.Allocate();
+  const uint32_t level = pool_[parent].level + 1;
+  Window& w = pool_[id];
+  w.kind = WindowKind::kInterval;
+  w.side = side;
+  w.element = he;
+  w.b0 = b0;
+  w.b1 = b1;
+  w.ix = ix;
+  w.iy = iy;
+  w.sigma = sigma;
+  w.pseudo_source = pseudo_source;
+  w.source = source;
+  w.level = level;
+  stats_.max_level = std::max(stats_.max_level, level);
+  pool_.AddChild(parent, id);
+  Push(id, key);
+}
+
+void IchSolver::ReleaseIfDone(uint32_t id) {
+  // Frees processed windows that have no children left, walking up: the tree keeps only what
+  // Lemma 1 may still need to prune.
+  while (id != kNoIndex) {
+    Window& w = pool_[id];
+    if (w.state != WindowState::kProcessed || w.first_child != kNoIndex) return;
+    const uint32_t parent = w.parent;
+    pool_.Unlink(id);
+    pool_.Free(id);
+    id = parent;
+  }
+}
+
+void IchSolver::DeleteSubtree(uint32_t root) {
+  const uint32_t parent = pool_[root].parent;
+  pool_.Unlink(root);
+  scratch_.clear();
+  scratch_.push_back(root);
+  while (!scratch_.empty()) {
+    const uint32_t id = scratch_.back();
+    scratch_.pop_back();
+    uint32_t c = pool_[id].first_child;
+    while (c != kNoIndex) {
+      const uint32_t next = pool_[c].next_sibling;
+      if (pool_[c].kind == WindowKind::kPseudoSource) {
+        pool_.Unlink(c);  // a vertex's distance is a fact: its pseudo-source survives as a root
+      } else {
+        scratch_.push_back(c);
+      }
+      c = next;
+    }
+    ++stats_.windows_deleted_one_split;
+    pool_.Free(id);
+  }
+  ReleaseIfDone(parent);
+}
+
+void IchSolver::ProcessPseudoSource(uint32_t id) {
+  const Window w = pool_[id];
+  const uint32_t v = w.element;
+  if (w.sigma != dist_[v]) {  // superseded by a shorter path to v
+    pool_[id].state = WindowState::kProcessed;
+    ReleaseIfDone(id);
+    return;
+  }
+  pool_[id].state = WindowState::kProcessed;
+  // Neighbours first: the filter of the windows below then already sees their distances.
+  RelaxNeighbors(v, w.sigma, w.source);
+  // Sources (distance 0) and saddle/boundary vertices spawn windows; with lambda > 0 other
+  // vertices only pass their distance along edges.
+  const bool spawns_windows = mesh_.IsPseudoSourceCandidate(v) || w.sigma == 0;
+  if (spawns_windows) {
+    for (const uint32_t* c = mesh_.CornersBegin(v); c != mesh_.CornersEnd(v); ++c) {
+      const uint32_t corner = *c;
+      if (mesh_.FaceDegenerate(TriangleMesh::FaceOf(corner))) continue;
+      const uint32_t opposite = TriangleMesh::Next(corner);  // the edge facing v in this face
+      const uint32_t t = mesh_.Twin(opposite);
+      if (t == kNoIndex) continue;
+      const double len = mesh_.Length(opposite);
+      MakeInterval(id, t, 0, len, len - mesh_.OppX(opposite), -mesh_.OppY(opposite),
+                   WindowSide::kInitial, v, w.sigma, w.source);
+    }
+  }
+  ReleaseIfDone(id);
+}
+
+void IchSolver::ProcessInterval(uint32_t id) {
+  const Window w = pool_[id];  // copy: the pool may grow below
+  const uint32_t h = w.element;
+  if (options_.use_filter && (IsFiltered(h, w.b0, w.b1, w.ix, w.iy, w.sigma, w.side, 0) ||
+                              (epsilon_ > 0 &&
+                               IsFiltered(h, w.b0, w.b1, w.ix, w.iy, w.sigma, w.side, epsilon_)))) {
+    ++stats_.windows_filtered_at_pop;
+    pool_[id].state = WindowState::kProcessed;
+    ReleaseIfDone(id);
+    return;
+  }
+  pool_[id].state = WindowState::kProcessed;
+  ++stats_.windows_processed;
+
+  const double len = mesh_.Length(h);
+  const double x3 = mesh_.OppX(h), y3 = mesh_.OppY(h);
+  const uint32_t v3 = mesh_.Opposite(h);
+  // Where the ray from the image to the opposite vertex crosses this edge.
+  const double cross_x = w.ix + (x3 - w.ix) * (-w.iy) / (y3 - w.iy);
+  const double cover_tol = kCoverRelTol * len;
+  const bool sees_v3 = cross_x >= w.b0 - cover_tol && cross_x <= w.b1 + cover_tol;
+  bool make_left = cross_x > w.b0 - cover_tol;  // some rays pass left of v3
+  bool make_right = cross_x < w.b1 + cover_tol;
+
+  if (sees_v3) {
+    const double d3 = w.sigma + Hypot(x3 - w.ix, y3 - w.iy);
+    UpdateVertex(v3, d3, id, h, w.ix, w.iy);
+    if (options_.use_one_angle_one_split) {
+      // Lemma 1 (one angle one split): of the windows on this directed edge that see v3, only the
+      // one giving v3 the smallest distance keeps both children; a loser keeps the child on the
+      // side where its own ray to v3 crosses the edge relative to the winner's.
+      SplitOwner& owner = owner_[h];
+      const double tie = kSplitTieRel * d3;
+      const bool has_owner = owner.window != kNoIndex;
+      if (!has_owner || d3 < owner.distance - tie) {
+        if (has_owner && pool_[owner.window].generation == owner.generation &&
+            pool_[owner.window].state != WindowState::kFree) {
+          const bool old_is_right = owner.cross_x > cross_x + cover_tol;
+          const bool old_is_left = owner.cross_x < cross_x - cover_tol;
+          if (old_is_right || old_is_left) {
+            const WindowSide doomed = old_is_right ? WindowSide::kLeft : WindowSide::kRight;
+            for (uint32_t c = pool_[owner.window].first_child; c != kNoIndex;) {
+              const uint32_t next = pool_[c].next_sibling;
+              if (pool_[c].kind == WindowKind::kInterval && pool_[c].side == doomed) {
+                DeleteSubtree(c);
+                break;
+              }
+              c = next;
+            }
+          }
+        }
+        // A pathological unfolding may revisit this edge inside the deleted subtree.
+        if (pool_[id].state != WindowState::kProcessed || pool_[id].generation != w.generation) {
+          return;
+        }
+        owner.window = id;
+        owner.generation = pool_[id].generation;
+        owner.distance = d3;
+        owner.cross_x = cross_x;
+      } else if (d3 > owner.distance + tie) {
+        if (cross_x > owner.cross_x + cover_tol) {
+          if (make_left) ++stats_.children_skipped_one_split;
+          make_left = false;
+        } else if (cross_x < owner.cross_x - cover_tol) {
+          if (make_right) ++stats_.children_skipped_one_split;
+          make_right = false;
+        }
+      }
+    }
+  }
+
+  if (make_left) {
+    // Child on the edge v1 -> v3 (v1 = this edge's start), in the twin's frame.
+    const uint32_t e = TriangleMesh::Prev(h);  // v3 -> v1 in this face
+    const uint32_t t = mesh_.Twin(e);
+    const double el = mesh_.Length(e);
+    const double t0 = RayHitParam(w.ix, w.iy, w.b0, 0, 0, x3, y3);
+    const double t1 = sees_v3 ? 1.0 : RayHitParam(w.ix, w.iy, w.b1, 0, 0, x3, y3);
+    // Endpoint distances when the child reaches a vertex.
+    if (t0 <= 0 && w.b0 <= kTinyWindowRel * len) UpdateVertex(mesh_.From(h), w.sigma + Hypot(w.ix, w.iy), id, h, w.ix, w.iy);
+    if (t != kNoIndex && t1 > t0) {
+      const double ux = x3 / el, uy = y3 / el;
+      const double nix = w.ix * ux + w.iy * uy;
+      const double niy = -w.ix * uy + w.iy * ux;
+      MakeInterval(id, t, t0 * el, t1 * el, nix, niy, WindowSide::kLeft, w.pseudo_source, w.sigma,
+                   w.source);
+    }
+  }
+  if (make_right) {
+    // Child on the edge v3 -> v2, in the twin's frame (origin v3).
+    const uint32_t e = TriangleMesh::Next(h);  // v2 -> v3 in this face
+    const uint32_t t = mesh_.Twin(e);
+    const double el = mesh_.Length(e);
+    const double wx = len - x3, wy = -y3;
+    const double t0 = sees_v3 ? 0.0 : RayHitParam(w.ix, w.iy, w.b0, x3, y3, wx, wy);
+    const double t1 = RayHitParam(w.ix, w.iy, w.b1, x3, y3, wx, wy);
+    if (t1 >= 1 && w.b1 >= len * (1 - kTinyWindowRel)) UpdateVertex(mesh_.To(h), w.sigma + Hypot(len - w.ix, w.iy), id, h, w.ix, w.iy);
+    if (t != kNoIndex && t1 > t0) {
+      const double ux = wx / el, uy = wy / el;
+      const double rx = w.ix - x3, ry = w.iy - y3;
+      const double nix = rx * ux + ry * uy;
+      const double niy = -rx * uy + ry * ux;
+      MakeInterval(id, t, t0 * el, t1 * el, nix, niy, WindowSide::kRight, w.pseudo_source, w.sigma,
+                   w.source);
+    }
+  }
+  ReleaseIfDone(id);
+}
+
+absl::Status IchSolver::Solve(const std::vector<ResolvedSource>& sources, DistanceField* out) {
+  const auto start = std::chrono::steady_clock::now();
+  const uint32_t nv = mesh_.vertex_count();
+  dist_.assign(nv, kUnreachable);
+  label_.assign(nv, kNoIndex);
+  origin_.assign(nv, VertexOrigin{});
+  if (options_.use_one_angle_one_split) owner_.assign(3 * size_t{mesh_.face_count()}, SplitOwner{});
+  queue_.clear();
+  queue_.reserve(4 * size_t{nv});
+
+  for (const ResolvedSource& s : sources) {
+    if (s.is_vertex) {
+      SeedVertex(s.vertex, s.label);
+    } else {
+      SeedFacePoint(s);
+    }
+  }
+
+  absl::Status status = absl::OkStatus();
+  uint32_t polls = 0;
+  while (!queue_.empty()) {
+    std::pop_heap(queue_.begin(), queue_.end(), QueueGreater());
+    const QueueEntry e = queue_.back();
+    queue_.pop_back();
+    if (pool_[e.window].generation != e.generation ||
+        pool_[e.window].state != WindowState::kQueued) {
+      continue;  // deleted (Lemma 1) or recycled since it was queued
+    }
+    if (e.key > options_.max_distance) break;
+    if (++polls == kCancelPollInterval) {
+      polls = 0;
+      if (options_.cancel != nullptr && options_.cancel->IsCancelled()) {
+        status = absl::CancelledError("geodesic solve cancelled");
+        break;
+      }
+    }
+    if (options_.max_windows != 0 && stats_.windows_created > options_.max_windows) {
+      status = absl::ResourceExhaustedError(absl::StrFormat(
+          "window budget exceeded: %d windows created (limit %d); use a larger budget, a "
+          "max_distance, or lambda > 0",
+          stats_.windows_created, options_.max_windows));
+      break;
+    }
+    if (pool_[e.window].kind == WindowKind::kPseudoSource) {
+      ProcessPseudoSource(e.window);
+    } else {
+      ProcessInterval(e.window);
+    }
+  }
+
+  stats_.peak_live_windows = pool_.peak_live();
+  stats_.peak_bytes = pool_.CapacityBytes() + queue_.capacity() * sizeof(QueueEntry) +
+                      owner_.capacity() * sizeof(SplitOwner) +
+                      nv * (sizeof(double) + sizeof(uint32_t) + sizeof(VertexOrigin));
+  if (!status.ok()) return status;
+  if (std::isfinite(options_.max_distance)) {
+    for (uint32_t v = 0; v < nv; ++v) {
+      if (dist_[v] > options_.max_distance) {
+        dist_[v] = kUnreachable;
+        label_[v] = kNoIndex;
+        origin_[v] = VertexOrigin{};
+      }
+    }
+  }
+  out->internal_distance = std::move(dist_);
+  out->internal_source = std::move(label_);
+  out->internal_origin = std::move(origin_);
+  stats_.solve_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  out->stats = stats_;
+  return absl::OkStatus();
+}
+
+}  // namespace geodex::ich

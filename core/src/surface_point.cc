@@ -1,0 +1,126 @@
+#include "geodex/surface_point.h"
+
+#include <charconv>
+#include <cmath>
+
+#include "absl/strings/str_format.h"
+#include "absl/strings/str_split.h"
+#include "geodex/triangle_mesh.h"
+
+namespace geodex {
+namespace {
+
+constexpr double kBarycentricSumTolerance = 1e-9;
+
+bool ParseUint(absl::string_view s, uint32_t* out) {
+  if (s.empty()) return false;
+  const char* end = s.data() + s.size();
+  auto [p, ec] = std::from_chars(s.data(), end, *out);
+  return ec == std::errc() && p == end;
+}
+
+bool ParseDouble(absl::string_view s, double* out) {
+  if (s.empty()) return false;
+  const char* end = s.data() + s.size();
+  auto [p, ec] = std::from_chars(s.data(), end, *out);
+  return ec == std::errc() && p == end && std::isfinite(*out);
+}
+
+}  // namespace
+
+absl::StatusOr<std::vector<SurfacePoint>> ParseSurfacePoints(absl::string_view spec) {
+  std::vector<SurfacePoint> points;
+  if (spec.empty()) return absl::InvalidArgumentError("empty point list");
+  for (absl::string_view item : absl::StrSplit(spec, ',')) {
+    auto bad = [&](const char* what) {
+      return absl::InvalidArgumentError(
+          absl::StrFormat("bad point '%s': %s", std::string(item), what));
+    };
+    if (item.empty()) return bad("empty item");
+    std::vector<absl::string_view> parts = absl::StrSplit(item, ':');
+    if (parts.size() == 1) {
+      uint32_t v;
+      if (!ParseUint(parts[0], &v)) return bad("expected a vertex id, e:V1:V2:T or f:FACE:B0:B1:B2");
+      points.push_back(SurfacePoint::AtVertex(v));
+    } else if (parts[0] == "e") {
+      uint32_t a, b;
+      double t;
+      if (parts.size() != 4 || !ParseUint(parts[1], &a) || !ParseUint(parts[2], &b) ||
+          !ParseDouble(parts[3], &t)) {
+        return bad("expected e:V1:V2:T");
+      }
+      points.push_back(SurfacePoint::OnEdge(a, b, t));
+    } else if (parts[0] == "f") {
+      uint32_t f;
+      double b[3];
+      if (parts.size() != 5 || !ParseUint(parts[1], &f) || !ParseDouble(parts[2], &b[0]) ||
+          !ParseDouble(parts[3], &b[1]) || !ParseDouble(parts[4], &b[2])) {
+        return bad("expected f:FACE:B0:B1:B2");
+      }
+      points.push_back(SurfacePoint::InFace(f, b[0], b[1], b[2]));
+    } else {
+      return bad("unknown kind (use a vertex id, e:V1:V2:T or f:FACE:B0:B1:B2)");
+    }
+  }
+  return points;
+}
+
+absl::Status ValidateSurfacePoint(const TriangleMesh& mesh, const SurfacePoint& p) {
+  const std::string name = SurfacePointToString(p);
+  const uint32_t nv = mesh.file_vertex_count();
+  switch (p.kind) {
+    case SurfacePoint::Kind::kVertex:
+      if (p.vertex >= nv) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "point %s: vertex %d does not exist (the mesh has %d vertices)", name, p.vertex, nv));
+      }
+      return absl::OkStatus();
+    case SurfacePoint::Kind::kEdge: {
+      if (p.edge_from >= nv || p.edge_to >= nv) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "point %s: vertex %d does not exist (the mesh has %d vertices)", name,
+            p.edge_from >= nv ? p.edge_from : p.edge_to, nv));
+      }
+      if (!(p.t >= 0 && p.t <= 1)) {
+        return absl::InvalidArgumentError(
+            absl::StrFormat("point %s: T = %g is outside [0, 1]", name, p.t));
+      }
+      return absl::OkStatus();  // existence of the edge is checked when the point is resolved
+    }
+    case SurfacePoint::Kind::kFace: {
+      if (p.face >= mesh.face_count()) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "point %s: face %d does not exist (the mesh has %d faces)", name, p.face,
+            mesh.face_count()));
+      }
+      double sum = 0;
+      for (double b : p.bary) {
+        if (!(b >= -kBarycentricSumTolerance)) {
+          return absl::InvalidArgumentError(
+              absl::StrFormat("point %s: barycentric coordinate %g is negative", name, b));
+        }
+        sum += b;
+      }
+      if (std::abs(sum - 1) > kBarycentricSumTolerance) {
+        return absl::InvalidArgumentError(absl::StrFormat(
+            "point %s: barycentric coordinates sum to %.17g, not 1", name, sum));
+      }
+      return absl::OkStatus();
+    }
+  }
+  return absl::InvalidArgumentError("unknown point kind");
+}
+
+std::string SurfacePointToString(const SurfacePoint& p) {
+  switch (p.kind) {
+    case SurfacePoint::Kind::kVertex:
+      return absl::StrFormat("%d", p.vertex);
+    case SurfacePoint::Kind::kEdge:
+      return absl::StrFormat("e:%d:%d:%.17g", p.edge_from, p.edge_to, p.t);
+    case SurfacePoint::Kind::kFace:
+      return absl::StrFormat("f:%d:%.17g:%.17g:%.17g", p.face, p.bary[0], p.bary[1], p.bary[2]);
+  }
+  return "?";
+}
+
+}  // namespace geodex

@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Installs every build and test dependency of geodex from Debian 12's packages.
+# Run as root (CI and the README's set-up commands call it). Safe to run again.
+set -euo pipefail
+
+if [ "$(id -u)" -ne 0 ]; then
+  echo "install-deps: run as root (apt-get needs it)" >&2
+  exit 1
+fi
+
+packages=(
+  # toolchain
+  g++ cmake ninja-build pkgconf ccache
+  # runtime libraries of the service (gRPC, Protobuf, Abseil, spdlog)
+  libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler libabsl-dev libspdlog-dev
+  grpc-proto
+  # mesh I/O
+  zlib1g-dev libtinyobjloader-dev
+  # tests and benchmarks (CGAL is a test-only reference)
+  libgtest-dev libgmock-dev libbenchmark-dev libcgal-dev libgmp-dev libmpfr-dev
+)
+
+# Skip apt entirely when everything is already there (fast re-runs).
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ "${#missing[@]}" -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+echo "install-deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+apt-get update -q
+apt-get install -y -q --no-install-recommends -o DPkg::Lock::Timeout=600 "${missing[@]}"
