@@ -247,7 +247,8 @@ int RunDistances(const Args& args) {
         "\"windows_created\": %llu, \"windows_filtered_at_creation\": %llu, "
         "\"windows_filtered_at_pop\": %llu, \"windows_filtered_overfilter\": %llu, "
         "\"children_skipped_one_split\": %llu, \"windows_deleted_one_split\": %llu, "
-        "\"windows_processed\": %llu, \"pseudo_sources\": %llu, \"edge_relaxations\": %llu, "
+        "\"windows_processed\": %llu, \"pseudo_sources\": %llu, \"pseudo_sources_full_fan\": %llu, "
+        "\"pseudo_sources_shadow_only\": %llu, \"edge_relaxations\": %llu, "
         "\"max_level\": %u, \"peak_live_windows\": %llu, \"peak_bytes\": %llu, "
         "\"mesh_bytes\": %llu, \"load_ms\": %.3f, \"build_ms\": %.3f, \"solve_ms\": %.3f, "
         "\"output_ms\": %.3f}\n",
@@ -258,7 +259,8 @@ int RunDistances(const Args& args) {
         (unsigned long long)s.windows_filtered_overfilter,
         (unsigned long long)s.children_skipped_one_split,
         (unsigned long long)s.windows_deleted_one_split, (unsigned long long)s.windows_processed,
-        (unsigned long long)s.pseudo_sources, (unsigned long long)s.edge_relaxations, s.max_level,
+        (unsigned long long)s.pseudo_sources, (unsigned long long)s.pseudo_sources_full_fan,
+        (unsigned long long)s.pseudo_sources_shadow_only, (unsigned long long)s.edge_relaxations, s.max_level,
         (unsigned long long)s.peak_live_windows, (unsigned long long)s.peak_bytes,
         (unsigned long long)loaded->mesh.MemoryBytes(), loaded->load_ms, loaded->build_ms,
         s.solve_ms, MsSince(t_out));

@@ -336,7 +336,7 @@ class MeshBuilder {
         m_.vertex_flags_[v] |= TriangleMesh::kBoundary;
       }
       if (m_.face_flags_[c / 3] & TriangleMesh::kFaceDegenerate) {
-        m_.vertex_flags_[v] |= TriangleMesh::kPseudoSource;
+        m_.vertex_flags_[v] |= TriangleMesh::kPseudoSource | TriangleMesh::kTouchesDegenerate;
       }
     }
     for (uint32_t v = 0; v < nv; ++v) {
@@ -387,12 +387,40 @@ class MeshBuilder {
       m_.neighbor_offsets_[v + 1] = static_cast<uint32_t>(m_.neighbors_.size());
     }
     m_.neighbors_.shrink_to_fit();
+    ComputeFanAngles();
     m_.neighbor_length_.resize(m_.neighbors_.size());
     for (uint32_t v = 0; v < nv; ++v) {
       for (uint32_t i = m_.neighbor_offsets_[v]; i < m_.neighbor_offsets_[v + 1]; ++i) {
         m_.neighbor_length_[i] =
             Dist3(&m_.positions_[3 * v], &m_.positions_[3 * m_.neighbors_[i]]);
       }
+    }
+  }
+
+  // Angular coordinates around each closed fan, walking corners counter-clockwise
+  // (c -> Twin(Prev(c))). Used to restrict a saddle's new windows to its shadow sector.
+  void ComputeFanAngles() {
+    const uint32_t nv = next_vertex_count();
+    m_.corner_start_angle_.assign(m_.corner_angle_.size(), 0.0);
+    for (uint32_t v = 0; v < nv; ++v) {
+      const uint8_t fl = m_.vertex_flags_[v];
+      if (fl & (TriangleMesh::kBoundary | TriangleMesh::kIsolated |
+                TriangleMesh::kTouchesDegenerate)) {
+        continue;
+      }
+      const uint32_t degree = m_.corner_offsets_[v + 1] - m_.corner_offsets_[v];
+      const uint32_t c0 = m_.vertex_corners_[m_.corner_offsets_[v]];
+      uint32_t c = c0, steps = 0;
+      double angle = 0;
+      do {
+        m_.corner_start_angle_[c] = angle;
+        angle += m_.corner_angle_[c];
+        const uint32_t t = m_.twin_[TriangleMesh::Prev(c)];
+        if (t == kNoIndex) break;
+        c = t;
+        ++steps;
+      } while (c != c0 && steps <= degree);
+      if (c == c0 && steps == degree) m_.vertex_flags_[v] |= TriangleMesh::kClosedFan;
     }
   }
 
@@ -453,7 +481,7 @@ absl::StatusOr<TriangleMesh> TriangleMesh::Build(const MeshData& data,
 uint64_t TriangleMesh::MemoryBytes() const {
   auto bytes = [](const auto& v) { return uint64_t{v.capacity()} * sizeof(v[0]); };
   return sizeof(*this) + bytes(positions_) + bytes(faces_) + bytes(face_flags_) + bytes(copy_of_) +
-         bytes(twin_) + bytes(length_) + bytes(opp_x_) + bytes(opp_y_) + bytes(corner_angle_) +
+         bytes(twin_) + bytes(length_) + bytes(opp_x_) + bytes(opp_y_) + bytes(corner_angle_) + bytes(corner_start_angle_) +
          bytes(angle_sum_) + bytes(vertex_flags_) + bytes(component_) + bytes(corner_offsets_) +
          bytes(vertex_corners_) + bytes(neighbor_offsets_) + bytes(neighbors_) +
          bytes(neighbor_length_);

@@ -18,6 +18,8 @@ struct SolveStats {
   uint64_t windows_deleted_one_split = 0;     // Lemma 1: windows of an old owner's removed subtree
   uint64_t windows_processed = 0;             // dequeued and propagated
   uint64_t pseudo_sources = 0;                // pseudo-source windows made (saddle/boundary/source)
+  uint64_t pseudo_sources_full_fan = 0;     // processed with windows on every opposite edge
+  uint64_t pseudo_sources_shadow_only = 0;  // saddles reached straight through: shadow sector only
   uint64_t edge_relaxations = 0;              // vertex-to-neighbour updates
   uint32_t max_level = 0;                     // deepest window in the sequence tree
   uint64_t peak_live_windows = 0;

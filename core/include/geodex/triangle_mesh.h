@@ -101,6 +101,12 @@ class TriangleMesh {
   // Paths may bend here: saddle, boundary, or touching a degenerate face (ICH pseudo-source).
   bool IsPseudoSourceCandidate(uint32_t v) const { return vertex_flags_[v] & kPseudoSource; }
   uint32_t Component(uint32_t v) const { return component_[v]; }
+  // True for an interior vertex whose faces close a full fan, none degenerate: only there does
+  // CornerStartAngle() give a consistent angular coordinate.
+  bool HasClosedFan(uint32_t v) const { return vertex_flags_[v] & kClosedFan; }
+  // For a vertex with a closed fan: the counter-clockwise angle, from the vertex's reference edge,
+  // of the corner's first edge (From(c) -> To(c)); the corner spans [start, start + angle).
+  double CornerStartAngle(uint32_t corner) const { return corner_start_angle_[corner]; }
   // Corners (3*f+k) at vertex v, in no particular order.
   const uint32_t* CornersBegin(uint32_t v) const { return &vertex_corners_[corner_offsets_[v]]; }
   const uint32_t* CornersEnd(uint32_t v) const { return &vertex_corners_[corner_offsets_[v + 1]]; }
@@ -122,7 +128,14 @@ class TriangleMesh {
   TriangleMesh() = default;
 
   enum : uint8_t { kFaceFlipped = 1, kFaceDegenerate = 2 };
-  enum : uint8_t { kSaddle = 1, kBoundary = 2, kIsolated = 4, kPseudoSource = 8 };
+  enum : uint8_t {
+    kSaddle = 1,
+    kBoundary = 2,
+    kIsolated = 4,
+    kPseudoSource = 8,
+    kTouchesDegenerate = 16,
+    kClosedFan = 32
+  };
 
   friend class MeshBuilder;
 
@@ -134,7 +147,7 @@ class TriangleMesh {
   std::vector<uint8_t> face_flags_;
   std::vector<uint32_t> copy_of_;
   std::vector<uint32_t> twin_;
-  std::vector<double> length_, opp_x_, opp_y_, corner_angle_;
+  std::vector<double> length_, opp_x_, opp_y_, corner_angle_, corner_start_angle_;
   std::vector<double> angle_sum_;
   std::vector<uint8_t> vertex_flags_;
   std::vector<uint32_t> component_;

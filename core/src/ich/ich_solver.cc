@@ -27,6 +27,8 @@ constexpr double kSplitTieRel = 1e-12;
 // Cancellation is polled every this many dequeued windows.
 constexpr uint32_t kCancelPollInterval = 1024;
 
+constexpr double kPi = 3.14159265358979323846;
+
 inline double Hypot(double x, double y) { return std::sqrt(x * x + y * y); }
 
 // Where the ray from image (ix, iy) through edge point (b, 0) meets the segment from p to p + w,
@@ -117,11 +119,12 @@ void IchSolver::SeedFacePoint(const ResolvedSource& s) {
   ReleaseIfDone(root);
 }
 
-void IchSolver::UpdateVertex(uint32_t v, double d, uint32_t parent, uint32_t half_edge, double ix,
+bool IchSolver::UpdateVertex(uint32_t v, double d, uint32_t parent, uint32_t half_edge, double ix,
                              double iy) {
-  if (!(d < dist_[v])) return;
+  if (!(d < dist_[v])) return false;
   const Window& p = pool_[parent];
   dist_[v] = d;
+  straight_through_[v] = 0;
   label_[v] = p.source;
   origin_[v] = VertexOrigin{half_edge, p.kind == WindowKind::kPseudoSource ? p.element
                                                                             : p.pseudo_source,
@@ -129,7 +132,7 @@ void IchSolver::UpdateVertex(uint32_t v, double d, uint32_t parent, uint32_t hal
   // Paths bend only at saddle and boundary vertices (P4); with lambda > 0 every vertex also passes
   // its distance along its edges, so it gets a (relax-only) pseudo-source window too.
   if (mesh_.IsPseudoSourceCandidate(v) || epsilon_ > 0) {
-    if (d > options_.max_distance) return;
+    if (d > options_.max_distance) return true;
     const uint32_t id = pool_.Allocate();
     const Window& pp = pool_[parent];  // re-read: Allocate may have moved the pool
     Window& w = pool_[id];
@@ -146,6 +149,7 @@ void IchSolver::UpdateVertex(uint32_t v, double d, uint32_t parent, uint32_t hal
     ++stats_.pseudo_sources;
     Push(id, d);
   }
+  return true;
 }
 
 void IchSolver::RelaxNeighbors(uint32_t v, double d, uint32_t source) {
@@ -155,6 +159,7 @@ void IchSolver::RelaxNeighbors(uint32_t v, double d, uint32_t source) {
     if (!(du < dist_[u])) continue;
     ++stats_.edge_relaxations;
     dist_[u] = du;
+    straight_through_[u] = 0;
     label_[u] = source;
     origin_[u] = VertexOrigin{kNoIndex, v, 0, 0};
     if ((mesh_.IsPseudoSourceCandidate(u) || epsilon_ > 0) && du <= options_.max_distance) {
@@ -194,6 +199,24 @@ bool IchSolver::IsFiltered(uint32_t he, double b0, double b1, double ix, double 
     if (d_b > r1 + kFilterRelTol * d_b) return true;
     if (d_a > r2 + kFilterRelTol * d_a) return true;
   }
+  // The vertex ahead (opposite this half-edge): if every point of the interval is reached more
+  // cheaply straight from it, the window is useless beyond the edge. |I p| - |v p| along the edge
+  // has a single critical point, where the line through I and v's mirror image meets the edge, so
+  // its minimum over the interval is at an end or there.
+  {
+    const double x3 = mesh_.OppX(he), y3 = mesh_.OppY(he);
+    const double d3 = dist_[mesh_.Opposite(he)];
+    auto excess = [&](double p) {
+      return sigma + Hypot(p - ix, iy) - Hypot(p - x3, y3);  // compared against d3
+    };
+    double lowest = std::min(excess(b0), excess(b1));
+    const double denom = iy + y3;
+    if (denom != 0) {
+      const double p0 = ix + (x3 - ix) * iy / denom;
+      if (p0 > b0 && p0 < b1) lowest = std::min(lowest, excess(p0));
+    }
+    if (lowest > d3 + kFilterRelTol * (d3 + len)) return true;
+  }
   if (side == WindowSide::kInitial) return false;  // third vertex = the pseudo-source itself
   // The third vertex of the face the window came through (opposite the twin), paired with the
   // interval end nearer the vertex this edge shares with the parent's edge: the start for a left
@@ -210,6 +233,42 @@ bool IchSolver::IsFiltered(uint32_t he, double b0, double b1, double ix, double 
   return d_b > r3 + kFilterRelTol * d_b;
 }
 
+bool IchSolver::TrimByEndpoints(uint32_t he, double* b0, double* b1, double ix, double iy,
+                                double sigma) const {
+  // The filter theorem applied point by point: along the edge, sigma + |I p| - |v p| is monotone
+  // for either endpoint v, so the points better reached straight from v form a prefix (start
+  // vertex) or a suffix (end vertex) of the interval; cut them off. Returns false when nothing is
+  // left.
+  const double len = mesh_.Length(he);
+  const double iy2 = iy * iy;
+  {
+    const double d = dist_[mesh_.From(he)];
+    const double thr = d + kFilterRelTol * (d + len);
+    auto g = [&](double p) { return sigma + std::sqrt((p - ix) * (p - ix) + iy2) - p; };
+    if (g(*b1) > thr) return false;
+    if (g(*b0) > thr) {
+      // Solve sigma + |I p| = thr + p for p.
+      const double s = thr - sigma;
+      const double p = (ix * ix + iy2 - s * s) / (2 * (ix + s));
+      if (p > *b0 && p <= *b1) *b0 = p;
+    }
+  }
+  {
+    const double d = dist_[mesh_.To(he)];
+    const double thr = d + kFilterRelTol * (d + len);
+    auto g = [&](double p) { return sigma + std::sqrt((p - ix) * (p - ix) + iy2) - (len - p); };
+    if (g(*b0) > thr) return false;
+    if (g(*b1) > thr) {
+      // Mirror of the case above, measured from the end vertex.
+      const double s = thr - sigma, mx = len - ix;
+      const double q = (mx * mx + iy2 - s * s) / (2 * (mx + s));
+      const double p = len - q;
+      if (p >= *b0 && p < *b1) *b1 = p;
+    }
+  }
+  return *b1 - *b0 > kTinyWindowRel * len;
+}
+
 void IchSolver::MakeInterval(uint32_t parent, uint32_t he, double b0, double b1, double ix,
                              double iy, WindowSide side, uint32_t pseudo_source, double sigma,
                              uint32_t source) {
@@ -219,7 +278,8 @@ void IchSolver::MakeInterval(uint32_t parent, uint32_t he, double b0, double b1,
   if (iy > -kGrazingRel * len) return;
   ++stats_.windows_created;
   if (options_.use_filter) {
-    if (IsFiltered(he, b0, b1, ix, iy, sigma, side, 0)) {
+    if (!TrimByEndpoints(he, &b0, &b1, ix, iy, sigma) ||
+        IsFiltered(he, b0, b1, ix, iy, sigma, side, 0)) {
       ++stats_.windows_filtered_at_creation;
       return;
     }
@@ -228,15 +288,7 @@ void IchSolver::MakeInterval(uint32_t parent, uint32_t he, double b0, double b1,
       return;
     }
   }
-  // Smallest distance any point of the interval can get through this window: the queue key.
-  double key;
-  if (ix < b0) {
-    key = sigma + Hypot(b0 - ix, iy);
-  } else if (ix > b1) {
-    key = sigma + Hypot(b1 - ix, iy);
-  } else {
-    key = sigma - iy;
-  }
+  const double key = IntervalKey(b0, b1, ix, iy, sigma);
   if (key > options_.max_distance) return;
   const uint32_t id = pool_.Allocate();
   const uint32_t level = pool_[parent].level + 1;
@@ -308,7 +360,11 @@ void IchSolver::ProcessPseudoSource(uint32_t id) {
   // Sources (distance 0) and saddle/boundary vertices spawn windows; with lambda > 0 other
   // vertices only pass their distance along edges.
   const bool spawns_windows = mesh_.IsPseudoSourceCandidate(v) || w.sigma == 0;
-  if (spawns_windows) {
+  if (spawns_windows && straight_through_[v] && mesh_.HasClosedFan(v)) {
+    ++stats_.pseudo_sources_shadow_only;
+    SpawnShadowWindows(id, v, w.sigma, w.source);
+  } else if (spawns_windows) {
+    ++stats_.pseudo_sources_full_fan;
     for (const uint32_t* c = mesh_.CornersBegin(v); c != mesh_.CornersEnd(v); ++c) {
       const uint32_t corner = *c;
       if (mesh_.FaceDegenerate(TriangleMesh::FaceOf(corner))) continue;
@@ -323,9 +379,83 @@ void IchSolver::ProcessPseudoSource(uint32_t id) {
   ReleaseIfDone(id);
 }
 
-void IchSolver::ProcessInterval(uint32_t id) {
-  const Window w = pool_[id];  // copy: the pool may grow below
+double IchSolver::IntervalKey(double b0, double b1, double ix, double iy, double sigma) {
+  // Smallest distance any point of the interval can get through the window.
+  if (ix < b0) return sigma + Hypot(b0 - ix, iy);
+  if (ix > b1) return sigma + Hypot(b1 - ix, iy);
+  return sigma - iy;
+}
+
+void IchSolver::SpawnShadowWindows(uint32_t id, uint32_t v, double sigma, uint32_t source) {
+  // The direction back towards the image, as an angle in v's fan: v was the opposite vertex of
+  // half-edge h, whose face has its corner at v on half-edge Prev(h) (v -> start of h).
+  const VertexOrigin& o = origin_[v];
+  const uint32_t h = o.half_edge;
+  const uint32_t corner_in = TriangleMesh::Prev(h);
+  const double x3 = mesh_.OppX(h), y3 = mesh_.OppY(h);
+  const double ax = -x3, ay = -y3;                // v -> start of h
+  const double dx = o.ix - x3, dy = o.iy - y3;   // v -> image
+  const double back =
+      mesh_.CornerStartAngle(corner_in) + std::atan2(std::abs(ax * dy - ay * dx), ax * dx + ay * dy);
+  // Geodesics through a saddle make angles >= pi on both sides (P4): new paths leave v only in the
+  // sector [back + pi, back + total - pi], empty or nearly so for a flat vertex.
+  const double total = mesh_.AngleSum(v);
+  const double lo = back + kPi, hi = back + total - kPi;
+  if (!(hi > lo)) return;
+  for (const uint32_t* c = mesh_.CornersBegin(v); c != mesh_.CornersEnd(v); ++c) {
+    const uint32_t corner = *c;
+    const uint32_t opposite = TriangleMesh::Next(corner);
+    const uint32_t t = mesh_.Twin(opposite);
+    if (t == kNoIndex) continue;
+    const double start = mesh_.CornerStartAngle(corner), span = mesh_.CornerAngle(corner);
+    // The sector may wrap around the fan: test it shifted by -total, 0 and +total.
+    for (int wrap = -1; wrap <= 1; ++wrap) {
+      const double s0 = std::max(lo + wrap * total, start) - start;
+      const double s1 = std::min(hi + wrap * total, start + span) - start;
+      if (!(s1 > s0)) continue;
+      // Rays from v at angles s0..s1 (from the corner's first edge, v -> To(corner)) meet the
+      // opposite edge; in its frame v is at (px, py) and To(corner) at the origin.
+      const double len = mesh_.Length(opposite);
+      const double px = mesh_.OppX(opposite), py = mesh_.OppY(opposite);
+      const double base = std::atan2(-py, -px);
+      auto hit = [&](double a) {
+        const double ux = std::cos(base + a), uy = std::sin(base + a);
+        if (uy >= 0) return a < 0.5 * span ? 0.0 : len;
+        const double x = px + ux * (py / -uy);
+        return std::min(len, std::max(0.0, x));
+      };
+      const double x0 = s0 <= 0 ? 0.0 : hit(s0);
+      const double x1 = s1 >= span ? len : hit(s1);
+      // In the twin's frame positions run the other way.
+      MakeInterval(id, t, len - x1, len - x0, len - px, -py, WindowSide::kInitial, v, sigma,
+                   source);
+    }
+  }
+}
+
+void IchSolver::ProcessInterval(uint32_t id, double popped_key) {
+  Window w = pool_[id];  // copy: the pool may grow below
   const uint32_t h = w.element;
+  if (options_.use_filter) {
+    // Vertex distances have dropped since the window was made: trim again, and if that raised its
+    // key, queue it again so windows keep being processed in distance order.
+    const double b0 = w.b0, b1 = w.b1;
+    if (!TrimByEndpoints(h, &w.b0, &w.b1, w.ix, w.iy, w.sigma)) {
+      ++stats_.windows_filtered_at_pop;
+      pool_[id].state = WindowState::kProcessed;
+      ReleaseIfDone(id);
+      return;
+    }
+    if (w.b0 != b0 || w.b1 != b1) {
+      pool_[id].b0 = w.b0;
+      pool_[id].b1 = w.b1;
+      const double key = IntervalKey(w.b0, w.b1, w.ix, w.iy, w.sigma);
+      if (key > popped_key * (1 + kFilterRelTol)) {
+        Push(id, key);
+        return;
+      }
+    }
+  }
   if (options_.use_filter && (IsFiltered(h, w.b0, w.b1, w.ix, w.iy, w.sigma, w.side, 0) ||
                               (epsilon_ > 0 &&
                                IsFiltered(h, w.b0, w.b1, w.ix, w.iy, w.sigma, w.side, epsilon_)))) {
@@ -346,10 +476,11 @@ void IchSolver::ProcessInterval(uint32_t id) {
   const bool sees_v3 = cross_x >= w.b0 - cover_tol && cross_x <= w.b1 + cover_tol;
   bool make_left = cross_x > w.b0 - cover_tol;  // some rays pass left of v3
   bool make_right = cross_x < w.b1 + cover_tol;
+  bool v3_improved = false;
 
   if (sees_v3) {
     const double d3 = w.sigma + Hypot(x3 - w.ix, y3 - w.iy);
-    UpdateVertex(v3, d3, id, h, w.ix, w.iy);
+    v3_improved = UpdateVertex(v3, d3, id, h, w.ix, w.iy);
     if (options_.use_one_angle_one_split) {
       // Lemma 1 (one angle one split): of the windows on this directed edge that see v3, only the
       // one giving v3 the smallest distance keeps both children; a loser keeps the child on the
@@ -394,6 +525,15 @@ void IchSolver::ProcessInterval(uint32_t id) {
     }
   }
 
+  // When v3's best path runs straight through it with windows continuing on both sides, those
+  // windows already cover every direction within pi of the incoming ray: v3's own windows are
+  // needed only in its shadow sector (see ProcessPseudoSource).
+  if (v3_improved) {
+    straight_through_[v3] = cross_x > w.b0 && cross_x < w.b1 && make_left && make_right &&
+                            mesh_.Twin(TriangleMesh::Prev(h)) != kNoIndex &&
+                            mesh_.Twin(TriangleMesh::Next(h)) != kNoIndex;
+  }
+
   if (make_left) {
     // Child on the edge v1 -> v3 (v1 = this edge's start), in the twin's frame.
     const uint32_t e = TriangleMesh::Prev(h);  // v3 -> v1 in this face
@@ -402,7 +542,12 @@ void IchSolver::ProcessInterval(uint32_t id) {
     const double t0 = RayHitParam(w.ix, w.iy, w.b0, 0, 0, x3, y3);
     const double t1 = sees_v3 ? 1.0 : RayHitParam(w.ix, w.iy, w.b1, 0, 0, x3, y3);
     // Endpoint distances when the child reaches a vertex.
-    if (t0 <= 0 && w.b0 <= kTinyWindowRel * len) UpdateVertex(mesh_.From(h), w.sigma + Hypot(w.ix, w.iy), id, h, w.ix, w.iy);
+    // Endpoint reached along the interval's end ray: in exact arithmetic already set by the same
+    // path, so only a real gain counts (a last-bit "gain" would hide a straight-through path).
+    const double d1 = w.sigma + Hypot(w.ix, w.iy);
+    if (t0 <= 0 && w.b0 <= kTinyWindowRel * len && d1 < dist_[mesh_.From(h)] * (1 - kFilterRelTol)) {
+      UpdateVertex(mesh_.From(h), d1, id, h, w.ix, w.iy);
+    }
     if (t != kNoIndex && t1 > t0) {
       const double ux = x3 / el, uy = y3 / el;
       const double nix = w.ix * ux + w.iy * uy;
@@ -419,7 +564,10 @@ void IchSolver::ProcessInterval(uint32_t id) {
     const double wx = len - x3, wy = -y3;
     const double t0 = sees_v3 ? 0.0 : RayHitParam(w.ix, w.iy, w.b0, x3, y3, wx, wy);
     const double t1 = RayHitParam(w.ix, w.iy, w.b1, x3, y3, wx, wy);
-    if (t1 >= 1 && w.b1 >= len * (1 - kTinyWindowRel)) UpdateVertex(mesh_.To(h), w.sigma + Hypot(len - w.ix, w.iy), id, h, w.ix, w.iy);
+    const double d2 = w.sigma + Hypot(len - w.ix, w.iy);
+    if (t1 >= 1 && w.b1 >= len * (1 - kTinyWindowRel) && d2 < dist_[mesh_.To(h)] * (1 - kFilterRelTol)) {
+      UpdateVertex(mesh_.To(h), d2, id, h, w.ix, w.iy);
+    }
     if (t != kNoIndex && t1 > t0) {
       const double ux = wx / el, uy = wy / el;
       const double rx = w.ix - x3, ry = w.iy - y3;
@@ -438,6 +586,7 @@ absl::Status IchSolver::Solve(const std::vector<ResolvedSource>& sources, Distan
   dist_.assign(nv, kUnreachable);
   label_.assign(nv, kNoIndex);
   origin_.assign(nv, VertexOrigin{});
+  straight_through_.assign(nv, 0);
   if (options_.use_one_angle_one_split) owner_.assign(3 * size_t{mesh_.face_count()}, SplitOwner{});
   queue_.clear();
   queue_.reserve(4 * size_t{nv});
@@ -478,7 +627,7 @@ absl::Status IchSolver::Solve(const std::vector<ResolvedSource>& sources, Distan
     if (pool_[e.window].kind == WindowKind::kPseudoSource) {
       ProcessPseudoSource(e.window);
     } else {
-      ProcessInterval(e.window);
+      ProcessInterval(e.window, e.key);
     }
   }
 

@@ -36,10 +36,17 @@ class IchSolver {
   void SeedVertex(uint32_t v, uint32_t label);
   void SeedFacePoint(const ResolvedSource& s);
   void ProcessPseudoSource(uint32_t id);
-  void ProcessInterval(uint32_t id);
+  void ProcessInterval(uint32_t id, double popped_key);
+  // Windows of a saddle whose best path runs straight through it: only its shadow sector.
+  void SpawnShadowWindows(uint32_t id, uint32_t v, double sigma, uint32_t source);
+  static double IntervalKey(double b0, double b1, double ix, double iy, double sigma);
+  // Cuts off the parts of [b0, b1] better reached straight from the edge's endpoints (the filter
+  // theorem, point by point). Returns false when nothing is left.
+  bool TrimByEndpoints(uint32_t half_edge, double* b0, double* b1, double ix, double iy,
+                       double sigma) const;
 
   // Lower a vertex's distance if `d` is smaller; spawns a pseudo-source window where paths may bend.
-  void UpdateVertex(uint32_t v, double d, uint32_t parent, uint32_t half_edge, double ix, double iy);
+  bool UpdateVertex(uint32_t v, double d, uint32_t parent, uint32_t half_edge, double ix, double iy);
   // Creates an interval window on `half_edge` (propagating into its face) unless Lemma 2 or size
   // rules drop it.
   void MakeInterval(uint32_t parent, uint32_t half_edge, double b0, double b1, double ix, double iy,
@@ -62,6 +69,7 @@ class IchSolver {
   std::vector<double> dist_;
   std::vector<uint32_t> label_;
   std::vector<VertexOrigin> origin_;
+  std::vector<uint8_t> straight_through_;  // see ProcessInterval
   std::vector<SplitOwner> owner_;
   WindowPool pool_;
   std::vector<QueueEntry> queue_;

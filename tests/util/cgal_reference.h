@@ -1,0 +1,27 @@
+#pragma once
+
+// Reference distances from CGAL's Surface_mesh_shortest_path (Xin & Wang / Chen & Han style exact
+// algorithm, independent implementation). Declared here without any CGAL header; the definition
+// lives in tests/cgal/cgal_reference.cc and is only linked into cgal_tests.
+
+#include <cstddef>  // geodex/mesh_data.h uses size_t without including it
+#include <vector>
+
+#include "geodex/mesh_data.h"
+#include "geodex/surface_point.h"
+
+namespace geodex {
+
+// Geodesic distance from every FILE vertex to the nearest of `sources` (file vertex ids, file face
+// ids, file corner order, as for ComputeDistanceField), in file vertex order. +inf for vertices
+// that no source reaches (other components) and for vertices referenced by no face.
+//
+// The mesh must be a consistently oriented 2-manifold (with or without boundary) that CGAL's
+// Surface_mesh accepts face by face; returns an empty vector otherwise, or if a source names a
+// vertex/face/edge that does not exist (or an isolated vertex). Vertex and face sources go to CGAL
+// as they are; an edge source is first made a vertex by splitting its edge (CGAL 5.5 mishandles
+// edge sources, see the .cc), so a face source in a face that an edge source splits is not
+// supported (empty result).
+std::vector<double> CgalDistances(const MeshData& mesh, const std::vector<SurfacePoint>& sources);
+
+}  // namespace geodex
