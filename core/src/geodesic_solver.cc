@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "absl/strings/str_format.h"
 #include "dijkstra.h"
@@ -204,7 +205,25 @@ absl::StatusOr<DistanceField> ComputeDistanceField(const TriangleMesh& mesh,
       return s;
     }
   } else {
-    ich::IchSolver solver(mesh, options);
+    double key_cap = std::numeric_limits<double>::infinity();
+    if (!options.use_filter) {
+      // Without the filter nothing stops windows wrapping around a closed surface until P3's depth
+      // bound; Dijkstra's distances bound every geodesic distance from above, so cap there.
+      DistanceField bound;
+      GeodesicOptions dijkstra = options;
+      dijkstra.method = Method::kDijkstra;
+      if (absl::Status s = RunDijkstra(mesh, SeedsForDijkstra(mesh, resolver.sources()), dijkstra,
+                                       &bound);
+          !s.ok()) {
+        return s;
+      }
+      double farthest = 0;
+      for (double d : bound.internal_distance) {
+        if (d < kUnreachable) farthest = std::max(farthest, d);
+      }
+      key_cap = farthest + mesh.MaxEdgeLength();
+    }
+    ich::IchSolver solver(mesh, options, key_cap);
     if (absl::Status s = solver.Solve(resolver.sources(), &field); !s.ok()) return s;
   }
   // File order: a split vertex takes the best of its copies.

@@ -47,8 +47,8 @@ inline double RayHitParam(double ix, double iy, double b, double px, double py, 
 
 }  // namespace
 
-IchSolver::IchSolver(const TriangleMesh& mesh, const GeodesicOptions& options)
-    : mesh_(mesh), options_(options) {
+IchSolver::IchSolver(const TriangleMesh& mesh, const GeodesicOptions& options, double key_cap)
+    : mesh_(mesh), options_(options), key_cap_(std::min(key_cap, options.max_distance)) {
   if (options.lambda > 0) {
     const double scale = options.lambda_scale == LambdaScale::kMaxEdge ? mesh.MaxEdgeLength()
                                                                        : mesh.MeanEdgeLength();
@@ -81,26 +81,38 @@ void IchSolver::SeedVertex(uint32_t v, uint32_t label) {
 }
 
 void IchSolver::SeedFacePoint(const ResolvedSource& s) {
-  // A point source is a pseudo-source at a point: its face's vertices are reached straight, and
-  // windows leave through the face's three edges. On an edge of the face, the matching window would
-  // graze; the caller seeds the neighbouring face too.
-  const uint32_t f = s.face;
-  // Corner positions in the frame of half-edge 3f.
-  const double cx[3] = {0, mesh_.Length(3 * f), mesh_.OppX(3 * f)};
-  const double cy[3] = {0, 0, mesh_.OppY(3 * f)};
   // A root window so the seed's children have a parent (kept for the tree's sake).
   const uint32_t root = pool_.Allocate();
+  Window& w = pool_[root];
+  w.kind = WindowKind::kPseudoSource;
+  w.side = WindowSide::kInitial;
+  w.element = kNoIndex;
+  w.sigma = 0;
+  w.b0 = w.b1 = w.ix = w.iy = 0;
+  w.pseudo_source = kNoIndex;
+  w.source = s.label;
+  w.level = 0;
+  w.state = WindowState::kProcessed;
+  EmitFromPointInFace(root, 3 * s.face, s.px, s.py, 0, kNoIndex, s.label);
+  ReleaseIfDone(root);
+}
+
+void IchSolver::EmitFromPointInFace(uint32_t parent, uint32_t frame_edge, double px, double py,
+                                    double sigma, uint32_t pseudo_source, uint32_t source) {
+  // Paths from a point in (or on the border of) a face: its vertices are reached straight, and
+  // windows leave through its edges. On an edge, the matching window would graze and is dropped;
+  // the neighbouring face is seeded by the caller.
+  const uint32_t f = TriangleMesh::FaceOf(frame_edge);
+  const double cx[3] = {0, mesh_.Length(3 * f), mesh_.OppX(3 * f)};
+  const double cy[3] = {0, 0, mesh_.OppY(3 * f)};
   {
-    Window& w = pool_[root];
-    w.kind = WindowKind::kPseudoSource;
-    w.side = WindowSide::kInitial;
-    w.element = kNoIndex;
-    w.sigma = 0;
-    w.b0 = w.b1 = w.ix = w.iy = 0;
-    w.pseudo_source = kNoIndex;
-    w.source = s.label;
-    w.level = 0;
-    w.state = WindowState::kProcessed;
+    // The point given in frame_edge's frame, re-expressed in the frame of half-edge 3f.
+    const int k = static_cast<int>(frame_edge % 3), k1 = (k + 1) % 3;
+    const double len = mesh_.Length(frame_edge);
+    const double ux = (cx[k1] - cx[k]) / len, uy = (cy[k1] - cy[k]) / len;
+    const double x = px, y = py;
+    px = cx[k] + x * ux - y * uy;
+    py = cy[k] + x * uy + y * ux;
   }
   for (int k = 0; k < 3; ++k) {
     const uint32_t h = 3 * f + k;
@@ -108,15 +120,15 @@ void IchSolver::SeedFacePoint(const ResolvedSource& s) {
     const double len = mesh_.Length(h);
     const double ux = (cx[k1] - cx[k]) / len, uy = (cy[k1] - cy[k]) / len;
     // The point in h's frame (+y towards the face).
-    const double qx = (s.px - cx[k]) * ux + (s.py - cy[k]) * uy;
-    const double qy = -(s.px - cx[k]) * uy + (s.py - cy[k]) * ux;
-    UpdateVertex(mesh_.From(h), Hypot(qx, qy), root, h, qx, qy);
+    const double qx = (px - cx[k]) * ux + (py - cy[k]) * uy;
+    const double qy = -(px - cx[k]) * uy + (py - cy[k]) * ux;
+    UpdateVertex(mesh_.From(h), sigma + Hypot(qx, qy), parent, h, qx, qy);
     const uint32_t t = mesh_.Twin(h);
     if (t == kNoIndex) continue;
     // In the twin's frame the point lies behind the edge: (len - x, -y).
-    MakeInterval(root, t, 0, len, len - qx, -qy, WindowSide::kInitial, kNoIndex, 0, s.label);
+    MakeInterval(parent, t, 0, len, len - qx, -qy, WindowSide::kInitial, pseudo_source, sigma,
+                 source);
   }
-  ReleaseIfDone(root);
 }
 
 bool IchSolver::UpdateVertex(uint32_t v, double d, uint32_t parent, uint32_t half_edge, double ix,
@@ -273,8 +285,10 @@ void IchSolver::MakeInterval(uint32_t parent, uint32_t he, double b0, double b1,
                              double iy, WindowSide side, uint32_t pseudo_source, double sigma,
                              uint32_t source) {
   const double len = mesh_.Length(he);
-  if (mesh_.FaceDegenerate(TriangleMesh::FaceOf(he))) return;  // no window crosses a zero-area face
   if (b1 - b0 <= kTinyWindowRel * len) return;
+  // P3: a shortest path crosses each face at most once, so no useful sequence is deeper than the
+  // face count (this is what bounds the tree when the filter is switched off).
+  if (pool_[parent].level + 1 > mesh_.face_count()) return;
   if (iy > -kGrazingRel * len) return;
   ++stats_.windows_created;
   if (options_.use_filter) {
@@ -289,7 +303,7 @@ void IchSolver::MakeInterval(uint32_t parent, uint32_t he, double b0, double b1,
     }
   }
   const double key = IntervalKey(b0, b1, ix, iy, sigma);
-  if (key > options_.max_distance) return;
+  if (key > key_cap_) return;
   const uint32_t id = pool_.Allocate();
   const uint32_t level = pool_[parent].level + 1;
   Window& w = pool_[id];
@@ -367,7 +381,10 @@ void IchSolver::ProcessPseudoSource(uint32_t id) {
     ++stats_.pseudo_sources_full_fan;
     for (const uint32_t* c = mesh_.CornersBegin(v); c != mesh_.CornersEnd(v); ++c) {
       const uint32_t corner = *c;
-      if (mesh_.FaceDegenerate(TriangleMesh::FaceOf(corner))) continue;
+      if (mesh_.FaceDegenerate(TriangleMesh::FaceOf(corner))) {
+        EmitAcrossDegenerate(id, corner, w.sigma, w.source);
+        continue;
+      }
       const uint32_t opposite = TriangleMesh::Next(corner);  // the edge facing v in this face
       const uint32_t t = mesh_.Twin(opposite);
       if (t == kNoIndex) continue;
@@ -433,6 +450,62 @@ void IchSolver::SpawnShadowWindows(uint32_t id, uint32_t v, double sigma, uint32
   }
 }
 
+void IchSolver::EmitAcrossDegenerate(uint32_t id, uint32_t corner, double sigma, uint32_t source) {
+  // v sits on the segment a zero-area face collapses to; the face across that face's opposite
+  // edge sees v as a point on its own edge, so paths leave v into it as from a point source.
+  const uint32_t v = mesh_.From(corner);
+  const uint32_t t = mesh_.Twin(TriangleMesh::Next(corner));
+  if (t == kNoIndex || mesh_.FaceDegenerate(TriangleMesh::FaceOf(t))) return;
+  const double len = mesh_.Length(t);
+  if (!(len > 0)) return;
+  const double* pos = mesh_.positions();
+  const double* a = pos + 3 * mesh_.From(t);
+  const double* b = pos + 3 * mesh_.To(t);
+  const double* p = pos + 3 * v;
+  const double x = ((p[0] - a[0]) * (b[0] - a[0]) + (p[1] - a[1]) * (b[1] - a[1]) +
+                    (p[2] - a[2]) * (b[2] - a[2])) / len;
+  if (!(x > 0 && x < len)) return;  // v is an end of that edge: its own fan covers it
+  EmitFromPointInFace(id, t, x, 0, sigma, v, source);
+}
+
+void IchSolver::PassThroughDegenerate(uint32_t id, const Window& w) {
+  // A zero-area face is a segment: the window's points on edge h lie on the face's other edges
+  // too, and paths continue straight into the faces beyond them. Positions are measured along
+  // h's line in 3D; the image keeps its distance from the line, behind the next edge.
+  const uint32_t h = w.element;
+  const double len = mesh_.Length(h);
+  if (!(len > 0)) return;
+  const double* pos = mesh_.positions();
+  const double* a = pos + 3 * mesh_.From(h);
+  const double* b = pos + 3 * mesh_.To(h);
+  const double u[3] = {(b[0] - a[0]) / len, (b[1] - a[1]) / len, (b[2] - a[2]) / len};
+  auto along = [&](uint32_t v) {
+    const double* p = pos + 3 * v;
+    return (p[0] - a[0]) * u[0] + (p[1] - a[1]) * u[1] + (p[2] - a[2]) * u[2];
+  };
+  // The face's middle vertex, if the window covers it, is reached straight.
+  const uint32_t v3 = mesh_.Opposite(h);
+  const double s3 = along(v3);
+  if (s3 >= w.b0 && s3 <= w.b1) UpdateVertex(v3, w.sigma + Hypot(s3 - w.ix, w.iy), id, h, w.ix, w.iy);
+  const uint32_t others[2] = {TriangleMesh::Next(h), TriangleMesh::Prev(h)};
+  for (const uint32_t e : others) {
+    const uint32_t t = mesh_.Twin(e);
+    if (t == kNoIndex) continue;
+    const double s_origin = along(mesh_.From(t)), s_end = along(mesh_.To(t));
+    const double dir = s_end >= s_origin ? 1.0 : -1.0;
+    const double o0 = std::max(w.b0, std::min(s_origin, s_end));
+    const double o1 = std::min(w.b1, std::max(s_origin, s_end));
+    if (!(o1 > o0)) continue;
+    const double tl = mesh_.Length(t);
+    double x0 = (o0 - s_origin) * dir, x1 = (o1 - s_origin) * dir;
+    if (x0 > x1) std::swap(x0, x1);
+    x0 = std::max(0.0, x0);
+    x1 = std::min(tl, x1);
+    MakeInterval(id, t, x0, x1, (w.ix - s_origin) * dir, -std::abs(w.iy), WindowSide::kInitial,
+                 w.pseudo_source, w.sigma, w.source);
+  }
+}
+
 void IchSolver::ProcessInterval(uint32_t id, double popped_key) {
   Window w = pool_[id];  // copy: the pool may grow below
   const uint32_t h = w.element;
@@ -466,6 +539,11 @@ void IchSolver::ProcessInterval(uint32_t id, double popped_key) {
   }
   pool_[id].state = WindowState::kProcessed;
   ++stats_.windows_processed;
+  if (mesh_.FaceDegenerate(TriangleMesh::FaceOf(h))) {
+    PassThroughDegenerate(id, w);
+    ReleaseIfDone(id);
+    return;
+  }
 
   const double len = mesh_.Length(h);
   const double x3 = mesh_.OppX(h), y3 = mesh_.OppY(h);

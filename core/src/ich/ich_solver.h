@@ -4,6 +4,7 @@
 // callers use ComputeDistanceField (geodex/geodesic_solver.h).
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "absl/status/status.h"
@@ -27,7 +28,10 @@ struct ResolvedSource {
 
 class IchSolver {
  public:
-  IchSolver(const TriangleMesh& mesh, const GeodesicOptions& options);
+  // Windows whose smallest distance exceeds `key_cap` (or options.max_distance) are never made:
+  // callers that switch the filter off pass an upper bound of every distance here.
+  IchSolver(const TriangleMesh& mesh, const GeodesicOptions& options,
+            double key_cap = std::numeric_limits<double>::infinity());
 
   // Fills out->internal_distance/_source/_origin and out->stats.
   absl::Status Solve(const std::vector<ResolvedSource>& sources, DistanceField* out);
@@ -37,6 +41,12 @@ class IchSolver {
   void SeedFacePoint(const ResolvedSource& s);
   void ProcessPseudoSource(uint32_t id);
   void ProcessInterval(uint32_t id, double popped_key);
+  void PassThroughDegenerate(uint32_t id, const Window& w);
+  void EmitAcrossDegenerate(uint32_t id, uint32_t corner, double sigma, uint32_t source);
+  // Straight distances to a face's vertices and windows through its edges, from a point given in
+  // the frame of half-edge `frame_edge` of that face.
+  void EmitFromPointInFace(uint32_t parent, uint32_t frame_edge, double px, double py, double sigma,
+                           uint32_t pseudo_source, uint32_t source);
   // Windows of a saddle whose best path runs straight through it: only its shadow sector.
   void SpawnShadowWindows(uint32_t id, uint32_t v, double sigma, uint32_t source);
   static double IntervalKey(double b0, double b1, double ix, double iy, double sigma);
@@ -64,6 +74,7 @@ class IchSolver {
 
   const TriangleMesh& mesh_;
   const GeodesicOptions& options_;
+  double key_cap_;
   double epsilon_ = 0;  // over-filtering margin lambda * L (section 7)
 
   std::vector<double> dist_;
