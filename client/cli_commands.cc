@@ -131,6 +131,7 @@ int RunInfo(const Args& args) {
       {"boundary_edges", absl::StrFormat("%d", r.boundary_edges)},
       {"boundary_loops", absl::StrFormat("%d", r.boundary_loops)},
       {"components", absl::StrFormat("%d", r.components)},
+      {"vertex_connected_components", absl::StrFormat("%d", r.vertex_connected_components)},
       {"isolated_vertices", absl::StrFormat("%d", r.isolated_vertices)},
       {"non_manifold_edges", absl::StrFormat("%d", r.non_manifold_edges)},
       {"non_manifold_vertices", absl::StrFormat("%d", r.non_manifold_vertices)},

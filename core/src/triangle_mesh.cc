@@ -437,13 +437,23 @@ class MeshBuilder {
     }
     m_.component_.resize(nv);
     for (uint32_t v = 0; v < nv; ++v) m_.component_[v] = internal.Find(v);
-    std::vector<uint8_t> seen(m_.file_vertex_count_, 0);
+    // `components` counts pieces after cutting at non-manifold vertices (what paths can cross);
+    // `vertex_connected_components` counts pieces joined through any shared vertex.
+    std::vector<uint8_t> seen(nv, 0);
+    for (uint32_t v = 0; v < nv; ++v) {
+      if (m_.vertex_flags_[v] & TriangleMesh::kIsolated) continue;
+      if (!seen[m_.component_[v]]) {
+        seen[m_.component_[v]] = 1;
+        ++m_.report_.components;
+      }
+    }
+    std::fill(seen.begin(), seen.end(), 0);
     for (uint32_t v = 0; v < m_.file_vertex_count_; ++v) {
       if (m_.vertex_flags_[v] & TriangleMesh::kIsolated) continue;
       const uint32_t r = file.Find(v);
       if (!seen[r]) {
         seen[r] = 1;
-        ++m_.report_.components;
+        ++m_.report_.vertex_connected_components;
       }
     }
     // Boundary loops: connected pieces of the graph of boundary half-edges (cut edges included).

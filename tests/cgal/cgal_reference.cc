@@ -5,6 +5,7 @@
 #include <CGAL/Surface_mesh_shortest_path.h>
 
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -38,9 +39,16 @@ Traits::Barycentric_coordinates CgalBary(const CgalMesh& m, FaceIndex f, WeightO
   return Traits().construct_barycentric_coordinates_object()(c[0], c[1], c[2]);
 }
 
+double MsSince(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since)
+      .count();
+}
+
 }  // namespace
 
-std::vector<double> CgalDistances(const MeshData& data, const std::vector<SurfacePoint>& sources) {
+std::vector<double> CgalDistances(const MeshData& data, const std::vector<SurfacePoint>& sources,
+                                  CgalTiming* timing) {
+  const auto start = std::chrono::steady_clock::now();
   const size_t nv = data.vertex_count(), nf = data.face_count();
   for (uint32_t v : data.faces) {
     if (v >= nv) return {};
@@ -138,7 +146,9 @@ std::vector<double> CgalDistances(const MeshData& data, const std::vector<Surfac
     };
     shortest_paths.add_source_point(cgal_faces[p.face], CgalBary(m, cgal_faces[p.face], weight));
   }
+  const auto solve_start = std::chrono::steady_clock::now();
   shortest_paths.build_sequence_tree();
+  const auto query_start = std::chrono::steady_clock::now();
 
   std::vector<double> distance(nv, kInf);
   for (VertexIndex v : m.vertices()) {
@@ -149,6 +159,11 @@ std::vector<double> CgalDistances(const MeshData& data, const std::vector<Surfac
     // source_points_end(): that is +inf here.
     if (result.second == shortest_paths.source_points_end() || !(result.first >= 0)) continue;
     distance[file_vertex] = result.first;
+  }
+  if (timing != nullptr) {
+    timing->setup_ms = std::chrono::duration<double, std::milli>(solve_start - start).count();
+    timing->solve_ms = std::chrono::duration<double, std::milli>(query_start - solve_start).count();
+    timing->query_ms = MsSince(query_start);
   }
   return distance;
 }

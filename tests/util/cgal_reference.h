@@ -2,7 +2,8 @@
 
 // Reference distances from CGAL's Surface_mesh_shortest_path (Xin & Wang / Chen & Han style exact
 // algorithm, independent implementation). Declared here without any CGAL header; the definition
-// lives in tests/cgal/cgal_reference.cc and is only linked into cgal_tests.
+// lives in tests/cgal/cgal_reference.cc, built as the library geodex_cgal_reference
+// (cmake/GeodexCgalReference.cmake) that cgal_tests and bench/geodex_bench link.
 
 #include <cstddef>  // geodex/mesh_data.h uses size_t without including it
 #include <vector>
@@ -22,6 +23,14 @@ namespace geodex {
 // as they are; an edge source is first made a vertex by splitting its edge (CGAL 5.5 mishandles
 // edge sources, see the .cc), so a face source in a face that an edge source splits is not
 // supported (empty result).
-std::vector<double> CgalDistances(const MeshData& mesh, const std::vector<SurfacePoint>& sources);
+//
+// `timing`, when given, receives the wall-clock split of the call (for the benchmark).
+struct CgalTiming {
+  double setup_ms = 0;  // working copy, CGAL Surface_mesh, source points
+  double solve_ms = 0;  // build_sequence_tree(): the propagation itself
+  double query_ms = 0;  // the distance of every vertex
+};
+std::vector<double> CgalDistances(const MeshData& mesh, const std::vector<SurfacePoint>& sources,
+                                  CgalTiming* timing = nullptr);
 
 }  // namespace geodex

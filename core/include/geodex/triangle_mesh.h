@@ -25,7 +25,8 @@ struct MeshReport {
   uint64_t file_faces = 0;
   uint64_t boundary_edges = 0;
   uint64_t boundary_loops = 0;
-  uint64_t components = 0;          // connected components of faces (isolated vertices excluded)
+  uint64_t components = 0;  // connected pieces of faces after cutting at non-manifold vertices
+  uint64_t vertex_connected_components = 0;  // pieces joined through any shared vertex
   uint64_t isolated_vertices = 0;   // vertices referenced by no face
   uint64_t non_manifold_edges = 0;  // edges shared by more than two faces (cut)
   uint64_t non_manifold_vertices = 0;  // file vertices split into several internal copies

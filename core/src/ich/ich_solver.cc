@@ -57,8 +57,7 @@ IchSolver::IchSolver(const TriangleMesh& mesh, const GeodesicOptions& options, d
 }
 
 void IchSolver::Push(uint32_t id, double key) {
-  queue_.push_back({key, id, pool_[id].generation});
-  std::push_heap(queue_.begin(), queue_.end(), QueueGreater());
+  queue_.Push({key, id, pool_[id].generation});
 }
 
 void IchSolver::SeedVertex(uint32_t v, uint32_t label) {
@@ -680,9 +679,7 @@ absl::Status IchSolver::Solve(const std::vector<ResolvedSource>& sources, Distan
   absl::Status status = absl::OkStatus();
   uint32_t polls = 0;
   while (!queue_.empty()) {
-    std::pop_heap(queue_.begin(), queue_.end(), QueueGreater());
-    const QueueEntry e = queue_.back();
-    queue_.pop_back();
+    const QueueEntry e = queue_.Pop();
     if (pool_[e.window].generation != e.generation ||
         pool_[e.window].state != WindowState::kQueued) {
       continue;  // deleted (Lemma 1) or recycled since it was queued
@@ -710,7 +707,7 @@ absl::Status IchSolver::Solve(const std::vector<ResolvedSource>& sources, Distan
   }
 
   stats_.peak_live_windows = pool_.peak_live();
-  stats_.peak_bytes = pool_.CapacityBytes() + queue_.capacity() * sizeof(QueueEntry) +
+  stats_.peak_bytes = pool_.CapacityBytes() + queue_.CapacityBytes() +
                       owner_.capacity() * sizeof(SplitOwner) +
                       nv * (sizeof(double) + sizeof(uint32_t) + sizeof(VertexOrigin));
   if (!status.ok()) return status;

@@ -83,7 +83,7 @@ class IchSolver {
   std::vector<uint8_t> straight_through_;  // see ProcessInterval
   std::vector<SplitOwner> owner_;
   WindowPool pool_;
-  std::vector<QueueEntry> queue_;
+  WindowQueue queue_;
   std::vector<uint32_t> scratch_;  // reused stack for subtree deletion
   SolveStats stats_;
 };
