@@ -13,6 +13,7 @@
 // See docs/performance.md for how to run it and for the numbers.
 
 #include <fcntl.h>
+#include <malloc.h>
 #include <poll.h>
 #include <sched.h>
 #include <signal.h>
@@ -59,9 +60,15 @@
 #ifdef GEODEX_BENCH_WITH_CGAL
 #include "util/cgal_reference.h"
 #endif
+#include "bench_build_info.h"  // generated: GEODEX_BENCH_BUILT_FROM
 
 #ifndef GEODEX_SOURCE_DIR
 #define GEODEX_SOURCE_DIR "."
+#endif
+#ifdef GEODEX_BENCH_BUILT_FROM
+#define GEODEX_BUILD_FROM_OR_UNKNOWN GEODEX_BENCH_BUILT_FROM
+#else
+#define GEODEX_BUILD_FROM_OR_UNKNOWN "unknown"
 #endif
 #ifndef GEODEX_BUILD_TYPE
 #define GEODEX_BUILD_TYPE "unknown"
@@ -231,19 +238,15 @@ int UsableCpus() {
   return static_cast<int>(sysconf(_SC_NPROCESSORS_ONLN));
 }
 
+// The commit the binary was built from; the checkout's HEAD too if it has moved since.
 std::string GitDescription() {
-  const std::string dir = GEODEX_SOURCE_DIR;
-  std::string commit(absl::StripAsciiWhitespace(
-      RunCommand("git -C '" + dir + "' rev-parse --short HEAD 2>/dev/null")));
-  if (commit.empty()) return "unknown (not a git checkout)";
-  // GIT_OPTIONAL_LOCKS=0: status must not refresh (write) the index of a tree others work in.
-  const std::string dirty = RunCommand("GIT_OPTIONAL_LOCKS=0 git -C '" + dir +
-                                       "' status --porcelain --untracked-files=no -- core 2>/dev/null");
-  if (!dirty.empty()) {
-    const int files = static_cast<int>(std::count(dirty.begin(), dirty.end(), '\n'));
-    absl::StrAppend(&commit, " + uncommitted changes to ", files, " file(s) under core/");
+  std::string description = absl::StrCat("built from ", GEODEX_BUILD_FROM_OR_UNKNOWN);
+  const std::string head(absl::StripAsciiWhitespace(
+      RunCommand("git -C '" GEODEX_SOURCE_DIR "' rev-parse --short HEAD 2>/dev/null")));
+  if (!head.empty() && !absl::StartsWith(GEODEX_BUILD_FROM_OR_UNKNOWN, head)) {
+    absl::StrAppend(&description, " (the checkout is now at ", head, ": rebuild?)");
   }
-  return commit;
+  return description;
 }
 
 std::string UtcNow() {
@@ -435,21 +438,25 @@ void ChildMain(const Job& job, int fd) {
   report.isolated = mesh->report().isolated_vertices;
   report.mean_edge = mesh->MeanEdgeLength();
   report.max_edge = mesh->MaxEdgeLength();
+  if (job.task == Task::kInfo) {  // before the baseline is taken
+    const std::vector<uint32_t> sources =
+        ChooseSources(*mesh, job.sources_wanted, &report.largest_component_faces);
+    report.source_count = static_cast<int32_t>(sources.size());
+    std::copy(sources.begin(), sources.end(), report.sources);
+  }
   struct rusage usage;
   getrusage(RUSAGE_SELF, &usage);
   report.load_peak_kb = usage.ru_maxrss;
+  // Give the loader's freed buffers back to the system: otherwise they stay resident, a method
+  // reuses them without growing the RSS, and its delta over the baseline looks too small.
+  malloc_trim(0);
   report.rss_after_load_kb = CurrentRssKb();
   report.hiwater_reset = ResetRssHighWater();
   report.ok = 1;
 
   switch (job.task) {
-    case Task::kInfo: {
-      const std::vector<uint32_t> sources =
-          ChooseSources(*mesh, job.sources_wanted, &report.largest_component_faces);
-      report.source_count = static_cast<int32_t>(sources.size());
-      std::copy(sources.begin(), sources.end(), report.sources);
+    case Task::kInfo:
       break;
-    }
     case Task::kGeodex: {
       const std::vector<SurfacePoint> sources = AsSurfacePoints(job.sources);
       std::vector<double> solve, wall;
@@ -600,8 +607,11 @@ Outcome RunChild(const Job& job, double timeout_s) {
 
 class Table {
  public:
-  Table(std::vector<std::string> headers, int left_columns)
-      : headers_(std::move(headers)), left_columns_(left_columns) {}
+  // `align`: one 'l' (left) or 'r' (right) per column.
+  Table(std::vector<std::string> headers, std::string align)
+      : headers_(std::move(headers)), align_(std::move(align)) {
+    align_.resize(headers_.size(), 'r');
+  }
 
   void AddRow(std::vector<std::string> cells) {
     cells.resize(headers_.size());
@@ -622,7 +632,7 @@ class Table {
       for (size_t c = 0; c < cells.size(); ++c) {
         const std::string pad(width[c] - cells[c].size(), ' ');
         if (c > 0) out += "  ";
-        out += static_cast<int>(c) < left_columns_ ? cells[c] + pad : pad + cells[c];
+        out += align_[c] == 'l' ? cells[c] + pad : pad + cells[c];
       }
       while (!out.empty() && out.back() == ' ') out.pop_back();
       return out + "\n";
@@ -638,7 +648,7 @@ class Table {
   std::string Markdown() const {
     std::string out = "| " + absl::StrJoin(headers_, " | ") + " |\n|";
     for (size_t c = 0; c < headers_.size(); ++c) {
-      out += static_cast<int>(c) < left_columns_ ? "---|" : "---:|";
+      out += align_[c] == 'l' ? "---|" : "---:|";
     }
     out += "\n";
     for (const auto& row : rows_) {
@@ -649,7 +659,7 @@ class Table {
 
  private:
   std::vector<std::string> headers_;
-  int left_columns_;
+  std::string align_;
   std::vector<std::vector<std::string>> rows_;
 };
 
@@ -774,7 +784,7 @@ Section MeshSection(const std::vector<MeshInfo>& meshes) {
             "the high-water mark while loading.",
             Table({"mesh", "vertices", "faces", "components", "largest comp. faces", "sources",
                    "load ms", "resident MiB", "load peak MiB"},
-                  1),
+                  "lrrrrlrrr"),
             {}};
   for (const MeshInfo& m : meshes) {
     s.table.AddRow({m.name, Count(m.report.file_vertices), Count(m.report.faces),
@@ -801,9 +811,9 @@ Section MainSection(const Config& config, const std::vector<MeshInfo>& meshes) {
             "ICH vs CGAL over all vertices, rel = max abs / largest distance.",
             Table({"mesh", "faces", "source", "method", "R", "solve ms", "wall ms", "x Dijkstra",
                    "CGAL/ICH", "windows created", "filtered", "processed", "max level",
-                   "peak live", "peak MiB", "RSS MiB", "delta RSS MiB", "max abs diff",
-                   "max rel diff"},
-                  4),
+                   "peak live", "peak MiB", "RSS MiB", "delta RSS MiB", "vs CGAL abs",
+                   "vs CGAL rel"},
+                  "lrrl"),
             {}};
   bool first = true;
   for (const MeshInfo& mesh : meshes) {
@@ -923,7 +933,7 @@ Section AblationSection(const Config& config, const std::vector<MeshInfo>& meshe
             Table({"mesh", "source", "filter (L2)", "one split (L1)", "status", "solve ms",
                    "wall ms", "windows created", "filtered", "one-split removed", "processed",
                    "max level", "peak live", "peak MiB", "delta RSS MiB", "max abs diff"},
-                  5),
+                  "lrlll"),
             {}};
   bool first = true;
   for (const MeshInfo& mesh : meshes) {
@@ -994,7 +1004,7 @@ Section LambdaSection(const Config& config, const std::vector<MeshInfo>& meshes)
             Table({"mesh", "source", "scale", "lambda", "epsilon", "solve ms", "x Dijkstra",
                    "windows created", "over-filtered", "max level", "max rel err", "mean rel err",
                    "changed", "vs Dijkstra"},
-                  3),
+                  "lrl"),
             {}};
   const std::vector<double> lambdas = {0, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0};
   bool first = true;
@@ -1104,7 +1114,7 @@ int Main(int argc, char** argv) {
   }
 
   const std::string header = absl::StrFormat(
-      "geodex_bench: %s; commit %s; %s build; CPU %s, %d usable core(s); "
+      "geodex_bench: %s; %s; %s build; CPU %s, %d usable core(s); "
       "each measurement in its own process, one at a time",
       UtcNow(), GitDescription(), GEODEX_BUILD_TYPE, CpuModel(), UsableCpus());
   std::printf("%s\n", header.c_str());

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <new>
 
 #include "absl/strings/str_format.h"
 #include "dijkstra.h"
@@ -224,7 +225,13 @@ absl::StatusOr<DistanceField> ComputeDistanceField(const TriangleMesh& mesh,
       key_cap = farthest + mesh.MaxEdgeLength();
     }
     ich::IchSolver solver(mesh, options, key_cap);
-    if (absl::Status s = solver.Solve(resolver.sources(), &field); !s.ok()) return s;
+    try {
+      if (absl::Status s = solver.Solve(resolver.sources(), &field); !s.ok()) return s;
+    } catch (const std::bad_alloc&) {
+      // The window pool outgrew memory: report it like the window budget, never crash.
+      return absl::ResourceExhaustedError(
+          "out of memory for geodesic windows; set a window budget, a max_distance or lambda > 0");
+    }
   }
   // File order: a split vertex takes the best of its copies.
   const uint32_t nf = mesh.file_vertex_count();
