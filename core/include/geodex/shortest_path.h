@@ -1,0 +1,36 @@
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "geodex/distance_field.h"
+#include "geodex/surface_point.h"
+#include "geodex/triangle_mesh.h"
+
+namespace geodex {
+
+// One point of a geodesic polyline: where it is (file coordinates) and the simplex it lies on
+// (a vertex, an edge point with its parameter, or a face point with barycentrics).
+struct PathPoint {
+  std::array<double, 3> position{};
+  SurfacePoint where;
+};
+
+// A geodesic from a query point back to its nearest source: points[0] is the query point, the last
+// point is on the source. The polyline is straight inside every face it crosses and bends only at
+// saddle or boundary vertices (or runs along an edge where the field came from edge relaxation,
+// as with lambda > 0 or Dijkstra).
+struct GeodesicPath {
+  double length = 0;
+  uint32_t source = 0xffffffffu;  // index into the solve's source list
+  std::vector<PathPoint> points;
+};
+
+// Backtraces the exact shortest path from vertex `vertex` (a file vertex id) to its nearest
+// source in `field`, using the per-vertex origins the solver keeps (no windows are needed).
+// Errors: InvalidArgument for an unknown vertex, NotFound when the vertex is unreachable.
+absl::StatusOr<GeodesicPath> TracePathFromVertex(const TriangleMesh& mesh,
+                                                 const DistanceField& field, uint32_t vertex);
+
+}  // namespace geodex

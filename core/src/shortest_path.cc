@@ -1,0 +1,235 @@
+#include "geodex/shortest_path.h"
+
+#include <cmath>
+
+#include "absl/strings/str_format.h"
+
+namespace geodex {
+namespace {
+
+struct Vec2 {
+  double x, y;
+};
+
+// The 3D frame of half-edge h: origin at its start, x along it, y into its face.
+struct Frame3 {
+  double o[3], u[3], n[3];
+};
+
+Frame3 FrameOf(const TriangleMesh& mesh, uint32_t h) {
+  Frame3 f;
+  const double* p = mesh.positions();
+  const double* a = p + 3 * mesh.From(h);
+  const double* b = p + 3 * mesh.To(h);
+  const double* c = p + 3 * mesh.Opposite(h);
+  const double len = mesh.Length(h);
+  for (int k = 0; k < 3; ++k) {
+    f.o[k] = a[k];
+    f.u[k] = len > 0 ? (b[k] - a[k]) / len : 0;
+  }
+  double w[3], dot = 0;
+  for (int k = 0; k < 3; ++k) dot += (c[k] - a[k]) * f.u[k];
+  double norm = 0;
+  for (int k = 0; k < 3; ++k) {
+    w[k] = c[k] - a[k] - dot * f.u[k];
+    norm += w[k] * w[k];
+  }
+  norm = std::sqrt(norm);
+  for (int k = 0; k < 3; ++k) f.n[k] = norm > 0 ? w[k] / norm : 0;
+  return f;
+}
+
+// Re-expresses q, given in the frame of half-edge `from`, in the frame of half-edge `to` of the
+// same face (both frames put the face on +y).
+Vec2 ToSiblingFrame(const TriangleMesh& mesh, uint32_t from, uint32_t to, Vec2 q) {
+  if (from == to) return q;
+  const uint32_t f = TriangleMesh::FaceOf(from);
+  // Corners of the face in `from`'s frame, indexed by local corner number.
+  Vec2 corner[3];
+  const int k = static_cast<int>(from % 3);
+  corner[k] = {0, 0};
+  corner[(k + 1) % 3] = {mesh.Length(from), 0};
+  corner[(k + 2) % 3] = {mesh.OppX(from), mesh.OppY(from)};
+  const int j = static_cast<int>(to % 3);
+  const Vec2 o = corner[j], e = corner[(j + 1) % 3];
+  const double len = std::hypot(e.x - o.x, e.y - o.y);
+  const double ux = (e.x - o.x) / len, uy = (e.y - o.y) / len;
+  const double dx = q.x - o.x, dy = q.y - o.y;
+  (void)f;
+  return {dx * ux + dy * uy, ux * dy - uy * dx};
+}
+
+class Tracer {
+ public:
+  Tracer(const TriangleMesh& mesh, const DistanceField& field) : mesh_(mesh), field_(field) {}
+
+  absl::Status FromVertex(uint32_t v, GeodesicPath* path) {
+    path_ = path;
+    AddVertex(v);
+    // Every leg ends at a pseudo-source; a chain is at most as long as the vertex count.
+    for (uint32_t legs = 0; legs <= mesh_.vertex_count(); ++legs) {
+      const VertexOrigin& o = field_.internal_origin[v];
+      if (field_.internal_distance[v] == 0 && o.half_edge == kNoIndex) return absl::OkStatus();
+      if (o.half_edge == kNoIndex) {
+        // Along an edge from a neighbour (edge relaxation), or v is a source vertex.
+        if (o.pseudo_source == kNoIndex || o.pseudo_source == v) return absl::OkStatus();
+        v = o.pseudo_source;
+        AddVertex(v);
+        continue;
+      }
+      absl::StatusOr<uint32_t> next = Leg(v, o);
+      if (!next.ok()) return next.status();
+      if (*next == kNoIndex) return absl::OkStatus();  // reached the source point itself
+      v = *next;
+    }
+    return absl::InternalError("path backtrace did not terminate");
+  }
+
+ private:
+  // Walks from vertex v straight towards the image in o's frame, face by face, until the image
+  // lies in the current face; returns the pseudo-source vertex reached (kNoIndex for a point
+  // source).
+  absl::StatusOr<uint32_t> Leg(uint32_t v, const VertexOrigin& o) {
+    uint32_t g = o.half_edge;
+    Vec2 image{o.ix, o.iy};
+    Vec2 p;
+    if (mesh_.From(g) == v) {
+      p = {0, 0};
+    } else if (mesh_.To(g) == v) {
+      p = {mesh_.Length(g), 0};
+    } else {
+      p = {mesh_.OppX(g), mesh_.OppY(g)};
+    }
+    const uint32_t max_steps = 2 * mesh_.face_count() + 8;
+    for (uint32_t step = 0; step < max_steps; ++step) {
+      const double len = mesh_.Length(g);
+      const double tol = 1e-12 * (len + std::abs(image.y));
+      if (image.y >= -tol) {
+        // The image is in this face (or on its border): the leg ends at it.
+        return Arrive(g, image, o.pseudo_source);
+      }
+      // Cross edge g where the segment p -> image meets it.
+      const double s = p.y / (p.y - image.y);
+      double x = p.x + (image.x - p.x) * s;
+      x = std::min(len, std::max(0.0, x));
+      AddEdgePoint(g, x);
+      const uint32_t t = mesh_.Twin(g);
+      if (t == kNoIndex) return absl::InternalError("path backtrace left the surface");
+      // Into the previous face: twin frame.
+      const Vec2 xp{len - x, 0};
+      const Vec2 ip{len - image.x, -image.y};
+      // Where does the ray xp -> ip leave face(t)? Through the edge on the side of the opposite
+      // corner it passes.
+      const Vec2 c{mesh_.OppX(t), mesh_.OppY(t)};
+      const double side = (ip.x - xp.x) * (c.y - xp.y) - (ip.y - xp.y) * (c.x - xp.x);
+      // If the image is inside face(t), the leg ends here.
+      if (InsideTriangle(ip, len, c)) {
+        return Arrive(t, ip, o.pseudo_source);
+      }
+      const uint32_t exit = side > 0 ? TriangleMesh::Next(t) : TriangleMesh::Prev(t);
+      p = ToSiblingFrame(mesh_, t, exit, xp);
+      image = ToSiblingFrame(mesh_, t, exit, ip);
+      g = exit;
+    }
+    return absl::InternalError("path backtrace did not reach its pseudo-source");
+  }
+
+  static bool InsideTriangle(Vec2 q, double len, Vec2 c) {
+    // Triangle (0,0), (len,0), c with c.y > 0; a small tolerance relative to the edge.
+    const double tol = 1e-12 * len;
+    if (q.y < -tol) return false;
+    const double right = (c.x - len) * (q.y) - (c.y) * (q.x - len);  // edge (len,0) -> c
+    const double left = (0 - c.x) * (q.y - c.y) - (0 - c.y) * (q.x - c.x);  // edge c -> (0,0)
+    return right >= -tol * len && left >= -tol * len;
+  }
+
+  absl::StatusOr<uint32_t> Arrive(uint32_t g, Vec2 image, uint32_t pseudo_source) {
+    if (pseudo_source != kNoIndex) {
+      AddVertex(pseudo_source);
+      return pseudo_source;
+    }
+    // A point source inside (or on the border of) this face.
+    AddFacePoint(g, image);
+    return kNoIndex;
+  }
+
+  void Append(const double* local3, const SurfacePoint& where) {
+    PathPoint pt;
+    const auto& c = mesh_.Center();
+    for (int k = 0; k < 3; ++k) pt.position[k] = local3[k] + c[k];
+    pt.where = where;
+    if (!path_->points.empty()) {
+      const auto& q = path_->points.back().position;
+      path_->length += std::sqrt((q[0] - pt.position[0]) * (q[0] - pt.position[0]) +
+                                 (q[1] - pt.position[1]) * (q[1] - pt.position[1]) +
+                                 (q[2] - pt.position[2]) * (q[2] - pt.position[2]));
+    }
+    path_->points.push_back(pt);
+  }
+
+  void AddVertex(uint32_t v) {
+    Append(mesh_.positions() + 3 * v, SurfacePoint::AtVertex(mesh_.FileVertex(v)));
+  }
+
+  void AddEdgePoint(uint32_t g, double x) {
+    const Frame3 f = FrameOf(mesh_, g);
+    double q[3];
+    for (int k = 0; k < 3; ++k) q[k] = f.o[k] + x * f.u[k];
+    const double len = mesh_.Length(g);
+    Append(q, SurfacePoint::OnEdge(mesh_.FileVertex(mesh_.From(g)), mesh_.FileVertex(mesh_.To(g)),
+                                   len > 0 ? x / len : 0));
+  }
+
+  void AddFacePoint(uint32_t g, Vec2 q2) {
+    const Frame3 f = FrameOf(mesh_, g);
+    double q[3];
+    for (int k = 0; k < 3; ++k) q[k] = f.o[k] + q2.x * f.u[k] + q2.y * f.n[k];
+    // Barycentrics in the file's corner order.
+    const uint32_t face = TriangleMesh::FaceOf(g);
+    const double len = mesh_.Length(g), cx = mesh_.OppX(g), cy = mesh_.OppY(g);
+    double w_opp = cy > 0 ? q2.y / cy : 0;
+    double w_to = len > 0 ? (q2.x - w_opp * cx) / len : 0;
+    double w_from = 1 - w_opp - w_to;
+    double bary[3];
+    const int k = static_cast<int>(g % 3);
+    bary[k] = w_from;
+    bary[(k + 1) % 3] = w_to;
+    bary[(k + 2) % 3] = w_opp;
+    if (mesh_.FaceFlipped(face)) std::swap(bary[1], bary[2]);
+    Append(q, SurfacePoint::InFace(face, bary[0], bary[1], bary[2]));
+  }
+
+  const TriangleMesh& mesh_;
+  const DistanceField& field_;
+  GeodesicPath* path_ = nullptr;
+};
+
+}  // namespace
+
+absl::StatusOr<GeodesicPath> TracePathFromVertex(const TriangleMesh& mesh,
+                                                 const DistanceField& field, uint32_t vertex) {
+  if (vertex >= mesh.file_vertex_count()) {
+    return absl::InvalidArgumentError(absl::StrFormat(
+        "vertex %d does not exist (the mesh has %d vertices)", vertex, mesh.file_vertex_count()));
+  }
+  if (field.internal_origin.size() != mesh.vertex_count()) {
+    return absl::InvalidArgumentError("the distance field was not computed on this mesh");
+  }
+  // A split vertex: start from its best copy.
+  uint32_t start = vertex;
+  for (uint32_t v = mesh.file_vertex_count(); v < mesh.vertex_count(); ++v) {
+    if (mesh.FileVertex(v) == vertex && field.internal_distance[v] < field.internal_distance[start]) {
+      start = v;
+    }
+  }
+  if (!std::isfinite(field.internal_distance[start])) {
+    return absl::NotFoundError(absl::StrFormat("vertex %d is unreachable from every source", vertex));
+  }
+  GeodesicPath path;
+  path.source = field.internal_source[start];
+  Tracer tracer(mesh, field);
+  if (absl::Status s = tracer.FromVertex(start, &path); !s.ok()) return s;
+  return path;
+}
+
+}  // namespace geodex
