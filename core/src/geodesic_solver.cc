@@ -8,6 +8,7 @@
 #include "absl/strings/str_format.h"
 #include "dijkstra.h"
 #include "ich/ich_solver.h"
+#include "mesh_lookup.h"
 
 namespace geodex {
 namespace {
@@ -15,27 +16,6 @@ namespace {
 // Barycentrics (and edge parameters) this close to 0 or 1 snap to the face's edge or vertex, so a
 // point "on" an edge behaves exactly like the edge point.
 constexpr double kSnap = 1e-12;
-
-// Corner c of face f in the frame of half-edge 3f.
-void CornerInFaceFrame(const TriangleMesh& mesh, uint32_t f, int c, double* x, double* y) {
-  const uint32_t h = 3 * f;
-  if (c == 0) {
-    *x = 0, *y = 0;
-  } else if (c == 1) {
-    *x = mesh.Length(h), *y = 0;
-  } else {
-    *x = mesh.OppX(h), *y = mesh.OppY(h);
-  }
-}
-
-void InternalCopies(const TriangleMesh& mesh, uint32_t file_vertex, std::vector<uint32_t>* out) {
-  out->clear();
-  out->push_back(file_vertex);
-  const std::vector<uint32_t>& copies = mesh.copy_of();
-  for (uint32_t i = 0; i < copies.size(); ++i) {
-    if (copies[i] == file_vertex) out->push_back(mesh.file_vertex_count() + i);
-  }
-}
 
 class SourceResolver {
  public:
@@ -73,31 +53,21 @@ class SourceResolver {
                             uint32_t label) {
     if (t <= kSnap) return AddVertex(a, label);
     if (t >= 1 - kSnap) return AddVertex(b, label);
-    bool found = false, placed = false;
-    InternalCopies(mesh_, a, &copies_);
-    for (uint32_t va : copies_) {
-      for (const uint32_t* c = mesh_.CornersBegin(va); c != mesh_.CornersEnd(va); ++c) {
-        // Corner c starts half-edge c (a -> next); half-edge Prev(c) ends at a.
-        const uint32_t candidates[2] = {*c, TriangleMesh::Prev(*c)};
-        for (const uint32_t h : candidates) {
-          const bool forward = mesh_.FileVertex(mesh_.From(h)) == a &&
-                               mesh_.FileVertex(mesh_.To(h)) == b;
-          const bool backward = mesh_.FileVertex(mesh_.From(h)) == b &&
-                                mesh_.FileVertex(mesh_.To(h)) == a;
-          if (!forward && !backward) continue;
-          found = true;
-          const uint32_t f = TriangleMesh::FaceOf(h);
-          if (mesh_.FaceDegenerate(f)) continue;
-          const double x = (forward ? t : 1 - t) * mesh_.Length(h);
-          const int k = static_cast<int>(h % 3);
-          double x0, y0, x1, y1;
-          CornerInFaceFrame(mesh_, f, k, &x0, &y0);
-          CornerInFaceFrame(mesh_, f, (k + 1) % 3, &x1, &y1);
-          const double len = mesh_.Length(h);
-          PlaceInFace(f, x0 + (x1 - x0) * x / len, y0 + (y1 - y0) * x / len, label);
-          placed = true;
-        }
-      }
+    HalfEdgesOfFileEdge(mesh_, a, b, &half_edges_);
+    const bool found = !half_edges_.empty();
+    bool placed = false;
+    for (const uint32_t h : half_edges_) {
+      const bool forward = mesh_.FileVertex(mesh_.From(h)) == a;
+      const uint32_t f = TriangleMesh::FaceOf(h);
+      if (mesh_.FaceDegenerate(f)) continue;
+      const double len = mesh_.Length(h);
+      const double x = (forward ? t : 1 - t) * len;
+      const int k = static_cast<int>(h % 3);
+      double x0, y0, x1, y1;
+      CornerInFaceFrame(mesh_, f, k, &x0, &y0);
+      CornerInFaceFrame(mesh_, f, (k + 1) % 3, &x1, &y1);
+      PlaceInFace(f, x0 + (x1 - x0) * x / len, y0 + (y1 - y0) * x / len, label);
+      placed = true;
     }
     if (!found) {
       return absl::InvalidArgumentError(absl::StrFormat(
@@ -161,6 +131,7 @@ class SourceResolver {
   const TriangleMesh& mesh_;
   std::vector<ich::ResolvedSource> sources_;
   std::vector<uint32_t> copies_;
+  std::vector<uint32_t> half_edges_;
 };
 
 std::vector<VertexSeed> SeedsForDijkstra(const TriangleMesh& mesh,
@@ -233,6 +204,7 @@ absl::StatusOr<DistanceField> ComputeDistanceField(const TriangleMesh& mesh,
           "out of memory for geodesic windows; set a window budget, a max_distance or lambda > 0");
     }
   }
+  field.sources = sources;
   // File order: a split vertex takes the best of its copies.
   const uint32_t nf = mesh.file_vertex_count();
   field.distance.assign(field.internal_distance.begin(), field.internal_distance.begin() + nf);

@@ -4,6 +4,8 @@
 #include <limits>
 #include <vector>
 
+#include "geodex/surface_point.h"
+
 namespace geodex {
 
 inline constexpr double kUnreachable = std::numeric_limits<double>::infinity();
@@ -46,6 +48,7 @@ struct DistanceField {
   std::vector<double> internal_distance;
   std::vector<uint32_t> internal_source;
   std::vector<VertexOrigin> internal_origin;
+  std::vector<SurfacePoint> sources;  // as given to the solve; labels index this list
   SolveStats stats;
 };
 
