@@ -5,11 +5,16 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <memory>
 #include <set>
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_format.h"
+#include "geodex/distance_matrix.h"
 #include "geodex/geodesic_solver.h"
+#include "geodex/locate.h"
+#include "geodex/point_distance.h"
+#include "geodex/shortest_path.h"
 #include "geodex/mesh_io.h"
 #include "geodex/samples.h"
 #include "geodex/surface_point.h"
@@ -78,6 +83,30 @@ bool CheckKnown(const Args& args, const std::set<std::string>& known, std::strin
   for (const auto& [key, value] : args.options) {
     if (!known.count(key)) {
       *error = absl::StrFormat("unknown option --%s (see geodex --help)", key);
+      return false;
+    }
+  }
+  return true;
+}
+
+// Snaps `p:X:Y:Z` points onto the surface (the locator is built once, on first need), then checks
+// every point against the mesh. Errors name the option and the point.
+bool ResolvePoints(const TriangleMesh& mesh, const std::string& option,
+                   std::vector<SurfacePoint>* points, std::unique_ptr<SurfaceLocator>* locator,
+                   std::string* error) {
+  for (SurfacePoint& p : *points) {
+    if (p.kind == SurfacePoint::Kind::kPosition) {
+      if (*locator == nullptr) *locator = std::make_unique<SurfaceLocator>(mesh);
+      absl::StatusOr<LocatedPoint> located = (*locator)->Locate(p.position);
+      if (!located.ok()) {
+        *error = absl::StrFormat("--%s: %s: %s", option, SurfacePointToString(p),
+                                 located.status().message());
+        return false;
+      }
+      p = located->point;
+    }
+    if (absl::Status s = ValidateSurfacePoint(mesh, p); !s.ok()) {
+      *error = absl::StrFormat("--%s: %s", option, s.message());
       return false;
     }
   }
@@ -168,7 +197,7 @@ int RunInfo(const Args& args) {
 int RunDistances(const Args& args) {
   std::string error;
   if (!CheckKnown(args, {"sources", "method", "lambda", "lambda-scale", "max-distance",
-                         "max-windows", "stats", "output", "no-filter", "no-one-split"},
+                         "max-windows", "stats", "output", "no-filter", "no-one-split", "at"},
                   &error)) {
     return Fail(kExitUsage, error);
   }
@@ -212,10 +241,9 @@ int RunDistances(const Args& args) {
   if (!sources.ok()) return Fail(kExitUsage, "--sources: " + std::string(sources.status().message()));
   absl::StatusOr<LoadedMesh> loaded = LoadMesh(args.positional[0], MeshBuildOptions{});
   if (!loaded.ok()) return Fail(kExitInput, std::string(loaded.status().message()));
-  for (const SurfacePoint& p : *sources) {
-    if (absl::Status s = ValidateSurfacePoint(loaded->mesh, p); !s.ok()) {
-      return Fail(kExitUsage, "--sources: " + std::string(s.message()));
-    }
+  std::unique_ptr<SurfaceLocator> locator;
+  if (!ResolvePoints(loaded->mesh, "sources", &*sources, &locator, &error)) {
+    return Fail(kExitUsage, error);
   }
   absl::StatusOr<DistanceField> field = ComputeDistanceField(loaded->mesh, *sources, options);
   if (!field.ok()) {
@@ -225,11 +253,30 @@ int RunDistances(const Args& args) {
   }
   const auto t_out = std::chrono::steady_clock::now();
   std::string text;
-  text.reserve(field->distance.size() * 24);
   char buf[64];
-  for (double d : field->distance) {
-    const int n = std::snprintf(buf, sizeof(buf), "%.17g\n", d);
-    text.append(buf, n);
+  if (args.options.count("at")) {
+    // Surface points: the unfolding estimate and the exact value, one line each.
+    absl::StatusOr<std::vector<SurfacePoint>> at = ParseSurfacePoints(args.options.at("at"));
+    if (!at.ok()) return Fail(kExitUsage, "--at: " + std::string(at.status().message()));
+    if (!ResolvePoints(loaded->mesh, "at", &*at, &locator, &error)) return Fail(kExitUsage, error);
+    absl::StatusOr<std::vector<std::pair<double, uint32_t>>> exact =
+        ComputeExactDistancesAt(loaded->mesh, *sources, *at, options);
+    if (!exact.ok()) return Fail(kExitSolveFailed, std::string(exact.status().message()));
+    for (size_t i = 0; i < at->size(); ++i) {
+      absl::StatusOr<PointEstimate> est = EstimateDistanceAt(loaded->mesh, *field, (*at)[i]);
+      if (!est.ok()) return Fail(kExitUsage, "--at: " + std::string(est.status().message()));
+      text += absl::StrFormat("%s\testimate %.17g\texact %.17g\tsource %d\n",
+                              SurfacePointToString((*at)[i]), est->distance, (*exact)[i].first,
+                              static_cast<int64_t>((*exact)[i].second == kNoIndex
+                                                       ? -1
+                                                       : (*exact)[i].second));
+    }
+  } else {
+    text.reserve(field->distance.size() * 24);
+    for (double d : field->distance) {
+      const int n = std::snprintf(buf, sizeof(buf), "%.17g\n", d);
+      text.append(buf, n);
+    }
   }
   if (args.options.count("output")) {
     const std::string& path = args.options.at("output");
@@ -265,6 +312,141 @@ int RunDistances(const Args& args) {
         (unsigned long long)s.peak_live_windows, (unsigned long long)s.peak_bytes,
         (unsigned long long)loaded->mesh.MemoryBytes(), loaded->load_ms, loaded->build_ms,
         s.solve_ms, MsSince(t_out));
+  }
+  return kExitOk;
+}
+
+namespace {
+
+std::string SimplexText(const SurfacePoint& p) {
+  switch (p.kind) {
+    case SurfacePoint::Kind::kVertex:
+      return absl::StrFormat("v %d", p.vertex);
+    case SurfacePoint::Kind::kEdge:
+      return absl::StrFormat("e %d %d %.17g", p.edge_from, p.edge_to, p.t);
+    case SurfacePoint::Kind::kFace:
+      return absl::StrFormat("f %d %.17g %.17g %.17g", p.face, p.bary[0], p.bary[1], p.bary[2]);
+    case SurfacePoint::Kind::kPosition:
+      break;
+  }
+  return "?";
+}
+
+// Parses a SPEC that must name exactly one point, and checks it against the mesh.
+bool OnePoint(const Args& args, const std::string& key, const TriangleMesh& mesh, SurfacePoint* out,
+              std::string* error) {
+  absl::StatusOr<std::vector<SurfacePoint>> p = ParseSurfacePoints(args.options.at(key));
+  if (!p.ok()) {
+    *error = absl::StrFormat("--%s: %s", key, p.status().message());
+    return false;
+  }
+  if (p->size() != 1) {
+    *error = absl::StrFormat("--%s: expected one point, got %d", key, p->size());
+    return false;
+  }
+  std::unique_ptr<SurfaceLocator> locator;
+  if (!ResolvePoints(mesh, key, &*p, &locator, error)) return false;
+  *out = p->front();
+  return true;
+}
+
+}  // namespace
+
+int RunPath(const Args& args) {
+  std::string error;
+  if (!CheckKnown(args, {"from", "to", "method", "stats", "lambda", "max-windows"}, &error)) {
+    return Fail(kExitUsage, error);
+  }
+  if (args.positional.size() != 1 || !args.options.count("from") || !args.options.count("to")) {
+    return Fail(kExitUsage, "usage: geodex path MESH --from SPEC --to SPEC [--method astar|full]");
+  }
+  PathQueryOptions options;
+  const std::string method = args.options.count("method") ? args.options.at("method") : "astar";
+  if (method == "astar") {
+    options.use_heuristic = true;
+  } else if (method == "full") {
+    options.full_field = true;
+  } else {
+    return Fail(kExitUsage, "--method must be astar or full");
+  }
+  if (!GetDouble(args, "lambda", &options.solver.lambda, &error) ||
+      !GetUint(args, "max-windows", &options.solver.max_windows, &error)) {
+    return Fail(kExitUsage, error);
+  }
+  absl::StatusOr<LoadedMesh> loaded = LoadMesh(args.positional[0], MeshBuildOptions{});
+  if (!loaded.ok()) return Fail(kExitInput, std::string(loaded.status().message()));
+  SurfacePoint from, to;
+  if (!OnePoint(args, "from", loaded->mesh, &from, &error) ||
+      !OnePoint(args, "to", loaded->mesh, &to, &error)) {
+    return Fail(kExitUsage, error);
+  }
+  absl::StatusOr<PathQueryResult> result = ComputeShortestPath(loaded->mesh, from, to, options);
+  if (!result.ok()) {
+    const int code = result.status().code() == absl::StatusCode::kInvalidArgument ? kExitUsage
+                                                                                   : kExitSolveFailed;
+    return Fail(code, std::string(result.status().message()));
+  }
+  std::string text = absl::StrFormat("%.17g\n", result->distance);
+  for (const PathPoint& p : result->path.points) {
+    text += absl::StrFormat("%.17g %.17g %.17g %s\n", p.position[0], p.position[1], p.position[2],
+                            SimplexText(p.where));
+  }
+  std::fwrite(text.data(), 1, text.size(), stdout);
+  if (args.options.count("stats")) {
+    const SolveStats& s = result->stats;
+    std::fprintf(stderr,
+                 "{\"method\": \"%s\", \"windows_created\": %llu, \"windows_processed\": %llu, "
+                 "\"peak_live_windows\": %llu, \"peak_bytes\": %llu, \"path_points\": %zu, "
+                 "\"load_ms\": %.3f, \"build_ms\": %.3f, \"solve_ms\": %.3f}\n",
+                 method.c_str(), (unsigned long long)s.windows_created,
+                 (unsigned long long)s.windows_processed, (unsigned long long)s.peak_live_windows,
+                 (unsigned long long)s.peak_bytes, result->path.points.size(), loaded->load_ms,
+                 loaded->build_ms, s.solve_ms);
+  }
+  return kExitOk;
+}
+
+int RunMatrix(const Args& args) {
+  std::string error;
+  if (!CheckKnown(args, {"sources", "targets", "stats", "max-windows"}, &error)) {
+    return Fail(kExitUsage, error);
+  }
+  if (args.positional.size() != 1 || !args.options.count("sources") ||
+      !args.options.count("targets")) {
+    return Fail(kExitUsage, "usage: geodex matrix MESH --sources SPEC --targets SPEC");
+  }
+  GeodesicOptions options;
+  if (!GetUint(args, "max-windows", &options.max_windows, &error)) return Fail(kExitUsage, error);
+  absl::StatusOr<LoadedMesh> loaded = LoadMesh(args.positional[0], MeshBuildOptions{});
+  if (!loaded.ok()) return Fail(kExitInput, std::string(loaded.status().message()));
+  std::vector<SurfacePoint> lists[2];
+  const char* keys[2] = {"sources", "targets"};
+  for (int i = 0; i < 2; ++i) {
+    absl::StatusOr<std::vector<SurfacePoint>> p = ParseSurfacePoints(args.options.at(keys[i]));
+    if (!p.ok()) return Fail(kExitUsage, absl::StrFormat("--%s: %s", keys[i], p.status().message()));
+    std::unique_ptr<SurfaceLocator> locator;
+    if (!ResolvePoints(loaded->mesh, keys[i], &*p, &locator, &error)) {
+      return Fail(kExitUsage, error);
+    }
+    lists[i] = *std::move(p);
+  }
+  absl::StatusOr<DistanceMatrix> m = ComputeDistanceMatrix(loaded->mesh, lists[0], lists[1], options);
+  if (!m.ok()) {
+    const int code = m.status().code() == absl::StatusCode::kInvalidArgument ? kExitUsage
+                                                                              : kExitSolveFailed;
+    return Fail(code, std::string(m.status().message()));
+  }
+  std::string text;
+  for (size_t i = 0; i < m->rows; ++i) {
+    for (size_t j = 0; j < m->cols; ++j) {
+      text += absl::StrFormat(j ? "\t%.17g" : "%.17g", m->values[i * m->cols + j]);
+    }
+    text += "\n";
+  }
+  std::fwrite(text.data(), 1, text.size(), stdout);
+  if (args.options.count("stats")) {
+    std::fprintf(stderr, "{\"rows\": %zu, \"cols\": %zu, \"windows_created\": %llu, \"solve_ms\": %.3f}\n",
+                 m->rows, m->cols, (unsigned long long)m->stats.windows_created, m->stats.solve_ms);
   }
   return kExitOk;
 }

@@ -28,5 +28,7 @@ bool ParseArgs(int argc, char** argv, int first, const std::vector<std::string>&
 
 int RunInfo(const Args& args);
 int RunDistances(const Args& args);
+int RunPath(const Args& args);
+int RunMatrix(const Args& args);
 
 }  // namespace geodex::cli

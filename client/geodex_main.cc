@@ -25,6 +25,14 @@ commands:
       One distance per vertex in the file's vertex order (%.17g; 'inf' if unreachable).
       --stats prints one JSON object with counters and times (*_ms) on stderr.
       --no-filter / --no-one-split switch off Lemma 2 / Lemma 1 (slower; same answer).
+      --at SPEC: instead, one line per surface point: its unfolding estimate (paper section 4)
+      and its exact distance ('POINT<TAB>estimate D<TAB>exact D<TAB>source I').
+  path MESH --from SPEC --to SPEC [--method astar|full] [--stats]
+      The exact shortest path: line 1 its length; then one line per polyline point,
+      'x y z' and the simplex it lies on ('v ID', 'e V1 V2 T' or 'f FACE B0 B1 B2').
+      astar (default) uses the paper's section 5 heuristic and stops at the target.
+  matrix MESH --sources SPEC --targets SPEC [--stats]
+      Exact distances, one row per source, tab-separated.
 
 SPEC: comma-separated points: 17 (vertex), e:V1:V2:T (the point (1-T)*V1 + T*V2 on an edge),
       f:FACE:B0:B1:B2 (barycentric in the face's vertex order as in the file).
@@ -55,6 +63,8 @@ int main(int argc, char** argv) {
   }
   if (command == "info") return RunInfo(args);
   if (command == "distances") return RunDistances(args);
+  if (command == "path") return RunPath(args);
+  if (command == "matrix") return RunMatrix(args);
   std::fprintf(stderr, "geodex: unknown command '%s' (see geodex --help)\n", command.c_str());
   return kExitUsage;
 }

@@ -2,6 +2,7 @@
 
 // Small lookups shared by the code that places surface points on faces (private to core).
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -46,6 +47,29 @@ inline void HalfEdgesOfFileEdge(const TriangleMesh& mesh, uint32_t a, uint32_t b
       }
     }
   }
+}
+
+}  // namespace geodex
+
+namespace geodex {
+
+// The internal (recentred) 3D position of the point (px, py) given in the frame of half-edge 3f.
+inline void FacePointPosition(const TriangleMesh& mesh, uint32_t f, double px, double py,
+                              double out[3]) {
+  const double* pos = mesh.positions();
+  const double* a = pos + 3 * mesh.FaceVertex(f, 0);
+  const double* b = pos + 3 * mesh.FaceVertex(f, 1);
+  const double* c = pos + 3 * mesh.FaceVertex(f, 2);
+  const double len = mesh.Length(3 * f);
+  double u[3], w[3], dot = 0, norm = 0;
+  for (int k = 0; k < 3; ++k) u[k] = len > 0 ? (b[k] - a[k]) / len : 0;
+  for (int k = 0; k < 3; ++k) dot += (c[k] - a[k]) * u[k];
+  for (int k = 0; k < 3; ++k) {
+    w[k] = c[k] - a[k] - dot * u[k];
+    norm += w[k] * w[k];
+  }
+  norm = std::sqrt(norm);
+  for (int k = 0; k < 3; ++k) out[k] = a[k] + px * u[k] + py * (norm > 0 ? w[k] / norm : 0);
 }
 
 }  // namespace geodex

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "absl/strings/str_format.h"
+#include "path_trace.h"
 
 namespace geodex {
 namespace {
@@ -66,6 +67,30 @@ class Tracer {
   absl::Status FromVertex(uint32_t v, GeodesicPath* path) {
     path_ = path;
     AddVertex(v);
+    return Chain(v);
+  }
+
+  // A target point answered by the solver: the start point, then straight to the image of its
+  // origin (or to a vertex), then on along the per-vertex origins.
+  absl::Status FromTarget(const ich::TargetResult& r, const SurfacePoint& where,
+                          GeodesicPath* path) {
+    path_ = path;
+    const Frame3 f = FrameOf(mesh_, 3 * r.face);
+    double q[3];
+    for (int k = 0; k < 3; ++k) q[k] = f.o[k] + r.px * f.u[k] + r.py * f.n[k];
+    Append(q, where);
+    if (r.origin.half_edge == kNoIndex) {
+      AddVertex(r.origin.pseudo_source);
+      return Chain(r.origin.pseudo_source);
+    }
+    absl::StatusOr<uint32_t> next = LegFrom({r.tx, r.ty}, r.origin);
+    if (!next.ok()) return next.status();
+    if (*next == kNoIndex) return absl::OkStatus();
+    return Chain(*next);
+  }
+
+ private:
+  absl::Status Chain(uint32_t v) {
     // Every leg ends at a pseudo-source; a chain is at most as long as the vertex count.
     for (uint32_t legs = 0; legs <= mesh_.vertex_count(); ++legs) {
       const VertexOrigin& o = field_.internal_origin[v];
@@ -85,21 +110,20 @@ class Tracer {
     return absl::InternalError("path backtrace did not terminate");
   }
 
- private:
   // Walks from vertex v straight towards the image in o's frame, face by face, until the image
   // lies in the current face; returns the pseudo-source vertex reached (kNoIndex for a point
   // source).
   absl::StatusOr<uint32_t> Leg(uint32_t v, const VertexOrigin& o) {
+    const uint32_t g = o.half_edge;
+    if (mesh_.From(g) == v) return LegFrom({0, 0}, o);
+    if (mesh_.To(g) == v) return LegFrom({mesh_.Length(g), 0}, o);
+    return LegFrom({mesh_.OppX(g), mesh_.OppY(g)}, o);
+  }
+
+  // The same from a point p given in the frame of o.half_edge (inside its face or on its border).
+  absl::StatusOr<uint32_t> LegFrom(Vec2 p, const VertexOrigin& o) {
     uint32_t g = o.half_edge;
     Vec2 image{o.ix, o.iy};
-    Vec2 p;
-    if (mesh_.From(g) == v) {
-      p = {0, 0};
-    } else if (mesh_.To(g) == v) {
-      p = {mesh_.Length(g), 0};
-    } else {
-      p = {mesh_.OppX(g), mesh_.OppY(g)};
-    }
     const uint32_t max_steps = 2 * mesh_.face_count() + 8;
     for (uint32_t step = 0; step < max_steps; ++step) {
       const double len = mesh_.Length(g);
@@ -205,6 +229,23 @@ class Tracer {
 };
 
 }  // namespace
+
+absl::StatusOr<GeodesicPath> TraceFromTarget(const TriangleMesh& mesh, const DistanceField& field,
+                                             const ich::TargetResult& result,
+                                             const SurfacePoint& where) {
+  if (!std::isfinite(result.distance)) {
+    return absl::NotFoundError("the target is unreachable from every source");
+  }
+  GeodesicPath path;
+  path.source = result.label;
+  Tracer tracer(mesh, field);
+  if (result.vertex != kNoIndex) {
+    if (absl::Status s = tracer.FromVertex(result.vertex, &path); !s.ok()) return s;
+  } else if (absl::Status s = tracer.FromTarget(result, where, &path); !s.ok()) {
+    return s;
+  }
+  return path;
+}
 
 absl::StatusOr<GeodesicPath> TracePathFromVertex(const TriangleMesh& mesh,
                                                  const DistanceField& field, uint32_t vertex) {

@@ -58,8 +58,15 @@ absl::StatusOr<std::vector<SurfacePoint>> ParseSurfacePoints(absl::string_view s
         return bad("expected f:FACE:B0:B1:B2");
       }
       points.push_back(SurfacePoint::InFace(f, b[0], b[1], b[2]));
+    } else if (parts[0] == "p") {
+      double x[3];
+      if (parts.size() != 4 || !ParseDouble(parts[1], &x[0]) || !ParseDouble(parts[2], &x[1]) ||
+          !ParseDouble(parts[3], &x[2])) {
+        return bad("expected p:X:Y:Z");
+      }
+      points.push_back(SurfacePoint::AtPosition(x[0], x[1], x[2]));
     } else {
-      return bad("unknown kind (use a vertex id, e:V1:V2:T or f:FACE:B0:B1:B2)");
+      return bad("unknown kind (use a vertex id, e:V1:V2:T, f:FACE:B0:B1:B2 or p:X:Y:Z)");
     }
   }
   return points;
@@ -107,6 +114,9 @@ absl::Status ValidateSurfacePoint(const TriangleMesh& mesh, const SurfacePoint& 
       }
       return absl::OkStatus();
     }
+    case SurfacePoint::Kind::kPosition:
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "point %s: a position must be located on the surface first (SurfaceLocator)", name));
   }
   return absl::InvalidArgumentError("unknown point kind");
 }
@@ -119,6 +129,8 @@ std::string SurfacePointToString(const SurfacePoint& p) {
       return absl::StrFormat("e:%d:%d:%.17g", p.edge_from, p.edge_to, p.t);
     case SurfacePoint::Kind::kFace:
       return absl::StrFormat("f:%d:%.17g:%.17g:%.17g", p.face, p.bary[0], p.bary[1], p.bary[2]);
+    case SurfacePoint::Kind::kPosition:
+      return absl::StrFormat("p:%.17g:%.17g:%.17g", p.position[0], p.position[1], p.position[2]);
   }
   return "?";
 }

@@ -1,5 +1,7 @@
 #include "geodex/triangle_mesh.h"
 
+#include <sys/mman.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -71,10 +73,41 @@ class MeshBuilder {
     ComputeGeometry();
     ComputeVertexRings();
     ComputeComponentsAndBoundary();
+    PackHalfEdges();
     return std::move(m_);
   }
 
  private:
+  // Half-edge topology while building (the mesh's own accessors read the packed records, which
+  // exist only at the end).
+  uint32_t From(uint32_t h) const { return m_.faces_[h]; }
+  uint32_t To(uint32_t h) const { return m_.faces_[TriangleMesh::Next(h)]; }
+  uint32_t Opposite(uint32_t h) const { return m_.faces_[TriangleMesh::Prev(h)]; }
+
+  void PackHalfEdges() {
+    const uint32_t nh = 3 * m_.face_count();
+    // The engine reads these records at random: ask for transparent huge pages before the first
+    // touch (a large vector's buffer is a fresh mapping), so those reads rarely miss the TLB.
+    m_.half_edges_.reserve(nh);
+#ifdef MADV_HUGEPAGE
+    {
+      constexpr uintptr_t kHuge = uintptr_t{1} << 21;
+      const uintptr_t begin = reinterpret_cast<uintptr_t>(m_.half_edges_.data());
+      const uintptr_t end = begin + uintptr_t{nh} * sizeof(TriangleMesh::HalfEdge);
+      const uintptr_t lo = (begin + kHuge - 1) & ~(kHuge - 1), hi = end & ~(kHuge - 1);
+      if (hi > lo) madvise(reinterpret_cast<void*>(lo), hi - lo, MADV_HUGEPAGE);
+    }
+#endif
+    m_.half_edges_.resize(nh);
+    for (uint32_t h = 0; h < nh; ++h) {
+      TriangleMesh::HalfEdge& r = m_.half_edges_[h];
+      r.length = length_[h];
+      r.opp_x = opp_x_[h];
+      r.opp_y = opp_y_[h];
+      r.twin = twin_[h];
+      r.from = m_.faces_[h];
+    }
+  }
   absl::Status Validate() {
     const size_t nv = data_.vertex_count(), nf = data_.face_count();
     if (data_.positions.size() % 3 != 0 || data_.faces.size() % 3 != 0) {
@@ -162,8 +195,8 @@ class MeshBuilder {
     const uint32_t nh = 3 * m_.face_count();
     const uint32_t nv = m_.file_vertex_count_;
     std::vector<uint32_t> offsets(nv + 1, 0);
-    auto lo_of = [&](uint32_t h) { return std::min(m_.From(h), m_.To(h)); };
-    auto hi_of = [&](uint32_t h) { return std::max(m_.From(h), m_.To(h)); };
+    auto lo_of = [&](uint32_t h) { return std::min(From(h), To(h)); };
+    auto hi_of = [&](uint32_t h) { return std::max(From(h), To(h)); };
     for (uint32_t h = 0; h < nh; ++h) ++offsets[lo_of(h) + 1];
     for (uint32_t v = 0; v < nv; ++v) offsets[v + 1] += offsets[v];
     std::vector<uint32_t> bucket(nh), fill(offsets.begin(), offsets.end() - 1);
@@ -217,7 +250,7 @@ class MeshBuilder {
           const uint32_t h = 3 * f + k, t = candidate_[h];
           if (t == kNoIndex) continue;
           const uint32_t g = t / 3;
-          const bool same_direction = m_.From(h) == m_.From(t);
+          const bool same_direction = From(h) == From(t);
           const int8_t want = static_cast<int8_t>(flip[f] ^ (same_direction ? 1 : 0));
           if (flip[g] < 0) {
             flip[g] = want;
@@ -234,13 +267,13 @@ class MeshBuilder {
       }
     }
     // Apply flips (swap corners 1 and 2: local edge k becomes 2-k) and set twins.
-    m_.twin_.assign(3 * nf, kNoIndex);
+    twin_.assign(3 * nf, kNoIndex);
     auto remap = [&](uint32_t h) {
       const uint32_t f = h / 3, k = h % 3;
       return flip[f] ? 3 * f + (2 - k) : h;
     };
     for (uint32_t h = 0; h < 3 * nf; ++h) {
-      if (candidate_[h] != kNoIndex) m_.twin_[remap(h)] = remap(candidate_[h]);
+      if (candidate_[h] != kNoIndex) twin_[remap(h)] = remap(candidate_[h]);
     }
     for (uint32_t f = 0; f < nf; ++f) {
       if (flip[f]) {
@@ -265,7 +298,7 @@ class MeshBuilder {
     const uint32_t nh = 3 * m_.face_count();
     DisjointSets fans(nh);  // one element per corner (corner c sits at vertex faces_[c])
     for (uint32_t h = 0; h < nh; ++h) {
-      const uint32_t t = m_.twin_[h];
+      const uint32_t t = twin_[h];
       if (t == kNoIndex || t < h) continue;
       // h: a->b, t: b->a. Corner of h's start (a) pairs with corner of t's end (a).
       fans.Union(h, TriangleMesh::Next(t));
@@ -303,19 +336,19 @@ class MeshBuilder {
 
   void ComputeGeometry() {
     const uint32_t nf = m_.face_count(), nh = 3 * nf, nv = next_vertex_count();
-    m_.length_.resize(nh);
-    m_.opp_x_.resize(nh);
-    m_.opp_y_.resize(nh);
+    length_.resize(nh);
+    opp_x_.resize(nh);
+    opp_y_.resize(nh);
     m_.corner_angle_.resize(nh);
     m_.angle_sum_.assign(nv, 0.0);
     m_.vertex_flags_.assign(nv, TriangleMesh::kIsolated);
     double total = 0;
     for (uint32_t h = 0; h < nh; ++h) {
-      const double* a = &m_.positions_[3 * m_.From(h)];
-      const double* b = &m_.positions_[3 * m_.To(h)];
-      const double* c = &m_.positions_[3 * m_.Opposite(h)];
+      const double* a = &m_.positions_[3 * From(h)];
+      const double* b = &m_.positions_[3 * To(h)];
+      const double* c = &m_.positions_[3 * Opposite(h)];
       const double len = Dist3(a, b);
-      m_.length_[h] = len;
+      length_[h] = len;
       total += len;
       m_.max_edge_length_ = std::max(m_.max_edge_length_, len);
       // Opposite corner in this half-edge's frame, from the two other edge lengths (law of
@@ -323,8 +356,8 @@ class MeshBuilder {
       const double lac = Dist3(a, c), lbc = Dist3(b, c);
       double x = len > 0 ? (len * len + lac * lac - lbc * lbc) / (2 * len) : 0;
       double y2 = lac * lac - x * x;
-      m_.opp_x_[h] = x;
-      m_.opp_y_[h] = y2 > 0 ? std::sqrt(y2) : 0;
+      opp_x_[h] = x;
+      opp_y_[h] = y2 > 0 ? std::sqrt(y2) : 0;
       m_.corner_angle_[h] = CornerAngleAt(a, b, c);  // corner h sits at From(h)
     }
     m_.mean_edge_length_ = nh ? total / nh : 0;
@@ -332,7 +365,7 @@ class MeshBuilder {
       const uint32_t v = m_.faces_[c];
       m_.angle_sum_[v] += m_.corner_angle_[c];
       m_.vertex_flags_[v] &= ~TriangleMesh::kIsolated;
-      if (m_.twin_[c] == kNoIndex || m_.twin_[TriangleMesh::Prev(c)] == kNoIndex) {
+      if (twin_[c] == kNoIndex || twin_[TriangleMesh::Prev(c)] == kNoIndex) {
         m_.vertex_flags_[v] |= TriangleMesh::kBoundary;
       }
       if (m_.face_flags_[c / 3] & TriangleMesh::kFaceDegenerate) {
@@ -367,15 +400,15 @@ class MeshBuilder {
     // Neighbours: both endpoints of every half-edge, then sort + unique per vertex.
     std::vector<uint32_t> offsets(nv + 1, 0);
     for (uint32_t h = 0; h < nh; ++h) {
-      ++offsets[m_.From(h) + 1];
-      ++offsets[m_.To(h) + 1];
+      ++offsets[From(h) + 1];
+      ++offsets[To(h) + 1];
     }
     for (uint32_t v = 0; v < nv; ++v) offsets[v + 1] += offsets[v];
     std::vector<uint32_t> raw(offsets[nv]);
     fill.assign(offsets.begin(), offsets.end() - 1);
     for (uint32_t h = 0; h < nh; ++h) {
-      raw[fill[m_.From(h)]++] = m_.To(h);
-      raw[fill[m_.To(h)]++] = m_.From(h);
+      raw[fill[From(h)]++] = To(h);
+      raw[fill[To(h)]++] = From(h);
     }
     m_.neighbor_offsets_.assign(nv + 1, 0);
     m_.neighbors_.clear();
@@ -415,7 +448,7 @@ class MeshBuilder {
       do {
         m_.corner_start_angle_[c] = angle;
         angle += m_.corner_angle_[c];
-        const uint32_t t = m_.twin_[TriangleMesh::Prev(c)];
+        const uint32_t t = twin_[TriangleMesh::Prev(c)];
         if (t == kNoIndex) break;
         c = t;
         ++steps;
@@ -460,9 +493,9 @@ class MeshBuilder {
     DisjointSets loops(nv);
     std::vector<uint8_t> on_boundary(nv, 0);
     for (uint32_t h = 0; h < 3 * nf; ++h) {
-      if (m_.twin_[h] != kNoIndex) continue;
-      loops.Union(m_.From(h), m_.To(h));
-      on_boundary[m_.From(h)] = on_boundary[m_.To(h)] = 1;
+      if (twin_[h] != kNoIndex) continue;
+      loops.Union(From(h), To(h));
+      on_boundary[From(h)] = on_boundary[To(h)] = 1;
     }
     std::vector<uint8_t> root_seen(nv, 0);
     for (uint32_t v = 0; v < nv; ++v) {
@@ -481,6 +514,8 @@ class MeshBuilder {
   const MeshBuildOptions& options_;
   TriangleMesh m_;
   std::vector<uint32_t> candidate_;  // twin candidates in file half-edge numbering
+  std::vector<uint32_t> twin_;       // packed into the mesh's half-edge records at the end
+  std::vector<double> length_, opp_x_, opp_y_;
 };
 
 absl::StatusOr<TriangleMesh> TriangleMesh::Build(const MeshData& data,
@@ -491,7 +526,7 @@ absl::StatusOr<TriangleMesh> TriangleMesh::Build(const MeshData& data,
 uint64_t TriangleMesh::MemoryBytes() const {
   auto bytes = [](const auto& v) { return uint64_t{v.capacity()} * sizeof(v[0]); };
   return sizeof(*this) + bytes(positions_) + bytes(faces_) + bytes(face_flags_) + bytes(copy_of_) +
-         bytes(twin_) + bytes(length_) + bytes(opp_x_) + bytes(opp_y_) + bytes(corner_angle_) + bytes(corner_start_angle_) +
+         bytes(half_edges_) + bytes(corner_angle_) + bytes(corner_start_angle_) +
          bytes(angle_sum_) + bytes(vertex_flags_) + bytes(component_) + bytes(corner_offsets_) +
          bytes(vertex_corners_) + bytes(neighbor_offsets_) + bytes(neighbors_) +
          bytes(neighbor_length_);

@@ -61,6 +61,8 @@ Vec3 PointPosition(const MeshData& data, const SurfacePoint& p) {
                  Scale(VertexPosition(data, p.edge_to), p.t));
     case SurfacePoint::Kind::kFace:
       return FacePoint(data, p.face, p.bary);
+    case SurfacePoint::Kind::kPosition:
+      return p.position;  // not produced by Locate
   }
   return {kNaN, kNaN, kNaN};
 }

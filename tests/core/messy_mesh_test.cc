@@ -239,7 +239,9 @@ TEST(MessyMeshTest, NonManifoldEdgeIsCutAndReported) {
   EXPECT_EQ(mesh->report().non_manifold_edges, 1u);
   // With the edge cut, each page meets the others only at 0 and at 1: both are split.
   EXPECT_EQ(mesh->report().non_manifold_vertices, 2u);
-  EXPECT_EQ(mesh->report().components, 1u);
+  // Cut at the spine, the three pages are separate pieces; through shared vertices, one.
+  EXPECT_EQ(mesh->report().components, 3u);
+  EXPECT_EQ(mesh->report().vertex_connected_components, 1u);
   EXPECT_EQ(mesh->report().degenerate_faces, 0u);
 
   // From a page's tip: its own page only.
@@ -264,7 +266,8 @@ TEST(MessyMeshTest, BowtieVertexIsSplitAndNotCrossed) {
   ASSERT_TRUE(mesh.ok()) << mesh.status();
   EXPECT_EQ(mesh->report().non_manifold_vertices, 1u);
   EXPECT_EQ(mesh->report().non_manifold_edges, 0u);
-  EXPECT_EQ(mesh->report().components, 1u);
+  EXPECT_EQ(mesh->report().components, 2u);  // the two fans, once cut at the shared vertex
+  EXPECT_EQ(mesh->report().vertex_connected_components, 1u);
   EXPECT_EQ(mesh->vertex_count(), 8u);  // vertex 0 has a second internal copy
   EXPECT_EQ(mesh->FileVertex(7), 0u);
 

@@ -5,6 +5,7 @@
 
 #include "absl/status/statusor.h"
 #include "geodex/distance_field.h"
+#include "geodex/geodesic_solver.h"
 #include "geodex/surface_point.h"
 #include "geodex/triangle_mesh.h"
 
@@ -32,5 +33,33 @@ struct GeodesicPath {
 // Errors: InvalidArgument for an unknown vertex, NotFound when the vertex is unreachable.
 absl::StatusOr<GeodesicPath> TracePathFromVertex(const TriangleMesh& mesh,
                                                  const DistanceField& field, uint32_t vertex);
+
+}  // namespace geodex
+
+namespace geodex {
+
+struct PathQueryOptions {
+  GeodesicOptions solver;      // lambda, budget, cancel token, ... (max_distance is honoured)
+  // Single source, single target (paper section 5): windows are ordered by
+  // sigma + min over the interval of (|I p| + |p t|), a lower bound of any path through them, and
+  // the solve stops once the smallest key reaches the target's distance. Exact either way.
+  bool use_heuristic = true;
+  // Solve the whole field first (no early stop), then trace: the baseline for benchmarks.
+  bool full_field = false;
+};
+
+struct PathQueryResult {
+  double distance = kUnreachable;
+  GeodesicPath path;  // from `from` to `to`
+  SolveStats stats;
+};
+
+// The exact shortest path between two surface points, with its length.
+// Errors: InvalidArgument (bad point), NotFound (`to` unreachable from `from`), Cancelled,
+// ResourceExhausted.
+absl::StatusOr<PathQueryResult> ComputeShortestPath(const TriangleMesh& mesh,
+                                                    const SurfacePoint& from,
+                                                    const SurfacePoint& to,
+                                                    const PathQueryOptions& options = {});
 
 }  // namespace geodex

@@ -15,13 +15,16 @@ class TriangleMesh;
 // A point on the surface, named in the file's terms (file vertex ids, file face ids and the
 // file's corner order), so it means the same thing to every client.
 struct SurfacePoint {
-  enum class Kind : uint8_t { kVertex, kEdge, kFace };
+  // kPosition: a 3D position (file coordinates) to be snapped onto the surface with
+  // SurfaceLocator (geodex/locate.h) before use; solvers reject it.
+  enum class Kind : uint8_t { kVertex, kEdge, kFace, kPosition };
   Kind kind = Kind::kVertex;
   uint32_t vertex = 0;                 // kVertex
   uint32_t edge_from = 0, edge_to = 0; // kEdge: the point (1 - t) * from + t * to
   double t = 0;
   uint32_t face = 0;                   // kFace: barycentric in the file's corner order
   std::array<double, 3> bary{};
+  std::array<double, 3> position{};    // kPosition
 
   static SurfacePoint AtVertex(uint32_t v) {
     SurfacePoint p;
@@ -37,6 +40,12 @@ struct SurfacePoint {
     p.t = t;
     return p;
   }
+  static SurfacePoint AtPosition(double x, double y, double z) {
+    SurfacePoint p;
+    p.kind = Kind::kPosition;
+    p.position = {x, y, z};
+    return p;
+  }
   static SurfacePoint InFace(uint32_t f, double b0, double b1, double b2) {
     SurfacePoint p;
     p.kind = Kind::kFace;
@@ -46,7 +55,7 @@ struct SurfacePoint {
   }
 };
 
-// Parses a comma list: `17` (vertex), `e:V1:V2:T`, `f:FACE:B0:B1:B2`. Checks the syntax only; the
+// Parses a comma list: `17` (vertex), `e:V1:V2:T`, `f:FACE:B0:B1:B2`, `p:X:Y:Z` (a position). Checks the syntax only; the
 // mesh checks ranges (see ValidateSurfacePoint). Errors name the offending item.
 absl::StatusOr<std::vector<SurfacePoint>> ParseSurfacePoints(absl::string_view spec);
 

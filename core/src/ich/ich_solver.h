@@ -26,6 +26,33 @@ struct ResolvedSource {
   uint32_t label = 0;
 };
 
+// A point the solve must answer exactly (single-target queries, matrices, exact point distances):
+// a vertex (all its internal copies), or a point placed in the non-degenerate faces that contain
+// it (an edge point lies in every face of its edge), in the frame of half-edge 3*face.
+struct ResolvedTarget {
+  struct Placement {
+    uint32_t face;
+    double px, py;
+  };
+  std::vector<uint32_t> vertices;
+  std::vector<Placement> placements;
+  double position[3] = {0, 0, 0};  // internal (recentred) 3D coordinates, for the heuristic
+};
+
+// What the solve found for a target. A face-point target is reached straight from the image of
+// `origin` (in the frame of origin.half_edge, where the target sits at (tx, ty)), or straight
+// from vertex origin.pseudo_source when origin.half_edge == kNoIndex. A vertex target's path
+// starts at `vertex` and follows the per-vertex origins.
+struct TargetResult {
+  double distance = kUnreachable;
+  uint32_t label = kNoIndex;
+  uint32_t vertex = kNoIndex;  // vertex targets: the internal copy that is nearest
+  VertexOrigin origin;
+  double tx = 0, ty = 0;
+  uint32_t face = kNoIndex;    // face-point targets: the placement used, for the start position
+  double px = 0, py = 0;
+};
+
 class IchSolver {
  public:
   // Windows whose smallest distance exceeds `key_cap` (or options.max_distance) are never made:
@@ -35,6 +62,15 @@ class IchSolver {
 
   // Fills out->internal_distance/_source/_origin and out->stats.
   absl::Status Solve(const std::vector<ResolvedSource>& sources, DistanceField* out);
+
+  // Same, answering `targets` exactly and stopping as soon as every target's distance is final.
+  // With `use_heuristic` (one target only) windows are ordered by the paper's section 5 key,
+  // sigma + min over the interval of (|I p| + |p t|), which never exceeds the length of a path
+  // through the window. Only the targets' results are meaningful then, not the whole field.
+  absl::Status SolveForTargets(const std::vector<ResolvedSource>& sources,
+                               const std::vector<ResolvedTarget>& targets, bool use_heuristic,
+                               bool stop_early, DistanceField* out,
+                               std::vector<TargetResult>* results);
 
  private:
   void SeedVertex(uint32_t v, uint32_t label);
@@ -52,8 +88,9 @@ class IchSolver {
   static double IntervalKey(double b0, double b1, double ix, double iy, double sigma);
   // Cuts off the parts of [b0, b1] better reached straight from the edge's endpoints (the filter
   // theorem, point by point). Returns false when nothing is left.
+  // *ra, *rb receive |I b0| and |I b1| of the trimmed interval (for IsFiltered and the key).
   bool TrimByEndpoints(uint32_t half_edge, double* b0, double* b1, double ix, double iy,
-                       double sigma) const;
+                       double sigma, double* ra, double* rb) const;
 
   // Lower a vertex's distance if `d` is smaller; spawns a pseudo-source window where paths may bend.
   bool UpdateVertex(uint32_t v, double d, uint32_t parent, uint32_t half_edge, double ix, double iy);
@@ -63,8 +100,9 @@ class IchSolver {
                     WindowSide side, uint32_t pseudo_source, double sigma, uint32_t source);
   // Lemma 2 (filter theorem): true when no point of the window's interval can be reached more
   // cheaply through it than straight from one of the three vertices of the face it came through.
+  // ra, rb: |I b0| and |I b1|.
   bool IsFiltered(uint32_t half_edge, double b0, double b1, double ix, double iy, double sigma,
-                  WindowSide side, double epsilon) const;
+                  double ra, double rb, WindowSide side, double epsilon) const;
   void Push(uint32_t id, double key);
   // Removes `id`'s subtree (pseudo-source windows are kept and become roots), then frees any
   // processed ancestor left without children.
@@ -72,6 +110,30 @@ class IchSolver {
   void ReleaseIfDone(uint32_t id);
   void RelaxNeighbors(uint32_t v, double d, uint32_t source);
 
+  // --- targets ---
+  // The queue key of an interval window: its smallest distance, plus the A* term when enabled.
+  double WindowKey(uint32_t half_edge, double b0, double b1, double ix, double iy, double sigma,
+                   double plain_key) const;
+  double VertexKey(uint32_t v, double d) const;
+  // Offers target candidates from a window entering face(h), and from a point (a pseudo-source
+  // vertex, or a source point) seen straight inside face f.
+  void OfferWindowToTargets(uint32_t h, const Window& w);
+  void OfferPointToTargets(uint32_t f, double px, double py, double d, uint32_t label,
+                           uint32_t via_vertex, uint32_t frame_edge, double fx, double fy);
+  void Offer(uint32_t t, uint32_t placement, double d, uint32_t label, const VertexOrigin& origin,
+             double tx, double ty);
+  double TargetsBound();  // the largest current target distance (+inf while any is unknown)
+
+  const std::vector<ResolvedTarget>* targets_ = nullptr;
+  std::vector<TargetResult>* target_results_ = nullptr;
+  bool heuristic_ = false;
+  bool stop_early_ = false;
+  std::vector<uint32_t> face_target_head_;   // per face: first (target, placement) entry
+  std::vector<uint32_t> face_target_next_;   // entry -> next entry in the same face
+  std::vector<std::pair<uint32_t, uint32_t>> face_target_entry_;  // entry -> (target, placement)
+  std::vector<uint8_t> vertex_is_target_;
+  bool targets_dirty_ = true;
+  double targets_bound_ = kUnreachable;
   const TriangleMesh& mesh_;
   const GeodesicOptions& options_;
   double key_cap_;
@@ -81,7 +143,7 @@ class IchSolver {
   std::vector<uint32_t> label_;
   std::vector<VertexOrigin> origin_;
   std::vector<uint8_t> straight_through_;  // see ProcessInterval
-  std::vector<SplitOwner> owner_;
+  HugeVector<SplitOwner> owner_;
   WindowPool pool_;
   WindowQueue queue_;
   std::vector<uint32_t> scratch_;  // reused stack for subtree deletion

@@ -2,12 +2,50 @@
 
 // The engine's private window types: the sequence tree lives in one flat pool, linked by index.
 
+#include <sys/mman.h>
+
+#include <algorithm>
 #include <cstdint>
+#include <cstdlib>
+#include <new>
 #include <vector>
 
 #include "geodex/triangle_mesh.h"
 
 namespace geodex::ich {
+
+// Allocates large arrays on 2 MiB boundaries and asks for transparent huge pages: the engine's
+// arrays are read at random, and with 4 KiB pages most of those reads also miss the TLB.
+template <typename T>
+struct HugePageAllocator {
+  using value_type = T;
+  HugePageAllocator() = default;
+  template <typename U>
+  HugePageAllocator(const HugePageAllocator<U>&) {}
+  T* allocate(size_t n) {
+    constexpr size_t kHuge = size_t{1} << 21;
+    const size_t bytes = n * sizeof(T);
+    if (bytes < kHuge) return std::allocator<T>().allocate(n);
+    const size_t rounded = (bytes + kHuge - 1) & ~(kHuge - 1);
+    void* p = std::aligned_alloc(kHuge, rounded);
+    if (p == nullptr) throw std::bad_alloc();
+#ifdef MADV_HUGEPAGE
+    madvise(p, rounded, MADV_HUGEPAGE);
+#endif
+    return static_cast<T*>(p);
+  }
+  void deallocate(T* p, size_t n) {
+    if (n * sizeof(T) < (size_t{1} << 21)) {
+      std::allocator<T>().deallocate(p, n);
+    } else {
+      std::free(p);
+    }
+  }
+  template <typename U>
+  bool operator==(const HugePageAllocator<U>&) const { return true; }
+};
+template <typename T>
+using HugeVector = std::vector<T, HugePageAllocator<T>>;
 
 enum class WindowKind : uint8_t { kInterval, kPseudoSource };
 // Which child of its parent an interval window is: the one on the edge from the parent edge's
@@ -20,19 +58,27 @@ enum class WindowState : uint8_t { kQueued, kProcessed, kFree };
 // interval [b0, b1] is measured from the half-edge's start and (ix, iy), iy < 0, is the unfolded
 // image of the pseudo-source in the half-edge's frame. Pseudo-source windows sit at vertex
 // `element` with sigma = its distance.
-struct Window {
+//
+// Split in two arrays: the geometry processing reads (exactly one cache line) and the tree links
+// the bookkeeping walks (24 bytes), so parent-chain walks and stale checks touch small records.
+struct alignas(64) Window {
   double b0, b1;
   double ix, iy;
   double sigma;
   uint32_t element;
-  uint32_t parent;
-  uint32_t first_child;
-  uint32_t prev_sibling, next_sibling;
   uint32_t pseudo_source;  // vertex the paths bend at last (kNoIndex: the source point itself)
   uint32_t source;         // label: index into the solve's source list
   uint32_t level;
-  uint32_t generation;     // bumped on free, so stale queue entries and owner records are detected
   WindowKind kind;
+  WindowSide side;
+};
+
+struct WindowLinks {
+  uint32_t parent;
+  uint32_t first_child;
+  uint32_t prev_sibling, next_sibling;
+  uint32_t generation;  // bumped on free, so stale queue entries and owner records are detected
+  WindowKind kind;      // copies of the window's (fixed once made), for tree walks
   WindowSide side;
   WindowState state;
 };
@@ -48,55 +94,72 @@ class WindowPool {
     } else {
       id = static_cast<uint32_t>(windows_.size());
       windows_.emplace_back();
-      windows_.back().generation = 0;
+      links_.emplace_back();
+      links_.back().generation = 0;
     }
-    Window& w = windows_[id];
-    w.parent = w.first_child = w.prev_sibling = w.next_sibling = kNoIndex;
-    w.state = WindowState::kQueued;
+    WindowLinks& l = links_[id];
+    l.parent = l.first_child = l.prev_sibling = l.next_sibling = kNoIndex;
+    l.state = WindowState::kQueued;
     ++live_;
     if (live_ > peak_live_) peak_live_ = live_;
     return id;
   }
+  // Records kind and side (call once the window's fields are set).
+  void SetKind(uint32_t id, WindowKind kind, WindowSide side) {
+    windows_[id].kind = kind;
+    windows_[id].side = side;
+    links_[id].kind = kind;
+    links_[id].side = side;
+  }
   void Free(uint32_t id) {
-    Window& w = windows_[id];
-    w.state = WindowState::kFree;
-    ++w.generation;
+    WindowLinks& l = links_[id];
+    l.state = WindowState::kFree;
+    ++l.generation;
     free_.push_back(id);
     --live_;
   }
   Window& operator[](uint32_t id) { return windows_[id]; }
   const Window& operator[](uint32_t id) const { return windows_[id]; }
+  WindowLinks& links(uint32_t id) { return links_[id]; }
+  const WindowLinks& links(uint32_t id) const { return links_[id]; }
+  void PrefetchLinks(uint32_t id) const { __builtin_prefetch(&links_[id]); }
+  void Prefetch(uint32_t id) const {
+    __builtin_prefetch(&windows_[id]);
+    __builtin_prefetch(&links_[id]);
+  }
 
   // Tree links (doubly linked sibling lists: unlinking is O(1) even under a pseudo-source).
   void AddChild(uint32_t parent, uint32_t child) {
-    Window& c = windows_[child];
-    Window& p = windows_[parent];
+    WindowLinks& c = links_[child];
+    WindowLinks& p = links_[parent];
     c.parent = parent;
     c.prev_sibling = kNoIndex;
     c.next_sibling = p.first_child;
-    if (p.first_child != kNoIndex) windows_[p.first_child].prev_sibling = child;
+    if (p.first_child != kNoIndex) links_[p.first_child].prev_sibling = child;
     p.first_child = child;
   }
   void Unlink(uint32_t child) {
-    Window& c = windows_[child];
+    WindowLinks& c = links_[child];
     if (c.parent == kNoIndex) return;
     if (c.prev_sibling != kNoIndex) {
-      windows_[c.prev_sibling].next_sibling = c.next_sibling;
+      links_[c.prev_sibling].next_sibling = c.next_sibling;
     } else {
-      windows_[c.parent].first_child = c.next_sibling;
+      links_[c.parent].first_child = c.next_sibling;
     }
-    if (c.next_sibling != kNoIndex) windows_[c.next_sibling].prev_sibling = c.prev_sibling;
+    if (c.next_sibling != kNoIndex) links_[c.next_sibling].prev_sibling = c.prev_sibling;
     c.parent = c.prev_sibling = c.next_sibling = kNoIndex;
   }
 
   uint64_t live() const { return live_; }
   uint64_t peak_live() const { return peak_live_; }
   uint64_t CapacityBytes() const {
-    return windows_.capacity() * sizeof(Window) + free_.capacity() * sizeof(uint32_t);
+    return windows_.capacity() * sizeof(Window) + links_.capacity() * sizeof(WindowLinks) +
+           free_.capacity() * sizeof(uint32_t);
   }
 
  private:
-  std::vector<Window> windows_;
+  HugeVector<Window> windows_;
+  HugeVector<WindowLinks> links_;
   std::vector<uint32_t> free_;
   uint64_t live_ = 0, peak_live_ = 0;
 };
@@ -108,56 +171,85 @@ struct QueueEntry {
   uint32_t generation;
 };
 
-// A 4-ary min-heap of queue entries: half the depth of a binary heap, and the four children of a
-// node share a cache line, which matters with millions of windows in flight.
+// A monotone radix heap of queue entries (keys are distances, >= 0, so their IEEE bit patterns
+// order like the values). Bucket i > 0 holds keys whose highest bit differing from the last
+// popped key is bit i-1; bucket 0 holds keys equal to it. Pops empty a bucket at a time into
+// smaller ones, so entries move a few times through sequential arrays instead of sifting through
+// a tree of cache misses and mispredicted compares.
+//
+// Keys never go below the last popped key: a push below it (round-off; a window's children can
+// come out a few ulps below their parent) is queued at the last popped key. Order only steers
+// efficiency (every rule that drops a window compares against current vertex distances, which are
+// always upper bounds), so this costs nothing in exactness. Runs are deterministic.
 class WindowQueue {
  public:
-  bool empty() const { return heap_.empty(); }
-  void clear() { heap_.clear(); }
-  void reserve(size_t n) { heap_.reserve(n); }
-  uint64_t CapacityBytes() const { return heap_.capacity() * sizeof(QueueEntry); }
-
-  void Push(const QueueEntry& e) {
-    size_t i = heap_.size();
-    heap_.push_back(e);
-    while (i > 0) {
-      const size_t parent = (i - 1) / 4;
-      if (!Less(e, heap_[parent])) break;
-      heap_[i] = heap_[parent];
-      i = parent;
-    }
-    heap_[i] = e;
+  bool empty() const { return size_ == 0; }
+  void clear() {
+    for (auto& b : buckets_) b.clear();
+    size_ = 0;
+    last_ = 0;
+  }
+  void reserve(size_t n) { buckets_[0].reserve(n / 8); }
+  uint64_t CapacityBytes() const {
+    uint64_t bytes = 0;
+    for (const auto& b : buckets_) bytes += b.capacity() * sizeof(QueueEntry);
+    return bytes;
   }
 
-  QueueEntry Pop() {
-    const QueueEntry top = heap_.front();
-    const QueueEntry last = heap_.back();
-    heap_.pop_back();
-    const size_t n = heap_.size();
-    if (n == 0) return top;
-    size_t i = 0;
-    for (;;) {
-      const size_t first = 4 * i + 1;
-      if (first >= n) break;
-      size_t best = first;
-      const size_t end = first + 4 < n ? first + 4 : n;
-      for (size_t c = first + 1; c < end; ++c) {
-        if (Less(heap_[c], heap_[best])) best = c;
-      }
-      if (!Less(heap_[best], last)) break;
-      heap_[i] = heap_[best];
-      i = best;
+  void Push(QueueEntry e) {
+    uint64_t bits = Bits(e.key);
+    if (bits < last_) {
+      bits = last_;
+      e.key = FromBits(bits);
     }
-    heap_[i] = last;
+    buckets_[BucketOf(bits)].push_back(e);
+    ++size_;
+  }
+
+  // The entry Pop() would return next, if it is already known without reorganising the buckets
+  // (for prefetching). Refilling here would advance the lower bound past keys the current window's
+  // children may still need, and those would be queued late with overstated keys.
+  const QueueEntry* Peek() const { return buckets_[0].empty() ? nullptr : &buckets_[0].back(); }
+
+  QueueEntry Pop() {
+    Refill();
+    const QueueEntry top = buckets_[0].back();
+    buckets_[0].pop_back();
+    --size_;
     return top;
   }
 
  private:
-  // Smallest key first; ties broken by window id so runs are deterministic.
-  static bool Less(const QueueEntry& a, const QueueEntry& b) {
-    return a.key != b.key ? a.key < b.key : a.window < b.window;
+  static uint64_t Bits(double key) {
+    uint64_t b;
+    __builtin_memcpy(&b, &key, sizeof b);
+    return b;
   }
-  std::vector<QueueEntry> heap_;
+  static double FromBits(uint64_t b) {
+    double key;
+    __builtin_memcpy(&key, &b, sizeof key);
+    return key;
+  }
+  size_t BucketOf(uint64_t bits) const {
+    return bits == last_ ? 0 : 64 - static_cast<size_t>(__builtin_clzll(bits ^ last_));
+  }
+  // Makes bucket 0 non-empty: the smallest non-empty bucket's minimum becomes the last key and the
+  // bucket's entries move down.
+  void Refill() {
+    if (!buckets_[0].empty()) return;
+    size_t i = 1;
+    while (buckets_[i].empty()) ++i;
+    std::vector<QueueEntry>& from = buckets_[i];
+    uint64_t lowest = Bits(from[0].key);
+    for (const QueueEntry& e : from) lowest = std::min(lowest, Bits(e.key));
+    last_ = lowest;
+    for (const QueueEntry& e : from) buckets_[BucketOf(Bits(e.key))].push_back(e);
+    from.clear();
+  }
+
+  std::vector<QueueEntry> buckets_[65];
+  uint64_t last_ = 0;
+  size_t size_ = 0;
 };
 
 // Lemma 1 bookkeeping per half-edge: the window on it that gave its opposite vertex the smallest
