@@ -61,6 +61,43 @@ check "dijkstra >= exact" /usr/bin/python3 -c "
 a=[float(x) for x in open('$tmp/d.txt')]; b=[float(x) for x in open('$tmp/dj.txt')]
 assert all(y >= x*(1-1e-12) for x,y in zip(a,b)) and any(y > x*1.001 for x,y in zip(a,b))"
 
+# path: first line the length, then 'x y z' + simplex lines from --from to --to; astar == full.
+"$GEODEX" path "$DATA/kitten.off" --from 0 --to f:100:0.2:0.3:0.5 --stats >"$tmp/p.txt" 2>"$tmp/ps.json"
+check "path exits 0" test $? -eq 0
+"$GEODEX" path "$DATA/kitten.off" --from 0 --to f:100:0.2:0.3:0.5 --method full >"$tmp/pf.txt"
+check "astar and full give the same length" /usr/bin/python3 -c "
+a=float(open('$tmp/p.txt').readline()); b=float(open('$tmp/pf.txt').readline())
+assert abs(a-b) <= 1e-12*b and a > 0"
+check "path starts at the source vertex" /usr/bin/python3 -c "
+l=open('$tmp/p.txt').read().split(chr(10)); assert l[1].split()[3:]==['v','0'], l[1]"
+check "path ends at the target face point" /usr/bin/python3 -c "
+l=[x for x in open('$tmp/p.txt').read().split(chr(10)) if x]; t=l[-1].split()
+assert t[3]=='f' and t[4]=='100', t"
+check "path points have lengths summing to the distance" /usr/bin/python3 -c "
+import math
+l=[x.split() for x in open('$tmp/p.txt').read().split(chr(10)) if x]
+pts=[tuple(map(float,x[:3])) for x in l[1:]]
+s=sum(math.dist(a,b) for a,b in zip(pts,pts[1:])); d=float(l[0][0])
+assert abs(s-d) <= 1e-9*d, (s,d)"
+check "path stats json" /usr/bin/python3 -c "import json; d=json.load(open('$tmp/ps.json')); assert d['windows_created']>0"
+
+# matrix: one row per source, tab-separated, equal to the path lengths.
+"$GEODEX" matrix "$DATA/kitten.off" --sources 0,1250 --targets 7,f:100:0.2:0.3:0.5 >"$tmp/m.txt"
+check "matrix exits 0" test $? -eq 0
+check "matrix shape and values" /usr/bin/python3 -c "
+rows=[r.split(chr(9)) for r in open('$tmp/m.txt').read().split(chr(10)) if r]
+assert len(rows)==2 and all(len(r)==2 for r in rows)
+d=float(open('$tmp/p.txt').readline()); assert abs(float(rows[0][1])-d) <= 1e-12*d"
+
+# distances --at: estimate and exact per point; p:X:Y:Z positions are located on the surface.
+"$GEODEX" distances "$DATA/bump-domain.off" --sources 0 --at f:10:0.2:0.3:0.5,e:0:1:0.5,p:0.1:0.2:0.5 >"$tmp/at.txt"
+check "--at exits 0" test $? -eq 0
+check "--at: estimate equals exact on a flat domain" /usr/bin/python3 -c "
+for l in open('$tmp/at.txt'):
+    f=l.split(chr(9)); e=float(f[1].split()[1]); x=float(f[2].split()[1])
+    assert abs(e-x) <= 1e-10*max(1,x), l
+assert len(open('$tmp/at.txt').read().split(chr(10)))==4"
+
 # bad arguments: exit 2, one line naming the problem.
 expect_usage() {  # NAME PATTERN ARGS...
   local name="$1" pattern="$2"
@@ -78,6 +115,11 @@ expect_usage "bad method" "--method" distances "$DATA/knight.off" --sources 0 --
 expect_usage "unknown option" "--frobnicate" distances "$DATA/knight.off" --sources 0 --frobnicate 1
 expect_usage "unknown command" "frobnicate" frobnicate
 expect_usage "missing sources" "usage" distances "$DATA/knight.off"
+expect_usage "path to unknown vertex" "vertex 9999" path "$DATA/knight.off" --from 0 --to 9999
+expect_usage "path with two points" "one point" path "$DATA/knight.off" --from 0,1 --to 2
+expect_usage "bad path method" "--method" path "$DATA/knight.off" --from 0 --to 2 --method foo
+expect_usage "matrix bad target" "--targets" matrix "$DATA/knight.off" --sources 0 --targets f:0:2:0:0
+expect_usage "bad position" "p:1:2" distances "$DATA/knight.off" --sources p:1:2
 
 echo "cli: $pass passed, $fail failed"
 test "$fail" -eq 0
