@@ -1,7 +1,7 @@
-// geodex_bench: times our exact ICH, Dijkstra on the edge graph and (when built with CGAL) CGAL's
-// Surface_mesh_shortest_path from the same sources in one run, and reports window counts, memory and
-// the ICH-vs-CGAL difference. Two extra modes: --ablation (Lemma 1 / Lemma 2 on and off) and
-// --lambda (the precision knob of section 7 of Xin & Wang 2010).
+// geodex_bench: times our exact ICH, Dijkstra on the edge graph and (when built with CGAL)
+// CGAL's Surface_mesh_shortest_path from the same sources in one run, and reports window counts,
+// memory and the ICH-vs-CGAL difference. Two extra modes: --ablation (Lemma 1 / Lemma 2 on and
+// off) and --lambda (the precision knob of section 7 of Xin & Wang 2010).
 //
 // Every measurement runs in its own fork()ed child that loads the mesh itself; the parent never
 // loads a mesh. Each child resets its RSS high-water mark right after loading (Linux
@@ -94,6 +94,7 @@ struct Config {
   bool run_ich = true, run_dijkstra = true, run_cgal = true;
   std::string markdown;
   double timeout_s = 300;
+  double wait_idle_s = 0;
   bool ablation = false;
   bool lambda = false;
 };
@@ -101,7 +102,7 @@ struct Config {
 constexpr char kUsage[] =
     "usage: geodex_bench [--meshes DIR] [--mesh FILE ...] [--sources N] [--repeat R]\n"
     "                    [--cgal-max-faces F] [--methods ich,dijkstra,cgal] [--markdown OUT.md]\n"
-    "                    [--timeout-s T] [--ablation] [--lambda]\n"
+    "                    [--timeout-s T] [--wait-idle S] [--ablation] [--lambda]\n"
     "\n"
     "  --meshes DIR        every mesh file in DIR (.off .obj .ply .stl, optionally .gz); default\n"
     "                      ../shared/meshes next to the source tree, unless --mesh is given\n"
@@ -114,6 +115,8 @@ constexpr char kUsage[] =
     "  --methods LIST      any of ich,dijkstra,cgal (default all)\n"
     "  --markdown OUT.md   also write the tables as Markdown\n"
     "  --timeout-s T       kill a measurement after T seconds (default 300)\n"
+    "  --wait-idle S       before each measurement wait up to S seconds until the other\n"
+    "                      processes use less than a quarter of a core (default 0: no wait)\n"
     "  --ablation          instead of the main table: ICH with the filter (Lemma 2) and one angle\n"
     "                      one split (Lemma 1) on/off, on each given mesh\n"
     "  --lambda            instead of the main table: lambda in {0 .. 1} x {max edge, mean edge}\n";
@@ -146,7 +149,7 @@ absl::StatusOr<Config> ParseArgs(int argc, char** argv) {
       config.lambda = true;
     } else if (arg == "--meshes" || arg == "--mesh" || arg == "--sources" || arg == "--repeat" ||
                arg == "--cgal-max-faces" || arg == "--methods" || arg == "--markdown" ||
-               arg == "--timeout-s") {
+               arg == "--timeout-s" || arg == "--wait-idle") {
       absl::StatusOr<std::string> v = next();
       if (!v.ok()) return v.status();
       if (arg == "--meshes") {
@@ -180,6 +183,10 @@ absl::StatusOr<Config> ParseArgs(int argc, char** argv) {
         config.markdown = *v;
       } else if (arg == "--timeout-s") {
         if (!absl::SimpleAtod(*v, &config.timeout_s) || !(config.timeout_s > 0)) return bad(*v);
+      } else if (arg == "--wait-idle") {
+        if (!absl::SimpleAtod(*v, &config.wait_idle_s) || !(config.wait_idle_s >= 0)) {
+          return bad(*v);
+        }
       }
     } else {
       return absl::InvalidArgumentError(absl::StrCat("unknown argument '", arg, "'"));
@@ -267,7 +274,7 @@ enum class Task : int32_t { kInfo, kGeodex, kCgal };
 struct Job {
   Task task = Task::kInfo;
   std::string path;
-  int sources_wanted = 2;        // kInfo
+  int sources_wanted = 2;         // kInfo
   std::vector<uint32_t> sources;  // file vertex ids, one multi-source solve (one id: one source)
   GeodesicOptions options;
   int repeat = 1;
@@ -282,6 +289,7 @@ struct ChildReport {
   // The mesh (every child fills these).
   uint64_t file_vertices = 0, vertices = 0, faces = 0, components = 0, isolated = 0;
   uint64_t largest_component_faces = 0;
+  uint64_t saddles = 0, boundary_vertices = 0;
   double mean_edge = 0, max_edge = 0;
   double load_ms = 0;             // read + TriangleMesh::Build
   int64_t load_peak_kb = 0;       // ru_maxrss while loading (before the reset)
@@ -292,6 +300,7 @@ struct ChildReport {
   // The measurement (medians over the repeats).
   int32_t runs = 0;
   double solve_ms = 0, wall_ms = 0, solve_ms_min = 0;
+  double cpu_ms = 0;  // CPU time of the whole call (user + system): immune to time slicing
   double cgal_setup_ms = 0, cgal_query_ms = 0;
   SolveStats stats;
   uint64_t distance_count = 0;
@@ -306,6 +315,7 @@ struct Outcome {
   std::vector<double> distance;
   int64_t maxrss_kb = 0;  // the child's ru_maxrss from wait4
   double elapsed_s = 0;
+  double other_load = 0;  // cores used by other processes while the child ran
 
   bool ok() const { return kind == kOk; }
   std::string StatusText() const {
@@ -335,6 +345,51 @@ double Median(std::vector<double> v) {
 double MsSince(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - since)
       .count();
+}
+
+double CpuMs() {
+  struct timespec t;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
+}
+
+// CPU seconds spent busy by the whole machine since boot (all cores), from /proc/stat.
+double MachineBusySeconds() {
+  std::ifstream in("/proc/stat");
+  std::string cpu;
+  uint64_t user = 0, nice = 0, system = 0, idle = 0, iowait = 0, irq = 0, softirq = 0, steal = 0;
+  in >> cpu >> user >> nice >> system >> idle >> iowait >> irq >> softirq >> steal;
+  return static_cast<double>(user + nice + system + irq + softirq + steal) /
+         static_cast<double>(sysconf(_SC_CLK_TCK));
+}
+
+// Load from other processes, in cores, over `seconds` (this process sleeps meanwhile).
+double SampleOtherLoad(double seconds) {
+  const double busy = MachineBusySeconds();
+  usleep(static_cast<useconds_t>(seconds * 1e6));
+  return (MachineBusySeconds() - busy) / seconds;
+}
+
+// Waits until other processes use less than a quarter of a core (sampled over 0.5 s), at most
+// `max_s` seconds. Returns the last sample.
+double WaitForIdle(double max_s) {
+  if (max_s <= 0) return 0;
+  const auto start = std::chrono::steady_clock::now();
+  double load = SampleOtherLoad(0.5);
+  bool said = false;
+  while (load >= 0.25 && MsSince(start) < max_s * 1000) {
+    if (!said) std::fprintf(stderr, "  (waiting for an idle machine: other load %.2f)\n", load);
+    said = true;
+    load = SampleOtherLoad(0.5);
+  }
+  return load;
+}
+
+std::string LoadAverage() {
+  std::ifstream in("/proc/loadavg");
+  double one = 0, five = 0;
+  in >> one >> five;
+  return absl::StrFormat("%.2f (1 min), %.2f (5 min)", one, five);
 }
 
 int64_t CurrentRssKb() {
@@ -383,12 +438,13 @@ void SetError(ChildReport& report, const std::string& message) {
 // Sources for a mesh: vertex 0, then for i >= 1 the smallest vertex id >= q_i * V in the largest
 // component (by faces), q = 1/2, 1/4, 3/4, 1/8, 3/8, ... (for i = 1 this is MANIFEST.md's
 // "suggested 2nd source").
-std::vector<uint32_t> ChooseSources(const TriangleMesh& mesh, int wanted,
-                                    uint64_t* largest_faces) {
+std::vector<uint32_t> ChooseSources(const TriangleMesh& mesh, int wanted, uint64_t* largest_faces) {
   std::vector<uint32_t> faces_of(mesh.vertex_count(), 0);
-  for (uint32_t f = 0; f < mesh.face_count(); ++f) ++faces_of[mesh.Component(mesh.FaceVertex(f, 0))];
-  const uint32_t largest = static_cast<uint32_t>(
-      std::max_element(faces_of.begin(), faces_of.end()) - faces_of.begin());
+  for (uint32_t f = 0; f < mesh.face_count(); ++f) {
+    ++faces_of[mesh.Component(mesh.FaceVertex(f, 0))];
+  }
+  const uint32_t largest =
+      static_cast<uint32_t>(std::max_element(faces_of.begin(), faces_of.end()) - faces_of.begin());
   *largest_faces = faces_of[largest];
   const uint32_t nv = mesh.file_vertex_count();
   std::vector<uint32_t> sources = {0};
@@ -436,6 +492,8 @@ void ChildMain(const Job& job, int fd) {
   report.faces = mesh->face_count();
   report.components = mesh->report().components;
   report.isolated = mesh->report().isolated_vertices;
+  report.saddles = mesh->report().saddle_vertices;
+  report.boundary_vertices = mesh->report().boundary_vertices;
   report.mean_edge = mesh->MeanEdgeLength();
   report.max_edge = mesh->MaxEdgeLength();
   if (job.task == Task::kInfo) {  // before the baseline is taken
@@ -459,12 +517,14 @@ void ChildMain(const Job& job, int fd) {
       break;
     case Task::kGeodex: {
       const std::vector<SurfacePoint> sources = AsSurfacePoints(job.sources);
-      std::vector<double> solve, wall;
+      std::vector<double> solve, wall, cpu;
       std::optional<DistanceField> field;
       for (int r = 0; r < job.repeat; ++r) {
         field.reset();  // never two fields alive at once
         const auto start = std::chrono::steady_clock::now();
+        const double cpu_start = CpuMs();
         absl::StatusOr<DistanceField> result = ComputeDistanceField(*mesh, sources, job.options);
+        cpu.push_back(CpuMs() - cpu_start);
         wall.push_back(MsSince(start));
         if (!result.ok()) {
           SetError(report, result.status().ToString());
@@ -479,19 +539,22 @@ void ChildMain(const Job& job, int fd) {
       report.solve_ms = Median(solve);
       report.solve_ms_min = solve.empty() ? 0 : *std::min_element(solve.begin(), solve.end());
       report.wall_ms = Median(wall);
+      report.cpu_ms = Median(cpu);
       if (report.ok && job.want_distances) distance = field->distance;
       break;
     }
     case Task::kCgal: {
 #ifdef GEODEX_BENCH_WITH_CGAL
       const std::vector<SurfacePoint> sources = AsSurfacePoints(job.sources);
-      std::vector<double> solve, wall, setup, query;
+      std::vector<double> solve, wall, cpu, setup, query;
       for (int r = 0; r < job.repeat; ++r) {
         distance.clear();
         distance.shrink_to_fit();
         CgalTiming timing;
         const auto start = std::chrono::steady_clock::now();
+        const double cpu_start = CpuMs();
         distance = CgalDistances(*data, sources, &timing);
+        cpu.push_back(CpuMs() - cpu_start);
         wall.push_back(MsSince(start));
         if (distance.empty()) {
           SetError(report, "CGAL refused the mesh (not a consistently oriented 2-manifold?)");
@@ -505,6 +568,7 @@ void ChildMain(const Job& job, int fd) {
       report.solve_ms = Median(solve);
       report.solve_ms_min = solve.empty() ? 0 : *std::min_element(solve.begin(), solve.end());
       report.wall_ms = Median(wall);
+      report.cpu_ms = Median(cpu);
       report.cgal_setup_ms = Median(setup);
       report.cgal_query_ms = Median(query);
       if (!job.want_distances) distance.clear();
@@ -517,8 +581,13 @@ void ChildMain(const Job& job, int fd) {
   SendReport(fd, report, distance);
 }
 
-Outcome RunChild(const Job& job, double timeout_s) {
+// Measurements run while other processes used >= 0.25 core, and all measurements.
+int busy_measurements = 0, all_measurements = 0;
+double max_other_load = 0;
+
+Outcome RunChild(const Job& job, double timeout_s, double wait_idle_s) {
   Outcome outcome;
+  if (job.task != Task::kInfo) WaitForIdle(wait_idle_s);
   int fds[2];
   if (pipe2(fds, O_CLOEXEC) != 0) {
     outcome.message = absl::StrCat("pipe: ", std::strerror(errno));
@@ -527,6 +596,7 @@ Outcome RunChild(const Job& job, double timeout_s) {
   std::fflush(stdout);
   std::fflush(stderr);
   const auto start = std::chrono::steady_clock::now();
+  const double busy_start = MachineBusySeconds();
   const pid_t pid = fork();
   if (pid < 0) {
     outcome.message = absl::StrCat("fork: ", std::strerror(errno));
@@ -568,6 +638,16 @@ Outcome RunChild(const Job& job, double timeout_s) {
   }
   outcome.elapsed_s = MsSince(start) / 1000;
   outcome.maxrss_kb = usage.ru_maxrss;
+  const double child_cpu_s = usage.ru_utime.tv_sec + usage.ru_utime.tv_usec * 1e-6 +
+                             usage.ru_stime.tv_sec + usage.ru_stime.tv_usec * 1e-6;
+  outcome.other_load = std::max(
+      0.0, (MachineBusySeconds() - busy_start - child_cpu_s) / std::max(outcome.elapsed_s, 1e-3));
+  if (job.task != Task::kInfo && outcome.elapsed_s >= 0.05) {
+    // (Shorter runs are below /proc/stat's 10 ms resolution.)
+    ++all_measurements;
+    if (outcome.other_load >= 0.25) ++busy_measurements;
+    max_other_load = std::max(max_other_load, outcome.other_load);
+  }
   if (timed_out) {
     outcome.kind = Outcome::kTimeout;
     outcome.message = absl::StrFormat("timeout (killed after %g s)", timeout_s);
@@ -579,8 +659,8 @@ Outcome RunChild(const Job& job, double timeout_s) {
       const int sig = WTERMSIG(status);
       outcome.message = absl::StrCat("killed by signal ", sig, sig == SIGKILL ? " (OOM?)" : "");
     } else {
-      outcome.message = absl::StrCat("child exited with status ", WEXITSTATUS(status),
-                                     " without a report");
+      outcome.message =
+          absl::StrCat("child exited with status ", WEXITSTATUS(status), " without a report");
     }
     return outcome;
   }
@@ -673,23 +753,25 @@ std::string Ms(double ms) {
 std::string Ratio(double r) { return std::isfinite(r) ? absl::StrFormat("%.1fx", r) : "-"; }
 std::string Count(uint64_t n) { return absl::StrCat(n); }
 std::string MiBOfBytes(double bytes) { return absl::StrFormat("%.1f", bytes / kMiB); }
-std::string MiBOfKb(int64_t kb) { return absl::StrFormat("%.1f", kb / 1024.0); }
+std::string MiBOfKb(int64_t kb) {
+  const double mib = kb / 1024.0;
+  return absl::StrFormat("%.1f", std::abs(mib) < 0.05 ? 0.0 : mib);  // no "-0.0"
+}
 std::string Sci(double x) { return std::isfinite(x) ? absl::StrFormat("%.1e", x) : "inf"; }
 
 uint64_t FilteredWindows(const SolveStats& s) {
-  return s.windows_filtered_at_creation + s.windows_filtered_at_pop +
-         s.windows_filtered_overfilter;
+  return s.windows_filtered_at_creation + s.windows_filtered_at_pop + s.windows_filtered_overfilter;
 }
 
 // Differences between two per-vertex fields, over vertices where both are finite.
 struct FieldDiff {
   double max_abs = 0;
-  double max_rel = 0;      // max_abs / the largest finite reference distance
+  double max_rel = 0;            // max_abs / the largest finite reference distance
   double max_pointwise_rel = 0;  // max |a - b| / b over b > 0
   double mean_pointwise_rel = 0;
-  uint64_t changed = 0;           // vertices with a != b
+  uint64_t changed = 0;              // vertices with a != b
   uint64_t finiteness_mismatch = 0;  // finite in one, +inf in the other
-  uint64_t below_reference = 0;   // a < b - 1e-12 * largest (for "a is an upper bound" checks)
+  uint64_t below_reference = 0;      // a < b - 1e-12 * largest (for "a is an upper bound" checks)
 };
 
 FieldDiff Compare(const std::vector<double>& a, const std::vector<double>& reference) {
@@ -747,13 +829,14 @@ std::string DeltaMiB(const Outcome& o, const MeshInfo& mesh) {
 }
 
 void Progress(const std::string& what, const Outcome& o) {
-  std::fprintf(stderr, "  %-48s %-16s %9.2f s  peak RSS %.0f MiB\n", what.c_str(),
-               o.ok() ? "ok" : o.StatusText().c_str(), o.elapsed_s, o.maxrss_kb / 1024.0);
+  std::fprintf(stderr, "  %-40s %-16s %9.2f s  peak RSS %6.0f MiB  other load %.2f\n", what.c_str(),
+               o.ok() ? "ok" : o.StatusText().c_str(), o.elapsed_s, o.maxrss_kb / 1024.0,
+               o.other_load);
 }
 
 Outcome RunGeodex(const MeshInfo& mesh, const std::vector<uint32_t>& sources,
                   const GeodesicOptions& options, int repeat, bool want_distances,
-                  double timeout_s) {
+                  const Config& config) {
   Job job;
   job.task = Task::kGeodex;
   job.path = mesh.path;
@@ -761,7 +844,12 @@ Outcome RunGeodex(const MeshInfo& mesh, const std::vector<uint32_t>& sources,
   job.options = options;
   job.repeat = repeat;
   job.want_distances = want_distances;
-  return RunChild(job, timeout_s);
+  return RunChild(job, config.timeout_s, config.wait_idle_s);
+}
+
+// Below 50 ms the /proc/stat sample (10 ms ticks) says nothing.
+std::string OtherLoad(const Outcome& o) {
+  return o.elapsed_s >= 0.05 ? absl::StrFormat("%.2f", o.other_load) : "-";
 }
 
 std::string Notes(const std::vector<std::string>& notes) {
@@ -782,18 +870,20 @@ Section MeshSection(const std::vector<MeshInfo>& meshes) {
             "Baseline child per mesh: read + TriangleMesh::Build, nothing else. \"resident\" is "
             "the RSS once loaded (the baseline subtracted from every measurement), \"load peak\" "
             "the high-water mark while loading.",
-            Table({"mesh", "vertices", "faces", "components", "largest comp. faces", "sources",
-                   "load ms", "resident MiB", "load peak MiB"},
-                  "lrrrrlrrr"),
+            Table({"mesh", "vertices", "faces", "components", "largest comp. faces", "saddles",
+                   "boundary vertices", "sources", "load ms", "resident MiB", "load peak MiB"},
+                  "lrrrrrrlrrr"),
             {}};
   for (const MeshInfo& m : meshes) {
     s.table.AddRow({m.name, Count(m.report.file_vertices), Count(m.report.faces),
                     Count(m.report.components), Count(m.report.largest_component_faces),
+                    Count(m.report.saddles), Count(m.report.boundary_vertices),
                     absl::StrJoin(m.sources, ", "), Ms(m.report.load_ms),
                     MiBOfKb(m.baseline_rss_kb), MiBOfKb(m.report.load_peak_kb)});
     if (!m.report.hiwater_reset) {
-      s.notes.push_back(absl::StrCat(m.name, ": /proc/self/clear_refs could not reset the RSS "
-                                             "high-water mark; RSS peaks include the load peak"));
+      s.notes.push_back(absl::StrCat(m.name,
+                                     ": /proc/self/clear_refs could not reset the RSS "
+                                     "high-water mark; RSS peaks include the load peak"));
     }
   }
   return s;
@@ -802,17 +892,23 @@ Section MeshSection(const std::vector<MeshInfo>& meshes) {
 Section MainSection(const Config& config, const std::vector<MeshInfo>& meshes) {
   Section s{"ICH vs Dijkstra vs CGAL",
             "solve ms: median of the repeats, propagation only (SolveStats.solve_ms; for CGAL "
-            "build_sequence_tree()); wall ms: the whole call (source setup, result arrays; for "
-            "CGAL also building its Surface_mesh and reading the distances back). x Dijkstra = "
-            "solve ms / Dijkstra's solve ms; CGAL/ICH = CGAL's solve ms / ICH's. filtered = "
-            "Lemma 2 filter removals (at creation + at pop + lambda over-filter). peak MiB = "
-            "SolveStats.peak_bytes. RSS MiB = the child's peak resident size while solving "
-            "(mesh included); delta = RSS minus the mesh-only baseline child. max abs / rel diff: "
-            "ICH vs CGAL over all vertices, rel = max abs / largest distance.",
-            Table({"mesh", "faces", "source", "method", "R", "solve ms", "wall ms", "x Dijkstra",
-                   "CGAL/ICH", "windows created", "filtered", "processed", "max level",
-                   "peak live", "peak MiB", "RSS MiB", "delta RSS MiB", "vs CGAL abs",
-                   "vs CGAL rel"},
+            "build_sequence_tree()). wall ms: the whole call (source setup, result arrays; for "
+            "CGAL also building its Surface_mesh, reading the distances back and destroying its "
+            "sequence tree). cpu ms: CPU time of the whole call (immune to time slicing, not to "
+            "a busy sibling core). x Dijkstra = solve ms / Dijkstra's solve ms; CGAL/ICH = "
+            "CGAL's solve ms / ICH's. filtered = Lemma 2 filter removals (at creation + at pop + "
+            "lambda over-filter). peak MiB = SolveStats.peak_bytes. RSS MiB = the child's peak "
+            "resident size while solving (mesh included); delta = RSS minus the mesh-only "
+            "baseline child. vs CGAL abs / rel: max |ICH - CGAL| over all vertices, and that "
+            "divided by the largest distance. other load: cores used by other processes during "
+            "the measurement (from /proc/stat; near 1 on a 2-core machine, the times are "
+            "unreliable).",
+            Table({"mesh",       "faces",         "source",          "method",
+                   "R",          "solve ms",      "wall ms",         "cpu ms",
+                   "x Dijkstra", "CGAL/ICH",      "windows created", "filtered",
+                   "processed",  "max level",     "peak live",       "peak MiB",
+                   "RSS MiB",    "delta RSS MiB", "vs CGAL abs",     "vs CGAL rel",
+                   "other load"},
                   "lrrl"),
             {}};
   bool first = true;
@@ -829,12 +925,11 @@ Section MainSection(const Config& config, const std::vector<MeshInfo>& meshes) {
       if (config.run_dijkstra) {
         GeodesicOptions options;
         options.method = Method::kDijkstra;
-        dijkstra = RunGeodex(mesh, src, options, repeat, config.run_ich, config.timeout_s);
+        dijkstra = RunGeodex(mesh, src, options, repeat, config.run_ich, config);
         Progress("dijkstra", *dijkstra);
       }
       if (config.run_ich) {
-        ich = RunGeodex(mesh, src, GeodesicOptions{}, repeat, cgal || config.run_dijkstra,
-                        config.timeout_s);
+        ich = RunGeodex(mesh, src, GeodesicOptions{}, repeat, cgal || config.run_dijkstra, config);
         Progress("ich", *ich);
       }
 #ifdef GEODEX_BENCH_WITH_CGAL
@@ -845,7 +940,7 @@ Section MainSection(const Config& config, const std::vector<MeshInfo>& meshes) {
         job.sources = src;
         job.repeat = repeat;
         job.want_distances = config.run_ich;
-        cgal_run = RunChild(job, config.timeout_s);
+        cgal_run = RunChild(job, config.timeout_s, config.wait_idle_s);
         Progress("cgal", *cgal_run);
       }
 #endif
@@ -858,12 +953,13 @@ Section MainSection(const Config& config, const std::vector<MeshInfo>& meshes) {
                                           method, Count(repeat)};
         if (!o.ok()) {
           cells.push_back(o.StatusText());
-          for (int i = 0; i < 10; ++i) cells.push_back("");
+          for (int i = 0; i < 11; ++i) cells.push_back("");
           cells.push_back(MiBOfKb(o.maxrss_kb));
           cells.push_back(DeltaMiB(o, mesh));
+          cells.insert(cells.end(), {"", "", OtherLoad(o)});
           if (!o.message.empty()) {
-            s.notes.push_back(absl::StrCat(mesh.name, " source ", source, " ", method, ": ",
-                                           o.message));
+            s.notes.push_back(
+                absl::StrCat(mesh.name, " source ", source, " ", method, ": ", o.message));
           }
           return cells;
         }
@@ -871,6 +967,7 @@ Section MainSection(const Config& config, const std::vector<MeshInfo>& meshes) {
         const bool windows = method == "ICH";
         cells.push_back(Ms(r.solve_ms));
         cells.push_back(Ms(r.wall_ms));
+        cells.push_back(Ms(r.cpu_ms));
         cells.push_back(Ratio(r.solve_ms / dijkstra_ms));
         cells.push_back(windows ? Ratio(cgal_ms / ich_ms) : "");
         cells.push_back(windows ? Count(r.stats.windows_created) : "");
@@ -878,9 +975,11 @@ Section MainSection(const Config& config, const std::vector<MeshInfo>& meshes) {
         cells.push_back(windows ? Count(r.stats.windows_processed) : "");
         cells.push_back(windows ? Count(r.stats.max_level) : "");
         cells.push_back(windows ? Count(r.stats.peak_live_windows) : "");
-        cells.push_back(method == "CGAL" ? "" : MiBOfBytes(static_cast<double>(r.stats.peak_bytes)));
+        cells.push_back(method == "CGAL" ? ""
+                                         : MiBOfBytes(static_cast<double>(r.stats.peak_bytes)));
         cells.push_back(MiBOfKb(o.maxrss_kb));
         cells.push_back(DeltaMiB(o, mesh));
+        cells.insert(cells.end(), {"", "", OtherLoad(o)});
         return cells;
       };
       if (dijkstra) s.table.AddRow(row("Dijkstra", *dijkstra));
@@ -888,8 +987,8 @@ Section MainSection(const Config& config, const std::vector<MeshInfo>& meshes) {
         std::vector<std::string> cells = row("ICH", *ich);
         if (ich->ok() && cgal_run && cgal_run->ok()) {
           const FieldDiff d = Compare(ich->distance, cgal_run->distance);
-          cells.push_back(Sci(d.max_abs));
-          cells.push_back(Sci(d.max_rel));
+          cells[cells.size() - 3] = Sci(d.max_abs);
+          cells[cells.size() - 2] = Sci(d.max_rel);
           if (d.finiteness_mismatch > 0) {
             s.notes.push_back(absl::StrCat(mesh.name, " source ", source, ": ",
                                            d.finiteness_mismatch,
@@ -900,8 +999,9 @@ Section MainSection(const Config& config, const std::vector<MeshInfo>& meshes) {
           // Dijkstra's edge paths are real paths: exact distances can only be shorter or equal.
           const FieldDiff d = Compare(dijkstra->distance, ich->distance);
           if (d.below_reference > 0) {
-            s.notes.push_back(absl::StrCat(mesh.name, " source ", source, ": ICH exceeds Dijkstra "
-                                           "at ", d.below_reference, " vertices (not exact there)"));
+            s.notes.push_back(absl::StrCat(mesh.name, " source ", source,
+                                           ": ICH exceeds Dijkstra at ", d.below_reference,
+                                           " vertices (not exact there)"));
           }
         }
         s.table.AddRow(cells);
@@ -943,10 +1043,15 @@ Section AblationSection(const Config& config, const std::vector<MeshInfo>& meshe
       first = false;
       std::fprintf(stderr, "ablation: %s, source %u, R = %d\n", mesh.name.c_str(), source, repeat);
       const std::vector<uint32_t> src = {source};
-      const Outcome reference =
-          RunGeodex(mesh, src, GeodesicOptions{}, repeat, true, config.timeout_s);
+      const Outcome reference = RunGeodex(mesh, src, GeodesicOptions{}, repeat, true, config);
       Progress("filter on, one split on", reference);
-      const uint64_t budget = reference.ok() ? 50 * reference.report.stats.windows_created : 0;
+      if (!reference.ok()) {  // no budget to give the variants: they could eat all memory
+        s.notes.push_back(absl::StrCat(mesh.name, " source ", source, ": the default run failed (",
+                                       reference.StatusText(), " ", reference.message,
+                                       "); variants skipped"));
+        continue;
+      }
+      const uint64_t budget = 50 * reference.report.stats.windows_created;
       for (const bool filter : {true, false}) {
         for (const bool one_split : {true, false}) {
           GeodesicOptions options;
@@ -954,9 +1059,8 @@ Section AblationSection(const Config& config, const std::vector<MeshInfo>& meshe
           options.use_one_angle_one_split = one_split;
           options.max_windows = budget;
           const bool is_reference = filter && one_split;
-          Outcome run = is_reference
-                            ? reference
-                            : RunGeodex(mesh, src, options, repeat, true, config.timeout_s);
+          Outcome run =
+              is_reference ? reference : RunGeodex(mesh, src, options, repeat, true, config);
           if (!is_reference) {
             Progress(absl::StrFormat("filter %s, one split %s", filter ? "on" : "off",
                                      one_split ? "on" : "off"),
@@ -966,19 +1070,19 @@ Section AblationSection(const Config& config, const std::vector<MeshInfo>& meshe
                                             one_split ? "on" : "off", run.StatusText()};
           const SolveStats& st = run.report.stats;
           if (run.ok()) {
-            cells.insert(cells.end(),
-                         {Ms(run.report.solve_ms), Ms(run.report.wall_ms),
-                          Count(st.windows_created), Count(FilteredWindows(st)),
-                          Count(st.children_skipped_one_split + st.windows_deleted_one_split),
-                          Count(st.windows_processed), Count(st.max_level),
-                          Count(st.peak_live_windows),
-                          MiBOfBytes(static_cast<double>(st.peak_bytes)), DeltaMiB(run, mesh)});
-            cells.push_back(reference.ok() ? Sci(Compare(run.distance, reference.distance).max_abs)
-                                           : "");
+            cells.insert(
+                cells.end(),
+                {Ms(run.report.solve_ms), Ms(run.report.wall_ms), Count(st.windows_created),
+                 Count(FilteredWindows(st)),
+                 Count(st.children_skipped_one_split + st.windows_deleted_one_split),
+                 Count(st.windows_processed), Count(st.max_level), Count(st.peak_live_windows),
+                 MiBOfBytes(static_cast<double>(st.peak_bytes)), DeltaMiB(run, mesh)});
+            cells.push_back(Sci(Compare(run.distance, reference.distance).max_abs));
           } else {
-            cells.insert(cells.end(), {"", Ms(run.elapsed_s * 1000),
-                                       run.kind == Outcome::kBudget ? absl::StrCat(">", budget) : "",
-                                       "", "", "", "", "", "", DeltaMiB(run, mesh), ""});
+            cells.insert(cells.end(),
+                         {"", Ms(run.elapsed_s * 1000),
+                          run.kind == Outcome::kBudget ? absl::StrCat(">", budget) : "", "", "", "",
+                          "", "", "", DeltaMiB(run, mesh), ""});
             if (run.kind != Outcome::kBudget && !run.message.empty()) {
               s.notes.push_back(absl::StrCat(mesh.name, " source ", source, ": ", run.message));
             }
@@ -988,9 +1092,10 @@ Section AblationSection(const Config& config, const std::vector<MeshInfo>& meshe
       }
     }
   }
-  s.notes.push_back("one-split removed = second children not made (Lemma 1) + windows of a "
-                    "beaten owner's subtree deleted; for a failed run wall ms is the child's "
-                    "lifetime including the mesh load");
+  s.notes.push_back(
+      "one-split removed = second children not made (Lemma 1) + windows of a "
+      "beaten owner's subtree deleted; for a failed run wall ms is the child's "
+      "lifetime including the mesh load");
   return s;
 }
 
@@ -1015,8 +1120,7 @@ Section LambdaSection(const Config& config, const std::vector<MeshInfo>& meshes)
       const std::vector<uint32_t> src = {source};
       GeodesicOptions dijkstra_options;
       dijkstra_options.method = Method::kDijkstra;
-      const Outcome dijkstra =
-          RunGeodex(mesh, src, dijkstra_options, repeat, true, config.timeout_s);
+      const Outcome dijkstra = RunGeodex(mesh, src, dijkstra_options, repeat, true, config);
       Progress("dijkstra", dijkstra);
       std::optional<Outcome> exact;
       for (const LambdaScale scale : {LambdaScale::kMaxEdge, LambdaScale::kMeanEdge}) {
@@ -1028,14 +1132,13 @@ Section LambdaSection(const Config& config, const std::vector<MeshInfo>& meshes)
           GeodesicOptions options;
           options.lambda = lambda;
           options.lambda_scale = scale;
-          const Outcome run = RunGeodex(mesh, src, options, repeat, true, config.timeout_s);
+          const Outcome run = RunGeodex(mesh, src, options, repeat, true, config);
           Progress(absl::StrFormat("%s lambda %g", max_edge ? "max edge" : "mean edge", lambda),
                    run);
           if (lambda == 0 && !exact && run.ok()) exact = run;
-          std::vector<std::string> cells = {mesh.name, Count(source),
-                                            max_edge ? "max edge" : "mean edge",
-                                            absl::StrFormat("%g", lambda),
-                                            absl::StrFormat("%.3g", lambda * length)};
+          std::vector<std::string> cells = {
+              mesh.name, Count(source), max_edge ? "max edge" : "mean edge",
+              absl::StrFormat("%g", lambda), absl::StrFormat("%.3g", lambda * length)};
           if (!run.ok()) {
             cells.push_back(run.StatusText());
             if (!run.message.empty()) {
@@ -1052,8 +1155,8 @@ Section LambdaSection(const Config& config, const std::vector<MeshInfo>& meshes)
                         Count(st.max_level)});
           if (exact) {
             const FieldDiff d = Compare(run.distance, exact->distance);
-            cells.insert(cells.end(), {Sci(d.max_pointwise_rel), Sci(d.mean_pointwise_rel),
-                                       Count(d.changed)});
+            cells.insert(cells.end(),
+                         {Sci(d.max_pointwise_rel), Sci(d.mean_pointwise_rel), Count(d.changed)});
             if (d.finiteness_mismatch > 0) {
               s.notes.push_back(absl::StrCat(mesh.name, " lambda ", lambda, ": ",
                                              d.finiteness_mismatch,
@@ -1069,10 +1172,10 @@ Section LambdaSection(const Config& config, const std::vector<MeshInfo>& meshes)
       }
       if (dijkstra.ok() && exact) {
         const FieldDiff d = Compare(dijkstra.distance, exact->distance);
-        s.notes.push_back(absl::StrFormat(
-            "%s source %u: Dijkstra itself: %s ms, max rel err %s, mean rel err %s", mesh.name,
-            source, Ms(dijkstra.report.solve_ms), Sci(d.max_pointwise_rel),
-            Sci(d.mean_pointwise_rel)));
+        s.notes.push_back(
+            absl::StrFormat("%s source %u: Dijkstra itself: %s ms, max rel err %s, mean rel err %s",
+                            mesh.name, source, Ms(dijkstra.report.solve_ms),
+                            Sci(d.max_pointwise_rel), Sci(d.mean_pointwise_rel)));
       }
     }
   }
@@ -1114,9 +1217,9 @@ int Main(int argc, char** argv) {
   }
 
   const std::string header = absl::StrFormat(
-      "geodex_bench: %s; %s; %s build; CPU %s, %d usable core(s); "
+      "geodex_bench: %s; %s; %s build; CPU %s, %d usable core(s); load average at start %s; "
       "each measurement in its own process, one at a time",
-      UtcNow(), GitDescription(), GEODEX_BUILD_TYPE, CpuModel(), UsableCpus());
+      UtcNow(), GitDescription(), GEODEX_BUILD_TYPE, CpuModel(), UsableCpus(), LoadAverage());
   std::printf("%s\n", header.c_str());
 #ifndef NDEBUG
   std::printf("WARNING: assertions are on (not a Release build): times are not representative\n");
@@ -1131,7 +1234,7 @@ int Main(int argc, char** argv) {
     job.task = Task::kInfo;
     job.path = path;
     job.sources_wanted = config.sources;
-    const Outcome o = RunChild(job, config.timeout_s);
+    const Outcome o = RunChild(job, config.timeout_s, 0);
     if (!o.ok()) {
       std::printf("skipping %s: %s\n", path.c_str(),
                   o.message.empty() ? o.StatusText().c_str() : o.message.c_str());
@@ -1155,6 +1258,10 @@ int Main(int argc, char** argv) {
   if (config.ablation) sections.push_back(AblationSection(config, meshes));
   if (config.lambda) sections.push_back(LambdaSection(config, meshes));
 
+  const std::string footer = absl::StrFormat(
+      "load average at the end: %s; %d of %d measurements (of 50 ms or more) ran while other "
+      "processes used a quarter of a core or more (at most %.2f cores)",
+      LoadAverage(), busy_measurements, all_measurements, max_other_load);
   std::string markdown = absl::StrCat("<!-- ", header, " -->\n");
   for (const Section& s : sections) {
     std::printf("\n== %s ==\n%s\n\n%s", s.title.c_str(), s.intro.c_str(), s.table.Text().c_str());
@@ -1162,6 +1269,8 @@ int Main(int argc, char** argv) {
     absl::StrAppend(&markdown, "\n### ", s.title, "\n\n", s.intro, "\n\n", s.table.Markdown());
     if (!s.notes.empty()) absl::StrAppend(&markdown, "\n", Notes(s.notes));
   }
+  std::printf("\n%s\n", footer.c_str());
+  absl::StrAppend(&markdown, "\n<!-- ", footer, " -->\n");
   if (!config.markdown.empty()) {
     std::ofstream out(config.markdown);
     out << markdown;
