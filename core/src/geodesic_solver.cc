@@ -17,14 +17,7 @@ absl::StatusOr<DistanceField> ComputeDistanceField(const TriangleMesh& mesh,
                                                    const std::vector<SurfacePoint>& sources,
                                                    const GeodesicOptions& options) {
   if (sources.empty()) return absl::InvalidArgumentError("no sources given");
-  if (!(options.lambda >= 0 && options.lambda <= 1)) {
-    return absl::InvalidArgumentError(
-        absl::StrFormat("lambda = %g is outside [0, 1]", options.lambda));
-  }
-  if (!(options.max_distance > 0)) {
-    return absl::InvalidArgumentError(
-        absl::StrFormat("max_distance = %g must be positive", options.max_distance));
-  }
+  if (absl::Status s = ValidateSolveOptions(options); !s.ok()) return s;
   SourceResolver resolver(mesh);
   for (uint32_t i = 0; i < sources.size(); ++i) {
     if (absl::Status s = resolver.Add(sources[i], i); !s.ok()) return s;

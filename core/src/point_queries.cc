@@ -20,15 +20,7 @@ absl::Status CheckOptions(const GeodesicOptions& options) {
   if (options.method != Method::kIch) {
     return absl::InvalidArgumentError("point queries and paths need method ich");
   }
-  if (!(options.lambda >= 0 && options.lambda <= 1)) {
-    return absl::InvalidArgumentError(
-        absl::StrFormat("lambda = %g is outside [0, 1]", options.lambda));
-  }
-  if (!(options.max_distance > 0)) {
-    return absl::InvalidArgumentError(
-        absl::StrFormat("max_distance = %g must be positive", options.max_distance));
-  }
-  return absl::OkStatus();
+  return ValidateSolveOptions(options);
 }
 
 absl::StatusOr<std::vector<ich::ResolvedSource>> ResolveSources(
@@ -71,6 +63,21 @@ absl::StatusOr<std::vector<ich::ResolvedTarget>> ResolveTargets(
     out.push_back(*std::move(t));
   }
   return out;
+}
+
+// One targeted solve without the heuristic, stopping once every target is final.
+absl::Status SolveUntilTargetsFinal(const TriangleMesh& mesh, const GeodesicOptions& options,
+                                    const std::vector<ich::ResolvedSource>& sources,
+                                    const std::vector<ich::ResolvedTarget>& targets,
+                                    std::vector<ich::TargetResult>* results, SolveStats* stats) {
+  ich::IchSolver solver(mesh, options);
+  DistanceField field;
+  if (absl::Status s = solver.SolveForTargets(sources, targets, false, true, &field, results);
+      !s.ok()) {
+    return s;
+  }
+  *stats = field.stats;
+  return absl::OkStatus();
 }
 
 void AddStats(const SolveStats& s, SolveStats* total) {
@@ -149,15 +156,14 @@ absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
     }
     absl::StatusOr<std::vector<ich::ResolvedSource>> src = ResolveSources(mesh, {sources[i]});
     if (!src.ok()) return src.status();
-    ich::IchSolver solver(mesh, options);
-    DistanceField field;
     std::vector<ich::TargetResult> results;
-    if (absl::Status s = solver.SolveForTargets(*src, *resolved, false, true, &field, &results);
+    SolveStats stats;
+    if (absl::Status s = SolveUntilTargetsFinal(mesh, options, *src, *resolved, &results, &stats);
         !s.ok()) {
       return s;
     }
     for (size_t j = 0; j < m.cols; ++j) m.values[i * m.cols + j] = results[j].distance;
-    AddStats(field.stats, &m.stats);
+    AddStats(stats, &m.stats);
     solved.emplace(key, i);
   }
   return m;
@@ -171,10 +177,9 @@ absl::StatusOr<std::vector<std::pair<double, uint32_t>>> ComputeExactDistancesAt
   if (!src.ok()) return src.status();
   absl::StatusOr<std::vector<ich::ResolvedTarget>> resolved = ResolveTargets(mesh, points);
   if (!resolved.ok()) return resolved.status();
-  ich::IchSolver solver(mesh, options);
-  DistanceField field;
   std::vector<ich::TargetResult> results;
-  if (absl::Status s = solver.SolveForTargets(*src, *resolved, false, true, &field, &results);
+  SolveStats stats;
+  if (absl::Status s = SolveUntilTargetsFinal(mesh, options, *src, *resolved, &results, &stats);
       !s.ok()) {
     return s;
   }
