@@ -5,6 +5,7 @@
 #include <string>
 
 #include "cli_commands.h"
+#include "cli_geometry.h"
 
 namespace {
 
@@ -33,6 +34,17 @@ commands:
       astar (default) uses the paper's section 5 heuristic and stops at the target.
   matrix MESH --sources SPEC --targets SPEC [--stats]
       Exact distances, one row per source, tab-separated.
+  isolines MESH --sources SPEC (--levels L1,L2,... | --count K) [--output FILE.json|.obj|.svg]
+      Approximate geodesic offsets (paper section 6.1; linear along edges): polylines of edge
+      points per level. --count K: the levels D*j/K, j = 1..K-1, D the largest distance.
+  voronoi MESH --sites SPEC [--output FILE.json|.obj|.svg]
+      Approximate Voronoi diagram (section 6.2): boundaries, cells (faces, fragments, areas),
+      adjacency.
+  delaunay MESH --sites SPEC [--output FILE.json|.obj|.svg]
+      Approximate Delaunay triangulation (sections 6.3-6.4): edges as polylines, triangles, XL
+      edges found and the Delaunay edges removed because of them.
+      These three print JSON ("approximate": true) unless --output names an .obj (lines) or
+      .svg (top view) file; see docs/geometry.md.
 
 SPEC: comma-separated points: 17 (vertex), e:V1:V2:T (the point (1-T)*V1 + T*V2 on an edge),
       f:FACE:B0:B1:B2 (barycentric in the face's vertex order as in the file).
@@ -65,6 +77,9 @@ int main(int argc, char** argv) {
   if (command == "distances") return RunDistances(args);
   if (command == "path") return RunPath(args);
   if (command == "matrix") return RunMatrix(args);
+  if (command == "isolines") return RunIsolines(args);
+  if (command == "voronoi") return RunVoronoi(args);
+  if (command == "delaunay") return RunDelaunay(args);
   std::fprintf(stderr, "geodex: unknown command '%s' (see geodex --help)\n", command.c_str());
   return kExitUsage;
 }

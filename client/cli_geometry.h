@@ -1,0 +1,17 @@
+#pragma once
+
+// The geodex commands for the approximate geometry of a distance field (paper section 6):
+// isolines, the Voronoi diagram and the Delaunay triangulation.
+
+#include "cli_commands.h"
+
+namespace geodex::cli {
+
+// geodex isolines MESH --sources SPEC (--levels L1,L2,... | --count K) [--output FILE]
+int RunIsolines(const Args& args);
+// geodex voronoi MESH --sites SPEC [--output FILE]
+int RunVoronoi(const Args& args);
+// geodex delaunay MESH --sites SPEC [--output FILE]
+int RunDelaunay(const Args& args);
+
+}  // namespace geodex::cli
