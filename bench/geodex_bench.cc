@@ -1,7 +1,10 @@
 // geodex_bench: times our exact ICH, Dijkstra on the edge graph and (when built with CGAL)
 // CGAL's Surface_mesh_shortest_path from the same sources in one run, and reports window counts,
-// memory and the ICH-vs-CGAL difference. Two extra modes: --ablation (Lemma 1 / Lemma 2 on and
-// off) and --lambda (the precision knob of section 7 of Xin & Wang 2010).
+// memory and the ICH-vs-CGAL difference. Extra modes: --ablation (Lemma 1 / Lemma 2 on and
+// off), --lambda (the precision knob of section 7 of Xin & Wang 2010), and the targeted queries of
+// its sections 4 and 5: --astar (exact A* paths vs solving the whole field, its Table 2),
+// --matrix (a distance matrix vs full fields vs pairwise A*) and --estimate (the unfolding
+// estimate at surface points vs the exact value, its Table 1 / Fig. 6).
 //
 // Every measurement runs in its own fork()ed child that loads the mesh itself; the parent never
 // loads a mesh. Each child resets its RSS high-water mark right after loading (Linux
@@ -52,9 +55,12 @@
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
 #include "geodex/distance_field.h"
+#include "geodex/distance_matrix.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/mesh_data.h"
 #include "geodex/mesh_io.h"
+#include "geodex/point_distance.h"
+#include "geodex/shortest_path.h"
 #include "geodex/surface_point.h"
 #include "geodex/triangle_mesh.h"
 #ifdef GEODEX_BENCH_WITH_CGAL
@@ -97,12 +103,39 @@ struct Config {
   double wait_idle_s = 0;
   bool ablation = false;
   bool lambda = false;
+  // The targeted-query modes (sections 4 and 5 of the paper).
+  bool astar = false, matrix = false, estimate = false;
+  uint64_t seed = 2010;  // the random points of --astar, --matrix and --estimate
+  int per_group = 12;    // --astar: target points per distance group
+  int points = 1000;     // --estimate: face points per mesh
+  int batch = 100;       // --estimate: points per ComputeExactDistancesAt call
 };
+
+// Without --mesh, each targeted-query mode takes these meshes from the mesh directory.
+const std::vector<std::string>& AstarMeshes() {
+  static const std::vector<std::string> names = {"gargoyle", "armadillo"};
+  return names;
+}
+const std::vector<std::string>& MatrixMeshes() {
+  static const std::vector<std::string> names = {"armadillo"};
+  return names;
+}
+const std::vector<std::string>& EstimateMeshes() {
+  static const std::vector<std::string> names = {"gargoyle", "armadillo", "fertility", "kitten",
+                                                 "bunny-npm", "camelhead", "face"};
+  return names;
+}
+
+bool PointQueryMode(const Config& config) {
+  return config.astar || config.matrix || config.estimate;
+}
 
 constexpr char kUsage[] =
     "usage: geodex_bench [--meshes DIR] [--mesh FILE ...] [--sources N] [--repeat R]\n"
     "                    [--cgal-max-faces F] [--methods ich,dijkstra,cgal] [--markdown OUT.md]\n"
     "                    [--timeout-s T] [--wait-idle S] [--ablation] [--lambda]\n"
+    "                    [--astar] [--matrix] [--estimate] [--seed N] [--per-group N]\n"
+    "                    [--points N] [--batch N]\n"
     "\n"
     "  --meshes DIR        every mesh file in DIR (.off .obj .ply .stl, optionally .gz); default\n"
     "                      ../shared/meshes next to the source tree, unless --mesh is given\n"
@@ -119,7 +152,25 @@ constexpr char kUsage[] =
     "                      processes use less than a quarter of a core (default 0: no wait)\n"
     "  --ablation          instead of the main table: ICH with the filter (Lemma 2) and one angle\n"
     "                      one split (Lemma 1) on/off, on each given mesh\n"
-    "  --lambda            instead of the main table: lambda in {0 .. 1} x {max edge, mean edge}\n";
+    "  --lambda            instead of the main table: lambda in {0 .. 1} x {max edge, mean edge}\n"
+    "  --astar             instead of the main table: exact paths from vertex 0 to random target\n"
+    "                      points, A* (section 5) vs solving the whole field, grouped by the\n"
+    "                      target's distance (default meshes: gargoyle, armadillo)\n"
+    "  --matrix            instead of the main table: a 16 x 16 distance matrix between random\n"
+    "                      points vs 16 full fields vs 256 A* queries (default mesh: armadillo)\n"
+    "  --estimate          instead of the main table: the unfolding estimate at random face points\n"
+    "                      (section 4) vs the exact distance, the straight line and Dijkstra\n"
+    "                      (default meshes: gargoyle armadillo fertility kitten bunny-npm\n"
+    "                      camelhead face)\n"
+    "  --seed N            seed of the random points of the three modes above (default 2010)\n"
+    "  --per-group N       --astar: target points per distance group (default 12)\n"
+    "  --points N          --estimate: face points per mesh (default 1000)\n"
+    "  --batch N           --estimate: points per exact solve (default 100)\n"
+    "\n"
+    "Without --mesh, --astar, --matrix and --estimate take their default meshes from the mesh\n"
+    "directory. The --astar pairs and the matrix and fields of --matrix run R times\n"
+    "(--repeat, default 3 below 100k faces and 1 above); the 256 queries of --matrix default\n"
+    "to 1, and --estimate runs once.\n";
 
 absl::StatusOr<Config> ParseArgs(int argc, char** argv) {
   Config config;
@@ -147,9 +198,16 @@ absl::StatusOr<Config> ParseArgs(int argc, char** argv) {
       config.ablation = true;
     } else if (arg == "--lambda") {
       config.lambda = true;
+    } else if (arg == "--astar") {
+      config.astar = true;
+    } else if (arg == "--matrix") {
+      config.matrix = true;
+    } else if (arg == "--estimate") {
+      config.estimate = true;
     } else if (arg == "--meshes" || arg == "--mesh" || arg == "--sources" || arg == "--repeat" ||
                arg == "--cgal-max-faces" || arg == "--methods" || arg == "--markdown" ||
-               arg == "--timeout-s" || arg == "--wait-idle") {
+               arg == "--timeout-s" || arg == "--wait-idle" || arg == "--seed" ||
+               arg == "--per-group" || arg == "--points" || arg == "--batch") {
       absl::StatusOr<std::string> v = next();
       if (!v.ok()) return v.status();
       if (arg == "--meshes") {
@@ -187,6 +245,20 @@ absl::StatusOr<Config> ParseArgs(int argc, char** argv) {
         if (!absl::SimpleAtod(*v, &config.wait_idle_s) || !(config.wait_idle_s >= 0)) {
           return bad(*v);
         }
+      } else if (arg == "--seed") {
+        if (!absl::SimpleAtoi(*v, &config.seed)) return bad(*v);
+      } else if (arg == "--per-group") {
+        if (!absl::SimpleAtoi(*v, &config.per_group) || config.per_group < 1 ||
+            config.per_group > 1000) {
+          return bad(*v);
+        }
+      } else if (arg == "--points") {
+        if (!absl::SimpleAtoi(*v, &config.points) || config.points < 1 ||
+            config.points > 1'000'000) {
+          return bad(*v);
+        }
+      } else if (arg == "--batch") {
+        if (!absl::SimpleAtoi(*v, &config.batch) || config.batch < 1) return bad(*v);
       }
     } else {
       return absl::InvalidArgumentError(absl::StrCat("unknown argument '", arg, "'"));
@@ -268,7 +340,18 @@ std::string UtcNow() {
 // ------------------------------------------------------------------------------------------------
 // Child processes
 
-enum class Task : int32_t { kInfo, kGeodex, kCgal };
+enum class Task : int32_t {
+  kInfo,
+  kGeodex,
+  kCgal,
+  kPlanTargets,  // --astar: the full field from sources[0], then target points by distance group
+  kSamplePoints,  // `count` random points (seeded), sent back packed
+  kPathPair,     // --astar: from[0] -> to[0], A* and full field, `repeat` times each
+  kMatrix,       // --matrix: ComputeDistanceMatrix(from, to)
+  kFields,       // --matrix: ComputeDistanceField per point of `from`
+  kPathQueries,  // --matrix: ComputeShortestPath for every (from, to) pair
+  kEstimate,     // --estimate: estimate vs exact vs straight line vs Dijkstra at random face points
+};
 
 // What a child does. `options` is used by kGeodex (its method picks ICH or Dijkstra).
 struct Job {
@@ -279,6 +362,12 @@ struct Job {
   GeodesicOptions options;
   int repeat = 1;
   bool want_distances = false;
+  // The targeted-query tasks.
+  std::vector<SurfacePoint> from, to;
+  uint64_t seed = 0;
+  int count = 0;               // kPlanTargets: points per group; kSamplePoints, kEstimate: points
+  double vertex_share = 0.25;  // kPlanTargets, kSamplePoints: the share of vertex points
+  int batch = 100;             // kEstimate
 };
 
 // What a child sends back, followed by `distance_count` doubles. Plain data: sent as bytes.
@@ -303,7 +392,21 @@ struct ChildReport {
   double cpu_ms = 0;  // CPU time of the whole call (user + system): immune to time slicing
   double cgal_setup_ms = 0, cgal_query_ms = 0;
   SolveStats stats;
-  uint64_t distance_count = 0;
+  // kPathPair: the A* run is in solve_ms / wall_ms / stats above, the full-field run here. The
+  // peaks are the RSS high-water mark over the resident size when it was reset (before each of
+  // the two runs); they need hiwater_reset.
+  double full_solve_ms = 0, full_wall_ms = 0;
+  SolveStats full_stats;
+  double astar_distance = 0, full_distance = 0;
+  int64_t astar_peak_kb = 0, full_peak_kb = 0;
+  // kPlanTargets and kEstimate: the largest finite vertex distance from the source.
+  double max_distance = 0;
+  uint64_t candidates = 0;  // kPlanTargets: random points drawn to fill the groups
+  double estimate_ms = 0;   // kEstimate: all estimates (the field's time is solve_ms)
+  double exact_ms = 0;      // kEstimate: all exact solves (their windows are in stats)
+  double dijkstra_ms = 0;   // kEstimate: the Dijkstra field
+  int32_t exact_solves = 0;
+  uint64_t distance_count = 0;  // doubles following the report (distances or other values)
 };
 static_assert(std::is_trivially_copyable_v<ChildReport>);
 
@@ -470,6 +573,411 @@ std::vector<SurfacePoint> AsSurfacePoints(const std::vector<uint32_t>& ids) {
   return points;
 }
 
+// ------------------------------------------------------------------------------------------------
+// Targeted queries (--astar, --matrix, --estimate): random points and the children
+
+// SplitMix64: the same sequence on every platform and standard library (std:: distributions are
+// not), so a seed names the same points everywhere.
+class Rng {
+ public:
+  explicit Rng(uint64_t seed) : state_(seed) {}
+  uint64_t Next() {
+    uint64_t z = (state_ += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+  }
+  double Uniform() { return static_cast<double>(Next() >> 11) * 0x1.0p-53; }  // [0, 1)
+  uint64_t Below(uint64_t n) { return Next() % n; }  // the bias is below 1e-9 for n < 2^32
+
+ private:
+  uint64_t state_;
+};
+
+std::array<double, 3> FilePosition(const MeshData& data, uint32_t v) {
+  return {data.positions[3 * v], data.positions[3 * v + 1], data.positions[3 * v + 2]};
+}
+
+double Distance3(const std::array<double, 3>& a, const std::array<double, 3>& b) {
+  return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                   (a[2] - b[2]) * (a[2] - b[2]));
+}
+
+// Where a vertex or face point is, in file coordinates.
+std::array<double, 3> PointPosition(const MeshData& data, const SurfacePoint& p) {
+  if (p.kind == SurfacePoint::Kind::kVertex) return FilePosition(data, p.vertex);
+  std::array<double, 3> q = {0, 0, 0};
+  for (int k = 0; k < 3; ++k) {
+    const std::array<double, 3> c = FilePosition(data, data.faces[3 * p.face + k]);
+    for (int i = 0; i < 3; ++i) q[i] += p.bary[k] * c[i];
+  }
+  return q;
+}
+
+// Random points on the connected component of file vertex `anchor`: with probability
+// `vertex_share` a vertex (uniform over the component's vertices), otherwise a face point
+// uniform over the component's area (a face picked by area, then a uniform point inside it).
+class PointSampler {
+ public:
+  PointSampler(const MeshData& data, const TriangleMesh& mesh, uint32_t anchor,
+               double vertex_share, uint64_t seed)
+      : rng_(seed), vertex_share_(vertex_share) {
+    const uint32_t component = mesh.Component(anchor);
+    for (uint32_t v = 0; v < mesh.file_vertex_count(); ++v) {
+      if (mesh.Component(v) == component && !mesh.IsIsolated(v)) vertices_.push_back(v);
+    }
+    double total = 0;
+    for (uint32_t f = 0; f < data.face_count() && f < mesh.face_count(); ++f) {
+      if (mesh.FaceDegenerate(f) || mesh.Component(mesh.FaceVertex(f, 0)) != component) continue;
+      const std::array<double, 3> a = FilePosition(data, data.faces[3 * f]);
+      const std::array<double, 3> b = FilePosition(data, data.faces[3 * f + 1]);
+      const std::array<double, 3> c = FilePosition(data, data.faces[3 * f + 2]);
+      const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+      const double w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+      const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2],
+                           u[0] * w[1] - u[1] * w[0]};
+      const double area = 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      if (!(area > 0)) continue;
+      total += area;
+      faces_.push_back(f);
+      cumulative_area_.push_back(total);
+    }
+  }
+
+  bool ok() const { return !vertices_.empty() && !faces_.empty(); }
+
+  SurfacePoint Next() {
+    if (vertex_share_ > 0 && rng_.Uniform() < vertex_share_) {
+      return SurfacePoint::AtVertex(vertices_[rng_.Below(vertices_.size())]);
+    }
+    const double x = rng_.Uniform() * cumulative_area_.back();
+    const size_t i = std::min<size_t>(
+        std::upper_bound(cumulative_area_.begin(), cumulative_area_.end(), x) -
+            cumulative_area_.begin(),
+        faces_.size() - 1);
+    const double r1 = std::sqrt(rng_.Uniform()), r2 = rng_.Uniform();
+    return SurfacePoint::InFace(faces_[i], 1 - r1, r1 * (1 - r2), r1 * r2);
+  }
+
+ private:
+  Rng rng_;
+  double vertex_share_;
+  std::vector<uint32_t> vertices_, faces_;
+  std::vector<double> cumulative_area_;
+};
+
+// Vertex and face points travel between processes as 5 doubles: kind, id, barycentrics.
+constexpr size_t kPackedPoint = 5;
+
+void PackPoint(const SurfacePoint& p, std::vector<double>* out) {
+  if (p.kind == SurfacePoint::Kind::kVertex) {
+    out->insert(out->end(), {0.0, static_cast<double>(p.vertex), 0.0, 0.0, 0.0});
+  } else {
+    out->insert(out->end(), {1.0, static_cast<double>(p.face), p.bary[0], p.bary[1], p.bary[2]});
+  }
+}
+
+std::vector<SurfacePoint> UnpackPoints(const std::vector<double>& values) {
+  std::vector<SurfacePoint> points;
+  for (size_t i = 0; i + kPackedPoint <= values.size(); i += kPackedPoint) {
+    const double* x = values.data() + i;
+    const uint32_t id = static_cast<uint32_t>(x[1]);
+    points.push_back(x[0] == 0 ? SurfacePoint::AtVertex(id)
+                               : SurfacePoint::InFace(id, x[2], x[3], x[4]));
+  }
+  return points;
+}
+
+std::string ShortPoint(const SurfacePoint& p) {
+  return p.kind == SurfacePoint::Kind::kVertex ? absl::StrCat("v ", p.vertex)
+                                               : absl::StrCat("f ", p.face);
+}
+
+// --astar's groups: the target's distance as a fraction of the source's largest distance, in
+// (0, 10%], (10%, 25%], (25%, 50%], (50%, 100%] (a face point a little beyond the farthest vertex
+// counts in the last group).
+constexpr int kGroups = 4;
+constexpr double kGroupLimit[kGroups] = {0.10, 0.25, 0.50, 1.00};
+constexpr const char* kGroupName[kGroups] = {"<= 10%", "10-25%", "25-50%", "50-100%"};
+
+int GroupOf(double fraction) {
+  for (int g = 0; g < kGroups; ++g) {
+    if (fraction <= kGroupLimit[g]) return g;
+  }
+  return kGroups - 1;
+}
+
+// The kernel's RSS high-water mark of this process (VmHWM), in KiB.
+int64_t PeakRssKb() {
+  std::ifstream in("/proc/self/status");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (absl::StartsWith(line, "VmHWM:")) {
+      int64_t kb = 0;
+      std::vector<std::string> parts =
+          absl::StrSplit(line.substr(6), ' ', absl::SkipWhitespace());
+      if (!parts.empty() && absl::SimpleAtoi(parts[0], &kb)) return kb;
+    }
+  }
+  return 0;
+}
+
+double LargestFinite(const std::vector<double>& distance) {
+  double largest = 0;
+  for (double d : distance) {
+    if (std::isfinite(d)) largest = std::max(largest, d);
+  }
+  return largest;
+}
+
+// kPlanTargets: the whole field from job.sources[0] gives the largest distance D; random points
+// (job.vertex_share of them vertices) are drawn and put into their group by the estimated
+// distance (EstimateDistanceAt; exact at vertices) until every group has job.count points. The
+// points go back group by group in turn (0, 1, 2, 3, 0, 1, ...), so that a slow drift of the
+// machine's speed touches every group alike.
+void PlanTargetsChild(const Job& job, const MeshData& data, const TriangleMesh& mesh,
+                      ChildReport& report, std::vector<double>& values) {
+  const uint32_t source = job.sources.at(0);
+  absl::StatusOr<DistanceField> field =
+      ComputeDistanceField(mesh, {SurfacePoint::AtVertex(source)});
+  if (!field.ok()) {
+    SetError(report, field.status().ToString());
+    return;
+  }
+  report.max_distance = LargestFinite(field->distance);
+  report.solve_ms = field->stats.solve_ms;
+  PointSampler sampler(data, mesh, source, job.vertex_share, job.seed);
+  if (!sampler.ok() || !(report.max_distance > 0)) {
+    SetError(report, "no points to sample around the source");
+    return;
+  }
+  const size_t wanted = static_cast<size_t>(job.count);
+  std::array<std::vector<SurfacePoint>, kGroups> groups;
+  auto short_of_points = [&] {
+    for (const auto& g : groups) {
+      if (g.size() < wanted) return true;
+    }
+    return false;
+  };
+  constexpr uint64_t kMaxDraws = 20'000'000;
+  while (short_of_points() && report.candidates < kMaxDraws) {
+    const SurfacePoint p = sampler.Next();
+    ++report.candidates;
+    absl::StatusOr<PointEstimate> e = EstimateDistanceAt(mesh, *field, p);
+    if (!e.ok() || !std::isfinite(e->distance)) continue;
+    const double fraction = e->distance / report.max_distance;
+    if (!(fraction > 1e-9)) continue;  // the source itself
+    std::vector<SurfacePoint>& group = groups[GroupOf(fraction)];
+    if (group.size() < wanted) group.push_back(p);
+  }
+  for (size_t i = 0; i < wanted; ++i) {
+    for (const auto& g : groups) {
+      if (i < g.size()) PackPoint(g[i], &values);
+    }
+  }
+}
+
+// kSamplePoints: job.count random points around job.sources[0].
+void SamplePointsChild(const Job& job, const MeshData& data, const TriangleMesh& mesh,
+                       ChildReport& report, std::vector<double>& values) {
+  PointSampler sampler(data, mesh, job.sources.at(0), job.vertex_share, job.seed);
+  if (!sampler.ok()) {
+    SetError(report, "no points to sample");
+    return;
+  }
+  for (int i = 0; i < job.count; ++i) PackPoint(sampler.Next(), &values);
+}
+
+// kPathPair: from[0] -> to[0], first A* (the default PathQueryOptions) `repeat` times, then the
+// full field (full_field = true: solve everything, then trace) `repeat` times, after one untimed
+// A* run. Times are the medians of the whole ComputeShortestPath call (wall) and of
+// SolveStats.solve_ms. Before each of the two series, freed memory goes back to the system
+// (malloc_trim) and the RSS high-water mark is reset, so each peak is the series' own.
+void PathPairChild(const Job& job, const TriangleMesh& mesh, ChildReport& report) {
+  auto run = [&](const PathQueryOptions& options, double* wall_ms, double* solve_ms,
+                 SolveStats* stats, double* distance) {
+    std::vector<double> wall, solve;
+    for (int r = 0; r < job.repeat; ++r) {
+      const auto start = std::chrono::steady_clock::now();
+      absl::StatusOr<PathQueryResult> result =
+          ComputeShortestPath(mesh, job.from.at(0), job.to.at(0), options);
+      wall.push_back(MsSince(start));
+      if (!result.ok()) {
+        SetError(report, result.status().ToString());
+        report.resource_exhausted = absl::IsResourceExhausted(result.status());
+        return false;
+      }
+      solve.push_back(result->stats.solve_ms);
+      *stats = result->stats;
+      *distance = result->distance;
+    }
+    *wall_ms = Median(wall);
+    *solve_ms = Median(solve);
+    return true;
+  };
+  PathQueryOptions astar;  // the defaults: A*, stop at the target
+  // One untimed A* run first, so that neither run's RSS pays for paging in the solver's code.
+  if (absl::StatusOr<PathQueryResult> warm =
+          ComputeShortestPath(mesh, job.from.at(0), job.to.at(0), astar);
+      !warm.ok()) {
+    SetError(report, warm.status().ToString());
+    return;
+  }
+  malloc_trim(0);
+  const int64_t before_astar_kb = CurrentRssKb();
+  if (!ResetRssHighWater()) report.hiwater_reset = 0;
+  if (!run(astar, &report.wall_ms, &report.solve_ms, &report.stats, &report.astar_distance)) {
+    return;
+  }
+  report.astar_peak_kb = PeakRssKb() - before_astar_kb;
+  malloc_trim(0);
+  const int64_t before_full_kb = CurrentRssKb();
+  if (!ResetRssHighWater()) report.hiwater_reset = 0;
+  PathQueryOptions full;
+  full.full_field = true;
+  if (!run(full, &report.full_wall_ms, &report.full_solve_ms, &report.full_stats,
+           &report.full_distance)) {
+    return;
+  }
+  report.full_peak_kb = PeakRssKb() - before_full_kb;
+  report.runs = job.repeat;
+}
+
+void AddUp(const SolveStats& s, SolveStats* total) {
+  total->windows_created += s.windows_created;
+  total->windows_processed += s.windows_processed;
+  total->max_level = std::max(total->max_level, s.max_level);
+  total->peak_live_windows = std::max(total->peak_live_windows, s.peak_live_windows);
+  total->peak_bytes = std::max(total->peak_bytes, s.peak_bytes);
+  total->solve_ms += s.solve_ms;
+}
+
+// kMatrix, kFields, kPathQueries: the three ways to get the distances between job.from and
+// job.to, `repeat` times each; wall_ms / solve_ms are the medians of the totals, stats the last
+// repeat's (windows summed over the solves, peaks the largest). kMatrix sends the matrix back;
+// kPathQueries the distances, then each query's median wall ms.
+void MatrixChild(const Job& job, const TriangleMesh& mesh, ChildReport& report,
+                 std::vector<double>& values) {
+  const size_t rows = job.from.size(), cols = job.to.size();
+  std::vector<double> wall, solve;
+  std::vector<std::vector<double>> query_ms(rows * cols);
+  for (int r = 0; r < job.repeat; ++r) {
+    SolveStats total;
+    const auto start = std::chrono::steady_clock::now();
+    if (job.task == Task::kMatrix) {
+      absl::StatusOr<DistanceMatrix> m = ComputeDistanceMatrix(mesh, job.from, job.to);
+      if (!m.ok()) {
+        SetError(report, m.status().ToString());
+        return;
+      }
+      total = m->stats;
+      values = m->values;
+    } else if (job.task == Task::kFields) {
+      for (const SurfacePoint& s : job.from) {
+        absl::StatusOr<DistanceField> field = ComputeDistanceField(mesh, {s});
+        if (!field.ok()) {
+          SetError(report, field.status().ToString());
+          return;
+        }
+        AddUp(field->stats, &total);
+      }
+    } else {
+      values.assign(rows * cols, kInf);
+      for (size_t i = 0; i < rows; ++i) {
+        for (size_t j = 0; j < cols; ++j) {
+          const auto query_start = std::chrono::steady_clock::now();
+          absl::StatusOr<PathQueryResult> q = ComputeShortestPath(mesh, job.from[i], job.to[j]);
+          query_ms[i * cols + j].push_back(MsSince(query_start));
+          if (!q.ok()) {
+            SetError(report, absl::StrCat("pair ", i, ", ", j, ": ", q.status().ToString()));
+            return;
+          }
+          values[i * cols + j] = q->distance;
+          AddUp(q->stats, &total);
+        }
+      }
+    }
+    wall.push_back(MsSince(start));
+    solve.push_back(total.solve_ms);
+    report.stats = total;
+  }
+  report.runs = job.repeat;
+  report.wall_ms = Median(wall);
+  report.solve_ms = Median(solve);
+  if (job.task == Task::kPathQueries) {
+    for (const auto& ms : query_ms) values.push_back(Median(ms));
+  }
+}
+
+// kEstimate: from file vertex job.sources[0], at job.count random face points: the exact distance
+// (ComputeExactDistancesAt, job.batch points per call), the unfolding estimate on the exact field
+// (EstimateDistanceAt), the straight line from the source, and Dijkstra's method (the Dijkstra
+// field at the face's corners: min over them of d(v) + |v p|). Sends 4 doubles per point in that
+// order.
+void EstimateChild(const Job& job, const MeshData& data, const TriangleMesh& mesh,
+                   ChildReport& report, std::vector<double>& values) {
+  const uint32_t source_vertex = job.sources.at(0);
+  const SurfacePoint source = SurfacePoint::AtVertex(source_vertex);
+  absl::StatusOr<DistanceField> field = ComputeDistanceField(mesh, {source});
+  GeodesicOptions dijkstra_options;
+  dijkstra_options.method = Method::kDijkstra;
+  absl::StatusOr<DistanceField> dijkstra = ComputeDistanceField(mesh, {source}, dijkstra_options);
+  if (!field.ok() || !dijkstra.ok()) {
+    SetError(report, (field.ok() ? dijkstra.status() : field.status()).ToString());
+    return;
+  }
+  report.solve_ms = field->stats.solve_ms;
+  report.dijkstra_ms = dijkstra->stats.solve_ms;
+  report.max_distance = LargestFinite(field->distance);
+  PointSampler sampler(data, mesh, source_vertex, 0.0, job.seed);
+  if (!sampler.ok()) {
+    SetError(report, "no faces to sample");
+    return;
+  }
+  std::vector<SurfacePoint> points;
+  for (int i = 0; i < job.count; ++i) points.push_back(sampler.Next());
+
+  std::vector<double> estimate(points.size(), kInf);
+  auto start = std::chrono::steady_clock::now();
+  for (size_t i = 0; i < points.size(); ++i) {
+    absl::StatusOr<PointEstimate> e = EstimateDistanceAt(mesh, *field, points[i]);
+    if (!e.ok()) {
+      SetError(report, e.status().ToString());
+      return;
+    }
+    estimate[i] = e->distance;
+  }
+  report.estimate_ms = MsSince(start);
+
+  std::vector<double> exact;
+  start = std::chrono::steady_clock::now();
+  for (size_t begin = 0; begin < points.size(); begin += static_cast<size_t>(job.batch)) {
+    const size_t end = std::min(points.size(), begin + static_cast<size_t>(job.batch));
+    const std::vector<SurfacePoint> batch(points.begin() + begin, points.begin() + end);
+    absl::StatusOr<std::vector<std::pair<double, uint32_t>>> d =
+        ComputeExactDistancesAt(mesh, {source}, batch);
+    if (!d.ok()) {
+      SetError(report, d.status().ToString());
+      return;
+    }
+    for (const auto& [distance, label] : *d) exact.push_back(distance);
+    ++report.exact_solves;
+  }
+  report.exact_ms = MsSince(start);
+
+  const std::array<double, 3> s = FilePosition(data, source_vertex);
+  for (size_t i = 0; i < points.size(); ++i) {
+    const std::array<double, 3> p = PointPosition(data, points[i]);
+    double via_dijkstra = kInf;
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t v = data.faces[3 * points[i].face + k];
+      via_dijkstra =
+          std::min(via_dijkstra, dijkstra->distance[v] + Distance3(FilePosition(data, v), p));
+    }
+    values.insert(values.end(), {exact[i], estimate[i], Distance3(s, p), via_dijkstra});
+  }
+}
+
 void ChildMain(const Job& job, int fd) {
   ChildReport report;
   std::vector<double> distance;
@@ -543,6 +1051,23 @@ void ChildMain(const Job& job, int fd) {
       if (report.ok && job.want_distances) distance = field->distance;
       break;
     }
+    case Task::kPlanTargets:
+      PlanTargetsChild(job, *data, *mesh, report, distance);
+      break;
+    case Task::kSamplePoints:
+      SamplePointsChild(job, *data, *mesh, report, distance);
+      break;
+    case Task::kPathPair:
+      PathPairChild(job, *mesh, report);
+      break;
+    case Task::kMatrix:
+    case Task::kFields:
+    case Task::kPathQueries:
+      MatrixChild(job, *mesh, report, distance);
+      break;
+    case Task::kEstimate:
+      EstimateChild(job, *data, *mesh, report, distance);
+      break;
     case Task::kCgal: {
 #ifdef GEODEX_BENCH_WITH_CGAL
       const std::vector<SurfacePoint> sources = AsSurfacePoints(job.sources);
@@ -1182,6 +1707,427 @@ Section LambdaSection(const Config& config, const std::vector<MeshInfo>& meshes)
   return s;
 }
 
+// ------------------------------------------------------------------------------------------------
+// Targeted queries: the parent's side
+
+// The meshes a targeted-query mode runs on: all given --mesh files, else its defaults.
+std::vector<const MeshInfo*> ModeMeshes(const Config& config, const std::vector<MeshInfo>& meshes,
+                                        const std::vector<std::string>& defaults) {
+  std::vector<const MeshInfo*> out;
+  for (const MeshInfo& m : meshes) {
+    if (!config.mesh_files.empty() ||
+        std::find(defaults.begin(), defaults.end(), m.name) != defaults.end()) {
+      out.push_back(&m);
+    }
+  }
+  return out;
+}
+
+Outcome RunPointJob(const MeshInfo& mesh, Job job, const Config& config) {
+  job.path = mesh.path;
+  return RunChild(job, config.timeout_s, config.wait_idle_s);
+}
+
+// The value at the nearest rank q (0 < q <= 1) of v.
+double Quantile(std::vector<double> v, double q) {
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  const size_t rank = static_cast<size_t>(std::ceil(q * static_cast<double>(v.size())));
+  return v[std::min(v.size(), std::max<size_t>(rank, 1)) - 1];
+}
+
+double MaxOf(const std::vector<double>& v) {
+  return v.empty() ? std::nan("") : *std::max_element(v.begin(), v.end());
+}
+double MinOf(const std::vector<double>& v) {
+  return v.empty() ? std::nan("") : *std::min_element(v.begin(), v.end());
+}
+
+// |a - b| / |b|, 0 when both are equal (also both infinite).
+double RelDiff(double a, double b) {
+  if (a == b) return 0;
+  return std::abs(a - b) / std::abs(b);
+}
+
+std::string Percent(double fraction) {
+  if (!std::isfinite(fraction)) return "-";
+  if (fraction == 0) return "0";
+  return absl::StrFormat("%.3g%%", 100 * fraction);
+}
+
+// One --astar pair as the parent sees it.
+struct PairResult {
+  SurfacePoint target;
+  Outcome outcome;
+  double fraction = 0;  // the exact (full-field) distance / the source's largest distance
+  int group = 0;
+  double full_ms = 0, astar_ms = 0;
+  double speedup = 0;  // full_ms / astar_ms
+  double rel_diff = 0;  // |A* - full| / full
+};
+
+std::vector<Section> AstarSections(const Config& config, const std::vector<MeshInfo>& meshes) {
+  Section groups{
+      "Exact paths: A* vs the full field (section 5, the shape of Table 2)",
+      absl::StrFormat(
+          "From vertex 0 to random target points (seed %d; a quarter vertices, the rest face "
+          "points uniform over the area), %d per group, grouped by the target's exact distance as "
+          "a fraction of the source's largest vertex distance D. Each pair runs in its own child: "
+          "ComputeShortestPath with the default options (A*: stop at the target) R times, then "
+          "with full_field = true (solve the whole field, then trace) R times. ms = median of "
+          "the whole call over the repeats; per group the median over its pairs. speedup = "
+          "median of the per-pair full ms / A* ms, min = the smallest; worst A*/full = the "
+          "largest per-pair A* ms / full ms (below 1: never slower). windows = windows created; "
+          "ratio = median of per-pair full / A*. peak MiB = SolveStats.peak_bytes, delta RSS = "
+          "the child's RSS high-water mark over its resident size before the run (medians). max "
+          "rel diff = max |d_A* - d_full| / d_full.",
+          config.seed, config.per_group),
+      Table({"mesh", "faces", "d / D", "pairs", "vertex targets", "full ms", "A* ms", "speedup",
+             "min speedup", "worst A*/full", "full windows", "A* windows", "windows ratio",
+             "full peak MiB", "A* peak MiB", "full delta RSS MiB", "A* delta RSS MiB",
+             "max rel diff"},
+            "lrl"),
+      {}};
+  Section pairs{"Exact paths: every pair",
+                "Per pair: the target (v: vertex, f: face point), its exact distance d and d / D; "
+                "ms of the whole call and SolveStats.solve_ms (medians of R); A* peak MiB = "
+                "SolveStats.peak_bytes of the A* run.",
+                Table({"mesh", "pair", "target", "d", "d / D", "full ms", "A* ms", "full solve ms",
+                       "A* solve ms", "speedup", "full windows", "A* windows", "A* peak MiB",
+                       "A* delta RSS MiB", "rel diff", "other load"},
+                      "lrl"),
+                {}};
+  bool first = true;
+  for (const MeshInfo* mesh : ModeMeshes(config, meshes, AstarMeshes())) {
+    const int repeat = RepeatFor(config, *mesh);
+    const uint32_t source = mesh->sources.at(0);
+    std::fprintf(stderr, "astar: %s, source %u, R = %d\n", mesh->name.c_str(), source, repeat);
+    Job plan_job;
+    plan_job.task = Task::kPlanTargets;
+    plan_job.sources = {source};
+    plan_job.seed = config.seed;
+    plan_job.count = config.per_group;
+    const Outcome plan = RunPointJob(*mesh, plan_job, config);
+    Progress("choose the targets", plan);
+    if (!plan.ok()) {
+      groups.notes.push_back(absl::StrCat(mesh->name, ": choosing the targets failed: ",
+                                          plan.StatusText(), " ", plan.message));
+      continue;
+    }
+    const double largest = plan.report.max_distance;
+    const std::vector<SurfacePoint> targets = UnpackPoints(plan.distance);
+    std::vector<PairResult> results;
+    for (size_t i = 0; i < targets.size(); ++i) {
+      Job job;
+      job.task = Task::kPathPair;
+      job.from = {SurfacePoint::AtVertex(source)};
+      job.to = {targets[i]};
+      job.repeat = repeat;
+      PairResult r;
+      r.target = targets[i];
+      r.outcome = RunPointJob(*mesh, job, config);
+      const ChildReport& c = r.outcome.report;
+      Progress(absl::StrFormat("pair %d/%d (%s): A* %.1f ms, full %.1f ms", i + 1,
+                               targets.size(), ShortPoint(targets[i]), c.wall_ms, c.full_wall_ms),
+               r.outcome);
+      if (r.outcome.ok()) {
+        r.fraction = c.full_distance / largest;
+        r.group = GroupOf(r.fraction);
+        r.full_ms = c.full_wall_ms;
+        r.astar_ms = c.wall_ms;
+        r.speedup = r.full_ms / r.astar_ms;
+        r.rel_diff = RelDiff(c.astar_distance, c.full_distance);
+      } else {
+        groups.notes.push_back(absl::StrCat(mesh->name, " target ",
+                                            SurfacePointToString(targets[i]), ": ",
+                                            r.outcome.StatusText(), " ", r.outcome.message));
+      }
+      results.push_back(std::move(r));
+    }
+
+    // Per group, then all pairs (group index kGroups).
+    for (int g = 0; g <= kGroups; ++g) {
+      std::vector<double> full_ms, astar_ms, speedup, worst, full_windows, astar_windows,
+          windows_ratio, full_peak, astar_peak, full_rss, astar_rss, rel_diff;
+      int vertex_targets = 0;
+      for (const PairResult& r : results) {
+        if (!r.outcome.ok() || (g < kGroups && r.group != g)) continue;
+        const ChildReport& c = r.outcome.report;
+        vertex_targets += r.target.kind == SurfacePoint::Kind::kVertex;
+        full_ms.push_back(r.full_ms);
+        astar_ms.push_back(r.astar_ms);
+        speedup.push_back(r.speedup);
+        worst.push_back(r.astar_ms / r.full_ms);
+        full_windows.push_back(static_cast<double>(c.full_stats.windows_created));
+        astar_windows.push_back(static_cast<double>(c.stats.windows_created));
+        windows_ratio.push_back(static_cast<double>(c.full_stats.windows_created) /
+                                std::max<double>(1, static_cast<double>(c.stats.windows_created)));
+        full_peak.push_back(static_cast<double>(c.full_stats.peak_bytes));
+        astar_peak.push_back(static_cast<double>(c.stats.peak_bytes));
+        full_rss.push_back(static_cast<double>(c.full_peak_kb));
+        astar_rss.push_back(static_cast<double>(c.astar_peak_kb));
+        rel_diff.push_back(r.rel_diff);
+      }
+      if (full_ms.empty()) continue;
+      groups.table.AddRow(
+          {mesh->name, Count(mesh->report.faces), g < kGroups ? kGroupName[g] : "all",
+           Count(full_ms.size()), Count(vertex_targets), Ms(Median(full_ms)), Ms(Median(astar_ms)),
+           Ratio(Median(speedup)), Ratio(MinOf(speedup)), absl::StrFormat("%.3f", MaxOf(worst)),
+           Count(static_cast<uint64_t>(Median(full_windows))),
+           Count(static_cast<uint64_t>(Median(astar_windows))), Ratio(Median(windows_ratio)),
+           MiBOfBytes(Median(full_peak)), MiBOfBytes(Median(astar_peak)),
+           MiBOfKb(static_cast<int64_t>(Median(full_rss))),
+           MiBOfKb(static_cast<int64_t>(Median(astar_rss))), Sci(MaxOf(rel_diff))});
+    }
+    if (!first) groups.table.AddBreak();
+    first = false;
+
+    // The targets of the task, stated as measured.
+    std::vector<double> near_speedup, worst_all, rel_all;
+    int slower = 0, near_below_10 = 0;
+    for (const PairResult& r : results) {
+      if (!r.outcome.ok()) continue;
+      worst_all.push_back(r.astar_ms / r.full_ms);
+      rel_all.push_back(r.rel_diff);
+      if (r.astar_ms > r.full_ms) ++slower;
+      if (r.fraction <= 0.25) {
+        near_speedup.push_back(r.speedup);
+        if (r.speedup < 10) ++near_below_10;
+      }
+    }
+    groups.notes.push_back(absl::StrFormat(
+        "%s: D = %.6g; %d targets from %d random points; within 25%%: %d pairs, A* speedup "
+        "%s-%s (median %s), %d below 10x; all pairs: worst A*/full %.3f, %d pairs where A* was "
+        "slower; max rel diff of the distances %s",
+        mesh->name, largest, targets.size(), plan.report.candidates, near_speedup.size(),
+        Ratio(MinOf(near_speedup)), Ratio(MaxOf(near_speedup)), Ratio(Median(near_speedup)),
+        near_below_10, MaxOf(worst_all), slower, Sci(MaxOf(rel_all))));
+    for (size_t i = 0; i < results.size(); ++i) {
+      const PairResult& r = results[i];
+      const ChildReport& c = r.outcome.report;
+      std::vector<std::string> cells = {mesh->name, Count(i + 1), ShortPoint(r.target)};
+      if (!r.outcome.ok()) {
+        cells.push_back(r.outcome.StatusText());
+      } else {
+        cells.insert(cells.end(),
+                     {absl::StrFormat("%.6g", c.full_distance), Percent(r.fraction),
+                      Ms(r.full_ms), Ms(r.astar_ms), Ms(c.full_solve_ms), Ms(c.solve_ms),
+                      Ratio(r.speedup), Count(c.full_stats.windows_created),
+                      Count(c.stats.windows_created),
+                      MiBOfBytes(static_cast<double>(c.stats.peak_bytes)),
+                      MiBOfKb(c.astar_peak_kb), Sci(r.rel_diff), OtherLoad(r.outcome)});
+      }
+      pairs.table.AddRow(cells);
+    }
+    pairs.table.AddBreak();
+  }
+  return {groups, pairs};
+}
+
+Section MatrixSection(const Config& config, const std::vector<MeshInfo>& meshes) {
+  constexpr int kSide = 16;
+  Section s{"Distance matrix: 16 x 16 vs 16 full fields vs 256 A* queries",
+            absl::StrFormat(
+                "16 random source points and 16 random target points (seed %d; a quarter "
+                "vertices, the rest face points uniform over the area). Each row is one child: "
+                "ComputeDistanceMatrix(sources, targets) (one solve per source, stopping once "
+                "all 16 targets are final); ComputeDistanceField once per source (the cost of 16 "
+                "full fields; on their own they give no exact values at face points); "
+                "ComputeShortestPath (A*) for each of the 256 pairs. ms = median over R of the "
+                "total wall time; solve ms = the summed SolveStats.solve_ms. x matrix = ms / the "
+                "matrix's ms. windows = created, summed over the solves. peak MiB = the largest "
+                "SolveStats.peak_bytes of one solve; delta RSS = the child's peak RSS over the "
+                "mesh-only baseline. vs matrix = max |d - d_matrix| / d_matrix over the 256 "
+                "pairs.",
+                config.seed),
+            Table({"mesh", "faces", "method", "solves", "R", "ms", "solve ms", "ms per solve",
+                   "x matrix", "windows", "peak MiB", "delta RSS MiB", "vs matrix", "other load"},
+                  "lrl"),
+            {}};
+  for (const MeshInfo* mesh : ModeMeshes(config, meshes, MatrixMeshes())) {
+    const int repeat = RepeatFor(config, *mesh);
+    const int query_repeat = config.repeat > 0 ? config.repeat : 1;
+    std::fprintf(stderr, "matrix: %s, R = %d (queries R = %d)\n", mesh->name.c_str(), repeat,
+                 query_repeat);
+    Job sample;
+    sample.task = Task::kSamplePoints;
+    sample.sources = {mesh->sources.at(0)};
+    sample.seed = config.seed;
+    sample.count = 2 * kSide;
+    const Outcome points = RunPointJob(*mesh, sample, config);
+    const std::vector<SurfacePoint> all = UnpackPoints(points.distance);
+    if (!points.ok() || all.size() != 2 * kSide) {
+      s.notes.push_back(absl::StrCat(mesh->name, ": sampling the points failed: ",
+                                     points.StatusText(), " ", points.message));
+      continue;
+    }
+    Job job;
+    job.from.assign(all.begin(), all.begin() + kSide);
+    job.to.assign(all.begin() + kSide, all.end());
+    job.repeat = repeat;
+    job.task = Task::kMatrix;
+    const Outcome matrix = RunPointJob(*mesh, job, config);
+    Progress("distance matrix", matrix);
+    job.task = Task::kFields;
+    const Outcome fields = RunPointJob(*mesh, job, config);
+    Progress("16 full fields", fields);
+    job.task = Task::kPathQueries;
+    job.repeat = query_repeat;
+    const Outcome queries = RunPointJob(*mesh, job, config);
+    Progress("256 A* queries", queries);
+
+    const size_t cells = static_cast<size_t>(kSide) * kSide;
+    const double matrix_ms = matrix.ok() ? matrix.report.wall_ms : std::nan("");
+    double query_rel = std::nan("");
+    if (matrix.ok() && queries.ok() && matrix.distance.size() == cells &&
+        queries.distance.size() == 2 * cells) {
+      query_rel = 0;
+      for (size_t k = 0; k < cells; ++k) {
+        query_rel = std::max(query_rel, RelDiff(queries.distance[k], matrix.distance[k]));
+      }
+    }
+    auto row = [&](const std::string& method, const Outcome& o, int solves, int r,
+                   const std::string& vs) {
+      std::vector<std::string> out = {mesh->name, Count(mesh->report.faces), method,
+                                      Count(solves), Count(r)};
+      if (!o.ok()) {
+        out.push_back(o.StatusText());
+        if (!o.message.empty()) s.notes.push_back(absl::StrCat(mesh->name, " ", method, ": ",
+                                                               o.message));
+        return out;
+      }
+      const ChildReport& c = o.report;
+      out.insert(out.end(), {Ms(c.wall_ms), Ms(c.solve_ms), Ms(c.wall_ms / solves),
+                             absl::StrFormat("%.2fx", c.wall_ms / matrix_ms),
+                             Count(c.stats.windows_created),
+                             MiBOfBytes(static_cast<double>(c.stats.peak_bytes)),
+                             DeltaMiB(o, *mesh), vs, OtherLoad(o)});
+      return out;
+    };
+    s.table.AddRow(row("distance matrix 16 x 16", matrix, kSide, repeat, "0"));
+    s.table.AddRow(row("16 full fields", fields, kSide, repeat, ""));
+    s.table.AddRow(row("256 A* queries", queries, static_cast<int>(cells), query_repeat,
+                       Sci(query_rel)));
+    int vertex_points = 0;
+    for (const SurfacePoint& p : all) vertex_points += p.kind == SurfacePoint::Kind::kVertex;
+    if (queries.ok() && queries.distance.size() == 2 * cells) {
+      const std::vector<double> per_query(queries.distance.begin() + cells,
+                                          queries.distance.end());
+      s.notes.push_back(absl::StrFormat(
+          "%s: the 256 A* queries took %s ms each at the median (%s-%s ms)", mesh->name,
+          Ms(Median(per_query)), Ms(MinOf(per_query)), Ms(MaxOf(per_query))));
+    }
+    if (matrix.ok() && fields.ok() && queries.ok()) {
+      const bool beats = matrix.report.wall_ms < fields.report.wall_ms &&
+                         matrix.report.wall_ms < queries.report.wall_ms;
+      s.notes.push_back(absl::StrFormat(
+          "%s: 16 full fields take %.2fx the matrix's time and 256 A* queries %.2fx (%s); the "
+          "matrix's solves create %.0f%% of the windows of the 16 full fields; its values equal "
+          "the A* distances to %s relative",
+          mesh->name, fields.report.wall_ms / matrix.report.wall_ms,
+          queries.report.wall_ms / matrix.report.wall_ms,
+          beats ? "the matrix beats both" : "the matrix does NOT beat both",
+          100.0 * static_cast<double>(matrix.report.stats.windows_created) /
+              static_cast<double>(std::max<uint64_t>(1, fields.report.stats.windows_created)),
+          Sci(query_rel)));
+    }
+    std::vector<std::string> sources, targets;
+    for (int k = 0; k < kSide; ++k) {
+      sources.push_back(ShortPoint(all[k]));
+      targets.push_back(ShortPoint(all[kSide + k]));
+    }
+    s.notes.push_back(absl::StrFormat("%s: %d of the 32 points are vertices; sources: %s; "
+                                      "targets: %s",
+                                      mesh->name, vertex_points, absl::StrJoin(sources, ", "),
+                                      absl::StrJoin(targets, ", ")));
+  }
+  return s;
+}
+
+Section EstimateSection(const Config& config, const std::vector<MeshInfo>& meshes) {
+  Section s{"Distance at a surface point: the unfolding estimate (section 4, Table 1 / Fig. 6)",
+            absl::StrFormat(
+                "From vertex 0 to %d random face points per mesh (seed %d; uniform over the "
+                "area). Relative error |d - d_exact| / d_exact of: the straight line from the "
+                "source (Euclidean), Dijkstra's method (the Dijkstra field at the face's corners, "
+                "min of d(v) + |v p|) and the estimate (EstimateDistanceAt on the exact field: "
+                "the paper's unfolding). d_exact from ComputeExactDistancesAt, %d points per "
+                "call. med / p90 / max over the points; <= 0.1%% = the share of points where "
+                "the estimate is within 0.1%%, below = the share where it is below d_exact. "
+                "est us = per point (the field computed once: field ms); exact ms = per call.",
+                config.points, config.seed, config.batch),
+            Table({"mesh", "faces", "points", "line med", "line p90", "line max",
+                   "Dijkstra med", "Dijkstra p90", "Dijkstra max", "estimate med",
+                   "estimate p90", "estimate max", "estimate <= 0.1%", "estimate <= 0.01%",
+                   "estimate below", "field ms", "est us", "exact ms", "other load"},
+                  "lrr"),
+            {}};
+  for (const MeshInfo* mesh : ModeMeshes(config, meshes, EstimateMeshes())) {
+    std::fprintf(stderr, "estimate: %s, %d points\n", mesh->name.c_str(), config.points);
+    Job job;
+    job.task = Task::kEstimate;
+    job.sources = {mesh->sources.at(0)};
+    job.seed = config.seed;
+    job.count = config.points;
+    job.batch = config.batch;
+    const Outcome o = RunPointJob(*mesh, job, config);
+    Progress("estimate vs exact", o);
+    if (!o.ok() || o.distance.size() != 4 * static_cast<size_t>(config.points)) {
+      s.table.AddRow({mesh->name, Count(mesh->report.faces), Count(config.points),
+                      o.StatusText()});
+      if (!o.message.empty()) s.notes.push_back(absl::StrCat(mesh->name, ": ", o.message));
+      continue;
+    }
+    std::vector<double> line, dijkstra, estimate;
+    int within_01 = 0, within_001 = 0, below = 0, skipped = 0, inconsistent = 0;
+    double worst = -1, worst_exact = 0;
+    for (size_t i = 0; i < o.distance.size(); i += 4) {
+      const double exact = o.distance[i];
+      if (!(exact > 0) || !std::isfinite(exact)) {
+        ++skipped;
+        continue;
+      }
+      const double e = RelDiff(o.distance[i + 1], exact);
+      // The straight line is a lower bound and Dijkstra's method (a real path) an upper bound.
+      if (o.distance[i + 2] > exact * (1 + 1e-12) || o.distance[i + 3] < exact * (1 - 1e-12)) {
+        ++inconsistent;
+      }
+      line.push_back(RelDiff(o.distance[i + 2], exact));
+      dijkstra.push_back(RelDiff(o.distance[i + 3], exact));
+      estimate.push_back(e);
+      within_01 += e <= 1e-3;
+      within_001 += e <= 1e-4;
+      below += o.distance[i + 1] < exact * (1 - 1e-12);
+      if (e > worst) {
+        worst = e;
+        worst_exact = exact;
+      }
+    }
+    const double n = static_cast<double>(estimate.size());
+    const ChildReport& c = o.report;
+    s.table.AddRow({mesh->name, Count(mesh->report.faces), Count(estimate.size()),
+                    Percent(Median(line)), Percent(Quantile(line, 0.9)), Percent(MaxOf(line)),
+                    Percent(Median(dijkstra)), Percent(Quantile(dijkstra, 0.9)),
+                    Percent(MaxOf(dijkstra)), Percent(Median(estimate)),
+                    Percent(Quantile(estimate, 0.9)), Percent(MaxOf(estimate)),
+                    Percent(within_01 / n), Percent(within_001 / n), Percent(below / n),
+                    Ms(c.solve_ms), absl::StrFormat("%.2f", 1000 * c.estimate_ms / n),
+                    Ms(c.exact_ms / std::max(1, c.exact_solves)), OtherLoad(o)});
+    s.notes.push_back(absl::StrFormat(
+        "%s: the worst estimate is off by %s at a point %s of D = %.6g from the source%s", mesh->name,
+        Percent(worst), Percent(worst_exact / c.max_distance), c.max_distance,
+        skipped > 0 ? absl::StrCat(" (", skipped, " points at distance 0 or unreachable skipped)")
+                    : ""));
+    if (inconsistent > 0) {
+      s.notes.push_back(absl::StrFormat(
+          "%s: at %d points the exact value is not between the straight line and Dijkstra's "
+          "method: not exact there",
+          mesh->name, inconsistent));
+    }
+  }
+  return s;
+}
+
 int Main(int argc, char** argv) {
   absl::StatusOr<Config> parsed = ParseArgs(argc, argv);
   if (!parsed.ok()) {
@@ -1209,6 +2155,16 @@ int Main(int argc, char** argv) {
         }
       }
     }
+  }
+  if (PointQueryMode(config) && config.mesh_files.empty()) {
+    // Only the default meshes of the modes asked for.
+    std::vector<std::string> keep;
+    if (config.astar) keep.insert(keep.end(), AstarMeshes().begin(), AstarMeshes().end());
+    if (config.matrix) keep.insert(keep.end(), MatrixMeshes().begin(), MatrixMeshes().end());
+    if (config.estimate) keep.insert(keep.end(), EstimateMeshes().begin(), EstimateMeshes().end());
+    std::erase_if(paths, [&](const std::string& path) {
+      return std::find(keep.begin(), keep.end(), MeshName(path)) == keep.end();
+    });
   }
   for (const std::string& f : config.mesh_files) paths.push_back(f);
   if (paths.empty()) {
@@ -1254,9 +2210,16 @@ int Main(int argc, char** argv) {
 
   std::vector<Section> sections;
   sections.push_back(MeshSection(meshes));
-  if (!config.ablation && !config.lambda) sections.push_back(MainSection(config, meshes));
+  if (!config.ablation && !config.lambda && !PointQueryMode(config)) {
+    sections.push_back(MainSection(config, meshes));
+  }
   if (config.ablation) sections.push_back(AblationSection(config, meshes));
   if (config.lambda) sections.push_back(LambdaSection(config, meshes));
+  if (config.astar) {
+    for (Section& s : AstarSections(config, meshes)) sections.push_back(std::move(s));
+  }
+  if (config.matrix) sections.push_back(MatrixSection(config, meshes));
+  if (config.estimate) sections.push_back(EstimateSection(config, meshes));
 
   const std::string footer = absl::StrFormat(
       "load average at the end: %s; %d of %d measurements (of 50 ms or more) ran while other "
