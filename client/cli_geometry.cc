@@ -3,6 +3,8 @@
 
 #include "cli_geometry.h"
 
+#include "cli_common.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -29,21 +31,6 @@ namespace {
 
 using Point3 = std::array<double, 3>;
 
-int Fail(int code, const std::string& message) {
-  std::fprintf(stderr, "geodex: %s\n", message.c_str());
-  return code;
-}
-
-bool CheckKnown(const Args& args, const std::set<std::string>& known, std::string* error) {
-  for (const auto& [key, value] : args.options) {
-    if (!known.count(key)) {
-      *error = absl::StrFormat("unknown option --%s (see geodex --help)", key);
-      return false;
-    }
-  }
-  return true;
-}
-
 // Everything a command needs: the mesh as read (file coordinates, for drawing) and built, the
 // points, the solved field.
 struct Solved {
@@ -56,32 +43,17 @@ struct Solved {
 // Reads the mesh (or sample:NAME), parses and resolves --`key`, solves. Returns 0 or an exit code
 // (after printing the one-line message).
 int Prepare(const Args& args, const std::string& key, Solved* out) {
-  const std::string& path = args.positional[0];
-  absl::StatusOr<MeshData> data =
-      path.rfind("sample:", 0) == 0 ? MakeSampleMesh(path) : ReadMeshFile(path);
-  if (!data.ok()) return Fail(kExitInput, std::string(data.status().message()));
-  absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(*data);
-  if (!mesh.ok()) return Fail(kExitInput, path + ": " + std::string(mesh.status().message()));
-  out->data = *std::move(data);
-  out->mesh = std::make_unique<TriangleMesh>(*std::move(mesh));
+  absl::StatusOr<LoadedMesh> loaded = LoadMesh(args.positional[0], MeshBuildOptions{});
+  if (!loaded.ok()) return Fail(kExitInput, std::string(loaded.status().message()));
+  out->data = std::move(loaded->data);
+  out->mesh = std::make_unique<TriangleMesh>(std::move(loaded->mesh));
   absl::StatusOr<std::vector<SurfacePoint>> points = ParseSurfacePoints(args.options.at(key));
-  if (!points.ok())
+  if (!points.ok()) {
     return Fail(kExitUsage, "--" + key + ": " + std::string(points.status().message()));
-  std::unique_ptr<SurfaceLocator> locator;
-  for (SurfacePoint& p : *points) {
-    if (p.kind == SurfacePoint::Kind::kPosition) {
-      if (locator == nullptr) locator = std::make_unique<SurfaceLocator>(*out->mesh);
-      absl::StatusOr<LocatedPoint> located = locator->Locate(p.position);
-      if (!located.ok()) {
-        return Fail(kExitUsage, absl::StrFormat("--%s: %s: %s", key, SurfacePointToString(p),
-                                                located.status().message()));
-      }
-      p = located->point;
-    }
-    if (absl::Status s = ValidateSurfacePoint(*out->mesh, p); !s.ok()) {
-      return Fail(kExitUsage, absl::StrFormat("--%s: %s", key, s.message()));
-    }
   }
+  std::unique_ptr<SurfaceLocator> locator;
+  std::string error;
+  if (!ResolvePoints(*out->mesh, key, &*points, &locator, &error)) return Fail(kExitUsage, error);
   out->points = *std::move(points);
   absl::StatusOr<DistanceField> field = ComputeDistanceField(*out->mesh, out->points);
   if (!field.ok()) {

@@ -1,0 +1,49 @@
+#pragma once
+
+// Helpers every geodex command shares: one-line failures, mesh loading, option parsing, and
+// resolving point SPECs against a mesh.
+
+#include <chrono>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "cli_commands.h"
+#include "geodex/locate.h"
+#include "geodex/mesh_data.h"
+#include "geodex/surface_point.h"
+#include "geodex/triangle_mesh.h"
+
+namespace geodex::cli {
+
+double MsSince(std::chrono::steady_clock::time_point t);
+
+// Prints "geodex: MESSAGE" on stderr and returns `code`.
+int Fail(int code, const std::string& message);
+
+// Reads a mesh file, or a built-in sample ("sample:terrain").
+absl::StatusOr<MeshData> LoadMeshData(const std::string& path);
+
+struct LoadedMesh {
+  MeshData data;
+  TriangleMesh mesh;
+  double load_ms, build_ms;
+};
+// Reads and builds; a Build error is prefixed with the path.
+absl::StatusOr<LoadedMesh> LoadMesh(const std::string& path, const MeshBuildOptions& options);
+
+// --key as a number; absent leaves *out unchanged. False with *error naming the option.
+bool GetDouble(const Args& args, const std::string& key, double* out, std::string* error);
+bool GetUint(const Args& args, const std::string& key, uint64_t* out, std::string* error);
+// False with *error naming the first option not in `known`.
+bool CheckKnown(const Args& args, const std::set<std::string>& known, std::string* error);
+
+// Snaps `p:X:Y:Z` points onto the surface (the locator is built once, on first need), then checks
+// every point against the mesh. Errors name the option and the point.
+bool ResolvePoints(const TriangleMesh& mesh, const std::string& option,
+                   std::vector<SurfacePoint>* points, std::unique_ptr<SurfaceLocator>* locator,
+                   std::string* error);
+
+}  // namespace geodex::cli
