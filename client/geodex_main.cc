@@ -49,7 +49,8 @@ commands:
 SPEC: comma-separated points: 17 (vertex), e:V1:V2:T (the point (1-T)*V1 + T*V2 on an edge),
       f:FACE:B0:B1:B2 (barycentric in the face's vertex order as in the file).
 
-exit codes: 0 ok; 1 the computation failed (cancelled, budget); 2 bad command line or argument;
+exit codes: 0 ok; 1 the computation failed (cancelled, budget, target unreachable); 2 bad command
+            line or argument;
             3 the mesh could not be read or is invalid.
 )";
 
