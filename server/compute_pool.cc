@@ -1,0 +1,70 @@
+#include "compute_pool.h"
+
+#include <utility>
+
+namespace geodex::server {
+
+ComputePool::ComputePool(size_t threads, size_t queue_capacity) : queue_capacity_(queue_capacity) {
+  if (threads == 0) threads = 1;
+  workers_.reserve(threads);
+  for (size_t i = 0; i < threads; ++i) workers_.emplace_back([this] { WorkerLoop(); });
+}
+
+ComputePool::~ComputePool() {
+  {
+    absl::MutexLock lock(&mu_);
+    stopping_ = true;
+  }
+  for (std::thread& t : workers_) t.join();
+}
+
+bool ComputePool::TrySubmit(std::function<void()> task) {
+  absl::MutexLock lock(&mu_);
+  // A task may start at once only if a worker is idle; otherwise it waits in the queue.
+  size_t idle = workers_.size() - busy_;
+  size_t waiting_after = queue_.size() + 1 > idle ? queue_.size() + 1 - idle : 0;
+  if (stopping_ || waiting_after > queue_capacity_) {
+    ++rejected_;
+    return false;
+  }
+  queue_.push_back(std::move(task));
+  return true;
+}
+
+void ComputePool::WorkerLoop() {
+  for (;;) {
+    std::function<void()> task;
+    {
+      absl::MutexLock lock(&mu_);
+      mu_.Await(absl::Condition(
+          +[](ComputePool* p) ABSL_EXCLUSIVE_LOCKS_REQUIRED(p->mu_) {
+            return p->stopping_ || !p->queue_.empty();
+          },
+          this));
+      if (queue_.empty()) return;  // stopping and drained
+      task = std::move(queue_.front());
+      queue_.pop_front();
+      ++busy_;
+    }
+    task();
+    absl::MutexLock lock(&mu_);
+    --busy_;
+  }
+}
+
+size_t ComputePool::queued() const {
+  absl::MutexLock lock(&mu_);
+  return queue_.size();
+}
+
+size_t ComputePool::busy() const {
+  absl::MutexLock lock(&mu_);
+  return busy_;
+}
+
+uint64_t ComputePool::rejected() const {
+  absl::MutexLock lock(&mu_);
+  return rejected_;
+}
+
+}  // namespace geodex::server

@@ -1,0 +1,110 @@
+// geodexd: the geodex gRPC server. `geodexd --help` lists every flag.
+
+#include <cerrno>
+#include <csignal>
+#include <cstring>
+#include <cstdio>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <unistd.h>
+
+#include "absl/flags/flag.h"
+#include "absl/flags/parse.h"
+#include "absl/flags/usage.h"
+#include "absl/time/clock.h"
+#include "geodex_server.h"
+#include "spdlog/spdlog.h"
+
+ABSL_FLAG(std::string, listen, "127.0.0.1:50051", "HOST:PORT to listen on (port 0 = any free port)");
+ABSL_FLAG(std::string, data_dir, "",
+          "Directory for persisted meshes (accepted; persistence is not implemented yet)");
+ABSL_FLAG(uint64_t, mesh_budget_bytes, uint64_t{4} << 30,
+          "RAM budget for preprocessed meshes; least-recently-used unpinned meshes are evicted");
+ABSL_FLAG(uint32_t, pool_threads, 0, "Compute worker threads (0 = one per hardware thread)");
+ABSL_FLAG(uint32_t, queue_capacity, 64,
+          "Queries that may wait for a worker; beyond that calls get RESOURCE_EXHAUSTED at once");
+ABSL_FLAG(uint64_t, max_upload_bytes, uint64_t{1} << 30, "Largest mesh file accepted by CreateMesh");
+ABSL_FLAG(uint64_t, max_vertices, 20'000'000, "Most vertices in an uploaded mesh");
+ABSL_FLAG(uint64_t, max_faces, 40'000'000, "Most faces in an uploaded mesh");
+ABSL_FLAG(uint32_t, max_sources, 100'000, "Most sources in one query");
+ABSL_FLAG(uint64_t, max_output_values, 100'000'000, "Most values one query may return");
+ABSL_FLAG(uint64_t, max_windows, 0, "Window budget per solve (0 = unlimited)");
+ABSL_FLAG(int32_t, max_receive_message_bytes, 4 << 20,
+          "Largest single request message (uploads are chunked below this)");
+ABSL_FLAG(double, shutdown_grace_seconds, 10,
+          "On SIGTERM/SIGINT, time given to running calls before they are cancelled");
+
+namespace {
+
+int g_signal_pipe[2] = {-1, -1};
+
+void OnSignal(int sig) {
+  const unsigned char byte = static_cast<unsigned char>(sig);
+  [[maybe_unused]] ssize_t n = write(g_signal_pipe[1], &byte, 1);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  absl::SetProgramUsageMessage(
+      "geodexd --listen HOST:PORT --data-dir DIR [flags]: the geodex gRPC server "
+      "(geodex.v1.Geodex, grpc.health.v1.Health, server reflection)");
+  // Accept --data-dir as well as --data_dir (absl flags use underscores).
+  std::vector<std::string> args(argv, argv + argc);
+  std::vector<char*> fixed;
+  for (std::string& a : args) {
+    if (a.rfind("--data-dir", 0) == 0) a.replace(0, 10, "--data_dir");
+    fixed.push_back(a.data());
+  }
+  absl::ParseCommandLine(static_cast<int>(fixed.size()), fixed.data());
+
+  // SIGTERM/SIGINT may land on any thread (gRPC starts threads before main): the handler only
+  // writes the signal number to a pipe, which the main thread reads.
+  if (pipe(g_signal_pipe) != 0) {
+    spdlog::error("pipe: {}", std::strerror(errno));
+    return 1;
+  }
+  struct sigaction action {};
+  action.sa_handler = OnSignal;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGTERM, &action, nullptr);
+  sigaction(SIGINT, &action, nullptr);
+
+  geodex::server::ServerOptions options;
+  options.listen = absl::GetFlag(FLAGS_listen);
+  options.data_dir = absl::GetFlag(FLAGS_data_dir);
+  options.mesh_budget_bytes = absl::GetFlag(FLAGS_mesh_budget_bytes);
+  options.pool_threads = absl::GetFlag(FLAGS_pool_threads);
+  options.queue_capacity = absl::GetFlag(FLAGS_queue_capacity);
+  options.max_receive_message_bytes = absl::GetFlag(FLAGS_max_receive_message_bytes);
+  options.limits.max_upload_bytes = absl::GetFlag(FLAGS_max_upload_bytes);
+  options.limits.max_vertices = absl::GetFlag(FLAGS_max_vertices);
+  options.limits.max_faces = absl::GetFlag(FLAGS_max_faces);
+  options.limits.max_sources = absl::GetFlag(FLAGS_max_sources);
+  options.limits.max_output_values = absl::GetFlag(FLAGS_max_output_values);
+  options.limits.max_windows = absl::GetFlag(FLAGS_max_windows);
+  if (!options.data_dir.empty()) {
+    spdlog::warn("--data-dir {}: persistence is not implemented yet; meshes live in RAM only",
+                 options.data_dir);
+  }
+
+  auto server = geodex::server::GeodexServer::Start(options);
+  if (!server.ok()) {
+    spdlog::error("{}", std::string(server.status().message()));
+    return 1;
+  }
+  spdlog::info("geodexd listening on port {} ({} workers, queue {}, mesh budget {} bytes)",
+               (*server)->port(), (*server)->pool().threads(), options.queue_capacity,
+               options.mesh_budget_bytes);
+
+  unsigned char sig = 0;
+  while (read(g_signal_pipe[0], &sig, 1) < 0 && errno == EINTR) {
+  }
+  spdlog::info("signal {}: shutting down (grace {} s)", static_cast<int>(sig),
+               absl::GetFlag(FLAGS_shutdown_grace_seconds));
+  (*server)->Shutdown(absl::Now() + absl::Seconds(absl::GetFlag(FLAGS_shutdown_grace_seconds)));
+  spdlog::info("geodexd stopped");
+  return 0;
+}

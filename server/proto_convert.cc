@@ -1,0 +1,185 @@
+#include "proto_convert.h"
+
+#include <cmath>
+
+#include "absl/strings/match.h"
+#include "absl/strings/str_cat.h"
+#include "google/protobuf/util/time_util.h"
+
+namespace geodex::server {
+namespace {
+
+// Whether file vertices a and b share an edge (over every internal copy of a).
+bool HasFileEdge(const TriangleMesh& mesh, uint32_t a, uint32_t b) {
+  auto touches = [&](uint32_t v) {
+    for (uint32_t i = mesh.NeighborBegin(v); i < mesh.NeighborEnd(v); ++i) {
+      if (mesh.FileVertex(mesh.NeighborVertex(i)) == b) return true;
+    }
+    return false;
+  };
+  if (touches(a)) return true;
+  const std::vector<uint32_t>& copies = mesh.copy_of();
+  for (size_t i = 0; i < copies.size(); ++i) {
+    if (copies[i] == a && touches(mesh.file_vertex_count() + static_cast<uint32_t>(i))) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+absl::StatusOr<std::string> ParseMeshName(const std::string& name, const std::string& field) {
+  constexpr absl::string_view kPrefix = "meshes/";
+  if (!absl::StartsWith(name, kPrefix) || name.size() == kPrefix.size() ||
+      name.find('/', kPrefix.size()) != std::string::npos) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ": expected \"meshes/{mesh_id}\" or \"meshes/{display_name}\", got \"",
+                     name, "\""));
+  }
+  return name.substr(kPrefix.size());
+}
+
+void MeshToProto(const StoredMesh& mesh, v1::Mesh* out) {
+  out->set_name(absl::StrCat("meshes/", mesh.id));
+  out->set_display_name(mesh.display_name);
+  out->set_vertex_count(mesh.vertex_count);
+  out->set_face_count(mesh.face_count);
+  out->set_upload_bytes(mesh.upload_bytes);
+  out->set_memory_bytes(mesh.memory_bytes);
+  *out->mutable_create_time() =
+      google::protobuf::util::TimeUtil::NanosecondsToTimestamp(absl::ToUnixNanos(mesh.create_time));
+  out->set_pinned(mesh.pinned);
+  const MeshReport& report = mesh.mesh->report();
+  out->set_boundary_edges(report.boundary_edges);
+  out->set_components(report.components);
+  out->set_non_manifold_edges(report.non_manifold_edges);
+  out->set_degenerate_faces(report.degenerate_faces);
+}
+
+absl::StatusOr<SurfacePoint> ResolvePoint(const StoredMesh& mesh, const v1::SurfacePoint& point,
+                                          const std::string& field) {
+  SurfacePoint p;
+  switch (point.point_case()) {
+    case v1::SurfacePoint::kVertex:
+      if (point.vertex() >= mesh.vertex_count) {
+        return absl::InvalidArgumentError(absl::StrCat(field, ".vertex: ", point.vertex(),
+                                                       " is out of range (the mesh has ",
+                                                       mesh.vertex_count, " vertices)"));
+      }
+      return SurfacePoint::AtVertex(point.vertex());
+    case v1::SurfacePoint::kEdge: {
+      const v1::EdgePoint& e = point.edge();
+      if (!std::isfinite(e.t())) {
+        return absl::InvalidArgumentError(absl::StrCat(field, ".edge.t: must be finite"));
+      }
+      p = SurfacePoint::OnEdge(e.from(), e.to(), e.t());
+      break;
+    }
+    case v1::SurfacePoint::kFace: {
+      const v1::FacePoint& f = point.face();
+      if (!std::isfinite(f.b0()) || !std::isfinite(f.b1()) || !std::isfinite(f.b2())) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(field, ".face: barycentrics must be finite"));
+      }
+      p = SurfacePoint::InFace(f.face(), f.b0(), f.b1(), f.b2());
+      break;
+    }
+    case v1::SurfacePoint::kPosition: {
+      const v1::Position& q = point.position();
+      absl::StatusOr<LocatedPoint> located = mesh.locator->Locate({q.x(), q.y(), q.z()});
+      if (!located.ok()) {
+        return absl::InvalidArgumentError(
+            absl::StrCat(field, ".position: ", located.status().message()));
+      }
+      return located->point;
+    }
+    case v1::SurfacePoint::POINT_NOT_SET:
+      return absl::InvalidArgumentError(
+          absl::StrCat(field, ": no point set (vertex, edge, face or position)"));
+  }
+  absl::Status valid = ValidateSurfacePoint(*mesh.mesh, p);
+  if (!valid.ok()) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        field, p.kind == SurfacePoint::Kind::kEdge ? ".edge: " : ".face: ", valid.message()));
+  }
+  if (p.kind == SurfacePoint::Kind::kEdge && !HasFileEdge(*mesh.mesh, p.edge_from, p.edge_to)) {
+    return absl::InvalidArgumentError(absl::StrCat(field, ".edge: the mesh has no edge between ",
+                                                   "vertices ", p.edge_from, " and ", p.edge_to));
+  }
+  return p;
+}
+
+void SurfacePointToProto(const SurfacePoint& point, v1::SurfacePoint* out) {
+  switch (point.kind) {
+    case SurfacePoint::Kind::kVertex:
+      out->set_vertex(point.vertex);
+      break;
+    case SurfacePoint::Kind::kEdge: {
+      v1::EdgePoint* e = out->mutable_edge();
+      e->set_from(point.edge_from);
+      e->set_to(point.edge_to);
+      e->set_t(point.t);
+      break;
+    }
+    case SurfacePoint::Kind::kFace: {
+      v1::FacePoint* f = out->mutable_face();
+      f->set_face(point.face);
+      f->set_b0(point.bary[0]);
+      f->set_b1(point.bary[1]);
+      f->set_b2(point.bary[2]);
+      break;
+    }
+    case SurfacePoint::Kind::kPosition: {
+      v1::Position* q = out->mutable_position();
+      q->set_x(point.position[0]);
+      q->set_y(point.position[1]);
+      q->set_z(point.position[2]);
+      break;
+    }
+  }
+}
+
+absl::StatusOr<GeodesicOptions> SolverOptionsFromProto(const v1::SolverOptions& options,
+                                                       uint64_t max_windows,
+                                                       const std::string& field) {
+  GeodesicOptions out;
+  if (!std::isfinite(options.lambda()) || options.lambda() < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(field, ".lambda: must be finite and >= 0, got ", options.lambda()));
+  }
+  out.lambda = options.lambda();
+  switch (options.lambda_scale()) {
+    case v1::LAMBDA_SCALE_UNSPECIFIED:
+    case v1::LAMBDA_SCALE_MAX_EDGE:
+      out.lambda_scale = LambdaScale::kMaxEdge;
+      break;
+    case v1::LAMBDA_SCALE_MEAN_EDGE:
+      out.lambda_scale = LambdaScale::kMeanEdge;
+      break;
+    default:
+      return absl::InvalidArgumentError(
+          absl::StrCat(field, ".lambda_scale: unknown value ", options.lambda_scale()));
+  }
+  if (options.has_max_distance()) {
+    if (std::isnan(options.max_distance()) || options.max_distance() <= 0) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(field, ".max_distance: must be > 0, got ", options.max_distance()));
+    }
+    out.max_distance = options.max_distance();
+  }
+  out.max_windows = max_windows;
+  return out;
+}
+
+void StatsToProto(const SolveStats& stats, v1::SolveStats* out) {
+  out->set_windows_created(stats.windows_created);
+  out->set_windows_processed(stats.windows_processed);
+  out->set_windows_filtered(stats.windows_filtered_at_creation + stats.windows_filtered_at_pop);
+  out->set_pseudo_sources(stats.pseudo_sources);
+  out->set_edge_relaxations(stats.edge_relaxations);
+  out->set_max_level(stats.max_level);
+  out->set_peak_live_windows(stats.peak_live_windows);
+  out->set_peak_bytes(stats.peak_bytes);
+  out->set_solve_ms(stats.solve_ms);
+}
+
+}  // namespace geodex::server

@@ -1,0 +1,37 @@
+#pragma once
+
+// Conversions between geodex.v1 messages and core types, with input validation. Every error is
+// InvalidArgument and names the request field ("sources[2].edge.t: ...").
+
+#include <string>
+
+#include "absl/status/statusor.h"
+#include "geodex/distance_field.h"
+#include "geodex/geodesic_solver.h"
+#include "geodex/surface_point.h"
+#include "geodex/v1/geodex.pb.h"
+#include "mesh_store.h"
+
+namespace geodex::server {
+
+// "meshes/{key}" -> key (an id or an alias). `field` names the request field in errors.
+absl::StatusOr<std::string> ParseMeshName(const std::string& name, const std::string& field);
+
+// Fills a Mesh resource.
+void MeshToProto(const StoredMesh& mesh, v1::Mesh* out);
+
+// A request point as a solver-ready SurfacePoint: range-checked against the mesh; positions are
+// snapped to the surface with the mesh's locator.
+absl::StatusOr<SurfacePoint> ResolvePoint(const StoredMesh& mesh, const v1::SurfacePoint& point,
+                                          const std::string& field);
+
+void SurfacePointToProto(const SurfacePoint& point, v1::SurfacePoint* out);
+
+// Solver options (lambda, lambda_scale, max_distance); `max_windows` comes from the server limit.
+absl::StatusOr<GeodesicOptions> SolverOptionsFromProto(const v1::SolverOptions& options,
+                                                       uint64_t max_windows,
+                                                       const std::string& field);
+
+void StatsToProto(const SolveStats& stats, v1::SolveStats* out);
+
+}  // namespace geodex::server
