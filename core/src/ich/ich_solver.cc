@@ -404,7 +404,7 @@ void IchSolver::ProcessPseudoSource(uint32_t id) {
   // Sources (distance 0) and saddle/boundary vertices spawn windows; with lambda > 0 other
   // vertices only pass their distance along edges.
   const bool spawns_windows = mesh_.IsPseudoSourceCandidate(v) || w.sigma == 0;
-  if (spawns_windows && straight_through_[v] && mesh_.HasClosedFan(v)) {
+  if (spawns_windows && straight_through_[v] == 3 && mesh_.HasClosedFan(v)) {
     ++stats_.pseudo_sources_shadow_only;
     SpawnShadowWindows(id, v, w.sigma, w.source);
   } else if (spawns_windows) {
@@ -653,10 +653,26 @@ void IchSolver::ProcessInterval(uint32_t id, double popped_key) {
   // When v3's best path runs straight through it with windows continuing on both sides, those
   // windows already cover every direction within pi of the incoming ray: v3's own windows are
   // needed only in its shadow sector (see ProcessPseudoSource).
-  if (v3_improved) {
-    straight_through_[v3] = cross_x > w.b0 && cross_x < w.b1 && make_left && make_right &&
-                            mesh_.Twin(TriangleMesh::Prev(h)) != kNoIndex &&
-                            mesh_.Twin(TriangleMesh::Next(h)) != kNoIndex;
+  // On regular grids the ray to v3 often runs exactly along the boundary between two windows of
+  // the same image (a ray through an earlier vertex): each covers one side. Record the sides a
+  // window covers (bit 1: rays pass left of v3, bit 2: right); the straight continuation is
+  // complete once both sides are covered by the image that gives v3 its distance.
+  if (sees_v3 && mesh_.Twin(TriangleMesh::Prev(h)) != kNoIndex &&
+      mesh_.Twin(TriangleMesh::Next(h)) != kNoIndex) {
+    const uint8_t sides = static_cast<uint8_t>((make_left && cross_x > w.b0 ? 1 : 0) |
+                                               (make_right && cross_x < w.b1 ? 2 : 0));
+    if (v3_improved) {
+      straight_through_[v3] = sides;
+    } else {
+      // A tie with the same image on the same edge completes the other side.
+      const VertexOrigin& o = origin_[v3];
+      const double d3 = w.sigma + Hypot(x3 - w.ix, y3 - w.iy);
+      const double tol = kSplitTieRel * (d3 + len);
+      if (o.half_edge == h && std::abs(d3 - dist_[v3]) <= tol && std::abs(o.ix - w.ix) <= tol &&
+          std::abs(o.iy - w.iy) <= tol) {
+        straight_through_[v3] |= sides;
+      }
+    }
   }
 
   if (make_left) {

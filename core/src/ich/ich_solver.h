@@ -142,7 +142,9 @@ class IchSolver {
   std::vector<double> dist_;
   std::vector<uint32_t> label_;
   std::vector<VertexOrigin> origin_;
-  std::vector<uint8_t> straight_through_;  // see ProcessInterval
+  // Per vertex: which sides of its best incoming ray continue straight (bit 1 left, bit 2 right;
+  // 3 = both, see ProcessInterval). Reset whenever the vertex's distance improves.
+  std::vector<uint8_t> straight_through_;
   HugeVector<SplitOwner> owner_;
   WindowPool pool_;
   WindowQueue queue_;
