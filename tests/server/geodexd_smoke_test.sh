@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# The geodexd binary as an operator runs it: starts on 127.0.0.1 (a port it picks), reports
+# where it listens, and on SIGTERM drains and exits 0. Bounded: gives up after 30 s.
+# Env: GEODEXD (the binary).
+set -u
+pass=0
+fail=0
+check() {
+  local name="$1"
+  shift
+  if "$@"; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAIL: $name"; fi
+}
+tmp=$(mktemp -d)
+"$GEODEXD" --listen 127.0.0.1:0 --data-dir "$tmp/data" --pool_threads 1 --shutdown_grace_seconds 2 \
+  >"$tmp/log" 2>&1 &
+pid=$!
+port=""
+for _ in $(seq 1 300); do  # up to 30 s for the listening line
+  port=$(sed -n 's/.*geodexd listening on port \([0-9]*\).*/\1/p' "$tmp/log" | head -1)
+  [ -n "$port" ] && break
+  kill -0 "$pid" 2>/dev/null || break
+  sleep 0.1
+done
+check "reports a listening port" test -n "$port"
+check "the port is open on 127.0.0.1" bash -c "exec 3<>/dev/tcp/127.0.0.1/$port"
+kill -TERM "$pid"
+rc=124
+for _ in $(seq 1 300); do  # up to 30 s to drain and exit
+  if ! kill -0 "$pid" 2>/dev/null; then
+    wait "$pid"
+    rc=$?
+    break
+  fi
+  sleep 0.1
+done
+if [ "$rc" -eq 124 ]; then kill -KILL "$pid" 2>/dev/null; fi
+check "SIGTERM exits 0" test "$rc" -eq 0
+check "logs the shutdown" grep -q "shutting down" "$tmp/log"
+rm -rf "$tmp"
+echo "geodexd smoke: $pass passed, $fail failed"
+test "$fail" -eq 0
