@@ -65,30 +65,28 @@ void IchSolver::SeedVertex(uint32_t v, uint32_t label) {
   dist_[v] = 0;
   label_[v] = label;
   origin_[v] = VertexOrigin{kNoIndex, v, 0, 0};
-  const uint32_t id = pool_.Allocate();
-  Window& w = pool_[id];
-  pool_.SetKind(id, WindowKind::kPseudoSource, WindowSide::kInitial);
-  w.element = v;
-  w.sigma = 0;
-  w.b0 = w.b1 = w.ix = w.iy = 0;
-  w.pseudo_source = v;
-  w.source = label;
-  w.level = 0;
+  const uint32_t id = NewPseudoSourceWindow(v, 0, label, 0);
   ++stats_.pseudo_sources;
   Push(id, 0);
 }
 
+uint32_t IchSolver::NewPseudoSourceWindow(uint32_t vertex, double sigma, uint32_t source,
+                                          uint32_t level) {
+  const uint32_t id = pool_.Allocate();
+  Window& w = pool_[id];
+  pool_.SetKind(id, WindowKind::kPseudoSource, WindowSide::kInitial);
+  w.element = vertex;
+  w.sigma = sigma;
+  w.b0 = w.b1 = w.ix = w.iy = 0;
+  w.pseudo_source = vertex;
+  w.source = source;
+  w.level = level;
+  return id;
+}
+
 void IchSolver::SeedFacePoint(const ResolvedSource& s) {
   // A root window so the seed's children have a parent (kept for the tree's sake).
-  const uint32_t root = pool_.Allocate();
-  Window& w = pool_[root];
-  pool_.SetKind(root, WindowKind::kPseudoSource, WindowSide::kInitial);
-  w.element = kNoIndex;
-  w.sigma = 0;
-  w.b0 = w.b1 = w.ix = w.iy = 0;
-  w.pseudo_source = kNoIndex;
-  w.source = s.label;
-  w.level = 0;
+  const uint32_t root = NewPseudoSourceWindow(kNoIndex, 0, s.label, 0);
   pool_.links(root).state = WindowState::kProcessed;
   EmitFromPointInFace(root, 3 * s.face, s.px, s.py, 0, kNoIndex, s.label);
   ReleaseIfDone(root);
@@ -148,17 +146,9 @@ bool IchSolver::UpdateVertex(uint32_t v, double d, uint32_t parent, uint32_t hal
   // its distance along its edges, so it gets a (relax-only) pseudo-source window too.
   if (mesh_.IsPseudoSourceCandidate(v) || epsilon_ > 0) {
     if (d > options_.max_distance) return true;
-    const uint32_t id = pool_.Allocate();
-    const Window& pp = pool_[parent];  // re-read: Allocate may have moved the pool
-    Window& w = pool_[id];
-    pool_.SetKind(id, WindowKind::kPseudoSource, WindowSide::kInitial);
-    w.element = v;
-    w.sigma = d;
-    w.b0 = w.b1 = w.ix = w.iy = 0;
-    w.pseudo_source = v;
-    w.source = pp.source;
-    w.level = pp.level + 1;
-    stats_.max_level = std::max(stats_.max_level, w.level);
+    const uint32_t level = pool_[parent].level + 1;
+    const uint32_t id = NewPseudoSourceWindow(v, d, pool_[parent].source, level);
+    stats_.max_level = std::max(stats_.max_level, level);
     pool_.AddChild(parent, id);
     ++stats_.pseudo_sources;
     Push(id, VertexKey(v, d));
@@ -180,15 +170,7 @@ void IchSolver::RelaxNeighbors(uint32_t v, double d, uint32_t source) {
     if ((mesh_.IsPseudoSourceCandidate(u) || epsilon_ > 0) && du <= options_.max_distance) {
       // The neighbour becomes a pseudo-source of its own (a root: it does not depend on any
       // interval window's survival).
-      const uint32_t id = pool_.Allocate();
-      Window& w = pool_[id];
-      pool_.SetKind(id, WindowKind::kPseudoSource, WindowSide::kInitial);
-      w.element = u;
-      w.sigma = du;
-      w.b0 = w.b1 = w.ix = w.iy = 0;
-      w.pseudo_source = u;
-      w.source = source;
-      w.level = 0;
+      const uint32_t id = NewPseudoSourceWindow(u, du, source, 0);
       ++stats_.pseudo_sources;
       Push(id, VertexKey(u, du));
     }

@@ -74,6 +74,8 @@ class IchSolver {
 
  private:
   void SeedVertex(uint32_t v, uint32_t label);
+  // A pseudo-source window at `vertex` (kNoIndex: a source point's root), not yet queued.
+  uint32_t NewPseudoSourceWindow(uint32_t vertex, double sigma, uint32_t source, uint32_t level);
   void SeedFacePoint(const ResolvedSource& s);
   void ProcessPseudoSource(uint32_t id);
   void ProcessInterval(uint32_t id, double popped_key);
