@@ -9,9 +9,10 @@
 #include "absl/strings/str_cat.h"
 #include "geodex/cancel.h"
 #include "geodex/mesh_io.h"
-#include "geodex/shortest_path.h"
 #include "mesh_id.h"
 #include "proto_convert.h"
+#include "queries.h"
+#include "query_reactors.h"
 #include "status_convert.h"
 
 namespace geodex::server {
@@ -19,17 +20,6 @@ namespace {
 
 constexpr int kDefaultPageSize = 50;
 constexpr int kMaxPageSize = 1000;
-
-grpc::Status PoolFull(const ComputePool& pool) {
-  return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
-                      absl::StrCat("compute queue full (", pool.threads(), " workers busy, ",
-                                   pool.queue_capacity(),
-                                   " queued; --pool_threads/--queue_capacity); retry later"));
-}
-
-grpc::Status Cancelled() {
-  return grpc::Status(grpc::StatusCode::CANCELLED, "call cancelled or deadline exceeded");
-}
 
 absl::Status ValidateDisplayName(const std::string& name) {
   if (name.empty()) return absl::OkStatus();
@@ -59,19 +49,6 @@ MeshFormat FormatFromProto(v1::MeshFormat format) {
     default:
       return MeshFormat::kAuto;
   }
-}
-
-// Looks up the request's mesh: InvalidArgument for a malformed name, NotFound for an unknown one.
-absl::StatusOr<std::shared_ptr<const StoredMesh>> LookupMesh(MeshStore& store,
-                                                             const std::string& name,
-                                                             const std::string& field) {
-  absl::StatusOr<std::string> key = ParseMeshName(name, field);
-  if (!key.ok()) return key.status();
-  absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh = store.Get(*key);
-  if (!mesh.ok()) {
-    return absl::NotFoundError(absl::StrCat(field, ": mesh \"", name, "\" not found"));
-  }
-  return mesh;
 }
 
 // ------------------------------------------------------------------------------------------
@@ -139,7 +116,7 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<v1::CreateMeshReq
 
   void EndOfUpload() {
     if (context_->IsCancelled()) {
-      Finish(Cancelled());
+      Finish(CancelledStatus());
       return;
     }
     if (!have_metadata_) {
@@ -147,13 +124,13 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<v1::CreateMeshReq
                           "metadata: the upload stream was empty"));
       return;
     }
-    if (!service_->pool()->TrySubmit([this] { Build(); })) Finish(PoolFull(*service_->pool()));
+    if (!service_->pool()->TrySubmit([this] { Build(); })) Finish(PoolFullStatus(*service_->pool()));
   }
 
   // On the pool.
   void Build() {
     if (cancel_.IsCancelled()) {
-      Finish(Cancelled());
+      Finish(CancelledStatus());
       return;
     }
     Finish(ToGrpcStatus(BuildAndStore()));
@@ -220,200 +197,6 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<v1::CreateMeshReq
   CancelToken cancel_;
 };
 
-// ------------------------------------------------------------------------------------------
-// ComputeDistanceField: solves on the pool, then streams chunks (each StartWrite after the
-// previous write completed).
-class DistanceFieldReactor final
-    : public grpc::ServerWriteReactor<v1::ComputeDistanceFieldResponse> {
- public:
-  DistanceFieldReactor(GeodexService* service, const v1::ComputeDistanceFieldRequest* request)
-      : service_(service), request_(request) {}
-
-  void Start() {
-    if (!service_->pool()->TrySubmit([this] { Solve(); })) Finish(PoolFull(*service_->pool()));
-  }
-
-  void OnWriteDone(bool ok) override {
-    if (!ok) {
-      Finish(Cancelled());
-      return;
-    }
-    WriteNext();
-  }
-  void OnCancel() override { cancel_.Cancel(); }
-  void OnDone() override { delete this; }
-
- private:
-  // On the pool.
-  void Solve() {
-    if (cancel_.IsCancelled()) {
-      Finish(Cancelled());
-      return;
-    }
-    absl::Status status = Compute();
-    if (!status.ok()) {
-      Finish(ToGrpcStatus(status));
-      return;
-    }
-    WriteNext();
-  }
-
-  absl::Status Compute() {
-    const ServiceLimits& limits = service_->limits();
-    absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh =
-        LookupMesh(*service_->store(), request_->mesh(), "mesh");
-    if (!mesh.ok()) return mesh.status();
-    if (request_->sources_size() == 0) {
-      return absl::InvalidArgumentError("sources: at least one source is required");
-    }
-    if (static_cast<uint64_t>(request_->sources_size()) > limits.max_sources) {
-      return absl::ResourceExhaustedError(absl::StrCat("sources: ", request_->sources_size(),
-                                                       " sources, over --max_sources=",
-                                                       limits.max_sources));
-    }
-    if ((*mesh)->vertex_count > limits.max_output_values) {
-      return absl::ResourceExhaustedError(
-          absl::StrCat("the field has ", (*mesh)->vertex_count,
-                       " values, over --max_output_values=", limits.max_output_values));
-    }
-    if (!v1::ValueType_IsValid(request_->value_type())) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("value_type: unknown value ", request_->value_type()));
-    }
-    std::vector<SurfacePoint> sources;
-    sources.reserve(request_->sources_size());
-    for (int i = 0; i < request_->sources_size(); ++i) {
-      absl::StatusOr<SurfacePoint> p =
-          ResolvePoint(**mesh, request_->sources(i), absl::StrCat("sources[", i, "]"));
-      if (!p.ok()) return p.status();
-      sources.push_back(*p);
-    }
-    absl::StatusOr<GeodesicOptions> options =
-        SolverOptionsFromProto(request_->options(), limits.max_windows, "options");
-    if (!options.ok()) return options.status();
-    options->cancel = &cancel_;
-    absl::StatusOr<DistanceField> field = ComputeDistanceField(*(*mesh)->mesh, sources, *options);
-    if (!field.ok()) {
-      if (field.status().code() == absl::StatusCode::kInvalidArgument) {
-        return absl::InvalidArgumentError(absl::StrCat("sources: ", field.status().message()));
-      }
-      return field.status();
-    }
-    distances_ = std::move(field->distance);
-    if (!request_->omit_labels()) labels_ = std::move(field->source);
-    stats_ = field->stats;
-    sources_ = std::move(sources);
-    return absl::OkStatus();
-  }
-
-  void WriteNext() {
-    const size_t n = distances_.size();
-    if (started_ && next_ >= n) {
-      Finish(grpc::Status::OK);
-      return;
-    }
-    response_.Clear();
-    response_.set_vertex_count(n);
-    response_.set_offset(next_);
-    if (!started_) {
-      for (const SurfacePoint& p : sources_) SurfacePointToProto(p, response_.add_resolved_sources());
-    }
-    const size_t end = std::min(n, next_ + std::max<size_t>(1, service_->limits().field_chunk_values));
-    if (request_->value_type() == v1::VALUE_TYPE_FLOAT32) {
-      auto* out = response_.mutable_distances_f32();
-      out->Reserve(static_cast<int>(end - next_));
-      for (size_t i = next_; i < end; ++i) out->AddAlreadyReserved(static_cast<float>(distances_[i]));
-    } else {
-      response_.mutable_distances_f64()->Add(distances_.begin() + next_, distances_.begin() + end);
-    }
-    if (!labels_.empty()) {
-      response_.mutable_labels()->Add(labels_.begin() + next_, labels_.begin() + end);
-    }
-    if (end == n && request_->want_stats()) StatsToProto(stats_, response_.mutable_stats());
-    started_ = true;
-    next_ = end;
-    StartWrite(&response_);
-  }
-
-  GeodexService* service_;
-  const v1::ComputeDistanceFieldRequest* request_;
-  CancelToken cancel_;
-  std::vector<double> distances_;
-  std::vector<uint32_t> labels_;
-  std::vector<SurfacePoint> sources_;
-  SolveStats stats_;
-  size_t next_ = 0;
-  bool started_ = false;
-  v1::ComputeDistanceFieldResponse response_;
-};
-
-// ------------------------------------------------------------------------------------------
-// FindShortestPath: one solve on the pool.
-class ShortestPathReactor final : public grpc::ServerUnaryReactor {
- public:
-  ShortestPathReactor(GeodexService* service, const v1::FindShortestPathRequest* request,
-                      v1::FindShortestPathResponse* response)
-      : service_(service), request_(request), response_(response) {}
-
-  void Start() {
-    if (!service_->pool()->TrySubmit([this] { Solve(); })) Finish(PoolFull(*service_->pool()));
-  }
-  void OnCancel() override { cancel_.Cancel(); }
-  void OnDone() override { delete this; }
-
- private:
-  void Solve() {
-    if (cancel_.IsCancelled()) {
-      Finish(Cancelled());
-      return;
-    }
-    Finish(ToGrpcStatus(Compute()));
-  }
-
-  absl::Status Compute() {
-    absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh =
-        LookupMesh(*service_->store(), request_->mesh(), "mesh");
-    if (!mesh.ok()) return mesh.status();
-    absl::StatusOr<SurfacePoint> from = ResolvePoint(**mesh, request_->from(), "from");
-    if (!from.ok()) return from.status();
-    absl::StatusOr<SurfacePoint> to = ResolvePoint(**mesh, request_->to(), "to");
-    if (!to.ok()) return to.status();
-    PathQueryOptions options;
-    absl::StatusOr<GeodesicOptions> solver =
-        SolverOptionsFromProto(request_->options(), service_->limits().max_windows, "options");
-    if (!solver.ok()) return solver.status();
-    options.solver = *solver;
-    options.solver.cancel = &cancel_;
-    absl::StatusOr<PathQueryResult> result =
-        ComputeShortestPath(*(*mesh)->mesh, *from, *to, options);
-    if (!result.ok()) {
-      if (result.status().code() == absl::StatusCode::kInvalidArgument) {
-        return absl::InvalidArgumentError(absl::StrCat("from/to: ", result.status().message()));
-      }
-      if (result.status().code() == absl::StatusCode::kNotFound) {
-        return absl::NotFoundError(absl::StrCat("to: unreachable from `from` (",
-                                                result.status().message(), ")"));
-      }
-      return result.status();
-    }
-    response_->set_distance(result->distance);
-    for (const PathPoint& p : result->path.points) {
-      v1::PathPoint* out = response_->add_points();
-      out->mutable_position()->set_x(p.position[0]);
-      out->mutable_position()->set_y(p.position[1]);
-      out->mutable_position()->set_z(p.position[2]);
-      SurfacePointToProto(p.where, out->mutable_where());
-    }
-    if (request_->want_stats()) StatsToProto(result->stats, response_->mutable_stats());
-    return absl::OkStatus();
-  }
-
-  GeodexService* service_;
-  const v1::FindShortestPathRequest* request_;
-  v1::FindShortestPathResponse* response_;
-  CancelToken cancel_;
-};
-
 }  // namespace
 
 grpc::ServerReadReactor<v1::CreateMeshRequest>* GeodexService::CreateMesh(
@@ -474,19 +257,56 @@ grpc::ServerUnaryReactor* GeodexService::DeleteMesh(grpc::CallbackServerContext*
   return reactor;
 }
 
+// Queries: the reactor templates run the query functions of queries.cc on the pool.
 grpc::ServerWriteReactor<v1::ComputeDistanceFieldResponse>* GeodexService::ComputeDistanceField(
     grpc::CallbackServerContext* /*context*/, const v1::ComputeDistanceFieldRequest* request) {
-  auto* reactor = new DistanceFieldReactor(this, request);
-  reactor->Start();
-  return reactor;
+  return StreamQueryReactor<v1::ComputeDistanceFieldRequest, v1::ComputeDistanceFieldResponse>::
+      Start(env(), &RunComputeDistanceField, request);
 }
 
 grpc::ServerUnaryReactor* GeodexService::FindShortestPath(
     grpc::CallbackServerContext* /*context*/, const v1::FindShortestPathRequest* request,
     v1::FindShortestPathResponse* response) {
-  auto* reactor = new ShortestPathReactor(this, request, response);
-  reactor->Start();
-  return reactor;
+  return UnaryQueryReactor<v1::FindShortestPathRequest, v1::FindShortestPathResponse>::Start(
+      env(), &RunFindShortestPath, request, response);
+}
+
+grpc::ServerWriteReactor<v1::ComputeDistanceMatrixResponse>* GeodexService::ComputeDistanceMatrix(
+    grpc::CallbackServerContext* /*context*/, const v1::ComputeDistanceMatrixRequest* request) {
+  return StreamQueryReactor<v1::ComputeDistanceMatrixRequest, v1::ComputeDistanceMatrixResponse>::
+      Start(env(), &RunComputeDistanceMatrix, request);
+}
+
+grpc::ServerUnaryReactor* GeodexService::EstimateDistances(
+    grpc::CallbackServerContext* /*context*/, const v1::EstimateDistancesRequest* request,
+    v1::EstimateDistancesResponse* response) {
+  return UnaryQueryReactor<v1::EstimateDistancesRequest, v1::EstimateDistancesResponse>::Start(
+      env(), &RunEstimateDistances, request, response);
+}
+
+grpc::ServerUnaryReactor* GeodexService::LocatePoints(grpc::CallbackServerContext* /*context*/,
+                                                      const v1::LocatePointsRequest* request,
+                                                      v1::LocatePointsResponse* response) {
+  return UnaryQueryReactor<v1::LocatePointsRequest, v1::LocatePointsResponse>::Start(
+      env(), &RunLocatePoints, request, response);
+}
+
+grpc::ServerWriteReactor<v1::ComputeIsolinesResponse>* GeodexService::ComputeIsolines(
+    grpc::CallbackServerContext* /*context*/, const v1::ComputeIsolinesRequest* request) {
+  return StreamQueryReactor<v1::ComputeIsolinesRequest, v1::ComputeIsolinesResponse>::Start(
+      env(), &RunComputeIsolines, request);
+}
+
+grpc::ServerWriteReactor<v1::ComputeVoronoiResponse>* GeodexService::ComputeVoronoi(
+    grpc::CallbackServerContext* /*context*/, const v1::ComputeVoronoiRequest* request) {
+  return StreamQueryReactor<v1::ComputeVoronoiRequest, v1::ComputeVoronoiResponse>::Start(
+      env(), &RunComputeVoronoi, request);
+}
+
+grpc::ServerWriteReactor<v1::ComputeDelaunayResponse>* GeodexService::ComputeDelaunay(
+    grpc::CallbackServerContext* /*context*/, const v1::ComputeDelaunayRequest* request) {
+  return StreamQueryReactor<v1::ComputeDelaunayRequest, v1::ComputeDelaunayResponse>::Start(
+      env(), &RunComputeDelaunay, request);
 }
 
 }  // namespace geodex::server

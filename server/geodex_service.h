@@ -10,20 +10,10 @@
 #include "compute_pool.h"
 #include "geodex/v1/geodex.grpc.pb.h"
 #include "mesh_store.h"
+#include "query_reactors.h"
+#include "service_limits.h"
 
 namespace geodex::server {
-
-// Request limits (all are geodexd flags; see geodexd_main.cc). Exceeding one answers
-// RESOURCE_EXHAUSTED naming the flag.
-struct ServiceLimits {
-  uint64_t max_upload_bytes = uint64_t{1} << 30;  // --max_upload_bytes
-  uint64_t max_vertices = 20'000'000;              // --max_vertices
-  uint64_t max_faces = 40'000'000;                 // --max_faces
-  uint32_t max_sources = 100'000;                  // --max_sources
-  uint64_t max_output_values = 100'000'000;        // --max_output_values
-  uint64_t max_windows = 0;                        // --max_windows (per solve; 0 = unlimited)
-  uint32_t field_chunk_values = 131'072;           // values per streamed chunk (~1.5 MiB)
-};
 
 class GeodexService final : public v1::Geodex::CallbackService {
  public:
@@ -49,12 +39,29 @@ class GeodexService final : public v1::Geodex::CallbackService {
   grpc::ServerUnaryReactor* FindShortestPath(grpc::CallbackServerContext* context,
                                              const v1::FindShortestPathRequest* request,
                                              v1::FindShortestPathResponse* response) override;
+  grpc::ServerWriteReactor<v1::ComputeDistanceMatrixResponse>* ComputeDistanceMatrix(
+      grpc::CallbackServerContext* context,
+      const v1::ComputeDistanceMatrixRequest* request) override;
+  grpc::ServerUnaryReactor* EstimateDistances(grpc::CallbackServerContext* context,
+                                              const v1::EstimateDistancesRequest* request,
+                                              v1::EstimateDistancesResponse* response) override;
+  grpc::ServerUnaryReactor* LocatePoints(grpc::CallbackServerContext* context,
+                                         const v1::LocatePointsRequest* request,
+                                         v1::LocatePointsResponse* response) override;
+  grpc::ServerWriteReactor<v1::ComputeIsolinesResponse>* ComputeIsolines(
+      grpc::CallbackServerContext* context, const v1::ComputeIsolinesRequest* request) override;
+  grpc::ServerWriteReactor<v1::ComputeVoronoiResponse>* ComputeVoronoi(
+      grpc::CallbackServerContext* context, const v1::ComputeVoronoiRequest* request) override;
+  grpc::ServerWriteReactor<v1::ComputeDelaunayResponse>* ComputeDelaunay(
+      grpc::CallbackServerContext* context, const v1::ComputeDelaunayRequest* request) override;
 
   MeshStore* store() const { return store_; }
   ComputePool* pool() const { return pool_; }
   const ServiceLimits& limits() const { return limits_; }
 
  private:
+  ReactorEnv env() { return ReactorEnv{store_, &limits_, pool_}; }
+
   MeshStore* store_;
   ComputePool* pool_;
   ServiceLimits limits_;

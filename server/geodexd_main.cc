@@ -29,7 +29,14 @@ ABSL_FLAG(uint64_t, max_upload_bytes, uint64_t{1} << 30, "Largest mesh file acce
 ABSL_FLAG(uint64_t, max_vertices, 20'000'000, "Most vertices in an uploaded mesh");
 ABSL_FLAG(uint64_t, max_faces, 40'000'000, "Most faces in an uploaded mesh");
 ABSL_FLAG(uint32_t, max_sources, 100'000, "Most sources in one query");
-ABSL_FLAG(uint64_t, max_output_values, 100'000'000, "Most values one query may return");
+ABSL_FLAG(uint32_t, max_targets, 50'000,
+          "Most targets (matrix columns, EstimateDistances points, LocatePoints positions) per query");
+ABSL_FLAG(uint32_t, max_levels, 1'000, "Most isoline levels per ComputeIsolines query");
+ABSL_FLAG(uint64_t, max_output_values, 100'000'000,
+          "Most values one query may return (field vertices, matrix cells)");
+ABSL_FLAG(uint64_t, max_unary_response_bytes, 4 << 20,
+          "Largest unary response (clients keep gRPC's default 4 MiB receive limit)");
+ABSL_FLAG(uint32_t, stream_chunk_bytes, 1 << 20, "Approximate size of one streamed result message");
 ABSL_FLAG(uint64_t, max_windows, 0, "Window budget per solve (0 = unlimited)");
 ABSL_FLAG(int32_t, max_receive_message_bytes, 4 << 20,
           "Largest single request message (uploads are chunked below this)");
@@ -83,7 +90,11 @@ int main(int argc, char** argv) {
   options.limits.max_vertices = absl::GetFlag(FLAGS_max_vertices);
   options.limits.max_faces = absl::GetFlag(FLAGS_max_faces);
   options.limits.max_sources = absl::GetFlag(FLAGS_max_sources);
+  options.limits.max_targets = absl::GetFlag(FLAGS_max_targets);
+  options.limits.max_levels = absl::GetFlag(FLAGS_max_levels);
   options.limits.max_output_values = absl::GetFlag(FLAGS_max_output_values);
+  options.limits.max_unary_response_bytes = absl::GetFlag(FLAGS_max_unary_response_bytes);
+  options.limits.stream_chunk_bytes = absl::GetFlag(FLAGS_stream_chunk_bytes);
   options.limits.max_windows = absl::GetFlag(FLAGS_max_windows);
   if (!options.data_dir.empty()) {
     spdlog::warn("--data-dir {}: persistence is not implemented yet; meshes live in RAM only",

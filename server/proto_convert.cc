@@ -138,6 +138,17 @@ void SurfacePointToProto(const SurfacePoint& point, v1::SurfacePoint* out) {
   }
 }
 
+void PositionToProto(const std::array<double, 3>& position, v1::Position* out) {
+  out->set_x(position[0]);
+  out->set_y(position[1]);
+  out->set_z(position[2]);
+}
+
+void PathPointToProto(const PathPoint& point, v1::PathPoint* out) {
+  PositionToProto(point.position, out->mutable_position());
+  SurfacePointToProto(point.where, out->mutable_where());
+}
+
 absl::StatusOr<GeodesicOptions> SolverOptionsFromProto(const v1::SolverOptions& options,
                                                        uint64_t max_windows,
                                                        const std::string& field) {

@@ -3,11 +3,13 @@
 // Conversions between geodex.v1 messages and core types, with input validation. Every error is
 // InvalidArgument and names the request field ("sources[2].edge.t: ...").
 
+#include <array>
 #include <string>
 
 #include "absl/status/statusor.h"
 #include "geodex/distance_field.h"
 #include "geodex/geodesic_solver.h"
+#include "geodex/shortest_path.h"
 #include "geodex/surface_point.h"
 #include "geodex/v1/geodex.pb.h"
 #include "mesh_store.h"
@@ -26,6 +28,8 @@ absl::StatusOr<SurfacePoint> ResolvePoint(const StoredMesh& mesh, const v1::Surf
                                           const std::string& field);
 
 void SurfacePointToProto(const SurfacePoint& point, v1::SurfacePoint* out);
+void PositionToProto(const std::array<double, 3>& position, v1::Position* out);
+void PathPointToProto(const PathPoint& point, v1::PathPoint* out);
 
 // Solver options (lambda, lambda_scale, max_distance); `max_windows` comes from the server limit.
 absl::StatusOr<GeodesicOptions> SolverOptionsFromProto(const v1::SolverOptions& options,

@@ -171,7 +171,8 @@ absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
 
 absl::StatusOr<std::vector<std::pair<double, uint32_t>>> ComputeExactDistancesAt(
     const TriangleMesh& mesh, const std::vector<SurfacePoint>& sources,
-    const std::vector<SurfacePoint>& points, const GeodesicOptions& options) {
+    const std::vector<SurfacePoint>& points, const GeodesicOptions& options,
+    SolveStats* stats_out) {
   if (absl::Status s = CheckOptions(options); !s.ok()) return s;
   absl::StatusOr<std::vector<ich::ResolvedSource>> src = ResolveSources(mesh, sources);
   if (!src.ok()) return src.status();
@@ -185,6 +186,7 @@ absl::StatusOr<std::vector<std::pair<double, uint32_t>>> ComputeExactDistancesAt
   }
   std::vector<std::pair<double, uint32_t>> out;
   for (const ich::TargetResult& r : results) out.push_back({r.distance, r.label});
+  if (stats_out != nullptr) *stats_out = stats;
   return out;
 }
 

@@ -27,9 +27,11 @@ absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
                                                      const GeodesicOptions& options = {});
 
 // Exact distances from the nearest of `sources` to each of `points`, with the nearest source's
-// index: one multi-source solve that stops once every point's distance is final.
+// index: one multi-source solve that stops once every point's distance is final. `stats`, when
+// given, receives the solve's counters.
 absl::StatusOr<std::vector<std::pair<double, uint32_t>>> ComputeExactDistancesAt(
     const TriangleMesh& mesh, const std::vector<SurfacePoint>& sources,
-    const std::vector<SurfacePoint>& points, const GeodesicOptions& options = {});
+    const std::vector<SurfacePoint>& points, const GeodesicOptions& options = {},
+    SolveStats* stats = nullptr);
 
 }  // namespace geodex

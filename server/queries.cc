@@ -1,0 +1,524 @@
+#include "queries.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "geodex/delaunay.h"
+#include "geodex/distance_matrix.h"
+#include "geodex/geodesic_solver.h"
+#include "geodex/isolines.h"
+#include "geodex/point_distance.h"
+#include "geodex/shortest_path.h"
+#include "geodex/voronoi.h"
+#include "proto_convert.h"
+#include "service_limits.h"
+
+namespace geodex::server {
+namespace {
+
+using PointList = google::protobuf::RepeatedPtrField<v1::SurfacePoint>;
+
+// Resolves a list of request points (sources or targets) after checking its size against a limit.
+absl::StatusOr<std::vector<SurfacePoint>> ResolvePoints(const StoredMesh& mesh,
+                                                        const PointList& points,
+                                                        const std::string& field, uint64_t limit,
+                                                        const char* flag) {
+  if (points.empty()) {
+    return absl::InvalidArgumentError(absl::StrCat(field, ": at least one point is required"));
+  }
+  if (static_cast<uint64_t>(points.size()) > limit) {
+    return absl::ResourceExhaustedError(
+        absl::StrCat(field, ": ", points.size(), " points, over --", flag, "=", limit));
+  }
+  std::vector<SurfacePoint> out;
+  out.reserve(points.size());
+  for (int i = 0; i < points.size(); ++i) {
+    absl::StatusOr<SurfacePoint> p = ResolvePoint(mesh, points[i], absl::StrCat(field, "[", i, "]"));
+    if (!p.ok()) return p.status();
+    out.push_back(*p);
+  }
+  return out;
+}
+
+absl::StatusOr<std::vector<SurfacePoint>> ResolveSources(const QueryEnv& env,
+                                                         const StoredMesh& mesh,
+                                                         const PointList& sources) {
+  return ResolvePoints(mesh, sources, "sources", env.limits->max_sources, "max_sources");
+}
+
+absl::StatusOr<GeodesicOptions> Options(const QueryEnv& env, const v1::SolverOptions& options) {
+  absl::StatusOr<GeodesicOptions> out =
+      SolverOptionsFromProto(options, env.limits->max_windows, "options");
+  if (out.ok()) out->cancel = env.cancel;
+  return out;
+}
+
+// Core's InvalidArgument from a solve concerns the points (e.g. two sources on one vertex of
+// different components is fine, but a point on a degenerate face is not): name the field.
+absl::Status NameSolveError(const absl::Status& status, const char* field) {
+  if (status.code() == absl::StatusCode::kInvalidArgument) {
+    return absl::InvalidArgumentError(absl::StrCat(field, ": ", status.message()));
+  }
+  return status;
+}
+
+absl::Status CheckFieldSize(const QueryEnv& env, const StoredMesh& mesh) {
+  if (mesh.vertex_count > env.limits->max_output_values) {
+    return absl::ResourceExhaustedError(absl::StrCat("the field has ", mesh.vertex_count,
+                                                     " values, over --max_output_values=",
+                                                     env.limits->max_output_values));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status CheckUnaryResponseSize(const QueryEnv& env, const google::protobuf::Message& response,
+                                    const char* what) {
+  const size_t bytes = response.ByteSizeLong();
+  if (bytes > env.limits->max_unary_response_bytes) {
+    return absl::ResourceExhaustedError(absl::StrCat(
+        "the response would be ", bytes, " bytes, over --max_unary_response_bytes=",
+        env.limits->max_unary_response_bytes, "; send fewer ", what, " per call"));
+  }
+  return absl::OkStatus();
+}
+
+// The field behind isolines, Voronoi and Delaunay.
+struct SolvedField {
+  std::shared_ptr<const StoredMesh> mesh;  // keeps the mesh alive while the result is built
+  std::vector<SurfacePoint> sources;
+  DistanceField field;
+};
+
+absl::StatusOr<SolvedField> SolveField(const QueryEnv& env, const std::string& mesh_name,
+                                       const PointList& sources,
+                                       const v1::SolverOptions& options) {
+  SolvedField out;
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh =
+      LookupMesh(*env.store, mesh_name, "mesh");
+  if (!mesh.ok()) return mesh.status();
+  out.mesh = *std::move(mesh);
+  if (absl::Status s = CheckFieldSize(env, *out.mesh); !s.ok()) return s;
+  absl::StatusOr<std::vector<SurfacePoint>> resolved = ResolveSources(env, *out.mesh, sources);
+  if (!resolved.ok()) return resolved.status();
+  out.sources = *std::move(resolved);
+  absl::StatusOr<GeodesicOptions> solver = Options(env, options);
+  if (!solver.ok()) return solver.status();
+  absl::StatusOr<DistanceField> field =
+      ComputeDistanceField(*out.mesh->mesh, out.sources, *solver);
+  if (!field.ok()) return NameSolveError(field.status(), "sources");
+  out.field = *std::move(field);
+  return out;
+}
+
+}  // namespace
+
+absl::StatusOr<std::shared_ptr<const StoredMesh>> LookupMesh(MeshStore& store,
+                                                             const std::string& name,
+                                                             const std::string& field) {
+  absl::StatusOr<std::string> key = ParseMeshName(name, field);
+  if (!key.ok()) return key.status();
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh = store.Get(*key);
+  if (!mesh.ok()) {
+    return absl::NotFoundError(absl::StrCat(field, ": mesh \"", name, "\" not found"));
+  }
+  return mesh;
+}
+
+// ------------------------------------------------------------------------------------------
+// Unary queries
+
+absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPathRequest& request,
+                                 v1::FindShortestPathResponse* response) {
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh =
+      LookupMesh(*env.store, request.mesh(), "mesh");
+  if (!mesh.ok()) return mesh.status();
+  absl::StatusOr<SurfacePoint> from = ResolvePoint(**mesh, request.from(), "from");
+  if (!from.ok()) return from.status();
+  absl::StatusOr<SurfacePoint> to = ResolvePoint(**mesh, request.to(), "to");
+  if (!to.ok()) return to.status();
+  absl::StatusOr<GeodesicOptions> solver = Options(env, request.options());
+  if (!solver.ok()) return solver.status();
+  PathQueryOptions options;
+  options.solver = *solver;
+  absl::StatusOr<PathQueryResult> result = ComputeShortestPath(*(*mesh)->mesh, *from, *to, options);
+  if (!result.ok()) {
+    if (result.status().code() == absl::StatusCode::kNotFound) {
+      return absl::NotFoundError(
+          absl::StrCat("to: unreachable from `from` (", result.status().message(), ")"));
+    }
+    return NameSolveError(result.status(), "from/to");
+  }
+  response->set_distance(result->distance);
+  for (const PathPoint& p : result->path.points) PathPointToProto(p, response->add_points());
+  if (request.want_stats()) StatsToProto(result->stats, response->mutable_stats());
+  return CheckUnaryResponseSize(env, *response, "paths");
+}
+
+absl::Status RunEstimateDistances(const QueryEnv& env, const v1::EstimateDistancesRequest& request,
+                                  v1::EstimateDistancesResponse* response) {
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh =
+      LookupMesh(*env.store, request.mesh(), "mesh");
+  if (!mesh.ok()) return mesh.status();
+  const TriangleMesh& tm = *(*mesh)->mesh;
+  absl::StatusOr<std::vector<SurfacePoint>> sources =
+      ResolveSources(env, **mesh, request.sources());
+  if (!sources.ok()) return sources.status();
+  absl::StatusOr<std::vector<SurfacePoint>> points =
+      ResolvePoints(**mesh, request.points(), "points", env.limits->max_targets, "max_targets");
+  if (!points.ok()) return points.status();
+  if (!v1::PointDistanceMode_IsValid(request.mode())) {
+    return absl::InvalidArgumentError(absl::StrCat("mode: unknown value ", request.mode()));
+  }
+  const bool estimate = request.mode() != v1::POINT_DISTANCE_MODE_EXACT;
+  const bool exact = request.mode() == v1::POINT_DISTANCE_MODE_EXACT ||
+                     request.mode() == v1::POINT_DISTANCE_MODE_BOTH;
+  absl::StatusOr<GeodesicOptions> solver = Options(env, request.options());
+  if (!solver.ok()) return solver.status();
+  if (estimate) {
+    absl::StatusOr<DistanceField> field = ComputeDistanceField(tm, *sources, *solver);
+    if (!field.ok()) return NameSolveError(field.status(), "sources");
+    for (size_t i = 0; i < points->size(); ++i) {
+      absl::StatusOr<PointEstimate> e = EstimateDistanceAt(tm, *field, (*points)[i]);
+      if (!e.ok()) return NameSolveError(e.status(), "points");
+      response->add_estimates(e->distance);
+      response->add_estimate_labels(e->source);
+    }
+    if (request.want_stats()) StatsToProto(field->stats, response->mutable_estimate_stats());
+  }
+  if (exact) {
+    SolveStats stats;
+    absl::StatusOr<std::vector<std::pair<double, uint32_t>>> values =
+        ComputeExactDistancesAt(tm, *sources, *points, *solver, &stats);
+    if (!values.ok()) return NameSolveError(values.status(), "points");
+    for (const auto& [distance, label] : *values) {
+      response->add_exact(distance);
+      response->add_exact_labels(label);
+    }
+    if (request.want_stats()) StatsToProto(stats, response->mutable_exact_stats());
+  }
+  return CheckUnaryResponseSize(env, *response, "points");
+}
+
+absl::Status RunLocatePoints(const QueryEnv& env, const v1::LocatePointsRequest& request,
+                             v1::LocatePointsResponse* response) {
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh =
+      LookupMesh(*env.store, request.mesh(), "mesh");
+  if (!mesh.ok()) return mesh.status();
+  if (request.positions().empty()) {
+    return absl::InvalidArgumentError("positions: at least one position is required");
+  }
+  if (static_cast<uint64_t>(request.positions_size()) > env.limits->max_targets) {
+    return absl::ResourceExhaustedError(absl::StrCat("positions: ", request.positions_size(),
+                                                     " points, over --max_targets=",
+                                                     env.limits->max_targets));
+  }
+  for (int i = 0; i < request.positions_size(); ++i) {
+    if ((i & 1023) == 0 && env.cancel->IsCancelled()) return absl::CancelledError("cancelled");
+    const v1::Position& q = request.positions(i);
+    absl::StatusOr<LocatedPoint> located = (*mesh)->locator->Locate({q.x(), q.y(), q.z()});
+    if (!located.ok()) {
+      return absl::Status(located.status().code(),
+                          absl::StrCat("positions[", i, "]: ", located.status().message()));
+    }
+    v1::LocatedPoint* out = response->add_points();
+    SurfacePointToProto(located->point, out->mutable_point());
+    PositionToProto(located->position, out->mutable_position());
+    out->set_distance(located->distance);
+  }
+  return CheckUnaryResponseSize(env, *response, "positions");
+}
+
+// ------------------------------------------------------------------------------------------
+// Streamed queries
+
+absl::StatusOr<MessageProducer<v1::ComputeDistanceFieldResponse>> RunComputeDistanceField(
+    const QueryEnv& env, const v1::ComputeDistanceFieldRequest& request) {
+  if (!v1::ValueType_IsValid(request.value_type())) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("value_type: unknown value ", request.value_type()));
+  }
+  absl::StatusOr<SolvedField> solved =
+      SolveField(env, request.mesh(), request.sources(), request.options());
+  if (!solved.ok()) return solved.status();
+
+  // Produced lazily from the field: no second copy of a large result.
+  struct State {
+    std::vector<double> distances;
+    std::vector<uint32_t> labels;
+    std::vector<SurfacePoint> sources;
+    SolveStats stats;
+    size_t next = 0;
+    bool started = false;
+  };
+  auto state = std::make_shared<State>();
+  state->distances = std::move(solved->field.distance);
+  if (!request.omit_labels()) state->labels = std::move(solved->field.source);
+  state->stats = solved->field.stats;
+  state->sources = std::move(solved->sources);
+  const bool f32 = request.value_type() == v1::VALUE_TYPE_FLOAT32;
+  const bool want_stats = request.want_stats();
+  const size_t bytes_per_value = (f32 ? 4 : 8) + (state->labels.empty() ? 0 : 4);
+  const size_t chunk = std::max<size_t>(1, env.limits->stream_chunk_bytes / bytes_per_value);
+  return MessageProducer<v1::ComputeDistanceFieldResponse>(
+      [state, f32, want_stats, chunk](v1::ComputeDistanceFieldResponse* out) {
+        const size_t n = state->distances.size();
+        if (state->started && state->next >= n) return false;
+        out->set_vertex_count(n);
+        out->set_offset(state->next);
+        if (!state->started) {
+          for (const SurfacePoint& p : state->sources) {
+            SurfacePointToProto(p, out->add_resolved_sources());
+          }
+        }
+        const size_t begin = state->next, end = std::min(n, begin + chunk);
+        if (f32) {
+          auto* values = out->mutable_distances_f32();
+          values->Reserve(static_cast<int>(end - begin));
+          for (size_t i = begin; i < end; ++i) {
+            values->AddAlreadyReserved(static_cast<float>(state->distances[i]));
+          }
+        } else {
+          out->mutable_distances_f64()->Add(state->distances.begin() + begin,
+                                            state->distances.begin() + end);
+        }
+        if (!state->labels.empty()) {
+          out->mutable_labels()->Add(state->labels.begin() + begin, state->labels.begin() + end);
+        }
+        if (end == n && want_stats) StatsToProto(state->stats, out->mutable_stats());
+        state->started = true;
+        state->next = end;
+        return true;
+      });
+}
+
+absl::StatusOr<MessageProducer<v1::ComputeDistanceMatrixResponse>> RunComputeDistanceMatrix(
+    const QueryEnv& env, const v1::ComputeDistanceMatrixRequest& request) {
+  if (!v1::ValueType_IsValid(request.value_type())) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("value_type: unknown value ", request.value_type()));
+  }
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh =
+      LookupMesh(*env.store, request.mesh(), "mesh");
+  if (!mesh.ok()) return mesh.status();
+  absl::StatusOr<std::vector<SurfacePoint>> sources =
+      ResolveSources(env, **mesh, request.sources());
+  if (!sources.ok()) return sources.status();
+  absl::StatusOr<std::vector<SurfacePoint>> targets =
+      ResolvePoints(**mesh, request.targets(), "targets", env.limits->max_targets, "max_targets");
+  if (!targets.ok()) return targets.status();
+  const uint64_t values = uint64_t{sources->size()} * targets->size();
+  if (values > env.limits->max_output_values) {
+    return absl::ResourceExhaustedError(
+        absl::StrCat("the matrix has ", sources->size(), " x ", targets->size(), " = ", values,
+                     " values, over --max_output_values=", env.limits->max_output_values));
+  }
+  absl::StatusOr<GeodesicOptions> solver = Options(env, request.options());
+  if (!solver.ok()) return solver.status();
+  absl::StatusOr<DistanceMatrix> matrix =
+      ComputeDistanceMatrix(*(*mesh)->mesh, *sources, *targets, *solver);
+  if (!matrix.ok()) return NameSolveError(matrix.status(), "sources/targets");
+
+  auto state = std::make_shared<DistanceMatrix>(*std::move(matrix));
+  auto next = std::make_shared<size_t>(0);
+  const bool f32 = request.value_type() == v1::VALUE_TYPE_FLOAT32;
+  const bool want_stats = request.want_stats();
+  const size_t chunk = std::max<size_t>(1, env.limits->stream_chunk_bytes / (f32 ? 4 : 8));
+  return MessageProducer<v1::ComputeDistanceMatrixResponse>(
+      [state, next, f32, want_stats, chunk](v1::ComputeDistanceMatrixResponse* out) {
+        const size_t n = state->values.size();
+        // Always one message, even for an empty result, so rows/cols arrive.
+        if (*next >= n && (n > 0 || *next > 0)) return false;
+        out->set_rows(state->rows);
+        out->set_cols(state->cols);
+        out->set_offset(*next);
+        const size_t begin = *next, end = std::min(n, begin + chunk);
+        if (f32) {
+          for (size_t i = begin; i < end; ++i) out->add_values_f32(static_cast<float>(state->values[i]));
+        } else {
+          out->mutable_values_f64()->Add(state->values.begin() + begin, state->values.begin() + end);
+        }
+        if (end == n && want_stats) StatsToProto(state->stats, out->mutable_stats());
+        *next = std::max(end, begin + 1);
+        return true;
+      });
+}
+
+absl::StatusOr<MessageProducer<v1::ComputeIsolinesResponse>> RunComputeIsolines(
+    const QueryEnv& env, const v1::ComputeIsolinesRequest& request) {
+  const uint32_t max_levels = env.limits->max_levels;
+  if (static_cast<uint64_t>(request.levels_size()) > max_levels) {
+    return absl::ResourceExhaustedError(absl::StrCat(
+        "levels: ", request.levels_size(), " levels, over --max_levels=", max_levels));
+  }
+  IsolineOptions options;
+  for (int i = 0; i < request.levels_size(); ++i) {
+    if (!std::isfinite(request.levels(i))) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("levels[", i, "]: must be finite, got ", request.levels(i)));
+    }
+    options.levels.push_back(request.levels(i));
+  }
+  if (options.levels.empty()) {
+    if (request.count() < 2) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("count: give levels, or a count >= 2 (got ", request.count(), ")"));
+    }
+    if (static_cast<uint64_t>(request.count()) > uint64_t{max_levels} + 1) {
+      return absl::ResourceExhaustedError(absl::StrCat(
+          "count: ", request.count(), " gives ", request.count() - 1,
+          " levels, over --max_levels=", max_levels));
+    }
+    options.count = request.count();
+  }
+  absl::StatusOr<SolvedField> solved =
+      SolveField(env, request.mesh(), request.sources(), request.options());
+  if (!solved.ok()) return solved.status();
+  absl::StatusOr<Isolines> isolines = ExtractIsolines(*solved->mesh->mesh, solved->field, options);
+  if (!isolines.ok()) return isolines.status();
+
+  StreamChunker<v1::ComputeIsolinesResponse> chunker(env.limits->stream_chunk_bytes);
+  for (double level : isolines->levels) chunker.first().add_levels(level);
+  chunker.Account(isolines->levels.size() * 8);
+  for (size_t i = 0; i < isolines->polylines.size(); ++i) {
+    const IsolinePolyline& line = isolines->polylines[i];
+    chunker.AppendPolyline(line.points, [&](v1::ComputeIsolinesResponse& message) {
+      v1::Isoline* item = message.add_isolines();
+      item->set_index(static_cast<uint32_t>(i));
+      item->set_level(line.level);
+      item->set_closed(line.closed);
+      return item;
+    });
+  }
+  if (request.want_stats()) StatsToProto(solved->field.stats, chunker.last().mutable_stats());
+  return chunker.TakeProducer();
+}
+
+absl::StatusOr<MessageProducer<v1::ComputeVoronoiResponse>> RunComputeVoronoi(
+    const QueryEnv& env, const v1::ComputeVoronoiRequest& request) {
+  absl::StatusOr<SolvedField> solved =
+      SolveField(env, request.mesh(), request.sources(), request.options());
+  if (!solved.ok()) return solved.status();
+  absl::StatusOr<VoronoiDiagram> diagram = BuildVoronoi(*solved->mesh->mesh, solved->field);
+  if (!diagram.ok()) return diagram.status();
+
+  StreamChunker<v1::ComputeVoronoiResponse> chunker(env.limits->stream_chunk_bytes);
+  v1::ComputeVoronoiResponse& first = chunker.first();
+  for (const auto& [a, b] : diagram->adjacency) {
+    v1::SitePair* pair = first.add_adjacency();
+    pair->set_a(a);
+    pair->set_b(b);
+  }
+  first.set_junction_faces(diagram->junction_faces);
+  first.set_total_area(diagram->total_area);
+  for (const SurfacePoint& p : solved->sources) SurfacePointToProto(p, first.add_resolved_sources());
+  chunker.Account(first.ByteSizeLong());
+
+  for (const VoronoiCell& cell : diagram->cells) {
+    chunker.MakeRoom();
+    auto new_piece = [&]() {
+      v1::VoronoiCell* piece = chunker.current().add_cells();
+      piece->set_site(cell.site);
+      piece->set_area(cell.area);
+      chunker.Account(16);
+      return piece;
+    };
+    v1::VoronoiCell* piece = new_piece();
+    if (request.omit_cell_faces()) continue;
+    for (uint32_t face : cell.whole_faces) {
+      if (chunker.Full()) {
+        piece->set_continued(true);
+        chunker.MakeRoom();
+        piece = new_piece();
+      }
+      piece->add_whole_faces(face);
+      chunker.Account(5);
+    }
+    for (const VoronoiFragment& fragment : cell.fragments) {
+      if (chunker.Full()) {
+        piece->set_continued(true);
+        chunker.MakeRoom();
+        piece = new_piece();
+      }
+      v1::VoronoiFragment* out = piece->add_fragments();
+      out->set_face(fragment.face);
+      out->set_area(fragment.area);
+      for (const PathPoint& p : fragment.polygon) PathPointToProto(p, out->add_polygon());
+      chunker.Account(out->ByteSizeLong() + 4);
+    }
+  }
+  for (size_t i = 0; i < diagram->boundaries.size(); ++i) {
+    const VoronoiBoundary& boundary = diagram->boundaries[i];
+    chunker.AppendPolyline(boundary.points, [&](v1::ComputeVoronoiResponse& message) {
+      v1::VoronoiBoundary* item = message.add_boundaries();
+      item->set_index(static_cast<uint32_t>(i));
+      item->set_site_a(boundary.site_a);
+      item->set_site_b(boundary.site_b);
+      item->set_closed(boundary.closed);
+      return item;
+    });
+  }
+  if (request.want_stats()) StatsToProto(solved->field.stats, chunker.last().mutable_stats());
+  return chunker.TakeProducer();
+}
+
+absl::StatusOr<MessageProducer<v1::ComputeDelaunayResponse>> RunComputeDelaunay(
+    const QueryEnv& env, const v1::ComputeDelaunayRequest& request) {
+  absl::StatusOr<SolvedField> solved =
+      SolveField(env, request.mesh(), request.sources(), request.options());
+  if (!solved.ok()) return solved.status();
+  absl::StatusOr<DelaunayTriangulation> delaunay =
+      BuildDelaunay(*solved->mesh->mesh, solved->field);
+  if (!delaunay.ok()) return delaunay.status();
+
+  StreamChunker<v1::ComputeDelaunayResponse> chunker(env.limits->stream_chunk_bytes);
+  for (const SurfacePoint& p : solved->sources) {
+    SurfacePointToProto(p, chunker.first().add_resolved_sources());
+  }
+  chunker.Account(chunker.first().ByteSizeLong());
+  auto append_edges = [&](const std::vector<DelaunayEdge>& edges, bool removed) {
+    for (size_t i = 0; i < edges.size(); ++i) {
+      const DelaunayEdge& edge = edges[i];
+      chunker.AppendPolyline(edge.points, [&](v1::ComputeDelaunayResponse& message) {
+        v1::DelaunayEdge* item = removed ? message.add_removed_edges() : message.add_edges();
+        item->set_index(static_cast<uint32_t>(i));
+        item->set_site_a(edge.site_a);
+        item->set_site_b(edge.site_b);
+        item->set_vertex_a(edge.vertex_a);
+        item->set_vertex_b(edge.vertex_b);
+        item->set_length(edge.length);
+        item->set_edge_start(edge.edge_start);
+        return item;
+      });
+    }
+  };
+  append_edges(delaunay->edges, false);
+  append_edges(delaunay->removed_edges, true);
+  for (const auto& [a, b, c] : delaunay->triangles) {
+    chunker.MakeRoom();
+    v1::SiteTriple* t = chunker.current().add_triangles();
+    t->set_a(a);
+    t->set_b(b);
+    t->set_c(c);
+    chunker.Account(t->ByteSizeLong() + 2);
+  }
+  for (const XlEdge& xl : delaunay->xl_edges) {
+    chunker.MakeRoom();
+    v1::XlEdge* out = chunker.current().add_xl_edges();
+    out->set_vertex_a(xl.vertex_a);
+    out->set_vertex_b(xl.vertex_b);
+    out->set_site_a(xl.site_a);
+    out->set_site_b(xl.site_b);
+    out->set_witness(xl.witness);
+    PathPointToProto(xl.point, out->mutable_point());
+    chunker.Account(out->ByteSizeLong() + 2);
+  }
+  if (request.want_stats()) StatsToProto(solved->field.stats, chunker.last().mutable_stats());
+  return chunker.TakeProducer();
+}
+
+}  // namespace geodex::server

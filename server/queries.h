@@ -1,0 +1,51 @@
+#pragma once
+
+// The query methods of geodex.v1.Geodex as plain functions: request in, response (or a producer of
+// stream messages) out, errors as absl::Status naming the request field or the server flag. They
+// run on the compute pool (see query_reactors.h); nothing here knows about gRPC calls.
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "geodex/cancel.h"
+#include "geodex/v1/geodex.pb.h"
+#include "mesh_store.h"
+#include "stream_chunker.h"
+
+namespace geodex::server {
+
+struct ServiceLimits;
+
+// What every query needs besides its request.
+struct QueryEnv {
+  MeshStore* store;
+  const ServiceLimits* limits;
+  const CancelToken* cancel;
+};
+
+// Unary queries.
+absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPathRequest& request,
+                                 v1::FindShortestPathResponse* response);
+absl::Status RunEstimateDistances(const QueryEnv& env, const v1::EstimateDistancesRequest& request,
+                                  v1::EstimateDistancesResponse* response);
+absl::Status RunLocatePoints(const QueryEnv& env, const v1::LocatePointsRequest& request,
+                             v1::LocatePointsResponse* response);
+
+// Streamed queries: compute everything, then produce the messages.
+absl::StatusOr<MessageProducer<v1::ComputeDistanceFieldResponse>> RunComputeDistanceField(
+    const QueryEnv& env, const v1::ComputeDistanceFieldRequest& request);
+absl::StatusOr<MessageProducer<v1::ComputeDistanceMatrixResponse>> RunComputeDistanceMatrix(
+    const QueryEnv& env, const v1::ComputeDistanceMatrixRequest& request);
+absl::StatusOr<MessageProducer<v1::ComputeIsolinesResponse>> RunComputeIsolines(
+    const QueryEnv& env, const v1::ComputeIsolinesRequest& request);
+absl::StatusOr<MessageProducer<v1::ComputeVoronoiResponse>> RunComputeVoronoi(
+    const QueryEnv& env, const v1::ComputeVoronoiRequest& request);
+absl::StatusOr<MessageProducer<v1::ComputeDelaunayResponse>> RunComputeDelaunay(
+    const QueryEnv& env, const v1::ComputeDelaunayRequest& request);
+
+// "meshes/{key}" looked up in the store: InvalidArgument for a malformed name, NotFound for an
+// unknown one. `field` names the request field.
+absl::StatusOr<std::shared_ptr<const StoredMesh>> LookupMesh(MeshStore& store,
+                                                             const std::string& name,
+                                                             const std::string& field);
+
+}  // namespace geodex::server

@@ -1,0 +1,28 @@
+#pragma once
+
+// Request limits of geodexd. Every one is a flag (geodexd_main.cc, README "geodexd flags");
+// exceeding one answers RESOURCE_EXHAUSTED with a message naming the flag.
+
+#include <cstddef>
+#include <cstdint>
+
+namespace geodex::server {
+
+struct ServiceLimits {
+  uint64_t max_upload_bytes = uint64_t{1} << 30;  // --max_upload_bytes
+  uint64_t max_vertices = 20'000'000;              // --max_vertices
+  uint64_t max_faces = 40'000'000;                 // --max_faces
+  uint32_t max_sources = 100'000;                  // --max_sources
+  uint32_t max_targets = 50'000;                   // --max_targets (matrix columns, points)
+  uint32_t max_levels = 1'000;                     // --max_levels (isolines)
+  uint64_t max_output_values = 100'000'000;        // --max_output_values
+  uint64_t max_windows = 0;                        // --max_windows (per solve; 0 = unlimited)
+  // Largest unary response (LocatePoints, EstimateDistances, FindShortestPath): clients keep
+  // gRPC's default 4 MiB receive limit. --max_unary_response_bytes
+  uint64_t max_unary_response_bytes = 4 << 20;
+  // Size of one streamed message (fields, matrices, isolines, Voronoi, Delaunay).
+  // --stream_chunk_bytes
+  uint32_t stream_chunk_bytes = 1 << 20;
+};
+
+}  // namespace geodex::server
