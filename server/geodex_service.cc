@@ -29,9 +29,9 @@ absl::Status ValidateDisplayName(const std::string& name) {
                 c == '.' || c == '_' || c == '-');
   }
   if (!ok) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "metadata.display_name: \"", name,
-        "\" must be 1-63 characters of [A-Za-z0-9._-] and not a 64-digit hex id"));
+    return absl::InvalidArgumentError(
+        absl::StrCat("metadata.display_name: \"", name,
+                     "\" must be 1-63 characters of [A-Za-z0-9._-] and not a 64-digit hex id"));
   }
   return absl::OkStatus();
 }
@@ -68,8 +68,8 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<v1::CreateMeshReq
     }
     if (!have_metadata_) {
       if (!request_.has_metadata()) {
-        Finish(grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                            "metadata: the first CreateMeshRequest must carry metadata"));
+        Finish(ToGrpcStatus(absl::InvalidArgumentError(
+            "metadata: the first CreateMeshRequest must carry metadata")));
         return;
       }
       metadata_ = request_.metadata();
@@ -80,8 +80,8 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<v1::CreateMeshReq
         return;
       }
       if (!metadata_.expected_mesh_id().empty() && !IsMeshId(metadata_.expected_mesh_id())) {
-        Finish(grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                            "metadata.expected_mesh_id: must be 64 lowercase hex digits"));
+        Finish(ToGrpcStatus(absl::InvalidArgumentError(
+            "metadata.expected_mesh_id: must be 64 lowercase hex digits")));
         return;
       }
       if (metadata_.total_bytes() > service_->limits().max_upload_bytes) {
@@ -90,8 +90,8 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<v1::CreateMeshReq
       }
       bytes_.reserve(metadata_.total_bytes());
     } else if (request_.has_metadata()) {
-      Finish(grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                          "metadata: only the first CreateMeshRequest may carry metadata"));
+      Finish(ToGrpcStatus(absl::InvalidArgumentError(
+          "metadata: only the first CreateMeshRequest may carry metadata")));
       return;
     } else {
       const std::string& chunk = request_.chunk();
@@ -109,9 +109,9 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<v1::CreateMeshReq
 
  private:
   grpc::Status TooLarge(uint64_t bytes) const {
-    return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
-                        absl::StrCat("upload of ", bytes, " bytes exceeds --max_upload_bytes=",
-                                     service_->limits().max_upload_bytes));
+    return ToGrpcStatus(absl::ResourceExhaustedError(
+        absl::StrCat("upload of ", bytes,
+                     " bytes exceeds --max_upload_bytes=", service_->limits().max_upload_bytes)));
   }
 
   void EndOfUpload() {
@@ -120,11 +120,11 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<v1::CreateMeshReq
       return;
     }
     if (!have_metadata_) {
-      Finish(grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                          "metadata: the upload stream was empty"));
+      Finish(ToGrpcStatus(absl::InvalidArgumentError("metadata: the upload stream was empty")));
       return;
     }
-    if (!service_->pool()->TrySubmit([this] { Build(); })) Finish(PoolFullStatus(*service_->pool()));
+    if (!service_->pool()->TrySubmit([this] { Build(); }))
+      Finish(PoolFullStatus(*service_->pool()));
   }
 
   // On the pool.
@@ -149,8 +149,9 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<v1::CreateMeshReq
       return absl::InvalidArgumentError(absl::StrCat("chunk: ", data.status().message()));
     }
     if (data->vertex_count() > limits.max_vertices) {
-      return absl::ResourceExhaustedError(absl::StrCat(
-          "mesh has ", data->vertex_count(), " vertices, over --max_vertices=", limits.max_vertices));
+      return absl::ResourceExhaustedError(
+          absl::StrCat("mesh has ", data->vertex_count(),
+                       " vertices, over --max_vertices=", limits.max_vertices));
     }
     if (data->face_count() > limits.max_faces) {
       return absl::ResourceExhaustedError(absl::StrCat(
@@ -221,17 +222,17 @@ grpc::ServerUnaryReactor* GeodexService::ListMeshes(grpc::CallbackServerContext*
                                                     v1::ListMeshesResponse* response) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
   if (request->page_size() < 0) {
-    reactor->Finish(grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                                 absl::StrCat("page_size: must be >= 0, got ", request->page_size())));
+    reactor->Finish(ToGrpcStatus(absl::InvalidArgumentError(
+        absl::StrCat("page_size: must be >= 0, got ", request->page_size()))));
     return reactor;
   }
   if (!request->page_token().empty() && !IsMeshId(request->page_token())) {
-    reactor->Finish(grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                                 "page_token: not a token returned by ListMeshes"));
+    reactor->Finish(
+        ToGrpcStatus(absl::InvalidArgumentError("page_token: not a token returned by ListMeshes")));
     return reactor;
   }
-  int page_size = request->page_size() == 0 ? kDefaultPageSize
-                                            : std::min(request->page_size(), kMaxPageSize);
+  int page_size =
+      request->page_size() == 0 ? kDefaultPageSize : std::min(request->page_size(), kMaxPageSize);
   bool more = false;
   std::vector<std::shared_ptr<const StoredMesh>> page =
       store_->List(request->page_token(), static_cast<size_t>(page_size), &more);
@@ -260,8 +261,10 @@ grpc::ServerUnaryReactor* GeodexService::DeleteMesh(grpc::CallbackServerContext*
 // Queries: the reactor templates run the query functions of queries.cc on the pool.
 grpc::ServerWriteReactor<v1::ComputeDistanceFieldResponse>* GeodexService::ComputeDistanceField(
     grpc::CallbackServerContext* /*context*/, const v1::ComputeDistanceFieldRequest* request) {
-  return StreamQueryReactor<v1::ComputeDistanceFieldRequest, v1::ComputeDistanceFieldResponse>::
-      Start(env(), &RunComputeDistanceField, request);
+  return StreamQueryReactor<v1::ComputeDistanceFieldRequest,
+                            v1::ComputeDistanceFieldResponse>::Start(env(),
+                                                                     &RunComputeDistanceField,
+                                                                     request);
 }
 
 grpc::ServerUnaryReactor* GeodexService::FindShortestPath(
@@ -273,8 +276,10 @@ grpc::ServerUnaryReactor* GeodexService::FindShortestPath(
 
 grpc::ServerWriteReactor<v1::ComputeDistanceMatrixResponse>* GeodexService::ComputeDistanceMatrix(
     grpc::CallbackServerContext* /*context*/, const v1::ComputeDistanceMatrixRequest* request) {
-  return StreamQueryReactor<v1::ComputeDistanceMatrixRequest, v1::ComputeDistanceMatrixResponse>::
-      Start(env(), &RunComputeDistanceMatrix, request);
+  return StreamQueryReactor<v1::ComputeDistanceMatrixRequest,
+                            v1::ComputeDistanceMatrixResponse>::Start(env(),
+                                                                      &RunComputeDistanceMatrix,
+                                                                      request);
 }
 
 grpc::ServerUnaryReactor* GeodexService::EstimateDistances(

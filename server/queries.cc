@@ -38,7 +38,8 @@ absl::StatusOr<std::vector<SurfacePoint>> ResolvePoints(const StoredMesh& mesh,
   std::vector<SurfacePoint> out;
   out.reserve(points.size());
   for (int i = 0; i < points.size(); ++i) {
-    absl::StatusOr<SurfacePoint> p = ResolvePoint(mesh, points[i], absl::StrCat(field, "[", i, "]"));
+    absl::StatusOr<SurfacePoint> p =
+        ResolvePoint(mesh, points[i], absl::StrCat(field, "[", i, "]"));
     if (!p.ok()) return p.status();
     out.push_back(*p);
   }
@@ -69,9 +70,9 @@ absl::Status NameSolveError(const absl::Status& status, const char* field) {
 
 absl::Status CheckFieldSize(const QueryEnv& env, const StoredMesh& mesh) {
   if (mesh.vertex_count > env.limits->max_output_values) {
-    return absl::ResourceExhaustedError(absl::StrCat("the field has ", mesh.vertex_count,
-                                                     " values, over --max_output_values=",
-                                                     env.limits->max_output_values));
+    return absl::ResourceExhaustedError(
+        absl::StrCat("the field has ", mesh.vertex_count,
+                     " values, over --max_output_values=", env.limits->max_output_values));
   }
   return absl::OkStatus();
 }
@@ -80,9 +81,9 @@ absl::Status CheckUnaryResponseSize(const QueryEnv& env, const google::protobuf:
                                     const char* what) {
   const size_t bytes = response.ByteSizeLong();
   if (bytes > env.limits->max_unary_response_bytes) {
-    return absl::ResourceExhaustedError(absl::StrCat(
-        "the response would be ", bytes, " bytes, over --max_unary_response_bytes=",
-        env.limits->max_unary_response_bytes, "; send fewer ", what, " per call"));
+    return absl::ResourceExhaustedError(
+        absl::StrCat("the response would be ", bytes, " bytes, over --max_unary_response_bytes=",
+                     env.limits->max_unary_response_bytes, "; send fewer ", what, " per call"));
   }
   return absl::OkStatus();
 }
@@ -95,8 +96,7 @@ struct SolvedField {
 };
 
 absl::StatusOr<SolvedField> SolveField(const QueryEnv& env, const std::string& mesh_name,
-                                       const PointList& sources,
-                                       const v1::SolverOptions& options) {
+                                       const PointList& sources, const v1::SolverOptions& options) {
   SolvedField out;
   absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh =
       LookupMesh(*env.store, mesh_name, "mesh");
@@ -108,8 +108,7 @@ absl::StatusOr<SolvedField> SolveField(const QueryEnv& env, const std::string& m
   out.sources = *std::move(resolved);
   absl::StatusOr<GeodesicOptions> solver = Options(env, options);
   if (!solver.ok()) return solver.status();
-  absl::StatusOr<DistanceField> field =
-      ComputeDistanceField(*out.mesh->mesh, out.sources, *solver);
+  absl::StatusOr<DistanceField> field = ComputeDistanceField(*out.mesh->mesh, out.sources, *solver);
   if (!field.ok()) return NameSolveError(field.status(), "sources");
   out.field = *std::move(field);
   return out;
@@ -213,9 +212,9 @@ absl::Status RunLocatePoints(const QueryEnv& env, const v1::LocatePointsRequest&
     return absl::InvalidArgumentError("positions: at least one position is required");
   }
   if (static_cast<uint64_t>(request.positions_size()) > env.limits->max_targets) {
-    return absl::ResourceExhaustedError(absl::StrCat("positions: ", request.positions_size(),
-                                                     " points, over --max_targets=",
-                                                     env.limits->max_targets));
+    return absl::ResourceExhaustedError(
+        absl::StrCat("positions: ", request.positions_size(),
+                     " points, over --max_targets=", env.limits->max_targets));
   }
   for (int i = 0; i < request.positions_size(); ++i) {
     if ((i & 1023) == 0 && env.cancel->IsCancelled()) return absl::CancelledError("cancelled");
@@ -338,9 +337,11 @@ absl::StatusOr<MessageProducer<v1::ComputeDistanceMatrixResponse>> RunComputeDis
         out->set_offset(*next);
         const size_t begin = *next, end = std::min(n, begin + chunk);
         if (f32) {
-          for (size_t i = begin; i < end; ++i) out->add_values_f32(static_cast<float>(state->values[i]));
+          for (size_t i = begin; i < end; ++i)
+            out->add_values_f32(static_cast<float>(state->values[i]));
         } else {
-          out->mutable_values_f64()->Add(state->values.begin() + begin, state->values.begin() + end);
+          out->mutable_values_f64()->Add(state->values.begin() + begin,
+                                         state->values.begin() + end);
         }
         if (end == n && want_stats) StatsToProto(state->stats, out->mutable_stats());
         *next = std::max(end, begin + 1);
@@ -352,8 +353,8 @@ absl::StatusOr<MessageProducer<v1::ComputeIsolinesResponse>> RunComputeIsolines(
     const QueryEnv& env, const v1::ComputeIsolinesRequest& request) {
   const uint32_t max_levels = env.limits->max_levels;
   if (static_cast<uint64_t>(request.levels_size()) > max_levels) {
-    return absl::ResourceExhaustedError(absl::StrCat(
-        "levels: ", request.levels_size(), " levels, over --max_levels=", max_levels));
+    return absl::ResourceExhaustedError(
+        absl::StrCat("levels: ", request.levels_size(), " levels, over --max_levels=", max_levels));
   }
   IsolineOptions options;
   for (int i = 0; i < request.levels_size(); ++i) {
@@ -369,9 +370,9 @@ absl::StatusOr<MessageProducer<v1::ComputeIsolinesResponse>> RunComputeIsolines(
           absl::StrCat("count: give levels, or a count >= 2 (got ", request.count(), ")"));
     }
     if (static_cast<uint64_t>(request.count()) > uint64_t{max_levels} + 1) {
-      return absl::ResourceExhaustedError(absl::StrCat(
-          "count: ", request.count(), " gives ", request.count() - 1,
-          " levels, over --max_levels=", max_levels));
+      return absl::ResourceExhaustedError(absl::StrCat("count: ", request.count(), " gives ",
+                                                       request.count() - 1,
+                                                       " levels, over --max_levels=", max_levels));
     }
     options.count = request.count();
   }
@@ -415,7 +416,8 @@ absl::StatusOr<MessageProducer<v1::ComputeVoronoiResponse>> RunComputeVoronoi(
   }
   first.set_junction_faces(diagram->junction_faces);
   first.set_total_area(diagram->total_area);
-  for (const SurfacePoint& p : solved->sources) SurfacePointToProto(p, first.add_resolved_sources());
+  for (const SurfacePoint& p : solved->sources)
+    SurfacePointToProto(p, first.add_resolved_sources());
   chunker.Account(first.ByteSizeLong());
 
   for (const VoronoiCell& cell : diagram->cells) {

@@ -1,9 +1,9 @@
 #pragma once
 
 // Two reactor shapes serve every query method: a unary one and a server-streaming one. Both hand
-// the work to the ComputePool (never computing on gRPC's threads), answer RESOURCE_EXHAUSTED at once
-// when the pool's queue is full, cancel the engine's CancelToken on client cancellation or deadline,
-// and always Finish (a reactor that never finishes would hang the server's shutdown).
+// the work to the ComputePool (never computing on gRPC's threads), answer RESOURCE_EXHAUSTED at
+// once when the pool's queue is full, cancel the engine's CancelToken on client cancellation or
+// deadline, and always Finish (a reactor that never finishes would hang the server's shutdown).
 
 #include <functional>
 #include <utility>
@@ -20,10 +20,9 @@
 namespace geodex::server {
 
 inline grpc::Status PoolFullStatus(const ComputePool& pool) {
-  return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
-                      absl::StrCat("compute queue full (", pool.threads(), " workers busy, ",
-                                   pool.queue_capacity(),
-                                   " queued; --pool_threads/--queue_capacity); retry later"));
+  return ToGrpcStatus(absl::ResourceExhaustedError(
+      absl::StrCat("compute queue full (", pool.threads(), " workers busy, ", pool.queue_capacity(),
+                   " queued; --pool_threads/--queue_capacity); retry later")));
 }
 
 inline grpc::Status CancelledStatus() {

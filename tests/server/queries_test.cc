@@ -87,8 +87,8 @@ class QueriesTest : public testing::ServerFixture {
   }
 
   std::vector<SurfacePoint> Sites() const {
-    return {SurfacePoint::AtVertex(3), SurfacePoint::AtVertex(260), SurfacePoint::OnEdge(400, 401, 0.3),
-            SurfacePoint::InFace(700, 0.2, 0.3, 0.5)};
+    return {SurfacePoint::AtVertex(3), SurfacePoint::AtVertex(260),
+            SurfacePoint::OnEdge(400, 401, 0.3), SurfacePoint::InFace(700, 0.2, 0.3, 0.5)};
   }
   template <typename Request>
   void AddSites(Request* request) const {
@@ -128,7 +128,8 @@ TEST_F(QueriesTest, DistanceMatrixEqualsCoreBitForBit) {
     values.insert(values.end(), m.values_f64().begin(), m.values_f64().end());
   }
   ASSERT_EQ(values.size(), expected.values.size());
-  for (size_t i = 0; i < values.size(); ++i) EXPECT_TRUE(BitEqual(values[i], expected.values[i])) << i;
+  for (size_t i = 0; i < values.size(); ++i)
+    EXPECT_TRUE(BitEqual(values[i], expected.values[i])) << i;
   for (size_t j = 0; j < targets.size(); ++j) {
     EXPECT_TRUE(BitEqual(values[4 * targets.size() + j], values[j]));  // repeated source row
   }
@@ -149,9 +150,9 @@ TEST_F(QueriesTest, DistanceMatrixEqualsCoreBitForBit) {
 }
 
 TEST_F(QueriesTest, EstimateAndExactDistancesEqualCore) {
-  std::vector<SurfacePoint> points = {SurfacePoint::AtVertex(5), SurfacePoint::InFace(11, 0.1, 0.1, 0.8),
-                                      SurfacePoint::OnEdge(200, 201, 0.5),
-                                      SurfacePoint::InFace(850, 0.3, 0.3, 0.4)};
+  std::vector<SurfacePoint> points = {
+      SurfacePoint::AtVertex(5), SurfacePoint::InFace(11, 0.1, 0.1, 0.8),
+      SurfacePoint::OnEdge(200, 201, 0.5), SurfacePoint::InFace(850, 0.3, 0.3, 0.4)};
   v1::EstimateDistancesRequest request;
   request.set_mesh("meshes/hills");
   AddSites(&request);
@@ -196,8 +197,8 @@ TEST_F(QueriesTest, LocatePointsEqualsCore) {
   SurfaceLocator locator(*local_);
   v1::LocatePointsRequest request;
   request.set_mesh("meshes/hills");
-  std::vector<std::array<double, 3>> queries = {{0, 0, 0}, {3.3, 7.1, 2}, {12, 9, -4}, {24, 18, 0.3},
-                                                {-5, 40, 1}};
+  std::vector<std::array<double, 3>> queries = {
+      {0, 0, 0}, {3.3, 7.1, 2}, {12, 9, -4}, {24, 18, 0.3}, {-5, 40, 1}};
   for (const auto& q : queries) {
     v1::Position* p = request.add_positions();
     p->set_x(q[0]);
@@ -332,10 +333,11 @@ TEST_F(QueriesTest, VoronoiEqualsCoreAcrossManyMessages) {
   // omit_cell_faces: sites and areas only.
   request.set_omit_cell_faces(true);
   messages.clear();
-  ASSERT_TRUE(ReadAll<v1::ComputeVoronoiResponse>(
-                  [&](grpc::ClientContext* c, const auto& r) { return stub_->ComputeVoronoi(c, r); },
-                  request, &messages)
-                  .ok());
+  ASSERT_TRUE(
+      ReadAll<v1::ComputeVoronoiResponse>(
+          [&](grpc::ClientContext* c, const auto& r) { return stub_->ComputeVoronoi(c, r); },
+          request, &messages)
+          .ok());
   int cell_count = 0;
   for (const auto& m : messages) {
     for (const auto& cell : m.cells()) {
@@ -402,8 +404,8 @@ TEST_F(QueriesTest, BadInputAndLimitsNameTheFieldOrFlag) {
   auto matrix = [&](const v1::ComputeDistanceMatrixRequest& r) {
     std::vector<v1::ComputeDistanceMatrixResponse> m;
     return ReadAll<v1::ComputeDistanceMatrixResponse>(
-        [&](grpc::ClientContext* c, const auto& q) { return stub_->ComputeDistanceMatrix(c, q); }, r,
-        &m, 30);
+        [&](grpc::ClientContext* c, const auto& q) { return stub_->ComputeDistanceMatrix(c, q); },
+        r, &m, 30);
   };
   auto isolines = [&](const v1::ComputeIsolinesRequest& r) {
     std::vector<v1::ComputeIsolinesResponse> m;
