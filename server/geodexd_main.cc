@@ -1,5 +1,6 @@
 // geodexd: the geodex gRPC server. `geodexd --help` lists every flag.
 
+#include <algorithm>
 #include <cerrno>
 #include <csignal>
 #include <cstring>
@@ -58,11 +59,17 @@ int main(int argc, char** argv) {
   absl::SetProgramUsageMessage(
       "geodexd --listen HOST:PORT --data-dir DIR [flags]: the geodex gRPC server "
       "(geodex.v1.Geodex, grpc.health.v1.Health, server reflection)");
-  // Accept --data-dir as well as --data_dir (absl flags use underscores).
+  // Accept --data-dir as well as --data_dir, for every flag (absl flags use underscores; the
+  // command-line contract in README uses dashes).
   std::vector<std::string> args(argv, argv + argc);
   std::vector<char*> fixed;
   for (std::string& a : args) {
-    if (a.rfind("--data-dir", 0) == 0) a.replace(0, 10, "--data_dir");
+    if (a.rfind("--", 0) == 0) {
+      const size_t name_end = std::min(a.find('='), a.size());
+      for (size_t i = 2; i < name_end; ++i) {
+        if (a[i] == '-') a[i] = '_';
+      }
+    }
     fixed.push_back(a.data());
   }
   absl::ParseCommandLine(static_cast<int>(fixed.size()), fixed.data());

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The geodexd binary as an operator runs it: starts on 127.0.0.1 (a port it picks), reports
-# where it listens, and on SIGTERM drains and exits 0. Bounded: gives up after 30 s.
+# where it listens (flags spelled with dashes or underscores), and on SIGTERM drains and exits 0. Bounded: gives up after 30 s.
 # Env: GEODEXD (the binary).
 set -u
 pass=0
@@ -11,7 +11,7 @@ check() {
   if "$@"; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAIL: $name"; fi
 }
 tmp=$(mktemp -d)
-"$GEODEXD" --listen 127.0.0.1:0 --data-dir "$tmp/data" --pool_threads 1 --shutdown_grace_seconds 2 \
+"$GEODEXD" --listen 127.0.0.1:0 --data-dir "$tmp/data" --pool-threads 1 --shutdown_grace_seconds 2 \
   >"$tmp/log" 2>&1 &
 pid=$!
 port=""
