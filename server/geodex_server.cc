@@ -1,5 +1,8 @@
 #include "geodex_server.h"
 
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
 #include <thread>
 
 #include "absl/strings/str_cat.h"
@@ -8,6 +11,9 @@
 #include "grpcpp/health_check_service_interface.h"
 #include "grpcpp/security/server_credentials.h"
 #include "grpcpp/server_builder.h"
+#include "geodex/mesh_io.h"
+#include "geodex/samples.h"
+#include "mesh_id.h"
 
 namespace geodex::server {
 
@@ -18,6 +24,30 @@ absl::StatusOr<std::unique_ptr<GeodexServer>> GeodexServer::Start(const ServerOp
   s->store_ = std::make_unique<MeshStore>(options.mesh_budget_bytes);
   s->pool_ = std::make_unique<ComputePool>(threads, options.queue_capacity);
   s->service_ = std::make_unique<GeodexService>(s->store_.get(), s->pool_.get(), options.limits);
+
+  // The store is complete before the port opens: health never says SERVING before the index is
+  // read (and no call sees a half-read index).
+  bool fresh = true;
+  if (!options.data_dir.empty()) {
+    MeshDisk::Index index;
+    absl::StatusOr<MeshDisk> disk = MeshDisk::Open(options.data_dir, &index);
+    if (!disk.ok()) return disk.status();
+    fresh = index.fresh;
+    s->report_.indexed = index.meshes.size();
+    s->report_.skipped = index.skipped;
+    s->report_.removed_temporaries = index.removed_temporaries;
+    s->store_->AttachDisk(*std::move(disk), index);
+  }
+  if (options.samples && fresh) {
+    for (const std::string& name : SampleMeshNames()) {
+      absl::StatusOr<MeshData> data = MakeSampleMesh(name);
+      if (!data.ok()) return data.status();
+      absl::StatusOr<std::string> id = AddMesh(*s->store_, *data, name, 0);
+      if (!id.ok()) return id.status();
+      s->report_.samples.push_back(absl::StrCat(name, " -> meshes/", *id));
+    }
+  }
+  if (!options.import_dir.empty()) s->ImportDirectory(options.import_dir);
 
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
@@ -34,6 +64,58 @@ absl::StatusOr<std::unique_ptr<GeodexServer>> GeodexServer::Start(const ServerOp
   health->SetServingStatus("", true);
   health->SetServingStatus(v1::Geodex::service_full_name(), true);
   return s;
+}
+
+absl::StatusOr<std::string> AddMesh(MeshStore& store, const MeshData& data,
+                                    const std::string& alias, uint64_t file_bytes) {
+  std::string id = ComputeMeshId(data);
+  if (store.Contains(id)) return id;
+  absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(data);
+  if (!mesh.ok()) return mesh.status();
+  std::shared_ptr<StoredMesh> stored = MakeStoredMesh(id, *std::move(mesh));
+  stored->display_name = alias;
+  stored->upload_bytes = file_bytes;
+  const std::string canonical = store.has_disk() ? CanonicalMeshEncoding(data) : std::string();
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> inserted =
+      store.Insert(std::move(stored), canonical);
+  if (!inserted.ok()) return inserted.status();
+  return id;
+}
+
+void GeodexServer::ImportDirectory(const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  std::vector<fs::path> files;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    if (it->is_regular_file()) files.push_back(it->path());
+  }
+  if (ec) {
+    report_.import_errors.push_back(absl::StrCat(dir, ": ", ec.message()));
+    return;
+  }
+  std::sort(files.begin(), files.end());  // deterministic alias assignment
+  for (const fs::path& path : files) {
+    absl::StatusOr<MeshData> data = ReadMeshFile(path.string());
+    if (!data.ok()) {
+      report_.import_errors.push_back(std::string(data.status().message()));
+      continue;
+    }
+    // The alias is the file name up to its first dot, when it is a valid, unused alias.
+    std::string alias = path.filename().string();
+    alias = alias.substr(0, alias.find('.'));
+    bool valid = !alias.empty() && alias.size() <= 63 && !IsMeshId(alias) &&
+                 !store_->GetRecord(alias).ok();
+    for (char c : alias) {
+      valid = valid && (std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-');
+    }
+    absl::StatusOr<std::string> id =
+        AddMesh(*store_, *data, valid ? alias : "", fs::file_size(path, ec));
+    if (!id.ok()) {
+      report_.import_errors.push_back(absl::StrCat(path.string(), ": ", id.status().message()));
+    } else {
+      report_.imported.push_back(absl::StrCat(path.string(), " -> meshes/", *id));
+    }
+  }
 }
 
 void GeodexServer::Shutdown(absl::Time deadline) {

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
@@ -17,9 +18,22 @@
 
 namespace geodex::server {
 
+// What happened at start, for geodexd to log.
+struct StartupReport {
+  size_t indexed = 0;                              // meshes found in the data directory
+  std::vector<MeshDisk::Skipped> skipped;          // corrupt/truncated files (left in place)
+  std::vector<std::string> removed_temporaries;    // writes interrupted by a crash
+  std::vector<std::string> samples;                // built-in samples added
+  std::vector<std::string> imported;               // "file -> meshes/id"
+  std::vector<std::string> import_errors;          // "file: reason"
+};
+
 struct ServerOptions {
   std::string listen = "127.0.0.1:50051";  // HOST:PORT; port 0 picks a free port
-  std::string data_dir;                    // accepted; persistence arrives in part 2
+  std::string data_dir;     // persisted meshes (mesh_disk.h); empty = RAM only
+  bool samples = false;     // offer the built-in samples on a fresh data directory (or RAM only);
+                            // geodexd turns this on by default (--samples)
+  std::string import_dir;   // meshes to import at start (server-side files; never request paths)
   uint64_t mesh_budget_bytes = uint64_t{4} << 30;
   size_t pool_threads = 0;    // 0 = hardware concurrency
   size_t queue_capacity = 64;
@@ -27,12 +41,18 @@ struct ServerOptions {
   ServiceLimits limits;
 };
 
+// Parses nothing: builds `data` and stores it under `alias` (may be empty) unless a mesh with the
+// same id is stored already. Returns the mesh id.
+absl::StatusOr<std::string> AddMesh(MeshStore& store, const MeshData& data,
+                                    const std::string& alias, uint64_t file_bytes);
+
 class GeodexServer {
  public:
   // Builds and starts the server. Errors: InvalidArgument/Unavailable when it cannot listen.
   static absl::StatusOr<std::unique_ptr<GeodexServer>> Start(const ServerOptions& options);
   ~GeodexServer();  // Shutdown(now) if not yet shut down
 
+  const StartupReport& startup_report() const { return report_; }
   // The port actually bound (useful with port 0).
   int port() const { return port_; }
   // Health NOT_SERVING, then grpc::Server::Shutdown(deadline): calls still running at the deadline
@@ -46,6 +66,7 @@ class GeodexServer {
 
  private:
   GeodexServer() = default;
+  void ImportDirectory(const std::string& dir);
   // Declaration order = reverse destruction order: the server goes first, then the pool (joins
   // its workers), the service and the store.
   std::unique_ptr<MeshStore> store_;
@@ -53,6 +74,7 @@ class GeodexServer {
   std::unique_ptr<ComputePool> pool_;
   std::unique_ptr<grpc::Server> server_;
   int port_ = 0;
+  StartupReport report_;
   bool shut_down_ = false;
 };
 

@@ -181,8 +181,11 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<v1::CreateMeshReq
       candidate->pinned = metadata_.pin();
     }
     candidate->display_name = metadata_.display_name();
+    const std::string canonical =
+        service_->store()->has_disk() && candidate->mesh != nullptr ? CanonicalMeshEncoding(*data)
+                                                                    : std::string();
     absl::StatusOr<std::shared_ptr<const StoredMesh>> stored =
-        service_->store()->Insert(std::move(candidate));
+        service_->store()->Insert(std::move(candidate), canonical);
     if (!stored.ok()) return stored.status();
     MeshToProto(**stored, response_);
     return absl::OkStatus();
@@ -205,15 +208,24 @@ grpc::ServerReadReactor<v1::CreateMeshRequest>* GeodexService::CreateMesh(
   return new CreateMeshReactor(this, context, response);
 }
 
-// Get/List/Delete are map look-ups under the store's mutex: answered inline.
+// Get/List/Delete are map look-ups under the store's mutex (Delete also unlinks a file): answered
+// inline.
 grpc::ServerUnaryReactor* GeodexService::GetMesh(grpc::CallbackServerContext* context,
                                                  const v1::GetMeshRequest* request,
                                                  v1::Mesh* response) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
-  absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh =
-      LookupMesh(*store_, request->name(), "name");
-  if (mesh.ok()) MeshToProto(**mesh, response);
-  reactor->Finish(ToGrpcStatus(mesh.status()));
+  absl::StatusOr<std::string> key = ParseMeshName(request->name(), "name");
+  absl::Status status = key.status();
+  if (key.ok()) {
+    // The record: a mesh that is only on disk is described without loading it.
+    absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh = store_->GetRecord(*key);
+    if (mesh.ok()) {
+      MeshToProto(**mesh, response);
+    } else {
+      status = absl::NotFoundError(absl::StrCat("name: mesh \"", request->name(), "\" not found"));
+    }
+  }
+  reactor->Finish(ToGrpcStatus(status));
   return reactor;
 }
 
@@ -250,7 +262,7 @@ grpc::ServerUnaryReactor* GeodexService::DeleteMesh(grpc::CallbackServerContext*
   absl::Status status = key.status();
   if (key.ok()) {
     status = store_->Delete(*key);
-    if (!status.ok()) {
+    if (absl::IsNotFound(status)) {
       status = absl::NotFoundError(absl::StrCat("name: mesh \"", request->name(), "\" not found"));
     }
   }

@@ -20,7 +20,11 @@
 
 ABSL_FLAG(std::string, listen, "127.0.0.1:50051", "HOST:PORT to listen on (port 0 = any free port)");
 ABSL_FLAG(std::string, data_dir, "",
-          "Directory for persisted meshes (accepted; persistence is not implemented yet)");
+          "Directory for persisted meshes (created if missing; empty = keep meshes in RAM only)");
+ABSL_FLAG(bool, samples, true,
+          "Offer the built-in sample meshes (terrain, torus, sphere) on a fresh data directory");
+ABSL_FLAG(std::string, import_dir, "",
+          "Import every mesh file of this server-side directory at start (alias = file name)");
 ABSL_FLAG(uint64_t, mesh_budget_bytes, uint64_t{4} << 30,
           "RAM budget for preprocessed meshes; least-recently-used unpinned meshes are evicted");
 ABSL_FLAG(uint32_t, pool_threads, 0, "Compute worker threads (0 = one per hardware thread)");
@@ -89,6 +93,8 @@ int main(int argc, char** argv) {
   geodex::server::ServerOptions options;
   options.listen = absl::GetFlag(FLAGS_listen);
   options.data_dir = absl::GetFlag(FLAGS_data_dir);
+  options.samples = absl::GetFlag(FLAGS_samples);
+  options.import_dir = absl::GetFlag(FLAGS_import_dir);
   options.mesh_budget_bytes = absl::GetFlag(FLAGS_mesh_budget_bytes);
   options.pool_threads = absl::GetFlag(FLAGS_pool_threads);
   options.queue_capacity = absl::GetFlag(FLAGS_queue_capacity);
@@ -103,16 +109,37 @@ int main(int argc, char** argv) {
   options.limits.max_unary_response_bytes = absl::GetFlag(FLAGS_max_unary_response_bytes);
   options.limits.stream_chunk_bytes = absl::GetFlag(FLAGS_stream_chunk_bytes);
   options.limits.max_windows = absl::GetFlag(FLAGS_max_windows);
-  if (!options.data_dir.empty()) {
-    spdlog::warn("--data-dir {}: persistence is not implemented yet; meshes live in RAM only",
-                 options.data_dir);
-  }
-
   auto server = geodex::server::GeodexServer::Start(options);
   if (!server.ok()) {
     spdlog::error("{}", std::string(server.status().message()));
     return 1;
   }
+  const geodex::server::StartupReport& report = (*server)->startup_report();
+  if (!options.data_dir.empty()) {
+    spdlog::info("data dir {}: {} meshes indexed", options.data_dir, report.indexed);
+  }
+  for (const auto& skipped : report.skipped) {
+    spdlog::warn("skipped {}: {}", skipped.path, skipped.reason);
+  }
+  for (const auto& path : report.removed_temporaries) {
+    spdlog::warn("removed {} (a write interrupted by a crash)", path);
+  }
+  for (const auto& line : report.samples) spdlog::info("sample {}", line);
+  for (const auto& line : report.imported) spdlog::info("imported {}", line);
+  for (const auto& line : report.import_errors) spdlog::warn("import failed: {}", line);
+  // The effective configuration, one line.
+  spdlog::info(
+      "config listen={} data_dir={} samples={} mesh_budget_bytes={} pool_threads={} "
+      "queue_capacity={} max_upload_bytes={} max_vertices={} max_faces={} max_sources={} "
+      "max_targets={} max_levels={} max_output_values={} max_windows={} "
+      "max_unary_response_bytes={} stream_chunk_bytes={} shutdown_grace_seconds={}",
+      options.listen, options.data_dir.empty() ? "(none)" : options.data_dir, options.samples,
+      options.mesh_budget_bytes, (*server)->pool().threads(), options.queue_capacity,
+      options.limits.max_upload_bytes, options.limits.max_vertices, options.limits.max_faces,
+      options.limits.max_sources, options.limits.max_targets, options.limits.max_levels,
+      options.limits.max_output_values, options.limits.max_windows,
+      options.limits.max_unary_response_bytes, options.limits.stream_chunk_bytes,
+      absl::GetFlag(FLAGS_shutdown_grace_seconds));
   spdlog::info("geodexd listening on port {} ({} workers, queue {}, mesh budget {} bytes)",
                (*server)->port(), (*server)->pool().threads(), options.queue_capacity,
                options.mesh_budget_bytes);

@@ -3,6 +3,8 @@
 #include <utility>
 
 #include "absl/strings/str_cat.h"
+#include "google/protobuf/util/time_util.h"
+#include "proto_convert.h"
 
 namespace geodex::server {
 
@@ -16,64 +18,148 @@ std::shared_ptr<StoredMesh> MakeStoredMesh(std::string id, TriangleMesh mesh) {
   stored->face_count = stored->mesh->face_count();
   stored->memory_bytes = stored->mesh->MemoryBytes() + stored->locator->MemoryBytes();
   stored->create_time = absl::Now();
+  const MeshReport& report = stored->mesh->report();
+  stored->boundary_edges = report.boundary_edges;
+  stored->components = report.components;
+  stored->non_manifold_edges = report.non_manifold_edges;
+  stored->degenerate_faces = report.degenerate_faces;
   return stored;
 }
 
-absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::Insert(
-    std::shared_ptr<StoredMesh> mesh) {
+std::shared_ptr<StoredMesh> RecordFromProto(const std::string& id, const v1::Mesh& proto) {
+  auto record = std::make_shared<StoredMesh>();
+  record->id = id;
+  record->display_name = proto.display_name();
+  record->vertex_count = proto.vertex_count();
+  record->face_count = proto.face_count();
+  record->upload_bytes = proto.upload_bytes();
+  record->memory_bytes = proto.memory_bytes();
+  record->pinned = proto.pinned();
+  record->create_time = absl::FromUnixNanos(
+      google::protobuf::util::TimeUtil::TimestampToNanoseconds(proto.create_time()));
+  record->boundary_edges = proto.boundary_edges();
+  record->components = proto.components();
+  record->non_manifold_edges = proto.non_manifold_edges();
+  record->degenerate_faces = proto.degenerate_faces();
+  return record;
+}
+
+namespace {
+
+// The record of a resident mesh: the same fields, no mesh.
+std::shared_ptr<const StoredMesh> Strip(const StoredMesh& mesh) {
+  auto record = std::make_shared<StoredMesh>(mesh);
+  record->mesh.reset();
+  record->locator.reset();
+  return record;
+}
+
+}  // namespace
+
+void MeshStore::AttachDisk(MeshDisk disk, const MeshDisk::Index& index) {
   absl::MutexLock lock(&mu_);
-  if (!mesh->display_name.empty()) {
-    auto alias = aliases_.find(mesh->display_name);
-    if (alias != aliases_.end() && alias->second != mesh->id) {
-      return absl::InvalidArgumentError(absl::StrCat("metadata.display_name: \"",
-                                                     mesh->display_name,
-                                                     "\" already names mesh ", alias->second));
+  disk_.emplace(std::move(disk));
+  for (const MeshDisk::IndexEntry& entry : index.meshes) {
+    std::shared_ptr<StoredMesh> record = RecordFromProto(entry.id, entry.header);
+    if (!record->display_name.empty()) {
+      // Aliases are unique when written; a clash means hand-copied files: first one wins.
+      if (aliases_.contains(record->display_name)) {
+        record->display_name.clear();
+      } else {
+        aliases_[record->display_name] = entry.id;
+      }
     }
+    meshes_[entry.id].mesh = std::move(record);
   }
-  auto existing = meshes_.find(mesh->id);
-  if (existing != meshes_.end()) {
-    Slot& slot = existing->second;
-    lru_.splice(lru_.begin(), lru_, slot.lru);
-    if (!mesh->display_name.empty() && slot.mesh->display_name.empty()) {
-      auto updated = std::make_shared<StoredMesh>(*slot.mesh);
-      updated->display_name = mesh->display_name;
-      aliases_[mesh->display_name] = mesh->id;
-      slot.mesh = std::move(updated);
-    }
-    return slot.mesh;
-  }
-  if (mesh->memory_bytes > budget_bytes_) {
+}
+
+absl::StatusOr<std::vector<std::string>> MeshStore::VictimsLocked(uint64_t bytes) const {
+  if (bytes > budget_bytes_) {
     return absl::ResourceExhaustedError(
-        absl::StrCat("mesh needs ", mesh->memory_bytes, " bytes of memory, more than the whole ",
+        absl::StrCat("mesh needs ", bytes, " bytes of memory, more than the whole ",
                      "mesh budget (--mesh_budget_bytes=", budget_bytes_, ")"));
   }
-  // Which unpinned meshes (oldest first) would have to go; fail without evicting if not enough.
   std::vector<std::string> victims;
   uint64_t freed = 0;
-  for (auto it = lru_.rbegin();
-       it != lru_.rend() && used_bytes_ - freed + mesh->memory_bytes > budget_bytes_; ++it) {
+  for (auto it = lru_.rbegin(); it != lru_.rend() && used_bytes_ - freed + bytes > budget_bytes_;
+       ++it) {
     const Slot& slot = meshes_.at(*it);
     if (slot.mesh->pinned) continue;
     victims.push_back(*it);
     freed += slot.mesh->memory_bytes;
   }
-  if (used_bytes_ - freed + mesh->memory_bytes > budget_bytes_) {
+  if (used_bytes_ - freed + bytes > budget_bytes_) {
     return absl::ResourceExhaustedError(absl::StrCat(
-        "mesh needs ", mesh->memory_bytes, " bytes of memory but pinned meshes hold ",
-        used_bytes_ - freed, " of the ", budget_bytes_, " byte budget (--mesh_budget_bytes)"));
+        "mesh needs ", bytes, " bytes of memory but pinned meshes hold ", used_bytes_ - freed,
+        " of the ", budget_bytes_, " byte budget (--mesh_budget_bytes)"));
   }
-  for (const std::string& id : victims) {
-    RemoveLocked(id);
-    ++evictions_;
-  }
-  lru_.push_front(mesh->id);
-  used_bytes_ += mesh->memory_bytes;
-  if (!mesh->display_name.empty()) aliases_[mesh->display_name] = mesh->id;
-  std::string id = mesh->id;
+  return victims;
+}
+
+std::shared_ptr<const StoredMesh> MeshStore::AdmitLocked(std::shared_ptr<const StoredMesh> mesh) {
+  const std::string id = mesh->id;
   Slot& slot = meshes_[id];
+  if (!mesh->display_name.empty()) aliases_[mesh->display_name] = id;
+  lru_.push_front(id);
+  used_bytes_ += mesh->memory_bytes;
   slot.mesh = std::move(mesh);
   slot.lru = lru_.begin();
+  slot.resident = true;
   return slot.mesh;
+}
+
+absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::Insert(
+    std::shared_ptr<StoredMesh> mesh, const std::string& canonical) {
+  {
+    absl::MutexLock lock(&mu_);
+    if (!mesh->display_name.empty()) {
+      auto alias = aliases_.find(mesh->display_name);
+      if (alias != aliases_.end() && alias->second != mesh->id) {
+        return absl::InvalidArgumentError(absl::StrCat("metadata.display_name: \"",
+                                                       mesh->display_name,
+                                                       "\" already names mesh ", alias->second));
+      }
+    }
+    auto existing = meshes_.find(mesh->id);
+    if (existing != meshes_.end()) {
+      Slot& slot = existing->second;
+      if (slot.resident) lru_.splice(lru_.begin(), lru_, slot.lru);
+      if (!mesh->display_name.empty() && slot.mesh->display_name.empty()) {
+        auto updated = std::make_shared<StoredMesh>(*slot.mesh);
+        updated->display_name = mesh->display_name;
+        if (disk_) {
+          v1::Mesh header;
+          MeshToProto(*Strip(*updated), &header);
+          if (absl::Status s = disk_->UpdateHeader(mesh->id, header); !s.ok()) return s;
+        }
+        aliases_[mesh->display_name] = mesh->id;
+        slot.mesh = std::move(updated);
+      }
+      return slot.mesh;
+    }
+    if (mesh->mesh == nullptr) {  // a re-upload whose stored mesh was deleted meanwhile
+      return absl::AbortedError(absl::StrCat("mesh ", mesh->id, " was deleted during the upload; retry"));
+    }
+    // Fail early, before writing anything, when the mesh can never fit.
+    if (absl::StatusOr<std::vector<std::string>> victims = VictimsLocked(mesh->memory_bytes);
+        !victims.ok()) {
+      return victims.status();
+    }
+  }
+  // Persist before acknowledging (outside the lock: writing a large mesh takes a while).
+  if (disk_) {
+    v1::Mesh header;
+    MeshToProto(*mesh, &header);
+    if (absl::Status s = disk_->Write(mesh->id, header, canonical); !s.ok()) return s;
+  }
+  absl::MutexLock lock(&mu_);
+  if (auto existing = meshes_.find(mesh->id); existing != meshes_.end() && existing->second.resident) {
+    return existing->second.mesh;  // a concurrent upload of the same mesh won
+  }
+  absl::StatusOr<std::vector<std::string>> victims = VictimsLocked(mesh->memory_bytes);
+  if (!victims.ok()) return victims.status();
+  for (const std::string& id : *victims) EvictLocked(id);
+  return AdmitLocked(std::move(mesh));
 }
 
 MeshStore::Slot* MeshStore::FindLocked(const std::string& id_or_alias) {
@@ -85,21 +171,95 @@ MeshStore::Slot* MeshStore::FindLocked(const std::string& id_or_alias) {
   return it == meshes_.end() ? nullptr : &it->second;
 }
 
+const MeshStore::Slot* MeshStore::FindLocked(const std::string& id_or_alias) const {
+  return const_cast<MeshStore*>(this)->FindLocked(id_or_alias);
+}
+
 void MeshStore::RemoveLocked(const std::string& id) {
   auto it = meshes_.find(id);
   if (it == meshes_.end()) return;
   const StoredMesh& mesh = *it->second.mesh;
   if (!mesh.display_name.empty()) aliases_.erase(mesh.display_name);
-  used_bytes_ -= mesh.memory_bytes;
-  lru_.erase(it->second.lru);
+  if (it->second.resident) {
+    used_bytes_ -= mesh.memory_bytes;
+    lru_.erase(it->second.lru);
+  }
   meshes_.erase(it);
 }
 
+void MeshStore::EvictLocked(const std::string& id) {
+  ++evictions_;
+  if (!disk_) {
+    RemoveLocked(id);
+    return;
+  }
+  Slot& slot = meshes_.at(id);
+  used_bytes_ -= slot.mesh->memory_bytes;
+  lru_.erase(slot.lru);
+  slot.resident = false;
+  slot.mesh = Strip(*slot.mesh);
+}
+
 absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::Get(const std::string& id_or_alias) {
+  std::shared_ptr<const StoredMesh> record;
+  {
+    absl::MutexLock lock(&mu_);
+    Slot* slot = FindLocked(id_or_alias);
+    if (slot == nullptr) {
+      return absl::NotFoundError(absl::StrCat("mesh \"", id_or_alias, "\" not found"));
+    }
+    if (slot->resident) {
+      lru_.splice(lru_.begin(), lru_, slot->lru);
+      return slot->mesh;
+    }
+    record = slot->mesh;
+  }
+  // Load from disk without holding the lock. Two concurrent first uses may both load; the second
+  // to finish takes the first's entry.
+  v1::Mesh header;
+  std::string canonical;
+  if (absl::Status s = disk_->Read(record->id, &header, &canonical); !s.ok()) return s;
+  absl::StatusOr<MeshData> data = DecodeCanonicalMesh(canonical);
+  if (!data.ok()) {
+    return absl::DataLossError(absl::StrCat("stored mesh ", disk_->PathOf(record->id), ": ",
+                                            data.status().message()));
+  }
+  canonical.clear();
+  absl::StatusOr<TriangleMesh> built = TriangleMesh::Build(*data);
+  if (!built.ok()) {
+    return absl::DataLossError(absl::StrCat("stored mesh ", disk_->PathOf(record->id), ": ",
+                                            built.status().message()));
+  }
+  std::shared_ptr<StoredMesh> loaded = MakeStoredMesh(record->id, *std::move(built));
+  loaded->display_name = record->display_name;
+  loaded->pinned = record->pinned;
+  loaded->upload_bytes = record->upload_bytes;
+  loaded->create_time = record->create_time;
+
   absl::MutexLock lock(&mu_);
-  Slot* slot = FindLocked(id_or_alias);
-  if (slot == nullptr) return absl::NotFoundError(absl::StrCat("mesh \"", id_or_alias, "\" not found"));
-  lru_.splice(lru_.begin(), lru_, slot->lru);
+  auto it = meshes_.find(record->id);
+  if (it == meshes_.end()) {
+    return absl::NotFoundError(absl::StrCat("mesh \"", id_or_alias, "\" was deleted"));
+  }
+  if (it->second.resident) {
+    lru_.splice(lru_.begin(), lru_, it->second.lru);
+    return it->second.mesh;
+  }
+  loaded->display_name = it->second.mesh->display_name;  // an alias may have been added meanwhile
+  absl::StatusOr<std::vector<std::string>> victims = VictimsLocked(loaded->memory_bytes);
+  if (!victims.ok()) return victims.status();
+  for (const std::string& id : *victims) EvictLocked(id);
+  ++disk_loads_;
+  return AdmitLocked(std::move(loaded));
+}
+
+absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::GetRecord(
+    const std::string& id_or_alias) const {
+  absl::MutexLock lock(&mu_);
+  const Slot* slot = FindLocked(id_or_alias);
+  if (slot == nullptr) {
+    return absl::NotFoundError(absl::StrCat("mesh \"", id_or_alias, "\" not found"));
+  }
   return slot->mesh;
 }
 
@@ -111,8 +271,14 @@ bool MeshStore::Contains(const std::string& id) const {
 absl::Status MeshStore::Delete(const std::string& id_or_alias) {
   absl::MutexLock lock(&mu_);
   Slot* slot = FindLocked(id_or_alias);
-  if (slot == nullptr) return absl::NotFoundError(absl::StrCat("mesh \"", id_or_alias, "\" not found"));
-  RemoveLocked(std::string(slot->mesh->id));
+  if (slot == nullptr) {
+    return absl::NotFoundError(absl::StrCat("mesh \"", id_or_alias, "\" not found"));
+  }
+  const std::string id = slot->mesh->id;
+  if (disk_) {
+    if (absl::Status s = disk_->Remove(id); !s.ok()) return s;
+  }
+  RemoveLocked(id);
   return absl::OkStatus();
 }
 
@@ -136,9 +302,19 @@ size_t MeshStore::size() const {
   return meshes_.size();
 }
 
+size_t MeshStore::resident_count() const {
+  absl::MutexLock lock(&mu_);
+  return lru_.size();
+}
+
 uint64_t MeshStore::evictions() const {
   absl::MutexLock lock(&mu_);
   return evictions_;
+}
+
+uint64_t MeshStore::disk_loads() const {
+  absl::MutexLock lock(&mu_);
+  return disk_loads_;
 }
 
 }  // namespace geodex::server

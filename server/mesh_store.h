@@ -1,14 +1,19 @@
 #pragma once
 
-// The in-memory mesh store: mesh id -> immutable preprocessed mesh, under a RAM byte budget with
-// LRU eviction of unpinned meshes. Thread-safe. Queries hold a shared_ptr to the entry, so a
-// delete or an eviction never disturbs a query in flight (the memory goes when the last query
-// drops it).
+// The mesh store: mesh id -> immutable preprocessed mesh, under a RAM byte budget with LRU eviction
+// of unpinned meshes, optionally backed by the data directory (mesh_disk.h). Thread-safe. Queries
+// hold a shared_ptr to the entry, so a delete or an eviction never disturbs a query in flight (the
+// memory goes when the last query drops it).
+//
+// With a data directory every mesh is written to disk before it is acknowledged; the budget then
+// evicts from memory only, and Get() loads an evicted (or not yet loaded) mesh back on first use.
+// Without one, evicting a mesh forgets it.
 
 #include <cstdint>
 #include <list>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,10 +24,12 @@
 #include "absl/time/time.h"
 #include "geodex/locate.h"
 #include "geodex/triangle_mesh.h"
+#include "mesh_disk.h"
 
 namespace geodex::server {
 
-// One stored mesh; immutable once built.
+// One stored mesh; immutable once built. A record of a mesh that is only on disk has no `mesh`
+// and `locator` (GetRecord); Get() always returns a loaded one.
 struct StoredMesh {
   std::string id;            // SHA-256 hex (see mesh_id.h)
   std::string display_name;  // optional alias
@@ -34,6 +41,11 @@ struct StoredMesh {
   uint64_t memory_bytes = 0;  // mesh + locator, counted against the budget
   bool pinned = false;
   absl::Time create_time;
+  // From the mesh's build report (kept so that records answer GetMesh without loading).
+  uint64_t boundary_edges = 0;
+  uint64_t components = 0;
+  uint64_t non_manifold_edges = 0;
+  uint64_t degenerate_faces = 0;
 };
 
 // Builds a StoredMesh (mesh + locator) from a built mesh; fills memory_bytes and counts.
@@ -43,46 +55,78 @@ class MeshStore {
  public:
   explicit MeshStore(uint64_t budget_bytes) : budget_bytes_(budget_bytes) {}
 
-  // Adds `mesh`, evicting least-recently-used unpinned meshes as needed. If a mesh with the same id
-  // is stored already, returns that one (re-uploads are idempotent; a new alias is added to it
-  // when it has none). Errors: ResourceExhausted when the mesh is larger than the budget or cannot
-  // fit beside the pinned meshes; InvalidArgument when the alias belongs to another mesh.
-  absl::StatusOr<std::shared_ptr<const StoredMesh>> Insert(std::shared_ptr<StoredMesh> mesh);
+  // Backs the store with a data directory and registers the meshes its index found (not loaded).
+  // Call once, before serving.
+  void AttachDisk(MeshDisk disk, const MeshDisk::Index& index);
+  bool has_disk() const { return disk_.has_value(); }
 
-  // The mesh with this id or alias (marks it recently used). NotFound otherwise.
+  // Adds `mesh` (built), persisting `canonical` (its canonical encoding) first when a data
+  // directory is attached, and evicting least-recently-used unpinned meshes from memory as needed.
+  // If a mesh with the same id is stored already, returns that one (re-uploads are idempotent; a
+  // new alias is added to it when it has none). Errors: ResourceExhausted when the mesh is larger
+  // than the budget, cannot fit beside the pinned meshes, or the disk is full; InvalidArgument
+  // when the alias belongs to another mesh; Internal for other I/O errors.
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> Insert(std::shared_ptr<StoredMesh> mesh,
+                                                           const std::string& canonical = "");
+
+  // The mesh with this id or alias, loaded (from disk if needed; that can take a while: call it on
+  // a compute thread). Marks it recently used. NotFound when unknown, DataLoss when its file does
+  // not verify.
   absl::StatusOr<std::shared_ptr<const StoredMesh>> Get(const std::string& id_or_alias);
 
-  // True if a mesh with this id is stored (does not touch the LRU order).
+  // What is known about a mesh without loading it (mesh/locator may be null). NotFound otherwise.
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> GetRecord(const std::string& id_or_alias) const;
+
+  // True if a mesh with this id is stored (in memory or on disk).
   bool Contains(const std::string& id) const;
 
-  // Removes the mesh with this id or alias. NotFound otherwise.
+  // Removes the mesh with this id or alias, from memory and disk. NotFound otherwise.
   absl::Status Delete(const std::string& id_or_alias);
 
-  // Up to `limit` meshes with id > `after`, ordered by id; `*more` tells whether more follow.
+  // Up to `limit` records with id > `after`, ordered by id; `*more` tells whether more follow.
   std::vector<std::shared_ptr<const StoredMesh>> List(const std::string& after, size_t limit,
                                                       bool* more) const;
 
-  uint64_t used_bytes() const;
+  uint64_t used_bytes() const;  // resident meshes
   uint64_t budget_bytes() const { return budget_bytes_; }
-  size_t size() const;
+  size_t size() const;           // all meshes (resident or on disk)
+  size_t resident_count() const;
   uint64_t evictions() const;
+  uint64_t disk_loads() const;
 
  private:
   struct Slot {
+    // The full entry when resident, else a record without mesh/locator.
     std::shared_ptr<const StoredMesh> mesh;
-    std::list<std::string>::iterator lru;  // position in lru_
+    std::list<std::string>::iterator lru;  // position in lru_ (valid when resident)
+    bool resident = false;
   };
   // The slot for an id or alias, or nullptr.
   Slot* FindLocked(const std::string& id_or_alias) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  const Slot* FindLocked(const std::string& id_or_alias) const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  // Removes the mesh entirely.
   void RemoveLocked(const std::string& id) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  // Drops a resident mesh from memory (disk-backed) or removes it (RAM only).
+  void EvictLocked(const std::string& id) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  // Unpinned resident meshes to evict (oldest first) so that `bytes` more fit; error if impossible.
+  absl::StatusOr<std::vector<std::string>> VictimsLocked(uint64_t bytes) const
+      ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  // Makes `mesh` resident in a slot (new or existing record), evicting `victims`.
+  std::shared_ptr<const StoredMesh> AdmitLocked(std::shared_ptr<const StoredMesh> mesh)
+      ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
 
   const uint64_t budget_bytes_;
+  std::optional<MeshDisk> disk_;
   mutable absl::Mutex mu_;
   std::map<std::string, Slot> meshes_ ABSL_GUARDED_BY(mu_);  // ordered by id for List
   absl::flat_hash_map<std::string, std::string> aliases_ ABSL_GUARDED_BY(mu_);  // alias -> id
-  std::list<std::string> lru_ ABSL_GUARDED_BY(mu_);  // most recently used first
+  std::list<std::string> lru_ ABSL_GUARDED_BY(mu_);  // resident meshes, most recently used first
   uint64_t used_bytes_ ABSL_GUARDED_BY(mu_) = 0;
   uint64_t evictions_ ABSL_GUARDED_BY(mu_) = 0;
+  uint64_t disk_loads_ ABSL_GUARDED_BY(mu_) = 0;
 };
+
+// A record from a Mesh resource (the disk header; MeshToProto in proto_convert.h is the reverse).
+std::shared_ptr<StoredMesh> RecordFromProto(const std::string& id, const v1::Mesh& proto);
 
 }  // namespace geodex::server

@@ -48,11 +48,10 @@ void MeshToProto(const StoredMesh& mesh, v1::Mesh* out) {
   *out->mutable_create_time() =
       google::protobuf::util::TimeUtil::NanosecondsToTimestamp(absl::ToUnixNanos(mesh.create_time));
   out->set_pinned(mesh.pinned);
-  const MeshReport& report = mesh.mesh->report();
-  out->set_boundary_edges(report.boundary_edges);
-  out->set_components(report.components);
-  out->set_non_manifold_edges(report.non_manifold_edges);
-  out->set_degenerate_faces(report.degenerate_faces);
+  out->set_boundary_edges(mesh.boundary_edges);
+  out->set_components(mesh.components);
+  out->set_non_manifold_edges(mesh.non_manifold_edges);
+  out->set_degenerate_faces(mesh.degenerate_faces);
 }
 
 absl::StatusOr<SurfacePoint> ResolvePoint(const StoredMesh& mesh, const v1::SurfacePoint& point,

@@ -122,10 +122,10 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> LookupMesh(MeshStore& store,
   absl::StatusOr<std::string> key = ParseMeshName(name, field);
   if (!key.ok()) return key.status();
   absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh = store.Get(*key);
-  if (!mesh.ok()) {
+  if (absl::IsNotFound(mesh.status())) {
     return absl::NotFoundError(absl::StrCat(field, ": mesh \"", name, "\" not found"));
   }
-  return mesh;
+  return mesh;  // or DataLoss (a corrupt file), ResourceExhausted (cannot be loaded back)
 }
 
 // ------------------------------------------------------------------------------------------

@@ -1,0 +1,216 @@
+// geodexd's data directory: restarts lose nothing, corrupt or truncated files are skipped, crashed
+// writes are cleaned up, built-in samples appear on a fresh directory only, evicted meshes come back
+// from disk, and a server-side import directory is read at start.
+
+#include <filesystem>
+#include <fstream>
+
+#include "absl/strings/str_cat.h"
+#include "mesh_disk.h"
+#include "server_test_util.h"
+
+namespace geodex::server {
+namespace {
+
+using testing::FieldRequest;
+using testing::GridOff;
+using testing::In;
+using testing::ReadField;
+using testing::Upload;
+
+namespace fs = std::filesystem;
+
+class PersistenceTest : public testing::ServerFixture {
+ protected:
+  void SetUp() override {
+    dir_ = fs::path(::testing::TempDir()) /
+           absl::StrCat("geodex-persist-", ::testing::UnitTest::GetInstance()->random_seed(), "-",
+                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+  }
+  void TearDown() override {
+    testing::ServerFixture::TearDown();
+    server_.reset();
+    fs::remove_all(dir_);
+  }
+  void Restart(ServerOptions options = {}) {
+    if (server_) server_->Shutdown(absl::Now() + absl::Seconds(10));
+    server_.reset();
+    options.data_dir = dir_.string();
+    StartServer(options);
+  }
+  std::vector<v1::Mesh> List() {
+    grpc::ClientContext context;
+    context.set_deadline(In(30));
+    v1::ListMeshesRequest request;
+    v1::ListMeshesResponse response;
+    EXPECT_TRUE(stub_->ListMeshes(&context, request, &response).ok());
+    return {response.meshes().begin(), response.meshes().end()};
+  }
+  grpc::Status GetMesh(const std::string& name, v1::Mesh* out) {
+    grpc::ClientContext context;
+    context.set_deadline(In(30));
+    v1::GetMeshRequest request;
+    request.set_name(name);
+    return stub_->GetMesh(&context, request, out);
+  }
+  std::string MeshFile(const v1::Mesh& mesh) {
+    return (dir_ / "meshes" / (mesh.name().substr(7) + ".gdxs")).string();
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(PersistenceTest, RestartKeepsEveryMeshWithItsIdAliasAndAnswers) {
+  Restart();
+  testing::UploadResult a = Upload(*stub_, GridOff(12, 9, true), "hills");
+  testing::UploadResult b = Upload(*stub_, GridOff(7, 7, false), "", 1 << 20, /*pin=*/true);
+  ASSERT_TRUE(a.status.ok() && b.status.ok());
+  testing::FieldResult before = ReadField(*stub_, FieldRequest("meshes/hills", {0, 50}));
+  ASSERT_TRUE(before.status.ok());
+  EXPECT_TRUE(fs::exists(MeshFile(a.mesh)));
+
+  Restart();
+  std::vector<v1::Mesh> meshes = List();
+  ASSERT_EQ(meshes.size(), 2u);
+  v1::Mesh got;
+  ASSERT_TRUE(GetMesh("meshes/hills", &got).ok());  // answered from the index, not loaded
+  EXPECT_EQ(got.name(), a.mesh.name());
+  EXPECT_EQ(got.vertex_count(), a.mesh.vertex_count());
+  EXPECT_EQ(got.memory_bytes(), a.mesh.memory_bytes());
+  EXPECT_EQ(got.create_time().seconds(), a.mesh.create_time().seconds());
+  EXPECT_EQ(server_->store().resident_count(), 0u);
+  ASSERT_TRUE(GetMesh(b.mesh.name(), &got).ok());
+  EXPECT_TRUE(got.pinned());
+
+  // First use loads from disk; the answer is bit-identical.
+  testing::FieldResult after = ReadField(*stub_, FieldRequest("meshes/hills", {0, 50}));
+  ASSERT_TRUE(after.status.ok()) << after.status.error_message();
+  EXPECT_EQ(after.distances, before.distances);
+  EXPECT_EQ(after.labels, before.labels);
+  EXPECT_EQ(server_->store().disk_loads(), 1u);
+
+  // Re-uploading is still idempotent; a delete removes the file and survives a restart.
+  testing::UploadResult again = Upload(*stub_, GridOff(12, 9, true));
+  EXPECT_EQ(again.mesh.name(), a.mesh.name());
+  grpc::ClientContext context;
+  v1::DeleteMeshRequest del;
+  del.set_name("meshes/hills");
+  v1::DeleteMeshResponse deleted;
+  ASSERT_TRUE(stub_->DeleteMesh(&context, del, &deleted).ok());
+  EXPECT_FALSE(fs::exists(MeshFile(a.mesh)));
+  Restart();
+  EXPECT_EQ(List().size(), 1u);
+}
+
+TEST_F(PersistenceTest, EvictionKeepsTheMeshOnDiskAndLoadsItBack) {
+  std::string a = GridOff(20, 20, true), b = GridOff(21, 21, true);
+  ServerOptions probe;
+  Restart(probe);
+  testing::UploadResult ua = Upload(*stub_, a);
+  ASSERT_TRUE(ua.status.ok());
+  // A budget that holds one of the two meshes at a time.
+  ServerOptions small;
+  small.mesh_budget_bytes = ua.mesh.memory_bytes() * 3 / 2;
+  Restart(small);
+  testing::UploadResult ub = Upload(*stub_, b);
+  ASSERT_TRUE(ub.status.ok()) << ub.status.error_message();
+  testing::FieldResult fa = ReadField(*stub_, FieldRequest(ua.mesh.name(), {0}));
+  ASSERT_TRUE(fa.status.ok()) << fa.status.error_message();  // loaded, evicting b from memory
+  testing::FieldResult fb = ReadField(*stub_, FieldRequest(ub.mesh.name(), {0}));
+  ASSERT_TRUE(fb.status.ok()) << fb.status.error_message();  // b back from disk, a evicted
+  EXPECT_GE(server_->store().evictions(), 1u);
+  EXPECT_EQ(server_->store().disk_loads(), 2u);
+  EXPECT_EQ(List().size(), 2u);  // eviction forgets nothing
+  EXPECT_EQ(server_->store().resident_count(), 1u);
+}
+
+TEST_F(PersistenceTest, CorruptTruncatedAndForeignFilesAreSkippedAndTemporariesRemoved) {
+  Restart();
+  testing::UploadResult good = Upload(*stub_, GridOff(6, 6, true), "good");
+  testing::UploadResult bad = Upload(*stub_, GridOff(8, 8, true), "flipped");
+  testing::UploadResult cut = Upload(*stub_, GridOff(9, 9, true), "cut");
+  ASSERT_TRUE(good.status.ok() && bad.status.ok() && cut.status.ok());
+  server_->Shutdown(absl::Now() + absl::Seconds(10));
+  server_.reset();
+
+  // One byte flipped inside the payload: the index accepts it (the framing is intact) and its
+  // first use answers DATA_LOSS naming the file; truncation is caught by the index.
+  {
+    std::fstream f(MeshFile(bad.mesh), std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(-100, std::ios::end);
+    f.put('\x5a');
+  }
+  fs::resize_file(MeshFile(cut.mesh), fs::file_size(MeshFile(cut.mesh)) - 7);
+  std::ofstream(dir_ / "meshes" / "notes.txt") << "not a mesh";
+  std::ofstream(dir_ / "meshes" / (std::string(64, 'a') + ".gdxs")) << "GDXSTOR1 garbage";
+  const fs::path temporary = dir_ / "meshes" / (good.mesh.name().substr(7) + ".gdxs.tmp.123.0");
+  std::ofstream(temporary) << "half a write";
+
+  Restart();
+  const StartupReport& report = server_->startup_report();
+  EXPECT_EQ(report.indexed, 2u);  // good and the flipped one
+  ASSERT_EQ(report.skipped.size(), 3u);
+  bool truncated_reported = false;
+  for (const auto& s : report.skipped) {
+    truncated_reported |= s.path == MeshFile(cut.mesh) && s.reason.find("truncated") != std::string::npos;
+  }
+  EXPECT_TRUE(truncated_reported);
+  ASSERT_EQ(report.removed_temporaries.size(), 1u);
+  EXPECT_FALSE(fs::exists(temporary));
+
+  EXPECT_TRUE(ReadField(*stub_, FieldRequest("meshes/good", {0})).status.ok());
+  grpc::Status s = ReadField(*stub_, FieldRequest("meshes/flipped", {0})).status;
+  EXPECT_EQ(s.error_code(), grpc::StatusCode::DATA_LOSS) << s.error_message();
+  EXPECT_NE(s.error_message().find(MeshFile(bad.mesh)), std::string::npos) << s.error_message();
+  v1::Mesh got;
+  EXPECT_EQ(GetMesh("meshes/cut", &got).error_code(), grpc::StatusCode::NOT_FOUND);
+  // The skipped files are left in place for an operator to inspect.
+  EXPECT_TRUE(fs::exists(MeshFile(cut.mesh)));
+}
+
+TEST_F(PersistenceTest, SamplesOnAFreshDirectoryOnly) {
+  ServerOptions options;
+  options.samples = true;
+  Restart(options);
+  std::vector<v1::Mesh> meshes = List();
+  ASSERT_EQ(meshes.size(), 3u);
+  for (const char* name : {"terrain", "torus", "sphere"}) {
+    v1::Mesh mesh;
+    ASSERT_TRUE(GetMesh(absl::StrCat("meshes/", name), &mesh).ok()) << name;
+    EXPECT_GT(mesh.face_count(), 1000u);
+  }
+  testing::FieldResult field = ReadField(*stub_, FieldRequest("meshes/terrain", {0}));
+  ASSERT_TRUE(field.status.ok());
+  EXPECT_EQ(field.distances.size(), 65u * 65u);
+
+  // A deleted sample stays deleted: samples are only added to a fresh directory.
+  grpc::ClientContext context;
+  v1::DeleteMeshRequest del;
+  del.set_name("meshes/torus");
+  v1::DeleteMeshResponse deleted;
+  ASSERT_TRUE(stub_->DeleteMesh(&context, del, &deleted).ok());
+  Restart(options);
+  EXPECT_EQ(List().size(), 2u);
+}
+
+TEST_F(PersistenceTest, ImportDirectoryAtStart) {
+  const fs::path import = dir_.string() + "-import";
+  fs::create_directories(import);
+  std::ofstream(import / "valley.off") << GridOff(5, 4, true);
+  std::ofstream(import / "broken.off") << "OFF\n3 1 0\n0 0 0\n";
+  ServerOptions options;
+  options.import_dir = import.string();
+  Restart(options);
+  const StartupReport& report = server_->startup_report();
+  EXPECT_EQ(report.imported.size(), 1u);
+  ASSERT_EQ(report.import_errors.size(), 1u);
+  EXPECT_NE(report.import_errors[0].find("broken.off"), std::string::npos) << report.import_errors[0];
+  v1::Mesh mesh;
+  ASSERT_TRUE(GetMesh("meshes/valley", &mesh).ok());
+  EXPECT_EQ(mesh.vertex_count(), 30u);
+  fs::remove_all(import);
+}
+
+}  // namespace
+}  // namespace geodex::server
