@@ -23,7 +23,9 @@ absl::StatusOr<std::unique_ptr<GeodexServer>> GeodexServer::Start(const ServerOp
   if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
   s->store_ = std::make_unique<MeshStore>(options.mesh_budget_bytes);
   s->pool_ = std::make_unique<ComputePool>(threads, options.queue_capacity);
-  s->service_ = std::make_unique<GeodexService>(s->store_.get(), s->pool_.get(), options.limits);
+  s->cache_ = std::make_unique<FieldCache>(options.result_cache_bytes);
+  s->service_ = std::make_unique<GeodexService>(s->store_.get(), s->pool_.get(), s->cache_.get(),
+                                                options.limits);
 
   // The store is complete before the port opens: health never says SERVING before the index is
   // read (and no call sees a half-read index).

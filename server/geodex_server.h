@@ -38,6 +38,7 @@ struct ServerOptions {
   size_t pool_threads = 0;    // 0 = hardware concurrency
   size_t queue_capacity = 64;
   int max_receive_message_bytes = 4 << 20;  // per message; uploads are chunked below this
+  uint64_t result_cache_bytes = uint64_t{256} << 20;  // finished fields kept for reuse; 0 = off
   ServiceLimits limits;
 };
 
@@ -62,6 +63,8 @@ class GeodexServer {
 
   MeshStore& store() { return *store_; }
   ComputePool& pool() { return *pool_; }
+  FieldCache& cache() { return *cache_; }
+  GeodexService& service() { return *service_; }
   grpc::Server& grpc_server() { return *server_; }
 
  private:
@@ -70,6 +73,7 @@ class GeodexServer {
   // Declaration order = reverse destruction order: the server goes first, then the pool (joins
   // its workers), the service and the store.
   std::unique_ptr<MeshStore> store_;
+  std::unique_ptr<FieldCache> cache_;
   std::unique_ptr<GeodexService> service_;
   std::unique_ptr<ComputePool> pool_;
   std::unique_ptr<grpc::Server> server_;

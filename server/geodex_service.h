@@ -8,6 +8,7 @@
 #include <cstdint>
 
 #include "compute_pool.h"
+#include "field_cache.h"
 #include "geodex/v1/geodex.grpc.pb.h"
 #include "mesh_store.h"
 #include "query_reactors.h"
@@ -19,8 +20,9 @@ class GeodexService final : public v1::Geodex::CallbackService {
  public:
   // `store` and `pool` must outlive the service; the pool must also outlive the grpc::Server's
   // Shutdown (its tasks finish the calls).
-  GeodexService(MeshStore* store, ComputePool* pool, const ServiceLimits& limits)
-      : store_(store), pool_(pool), limits_(limits) {}
+  // `cache` (the result cache) must outlive the service too.
+  GeodexService(MeshStore* store, ComputePool* pool, FieldCache* cache, const ServiceLimits& limits)
+      : store_(store), pool_(pool), cache_(cache), limits_(limits) {}
 
   grpc::ServerReadReactor<v1::CreateMeshRequest>* CreateMesh(grpc::CallbackServerContext* context,
                                                              v1::Mesh* response) override;
@@ -58,12 +60,15 @@ class GeodexService final : public v1::Geodex::CallbackService {
   MeshStore* store() const { return store_; }
   ComputePool* pool() const { return pool_; }
   const ServiceLimits& limits() const { return limits_; }
+  const ServiceCounters& counters() const { return counters_; }
 
  private:
-  ReactorEnv env() { return ReactorEnv{store_, &limits_, pool_}; }
+  ReactorEnv env() { return ReactorEnv{store_, &limits_, pool_, cache_, &counters_}; }
 
   MeshStore* store_;
   ComputePool* pool_;
+  FieldCache* cache_;
+  ServiceCounters counters_;
   ServiceLimits limits_;
 };
 

@@ -27,6 +27,9 @@ ABSL_FLAG(std::string, import_dir, "",
           "Import every mesh file of this server-side directory at start (alias = file name)");
 ABSL_FLAG(uint64_t, mesh_budget_bytes, uint64_t{4} << 30,
           "RAM budget for preprocessed meshes; least-recently-used unpinned meshes are evicted");
+ABSL_FLAG(uint64_t, result_cache_bytes, uint64_t{256} << 20,
+          "Memory for finished distance fields reused by later queries with the same mesh, sources "
+          "and options (0 = off)");
 ABSL_FLAG(uint32_t, pool_threads, 0, "Compute worker threads (0 = one per hardware thread)");
 ABSL_FLAG(uint32_t, queue_capacity, 64,
           "Queries that may wait for a worker; beyond that calls get RESOURCE_EXHAUSTED at once");
@@ -96,6 +99,7 @@ int main(int argc, char** argv) {
   options.samples = absl::GetFlag(FLAGS_samples);
   options.import_dir = absl::GetFlag(FLAGS_import_dir);
   options.mesh_budget_bytes = absl::GetFlag(FLAGS_mesh_budget_bytes);
+  options.result_cache_bytes = absl::GetFlag(FLAGS_result_cache_bytes);
   options.pool_threads = absl::GetFlag(FLAGS_pool_threads);
   options.queue_capacity = absl::GetFlag(FLAGS_queue_capacity);
   options.max_receive_message_bytes = absl::GetFlag(FLAGS_max_receive_message_bytes);
@@ -129,12 +133,13 @@ int main(int argc, char** argv) {
   for (const auto& line : report.import_errors) spdlog::warn("import failed: {}", line);
   // The effective configuration, one line.
   spdlog::info(
-      "config listen={} data_dir={} samples={} mesh_budget_bytes={} pool_threads={} "
+      "config listen={} data_dir={} samples={} mesh_budget_bytes={} result_cache_bytes={} "
+      "pool_threads={} "
       "queue_capacity={} max_upload_bytes={} max_vertices={} max_faces={} max_sources={} "
       "max_targets={} max_levels={} max_output_values={} max_windows={} "
       "max_unary_response_bytes={} stream_chunk_bytes={} shutdown_grace_seconds={}",
       options.listen, options.data_dir.empty() ? "(none)" : options.data_dir, options.samples,
-      options.mesh_budget_bytes, (*server)->pool().threads(), options.queue_capacity,
+      options.mesh_budget_bytes, options.result_cache_bytes, (*server)->pool().threads(), options.queue_capacity,
       options.limits.max_upload_bytes, options.limits.max_vertices, options.limits.max_faces,
       options.limits.max_sources, options.limits.max_targets, options.limits.max_levels,
       options.limits.max_output_values, options.limits.max_windows,

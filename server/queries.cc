@@ -15,6 +15,7 @@
 #include "geodex/point_distance.h"
 #include "geodex/shortest_path.h"
 #include "geodex/voronoi.h"
+#include "field_cache.h"
 #include "proto_convert.h"
 #include "service_limits.h"
 
@@ -88,15 +89,42 @@ absl::Status CheckUnaryResponseSize(const QueryEnv& env, const google::protobuf:
   return absl::OkStatus();
 }
 
-// The field behind isolines, Voronoi and Delaunay.
+// A distance field from the result cache, or solved (and then cached). `cached` tells which.
+absl::StatusOr<std::shared_ptr<const DistanceField>> CachedField(
+    const QueryEnv& env, const StoredMesh& mesh, const std::vector<SurfacePoint>& sources,
+    const GeodesicOptions& options, bool* cached) {
+  const std::string key = FieldCacheKey(mesh.id, sources, options);
+  if (std::shared_ptr<const DistanceField> hit = env.cache->Find(key)) {
+    *cached = true;
+    return hit;
+  }
+  *cached = false;
+  absl::StatusOr<DistanceField> field = ComputeDistanceField(*mesh.mesh, sources, options);
+  if (!field.ok()) return NameSolveError(field.status(), "sources");
+  env.counters->solves.fetch_add(1, std::memory_order_relaxed);
+  env.counters->windows_processed.fetch_add(field->stats.windows_processed,
+                                            std::memory_order_relaxed);
+  auto shared = std::make_shared<const DistanceField>(*std::move(field));
+  env.cache->Insert(key, shared);
+  return shared;
+}
+
+void FieldStatsToProto(const DistanceField& field, bool cached, v1::SolveStats* out) {
+  StatsToProto(field.stats, out);
+  out->set_cached(cached);
+}
+
+// The field behind distance fields, isolines, Voronoi and Delaunay.
 struct SolvedField {
   std::shared_ptr<const StoredMesh> mesh;  // keeps the mesh alive while the result is built
   std::vector<SurfacePoint> sources;
-  DistanceField field;
+  std::shared_ptr<const DistanceField> field;
+  bool cached = false;
 };
 
 absl::StatusOr<SolvedField> SolveField(const QueryEnv& env, const std::string& mesh_name,
-                                       const PointList& sources, const v1::SolverOptions& options) {
+                                       const PointList& sources,
+                                       const v1::SolverOptions& options) {
   SolvedField out;
   absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh =
       LookupMesh(*env.store, mesh_name, "mesh");
@@ -108,8 +136,9 @@ absl::StatusOr<SolvedField> SolveField(const QueryEnv& env, const std::string& m
   out.sources = *std::move(resolved);
   absl::StatusOr<GeodesicOptions> solver = Options(env, options);
   if (!solver.ok()) return solver.status();
-  absl::StatusOr<DistanceField> field = ComputeDistanceField(*out.mesh->mesh, out.sources, *solver);
-  if (!field.ok()) return NameSolveError(field.status(), "sources");
+  absl::StatusOr<std::shared_ptr<const DistanceField>> field =
+      CachedField(env, *out.mesh, out.sources, *solver, &out.cached);
+  if (!field.ok()) return field.status();
   out.field = *std::move(field);
   return out;
 }
@@ -142,9 +171,40 @@ absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPath
   if (!to.ok()) return to.status();
   absl::StatusOr<GeodesicOptions> solver = Options(env, request.options());
   if (!solver.ok()) return solver.status();
+  // From a cached field of `from` a path to a vertex is a trace, not a solve; the second query
+  // from the same point solves (and caches) the full field so that the following ones reuse it.
+  if (to->kind == SurfacePoint::Kind::kVertex && env.cache->enabled()) {
+    const std::string key = FieldCacheKey((*mesh)->id, {*from}, *solver);
+    std::shared_ptr<const DistanceField> field = env.cache->Find(key);
+    bool cached = field != nullptr;
+    if (field == nullptr && env.cache->NotePathSource(key)) {
+      absl::StatusOr<std::shared_ptr<const DistanceField>> solved =
+          CachedField(env, **mesh, {*from}, *solver, &cached);
+      if (!solved.ok()) return NameSolveError(solved.status(), "from");
+      field = *std::move(solved);
+    }
+    if (field != nullptr) {
+      absl::StatusOr<GeodesicPath> path = TracePathFromVertex(*(*mesh)->mesh, *field, to->vertex);
+      if (absl::IsNotFound(path.status())) {
+        return absl::NotFoundError("to: unreachable from `from`");
+      }
+      if (!path.ok()) return path.status();
+      response->set_distance(field->distance[to->vertex]);
+      for (auto it = path->points.rbegin(); it != path->points.rend(); ++it) {
+        PathPointToProto(*it, response->add_points());
+      }
+      if (request.want_stats()) FieldStatsToProto(*field, cached, response->mutable_stats());
+      return CheckUnaryResponseSize(env, *response, "paths");
+    }
+  }
   PathQueryOptions options;
   options.solver = *solver;
   absl::StatusOr<PathQueryResult> result = ComputeShortestPath(*(*mesh)->mesh, *from, *to, options);
+  if (result.ok()) {
+    env.counters->solves.fetch_add(1, std::memory_order_relaxed);
+    env.counters->windows_processed.fetch_add(result->stats.windows_processed,
+                                              std::memory_order_relaxed);
+  }
   if (!result.ok()) {
     if (result.status().code() == absl::StatusCode::kNotFound) {
       return absl::NotFoundError(
@@ -179,21 +239,27 @@ absl::Status RunEstimateDistances(const QueryEnv& env, const v1::EstimateDistanc
   absl::StatusOr<GeodesicOptions> solver = Options(env, request.options());
   if (!solver.ok()) return solver.status();
   if (estimate) {
-    absl::StatusOr<DistanceField> field = ComputeDistanceField(tm, *sources, *solver);
-    if (!field.ok()) return NameSolveError(field.status(), "sources");
+    bool cached = false;
+    absl::StatusOr<std::shared_ptr<const DistanceField>> field =
+        CachedField(env, **mesh, *sources, *solver, &cached);
+    if (!field.ok()) return field.status();
     for (size_t i = 0; i < points->size(); ++i) {
-      absl::StatusOr<PointEstimate> e = EstimateDistanceAt(tm, *field, (*points)[i]);
+      absl::StatusOr<PointEstimate> e = EstimateDistanceAt(tm, **field, (*points)[i]);
       if (!e.ok()) return NameSolveError(e.status(), "points");
       response->add_estimates(e->distance);
       response->add_estimate_labels(e->source);
     }
-    if (request.want_stats()) StatsToProto(field->stats, response->mutable_estimate_stats());
+    if (request.want_stats()) {
+      FieldStatsToProto(**field, cached, response->mutable_estimate_stats());
+    }
   }
   if (exact) {
     SolveStats stats;
     absl::StatusOr<std::vector<std::pair<double, uint32_t>>> values =
         ComputeExactDistancesAt(tm, *sources, *points, *solver, &stats);
     if (!values.ok()) return NameSolveError(values.status(), "points");
+    env.counters->solves.fetch_add(1, std::memory_order_relaxed);
+    env.counters->windows_processed.fetch_add(stats.windows_processed, std::memory_order_relaxed);
     for (const auto& [distance, label] : *values) {
       response->add_exact(distance);
       response->add_exact_labels(label);
@@ -247,30 +313,26 @@ absl::StatusOr<MessageProducer<v1::ComputeDistanceFieldResponse>> RunComputeDist
 
   // Produced lazily from the field: no second copy of a large result.
   struct State {
-    std::vector<double> distances;
-    std::vector<uint32_t> labels;
-    std::vector<SurfacePoint> sources;
-    SolveStats stats;
+    SolvedField solved;  // the shared field: chunks are read from it, never copied whole
     size_t next = 0;
     bool started = false;
   };
   auto state = std::make_shared<State>();
-  state->distances = std::move(solved->field.distance);
-  if (!request.omit_labels()) state->labels = std::move(solved->field.source);
-  state->stats = solved->field.stats;
-  state->sources = std::move(solved->sources);
+  state->solved = *std::move(solved);
   const bool f32 = request.value_type() == v1::VALUE_TYPE_FLOAT32;
   const bool want_stats = request.want_stats();
-  const size_t bytes_per_value = (f32 ? 4 : 8) + (state->labels.empty() ? 0 : 4);
+  const bool labels = !request.omit_labels();
+  const size_t bytes_per_value = (f32 ? 4 : 8) + (labels ? 4 : 0);
   const size_t chunk = std::max<size_t>(1, env.limits->stream_chunk_bytes / bytes_per_value);
   return MessageProducer<v1::ComputeDistanceFieldResponse>(
-      [state, f32, want_stats, chunk](v1::ComputeDistanceFieldResponse* out) {
-        const size_t n = state->distances.size();
+      [state, f32, want_stats, labels, chunk](v1::ComputeDistanceFieldResponse* out) {
+        const DistanceField& field = *state->solved.field;
+        const size_t n = field.distance.size();
         if (state->started && state->next >= n) return false;
         out->set_vertex_count(n);
         out->set_offset(state->next);
         if (!state->started) {
-          for (const SurfacePoint& p : state->sources) {
+          for (const SurfacePoint& p : state->solved.sources) {
             SurfacePointToProto(p, out->add_resolved_sources());
           }
         }
@@ -279,16 +341,18 @@ absl::StatusOr<MessageProducer<v1::ComputeDistanceFieldResponse>> RunComputeDist
           auto* values = out->mutable_distances_f32();
           values->Reserve(static_cast<int>(end - begin));
           for (size_t i = begin; i < end; ++i) {
-            values->AddAlreadyReserved(static_cast<float>(state->distances[i]));
+            values->AddAlreadyReserved(static_cast<float>(field.distance[i]));
           }
         } else {
-          out->mutable_distances_f64()->Add(state->distances.begin() + begin,
-                                            state->distances.begin() + end);
+          out->mutable_distances_f64()->Add(field.distance.begin() + begin,
+                                            field.distance.begin() + end);
         }
-        if (!state->labels.empty()) {
-          out->mutable_labels()->Add(state->labels.begin() + begin, state->labels.begin() + end);
+        if (labels) {
+          out->mutable_labels()->Add(field.source.begin() + begin, field.source.begin() + end);
         }
-        if (end == n && want_stats) StatsToProto(state->stats, out->mutable_stats());
+        if (end == n && want_stats) {
+          FieldStatsToProto(field, state->solved.cached, out->mutable_stats());
+        }
         state->started = true;
         state->next = end;
         return true;
@@ -321,6 +385,9 @@ absl::StatusOr<MessageProducer<v1::ComputeDistanceMatrixResponse>> RunComputeDis
   absl::StatusOr<DistanceMatrix> matrix =
       ComputeDistanceMatrix(*(*mesh)->mesh, *sources, *targets, *solver);
   if (!matrix.ok()) return NameSolveError(matrix.status(), "sources/targets");
+  env.counters->solves.fetch_add(1, std::memory_order_relaxed);
+  env.counters->windows_processed.fetch_add(matrix->stats.windows_processed,
+                                            std::memory_order_relaxed);
 
   auto state = std::make_shared<DistanceMatrix>(*std::move(matrix));
   auto next = std::make_shared<size_t>(0);
@@ -379,7 +446,7 @@ absl::StatusOr<MessageProducer<v1::ComputeIsolinesResponse>> RunComputeIsolines(
   absl::StatusOr<SolvedField> solved =
       SolveField(env, request.mesh(), request.sources(), request.options());
   if (!solved.ok()) return solved.status();
-  absl::StatusOr<Isolines> isolines = ExtractIsolines(*solved->mesh->mesh, solved->field, options);
+  absl::StatusOr<Isolines> isolines = ExtractIsolines(*solved->mesh->mesh, *solved->field, options);
   if (!isolines.ok()) return isolines.status();
 
   StreamChunker<v1::ComputeIsolinesResponse> chunker(env.limits->stream_chunk_bytes);
@@ -395,7 +462,9 @@ absl::StatusOr<MessageProducer<v1::ComputeIsolinesResponse>> RunComputeIsolines(
       return item;
     });
   }
-  if (request.want_stats()) StatsToProto(solved->field.stats, chunker.last().mutable_stats());
+  if (request.want_stats()) {
+    FieldStatsToProto(*solved->field, solved->cached, chunker.last().mutable_stats());
+  }
   return chunker.TakeProducer();
 }
 
@@ -404,7 +473,7 @@ absl::StatusOr<MessageProducer<v1::ComputeVoronoiResponse>> RunComputeVoronoi(
   absl::StatusOr<SolvedField> solved =
       SolveField(env, request.mesh(), request.sources(), request.options());
   if (!solved.ok()) return solved.status();
-  absl::StatusOr<VoronoiDiagram> diagram = BuildVoronoi(*solved->mesh->mesh, solved->field);
+  absl::StatusOr<VoronoiDiagram> diagram = BuildVoronoi(*solved->mesh->mesh, *solved->field);
   if (!diagram.ok()) return diagram.status();
 
   StreamChunker<v1::ComputeVoronoiResponse> chunker(env.limits->stream_chunk_bytes);
@@ -464,7 +533,9 @@ absl::StatusOr<MessageProducer<v1::ComputeVoronoiResponse>> RunComputeVoronoi(
       return item;
     });
   }
-  if (request.want_stats()) StatsToProto(solved->field.stats, chunker.last().mutable_stats());
+  if (request.want_stats()) {
+    FieldStatsToProto(*solved->field, solved->cached, chunker.last().mutable_stats());
+  }
   return chunker.TakeProducer();
 }
 
@@ -474,7 +545,7 @@ absl::StatusOr<MessageProducer<v1::ComputeDelaunayResponse>> RunComputeDelaunay(
       SolveField(env, request.mesh(), request.sources(), request.options());
   if (!solved.ok()) return solved.status();
   absl::StatusOr<DelaunayTriangulation> delaunay =
-      BuildDelaunay(*solved->mesh->mesh, solved->field);
+      BuildDelaunay(*solved->mesh->mesh, *solved->field);
   if (!delaunay.ok()) return delaunay.status();
 
   StreamChunker<v1::ComputeDelaunayResponse> chunker(env.limits->stream_chunk_bytes);
@@ -519,7 +590,9 @@ absl::StatusOr<MessageProducer<v1::ComputeDelaunayResponse>> RunComputeDelaunay(
     PathPointToProto(xl.point, out->mutable_point());
     chunker.Account(out->ByteSizeLong() + 2);
   }
-  if (request.want_stats()) StatsToProto(solved->field.stats, chunker.last().mutable_stats());
+  if (request.want_stats()) {
+    FieldStatsToProto(*solved->field, solved->cached, chunker.last().mutable_stats());
+  }
   return chunker.TakeProducer();
 }
 

@@ -4,6 +4,9 @@
 // stream messages) out, errors as absl::Status naming the request field or the server flag. They
 // run on the compute pool (see query_reactors.h); nothing here knows about gRPC calls.
 
+#include <atomic>
+#include <cstdint>
+
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "geodex/cancel.h"
@@ -14,12 +17,21 @@
 namespace geodex::server {
 
 struct ServiceLimits;
+class FieldCache;
+
+// Counters of the work done (read by the metrics).
+struct ServiceCounters {
+  std::atomic<uint64_t> solves{0};
+  std::atomic<uint64_t> windows_processed{0};
+};
 
 // What every query needs besides its request.
 struct QueryEnv {
   MeshStore* store;
   const ServiceLimits* limits;
   const CancelToken* cancel;
+  FieldCache* cache;
+  ServiceCounters* counters;
 };
 
 // Unary queries.

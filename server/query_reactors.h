@@ -34,6 +34,8 @@ struct ReactorEnv {
   MeshStore* store;
   const ServiceLimits* limits;
   ComputePool* pool;
+  FieldCache* cache;
+  ServiceCounters* counters;
 };
 
 template <typename Request, typename Response>
@@ -63,7 +65,7 @@ class UnaryQueryReactor final : public grpc::ServerUnaryReactor {
       Finish(CancelledStatus());
       return;
     }
-    absl::Status status = run_(QueryEnv{env_.store, env_.limits, &cancel_}, *request_, response_);
+    absl::Status status = run_(QueryEnv{env_.store, env_.limits, &cancel_, env_.cache, env_.counters}, *request_, response_);
     if (!status.ok()) response_->Clear();
     Finish(ToGrpcStatus(status));
   }
@@ -110,7 +112,7 @@ class StreamQueryReactor final : public grpc::ServerWriteReactor<Response> {
       return;
     }
     absl::StatusOr<MessageProducer<Response>> producer =
-        run_(QueryEnv{env_.store, env_.limits, &cancel_}, *request_);
+        run_(QueryEnv{env_.store, env_.limits, &cancel_, env_.cache, env_.counters}, *request_);
     if (!producer.ok()) {
       this->Finish(ToGrpcStatus(producer.status()));
       return;

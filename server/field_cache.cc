@@ -1,0 +1,114 @@
+#include "field_cache.h"
+
+#include <cstring>
+
+namespace geodex::server {
+namespace {
+
+constexpr size_t kMaxPathSources = 4096;
+
+template <typename T>
+void Append(std::string* out, const T& value) {
+  out->append(reinterpret_cast<const char*>(&value), sizeof value);
+}
+
+}  // namespace
+
+std::string FieldCacheKey(const std::string& mesh_id, const std::vector<SurfacePoint>& sources,
+                          const GeodesicOptions& options) {
+  std::string key = mesh_id;
+  Append(&key, options.lambda);
+  Append(&key, static_cast<int>(options.lambda_scale));
+  Append(&key, options.max_distance);
+  Append(&key, sources.size());
+  for (const SurfacePoint& p : sources) {
+    Append(&key, static_cast<uint8_t>(p.kind));
+    switch (p.kind) {
+      case SurfacePoint::Kind::kVertex:
+        Append(&key, p.vertex);
+        break;
+      case SurfacePoint::Kind::kEdge:
+        Append(&key, p.edge_from);
+        Append(&key, p.edge_to);
+        Append(&key, p.t);
+        break;
+      case SurfacePoint::Kind::kFace:
+        Append(&key, p.face);
+        Append(&key, p.bary);
+        break;
+      case SurfacePoint::Kind::kPosition:
+        Append(&key, p.position);
+        break;
+    }
+  }
+  return key;
+}
+
+uint64_t FieldBytes(const DistanceField& field) {
+  return field.distance.capacity() * sizeof(double) + field.source.capacity() * sizeof(uint32_t) +
+         field.internal_distance.capacity() * sizeof(double) +
+         field.internal_source.capacity() * sizeof(uint32_t) +
+         field.internal_origin.capacity() * sizeof(VertexOrigin) +
+         field.sources.capacity() * sizeof(SurfacePoint) + sizeof(DistanceField);
+}
+
+std::shared_ptr<const DistanceField> FieldCache::Find(const std::string& key) {
+  if (!enabled()) return nullptr;
+  absl::MutexLock lock(&mu_);
+  auto it = entries_.find(key);
+  if (it == entries_.end()) {
+    ++misses_;
+    return nullptr;
+  }
+  ++hits_;
+  lru_.splice(lru_.begin(), lru_, it->second.lru);
+  return it->second.field;
+}
+
+void FieldCache::Insert(const std::string& key, std::shared_ptr<const DistanceField> field) {
+  const uint64_t bytes = FieldBytes(*field) + key.size();
+  if (!enabled() || bytes > budget_bytes_) return;
+  absl::MutexLock lock(&mu_);
+  if (entries_.contains(key)) return;
+  while (bytes_ + bytes > budget_bytes_ && !lru_.empty()) {
+    auto victim = entries_.find(lru_.back());
+    bytes_ -= victim->second.bytes;
+    entries_.erase(victim);
+    lru_.pop_back();
+  }
+  lru_.push_front(key);
+  entries_[key] = Entry{std::move(field), bytes, lru_.begin()};
+  bytes_ += bytes;
+}
+
+bool FieldCache::NotePathSource(const std::string& key) {
+  if (!enabled()) return false;
+  absl::MutexLock lock(&mu_);
+  if (path_sources_.contains(key)) return true;
+  path_sources_[key] = 1;
+  path_source_order_.push_back(key);
+  if (path_source_order_.size() > kMaxPathSources) {
+    path_sources_.erase(path_source_order_.front());
+    path_source_order_.pop_front();
+  }
+  return false;
+}
+
+uint64_t FieldCache::bytes() const {
+  absl::MutexLock lock(&mu_);
+  return bytes_;
+}
+size_t FieldCache::entries() const {
+  absl::MutexLock lock(&mu_);
+  return entries_.size();
+}
+uint64_t FieldCache::hits() const {
+  absl::MutexLock lock(&mu_);
+  return hits_;
+}
+uint64_t FieldCache::misses() const {
+  absl::MutexLock lock(&mu_);
+  return misses_;
+}
+
+}  // namespace geodex::server

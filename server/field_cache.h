@@ -1,0 +1,67 @@
+#pragma once
+
+// The result cache: finished distance fields under a byte budget with LRU eviction, keyed by mesh
+// id, the resolved sources and the solver options. Many queries from one source position (a robot
+// asking for paths to many goals, isolines then Voronoi of the same sites) reuse one solve. Fields
+// are immutable and shared (shared_ptr), so eviction never disturbs a reader. Thread-safe.
+
+#include <cstdint>
+#include <list>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "absl/base/thread_annotations.h"
+#include "absl/container/flat_hash_map.h"
+#include "absl/synchronization/mutex.h"
+#include "geodex/distance_field.h"
+#include "geodex/geodesic_solver.h"
+#include "geodex/surface_point.h"
+
+namespace geodex::server {
+
+// The key of a field: mesh id, every source bit for bit, lambda, its scale and max_distance.
+std::string FieldCacheKey(const std::string& mesh_id, const std::vector<SurfacePoint>& sources,
+                          const GeodesicOptions& options);
+
+// Memory a cached field occupies.
+uint64_t FieldBytes(const DistanceField& field);
+
+class FieldCache {
+ public:
+  // budget_bytes = 0 disables the cache (Find always misses, Insert keeps nothing).
+  explicit FieldCache(uint64_t budget_bytes) : budget_bytes_(budget_bytes) {}
+
+  std::shared_ptr<const DistanceField> Find(const std::string& key);
+  // Keeps `field` unless it alone exceeds the budget; evicts least recently used fields.
+  void Insert(const std::string& key, std::shared_ptr<const DistanceField> field);
+  // Records that a path query started from `key`'s source; true when one did recently (the
+  // second query from a point pays for a full field that the following ones reuse).
+  bool NotePathSource(const std::string& key);
+
+  bool enabled() const { return budget_bytes_ > 0; }
+  uint64_t budget_bytes() const { return budget_bytes_; }
+  uint64_t bytes() const;
+  size_t entries() const;
+  uint64_t hits() const;
+  uint64_t misses() const;
+
+ private:
+  struct Entry {
+    std::shared_ptr<const DistanceField> field;
+    uint64_t bytes = 0;
+    std::list<std::string>::iterator lru;
+  };
+  const uint64_t budget_bytes_;
+  mutable absl::Mutex mu_;
+  absl::flat_hash_map<std::string, Entry> entries_ ABSL_GUARDED_BY(mu_);
+  std::list<std::string> lru_ ABSL_GUARDED_BY(mu_);  // most recent first
+  uint64_t bytes_ ABSL_GUARDED_BY(mu_) = 0;
+  uint64_t hits_ ABSL_GUARDED_BY(mu_) = 0;
+  uint64_t misses_ ABSL_GUARDED_BY(mu_) = 0;
+  // Recent path sources (bounded FIFO of keys).
+  absl::flat_hash_map<std::string, uint64_t> path_sources_ ABSL_GUARDED_BY(mu_);
+  std::list<std::string> path_source_order_ ABSL_GUARDED_BY(mu_);
+};
+
+}  // namespace geodex::server
