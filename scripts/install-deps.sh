@@ -12,7 +12,7 @@ packages=(
   # toolchain
   g++ cmake ninja-build pkgconf ccache
   # runtime libraries of the service (gRPC, Protobuf, Abseil, spdlog)
-  libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler libabsl-dev libspdlog-dev
+  libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler libabsl-dev libspdlog-dev prometheus-cpp-dev
   grpc-proto
   # mesh I/O
   zlib1g-dev

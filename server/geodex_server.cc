@@ -51,6 +51,13 @@ absl::StatusOr<std::unique_ptr<GeodexServer>> GeodexServer::Start(const ServerOp
   }
   if (!options.import_dir.empty()) s->ImportDirectory(options.import_dir);
 
+  absl::StatusOr<std::unique_ptr<ServerMetrics>> metrics = ServerMetrics::Start(
+      options.metrics_listen,
+      MetricSources{s->pool_.get(), s->store_.get(), s->cache_.get(), &s->service_->counters()},
+      options.log_requests);
+  if (!metrics.ok()) return metrics.status();
+  s->metrics_ = *std::move(metrics);
+
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;
@@ -58,6 +65,9 @@ absl::StatusOr<std::unique_ptr<GeodexServer>> GeodexServer::Start(const ServerOp
   builder.SetMaxReceiveMessageSize(options.max_receive_message_bytes);
   builder.AddListeningPort(options.listen, grpc::InsecureServerCredentials(), &s->port_);
   builder.RegisterService(s->service_.get());
+  std::vector<std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>> interceptors;
+  interceptors.push_back(s->metrics_->InterceptorFactory());
+  builder.experimental().SetInterceptorCreators(std::move(interceptors));
   s->server_ = builder.BuildAndStart();
   if (s->server_ == nullptr || s->port_ == 0) {
     return absl::UnavailableError(absl::StrCat("cannot listen on ", options.listen));
@@ -131,6 +141,7 @@ void GeodexServer::Wait() { server_->Wait(); }
 
 GeodexServer::~GeodexServer() {
   if (server_ != nullptr) Shutdown(absl::Now());
+  if (metrics_ != nullptr) metrics_->StopHttp();  // no scrape may read a pool being destroyed
 }
 
 }  // namespace geodex::server

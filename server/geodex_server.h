@@ -15,6 +15,7 @@
 #include "geodex_service.h"
 #include "grpcpp/server.h"
 #include "mesh_store.h"
+#include "metrics.h"
 
 namespace geodex::server {
 
@@ -39,6 +40,8 @@ struct ServerOptions {
   size_t queue_capacity = 64;
   int max_receive_message_bytes = 4 << 20;  // per message; uploads are chunked below this
   uint64_t result_cache_bytes = uint64_t{256} << 20;  // finished fields kept for reuse; 0 = off
+  std::string metrics_listen;  // HOST:PORT of the Prometheus /metrics endpoint; "" = none
+  bool log_requests = false;   // one spdlog line per call (geodexd: on)
   ServiceLimits limits;
 };
 
@@ -64,6 +67,7 @@ class GeodexServer {
   MeshStore& store() { return *store_; }
   ComputePool& pool() { return *pool_; }
   FieldCache& cache() { return *cache_; }
+  ServerMetrics& metrics() { return *metrics_; }
   GeodexService& service() { return *service_; }
   grpc::Server& grpc_server() { return *server_; }
 
@@ -74,6 +78,7 @@ class GeodexServer {
   // its workers), the service and the store.
   std::unique_ptr<MeshStore> store_;
   std::unique_ptr<FieldCache> cache_;
+  std::unique_ptr<ServerMetrics> metrics_;  // the interceptor records into it: outlives server_
   std::unique_ptr<GeodexService> service_;
   std::unique_ptr<ComputePool> pool_;
   std::unique_ptr<grpc::Server> server_;

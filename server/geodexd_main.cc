@@ -30,6 +30,9 @@ ABSL_FLAG(uint64_t, mesh_budget_bytes, uint64_t{4} << 30,
 ABSL_FLAG(uint64_t, result_cache_bytes, uint64_t{256} << 20,
           "Memory for finished distance fields reused by later queries with the same mesh, sources "
           "and options (0 = off)");
+ABSL_FLAG(std::string, metrics_listen, "127.0.0.1:9464",
+          "HOST:PORT of the Prometheus /metrics HTTP endpoint (empty = off)");
+ABSL_FLAG(bool, log_requests, true, "Log one line per call (method, mesh, sources, time, status)");
 ABSL_FLAG(uint32_t, pool_threads, 0, "Compute worker threads (0 = one per hardware thread)");
 ABSL_FLAG(uint32_t, queue_capacity, 64,
           "Queries that may wait for a worker; beyond that calls get RESOURCE_EXHAUSTED at once");
@@ -100,6 +103,8 @@ int main(int argc, char** argv) {
   options.import_dir = absl::GetFlag(FLAGS_import_dir);
   options.mesh_budget_bytes = absl::GetFlag(FLAGS_mesh_budget_bytes);
   options.result_cache_bytes = absl::GetFlag(FLAGS_result_cache_bytes);
+  options.metrics_listen = absl::GetFlag(FLAGS_metrics_listen);
+  options.log_requests = absl::GetFlag(FLAGS_log_requests);
   options.pool_threads = absl::GetFlag(FLAGS_pool_threads);
   options.queue_capacity = absl::GetFlag(FLAGS_queue_capacity);
   options.max_receive_message_bytes = absl::GetFlag(FLAGS_max_receive_message_bytes);
@@ -145,6 +150,11 @@ int main(int argc, char** argv) {
       options.limits.max_output_values, options.limits.max_windows,
       options.limits.max_unary_response_bytes, options.limits.stream_chunk_bytes,
       absl::GetFlag(FLAGS_shutdown_grace_seconds));
+  if ((*server)->metrics().port() != 0) {
+    const std::string& listen = options.metrics_listen;
+    spdlog::info("metrics on http://{}:{}/metrics", listen.substr(0, listen.rfind(':')),
+                 (*server)->metrics().port());
+  }
   spdlog::info("geodexd listening on port {} ({} workers, queue {}, mesh budget {} bytes)",
                (*server)->port(), (*server)->pool().threads(), options.queue_capacity,
                options.mesh_budget_bytes);
