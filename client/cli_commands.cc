@@ -62,43 +62,17 @@ int RunInfo(const Args& args) {
   if (!loaded.ok()) return Fail(kExitInput, std::string(loaded.status().message()));
   const TriangleMesh& mesh = loaded->mesh;
   const MeshReport& r = mesh.report();
-  const std::vector<std::pair<std::string, std::string>> rows = {
-      {"vertices", absl::StrFormat("%d", r.file_vertices)},
-      {"faces", absl::StrFormat("%d", r.file_faces)},
-      {"boundary_edges", absl::StrFormat("%d", r.boundary_edges)},
-      {"boundary_loops", absl::StrFormat("%d", r.boundary_loops)},
-      {"components", absl::StrFormat("%d", r.components)},
-      {"vertex_connected_components", absl::StrFormat("%d", r.vertex_connected_components)},
-      {"isolated_vertices", absl::StrFormat("%d", r.isolated_vertices)},
-      {"non_manifold_edges", absl::StrFormat("%d", r.non_manifold_edges)},
-      {"non_manifold_vertices", absl::StrFormat("%d", r.non_manifold_vertices)},
-      {"degenerate_faces", absl::StrFormat("%d", r.degenerate_faces)},
-      {"flipped_faces", absl::StrFormat("%d", r.flipped_faces)},
-      {"orientation_cuts", absl::StrFormat("%d", r.orientation_cuts)},
-      {"saddle_vertices", absl::StrFormat("%d", r.saddle_vertices)},
-      {"boundary_vertices", absl::StrFormat("%d", r.boundary_vertices)},
-      {"internal_vertices", absl::StrFormat("%d", mesh.vertex_count())},
-      {"mean_edge_length", absl::StrFormat("%.17g", mesh.MeanEdgeLength())},
-      {"max_edge_length", absl::StrFormat("%.17g", mesh.MaxEdgeLength())},
-      {"bbox_min", absl::StrFormat("%.17g %.17g %.17g", mesh.BoundsMin()[0], mesh.BoundsMin()[1],
-                                   mesh.BoundsMin()[2])},
-      {"bbox_max", absl::StrFormat("%.17g %.17g %.17g", mesh.BoundsMax()[0], mesh.BoundsMax()[1],
-                                   mesh.BoundsMax()[2])},
-      {"bytes", absl::StrFormat("%d", mesh.MemoryBytes())},
-      {"load_ms", absl::StrFormat("%.3f", loaded->load_ms)},
-      {"build_ms", absl::StrFormat("%.3f", loaded->build_ms)},
-  };
-  if (format == "text") {
-    for (const auto& [k, v] : rows) std::printf("%s: %s\n", k.c_str(), v.c_str());
-  } else {
-    std::string json = "{";
-    for (size_t i = 0; i < rows.size(); ++i) {
-      const bool quoted = rows[i].first.rfind("bbox_", 0) == 0;
-      json += absl::StrFormat("%s\"%s\": %s%s%s", i ? ", " : "", rows[i].first, quoted ? "\"" : "",
-                              rows[i].second, quoted ? "\"" : "");
-    }
-    std::printf("%s}\n", json.c_str());
-  }
+  InfoValues v;
+  v.report = r;
+  v.internal_vertices = mesh.vertex_count();
+  v.mean_edge_length = mesh.MeanEdgeLength();
+  v.max_edge_length = mesh.MaxEdgeLength();
+  v.bbox_min = mesh.BoundsMin();
+  v.bbox_max = mesh.BoundsMax();
+  v.bytes = mesh.MemoryBytes();
+  v.load_ms = loaded->load_ms;
+  v.build_ms = loaded->build_ms;
+  std::fputs(FormatInfo(v, format == "json").c_str(), stdout);
   return kExitOk;
 }
 
@@ -161,7 +135,6 @@ int RunDistances(const Args& args) {
   }
   const auto t_out = std::chrono::steady_clock::now();
   std::string text;
-  char buf[64];
   if (args.options.count("at")) {
     // Surface points: the unfolding estimate and the exact value, one line each.
     absl::StatusOr<std::vector<SurfacePoint>> at = ParseSurfacePoints(args.options.at("at"));
@@ -173,28 +146,12 @@ int RunDistances(const Args& args) {
     for (size_t i = 0; i < at->size(); ++i) {
       absl::StatusOr<PointEstimate> est = EstimateDistanceAt(loaded->mesh, *field, (*at)[i]);
       if (!est.ok()) return Fail(kExitUsage, "--at: " + std::string(est.status().message()));
-      text += absl::StrFormat("%s\testimate %.17g\texact %.17g\tsource %d\n",
-                              SurfacePointToString((*at)[i]), est->distance, (*exact)[i].first,
-                              static_cast<int64_t>((*exact)[i].second == kNoIndex
-                                                       ? -1
-                                                       : (*exact)[i].second));
+      text += FormatAtLine((*at)[i], est->distance, (*exact)[i].first, (*exact)[i].second);
     }
   } else {
-    text.reserve(field->distance.size() * 24);
-    for (double d : field->distance) {
-      const int n = std::snprintf(buf, sizeof(buf), "%.17g\n", d);
-      text.append(buf, n);
-    }
+    text = FormatDistances(field->distance);
   }
-  if (args.options.count("output")) {
-    const std::string& path = args.options.at("output");
-    std::ofstream out(path, std::ios::binary);
-    out << text;
-    out.close();
-    if (!out) return Fail(kExitInput, absl::StrFormat("cannot write %s", path));
-  } else {
-    std::fwrite(text.data(), 1, text.size(), stdout);
-  }
+  if (int code = WriteOutput(args, text); code != kExitOk) return code;
   if (args.options.count("stats")) {
     const SolveStats& s = field->stats;
     std::fprintf(
@@ -226,19 +183,6 @@ int RunDistances(const Args& args) {
 
 namespace {
 
-std::string SimplexText(const SurfacePoint& p) {
-  switch (p.kind) {
-    case SurfacePoint::Kind::kVertex:
-      return absl::StrFormat("v %d", p.vertex);
-    case SurfacePoint::Kind::kEdge:
-      return absl::StrFormat("e %d %d %.17g", p.edge_from, p.edge_to, p.t);
-    case SurfacePoint::Kind::kFace:
-      return absl::StrFormat("f %d %.17g %.17g %.17g", p.face, p.bary[0], p.bary[1], p.bary[2]);
-    case SurfacePoint::Kind::kPosition:
-      break;
-  }
-  return "?";
-}
 
 // Parses a SPEC that must name exactly one point, and checks it against the mesh.
 bool OnePoint(const Args& args, const std::string& key, const TriangleMesh& mesh, SurfacePoint* out,
@@ -294,11 +238,7 @@ int RunPath(const Args& args) {
                                                                                    : kExitSolveFailed;
     return Fail(code, std::string(result.status().message()));
   }
-  std::string text = absl::StrFormat("%.17g\n", result->distance);
-  for (const PathPoint& p : result->path.points) {
-    text += absl::StrFormat("%.17g %.17g %.17g %s\n", p.position[0], p.position[1], p.position[2],
-                            SimplexText(p.where));
-  }
+  const std::string text = FormatPath(*result);
   std::fwrite(text.data(), 1, text.size(), stdout);
   if (args.options.count("stats")) {
     const SolveStats& s = result->stats;
@@ -344,13 +284,7 @@ int RunMatrix(const Args& args) {
                                                                               : kExitSolveFailed;
     return Fail(code, std::string(m.status().message()));
   }
-  std::string text;
-  for (size_t i = 0; i < m->rows; ++i) {
-    for (size_t j = 0; j < m->cols; ++j) {
-      text += absl::StrFormat(j ? "\t%.17g" : "%.17g", m->values[i * m->cols + j]);
-    }
-    text += "\n";
-  }
+  const std::string text = FormatMatrix(*m);
   std::fwrite(text.data(), 1, text.size(), stdout);
   if (args.options.count("stats")) {
     std::fprintf(stderr, "{\"rows\": %zu, \"cols\": %zu, \"windows_created\": %llu, \"solve_ms\": %.3f}\n",

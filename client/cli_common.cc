@@ -1,8 +1,10 @@
 #include "cli_common.h"
 
 #include <cstdio>
+#include <fstream>
 
 #include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "geodex/mesh_io.h"
 #include "geodex/samples.h"
@@ -91,5 +93,114 @@ bool ResolvePoints(const TriangleMesh& mesh, const std::string& option,
   return true;
 }
 
+
+std::string FormatInfo(const InfoValues& v, bool json) {
+  const MeshReport& r = v.report;
+  const std::vector<std::pair<std::string, std::string>> rows = {
+      {"vertices", absl::StrFormat("%d", r.file_vertices)},
+      {"faces", absl::StrFormat("%d", r.file_faces)},
+      {"boundary_edges", absl::StrFormat("%d", r.boundary_edges)},
+      {"boundary_loops", absl::StrFormat("%d", r.boundary_loops)},
+      {"components", absl::StrFormat("%d", r.components)},
+      {"vertex_connected_components", absl::StrFormat("%d", r.vertex_connected_components)},
+      {"isolated_vertices", absl::StrFormat("%d", r.isolated_vertices)},
+      {"non_manifold_edges", absl::StrFormat("%d", r.non_manifold_edges)},
+      {"non_manifold_vertices", absl::StrFormat("%d", r.non_manifold_vertices)},
+      {"degenerate_faces", absl::StrFormat("%d", r.degenerate_faces)},
+      {"flipped_faces", absl::StrFormat("%d", r.flipped_faces)},
+      {"orientation_cuts", absl::StrFormat("%d", r.orientation_cuts)},
+      {"saddle_vertices", absl::StrFormat("%d", r.saddle_vertices)},
+      {"boundary_vertices", absl::StrFormat("%d", r.boundary_vertices)},
+      {"internal_vertices", absl::StrFormat("%d", v.internal_vertices)},
+      {"mean_edge_length", absl::StrFormat("%.17g", v.mean_edge_length)},
+      {"max_edge_length", absl::StrFormat("%.17g", v.max_edge_length)},
+      {"bbox_min", absl::StrFormat("%.17g %.17g %.17g", v.bbox_min[0], v.bbox_min[1], v.bbox_min[2])},
+      {"bbox_max", absl::StrFormat("%.17g %.17g %.17g", v.bbox_max[0], v.bbox_max[1], v.bbox_max[2])},
+      {"bytes", absl::StrFormat("%d", v.bytes)},
+      {"load_ms", absl::StrFormat("%.3f", v.load_ms)},
+      {"build_ms", absl::StrFormat("%.3f", v.build_ms)},
+  };
+  std::string out;
+  if (!json) {
+    for (const auto& [k, value] : rows) absl::StrAppend(&out, k, ": ", value, "\n");
+    return out;
+  }
+  out = "{";
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const bool quoted = rows[i].first.rfind("bbox_", 0) == 0;
+    out += absl::StrFormat("%s\"%s\": %s%s%s", i ? ", " : "", rows[i].first, quoted ? "\"" : "",
+                           rows[i].second, quoted ? "\"" : "");
+  }
+  return out + "}\n";
+}
+
+std::string FormatDistances(const std::vector<double>& distances) {
+  std::string text;
+  text.reserve(distances.size() * 24);
+  char buf[64];
+  for (double d : distances) {
+    const int n = std::snprintf(buf, sizeof(buf), "%.17g\n", d);
+    text.append(buf, n);
+  }
+  return text;
+}
+
+std::string FormatAtLine(const SurfacePoint& point, double estimate, double exact,
+                         uint32_t source) {
+  return absl::StrFormat("%s\testimate %.17g\texact %.17g\tsource %d\n", SurfacePointToString(point),
+                         estimate, exact,
+                         static_cast<int64_t>(source == kNoIndex ? -1 : int64_t{source}));
+}
+
+namespace {
+
+std::string SimplexText(const SurfacePoint& p) {
+  switch (p.kind) {
+    case SurfacePoint::Kind::kVertex:
+      return absl::StrFormat("v %d", p.vertex);
+    case SurfacePoint::Kind::kEdge:
+      return absl::StrFormat("e %d %d %.17g", p.edge_from, p.edge_to, p.t);
+    case SurfacePoint::Kind::kFace:
+      return absl::StrFormat("f %d %.17g %.17g %.17g", p.face, p.bary[0], p.bary[1], p.bary[2]);
+    case SurfacePoint::Kind::kPosition:
+      break;
+  }
+  return "?";
+}
+
+}  // namespace
+
+std::string FormatPath(const PathQueryResult& result) {
+  std::string text = absl::StrFormat("%.17g\n", result.distance);
+  for (const PathPoint& p : result.path.points) {
+    text += absl::StrFormat("%.17g %.17g %.17g %s\n", p.position[0], p.position[1], p.position[2],
+                            SimplexText(p.where));
+  }
+  return text;
+}
+
+std::string FormatMatrix(const DistanceMatrix& m) {
+  std::string text;
+  for (size_t i = 0; i < m.rows; ++i) {
+    for (size_t j = 0; j < m.cols; ++j) {
+      text += absl::StrFormat(j ? "\t%.17g" : "%.17g", m.values[i * m.cols + j]);
+    }
+    text += "\n";
+  }
+  return text;
+}
+
+int WriteOutput(const Args& args, const std::string& text) {
+  auto it = args.options.find("output");
+  if (it == args.options.end()) {
+    std::fwrite(text.data(), 1, text.size(), stdout);
+    return kExitOk;
+  }
+  std::ofstream out(it->second, std::ios::binary);
+  out << text;
+  out.close();
+  if (!out) return Fail(kExitInput, absl::StrFormat("cannot write %s", it->second));
+  return kExitOk;
+}
 
 }  // namespace geodex::cli

@@ -3,6 +3,7 @@
 // Helpers every geodex command shares: one-line failures, mesh loading, option parsing, and
 // resolving point SPECs against a mesh.
 
+#include <array>
 #include <chrono>
 #include <memory>
 #include <set>
@@ -11,7 +12,9 @@
 
 #include "absl/status/statusor.h"
 #include "cli_commands.h"
+#include "geodex/distance_matrix.h"
 #include "geodex/locate.h"
+#include "geodex/shortest_path.h"
 #include "geodex/mesh_data.h"
 #include "geodex/surface_point.h"
 #include "geodex/triangle_mesh.h"
@@ -45,5 +48,28 @@ bool CheckKnown(const Args& args, const std::set<std::string>& known, std::strin
 bool ResolvePoints(const TriangleMesh& mesh, const std::string& option,
                    std::vector<SurfacePoint>* points, std::unique_ptr<SurfaceLocator>* locator,
                    std::string* error);
+
+// --- Output, shared by local and remote mode (so both print the same bytes) ---
+
+// What `geodex info` prints.
+struct InfoValues {
+  MeshReport report;
+  uint64_t internal_vertices = 0;
+  double mean_edge_length = 0, max_edge_length = 0;
+  std::array<double, 3> bbox_min{}, bbox_max{};
+  uint64_t bytes = 0;
+  double load_ms = 0, build_ms = 0;
+};
+std::string FormatInfo(const InfoValues& v, bool json);
+// One distance per line, %.17g ("inf" if unreachable).
+std::string FormatDistances(const std::vector<double>& distances);
+// "POINT<TAB>estimate D<TAB>exact D<TAB>source I" (I = -1 when unreachable).
+std::string FormatAtLine(const SurfacePoint& point, double estimate, double exact, uint32_t source);
+// Line 1 the length, then "x y z SIMPLEX" per point.
+std::string FormatPath(const PathQueryResult& result);
+// One tab-separated row per source.
+std::string FormatMatrix(const DistanceMatrix& matrix);
+// Writes `text` to --output FILE, or stdout. kExitOk or kExitInput.
+int WriteOutput(const Args& args, const std::string& text);
 
 }  // namespace geodex::cli

@@ -1,20 +1,30 @@
-// geodex: the command line. Thin: parses the command and hands over to cli_commands.cc.
+// geodex: the command line. Thin: parses the command and hands over to cli_commands.cc (local)
+// or cli_remote.cc (--server).
 
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <string>
 
 #include "cli_commands.h"
 #include "cli_geometry.h"
+#include "cli_remote.h"
 
 namespace {
 
 constexpr char kUsage[] = R"(geodex - exact geodesic distances on triangle meshes (improved Chen-Han)
 
-usage: geodex COMMAND MESH [options]
+usage: geodex [--server HOST:PORT] COMMAND MESH [options]
 
 MESH is a mesh file (OFF, OBJ, PLY, STL, optionally .gz) or a built-in sample:
 sample:terrain, sample:torus, sample:sphere.
+
+Local by default; remote with --server HOST:PORT (or GEODEX_SERVER=HOST:PORT): the command runs on
+a geodexd and prints the same output. There MESH may also be a mesh id or a name known to the
+server; a file is uploaded once (only if the server does not have it, by content hash).
+  mesh upload FILE [--name NAME] | mesh list | mesh get MESH | mesh delete MESH   [--format json]
+  health [--service NAME]      prints SERVING (exit 0) or NOT_SERVING (exit 1)
+isolines, voronoi and delaunay run locally only, for now.
 
 commands:
   info MESH [--format text|json] [--strict]
@@ -67,11 +77,37 @@ int main(int argc, char** argv) {
     std::puts("geodex 0.1.0");
     return kExitOk;
   }
-  const std::string command = argv[1];
+  // --server HOST:PORT (or --server=HOST:PORT) before the command; else GEODEX_SERVER.
+  int first = 1;
+  std::string server;
+  if (const char* env = std::getenv("GEODEX_SERVER")) server = env;
+  if (!std::strcmp(argv[1], "--server")) {
+    if (argc < 4) {
+      std::fputs("geodex: usage: geodex --server HOST:PORT COMMAND ...\n", stderr);
+      return kExitUsage;
+    }
+    server = argv[2];
+    first = 3;
+  } else if (!std::strncmp(argv[1], "--server=", 9)) {
+    server = argv[1] + 9;
+    first = 2;
+    if (argc < 3) {
+      std::fputs("geodex: usage: geodex --server HOST:PORT COMMAND ...\n", stderr);
+      return kExitUsage;
+    }
+  }
+  const std::string command = argv[first];
   Args args;
   std::string error;
-  if (!ParseArgs(argc, argv, 2, {"stats", "strict", "no-filter", "no-one-split"}, &args, &error)) {
+  if (!ParseArgs(argc, argv, first + 1, {"stats", "strict", "no-filter", "no-one-split"}, &args,
+                 &error)) {
     std::fprintf(stderr, "geodex: %s\n", error.c_str());
+    return kExitUsage;
+  }
+  if (!server.empty()) return RunRemote(server, command, args);
+  if (command == "mesh" || command == "health") {
+    std::fprintf(stderr, "geodex: '%s' talks to a server: use --server HOST:PORT\n",
+                 command.c_str());
     return kExitUsage;
   }
   if (command == "info") return RunInfo(args);

@@ -4,6 +4,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "google/protobuf/util/time_util.h"
+#include "api_convert.h"
 #include "proto_convert.h"
 
 namespace geodex::server {
@@ -23,6 +24,22 @@ std::shared_ptr<StoredMesh> MakeStoredMesh(std::string id, TriangleMesh mesh) {
   stored->components = report.components;
   stored->non_manifold_edges = report.non_manifold_edges;
   stored->degenerate_faces = report.degenerate_faces;
+  const TriangleMesh& m = *stored->mesh;
+  v1::MeshInfo& info = stored->info;
+  info.set_boundary_loops(report.boundary_loops);
+  info.set_vertex_connected_components(report.vertex_connected_components);
+  info.set_isolated_vertices(report.isolated_vertices);
+  info.set_non_manifold_vertices(report.non_manifold_vertices);
+  info.set_flipped_faces(report.flipped_faces);
+  info.set_orientation_cuts(report.orientation_cuts);
+  info.set_saddle_vertices(report.saddle_vertices);
+  info.set_boundary_vertices(report.boundary_vertices);
+  info.set_internal_vertices(m.vertex_count());
+  info.set_mean_edge_length(m.MeanEdgeLength());
+  info.set_max_edge_length(m.MaxEdgeLength());
+  api::PositionToProto(m.BoundsMin(), info.mutable_bbox_min());
+  api::PositionToProto(m.BoundsMax(), info.mutable_bbox_max());
+  info.set_mesh_bytes(m.MemoryBytes());
   return stored;
 }
 
@@ -41,6 +58,7 @@ std::shared_ptr<StoredMesh> RecordFromProto(const std::string& id, const v1::Mes
   record->components = proto.components();
   record->non_manifold_edges = proto.non_manifold_edges();
   record->degenerate_faces = proto.degenerate_faces();
+  record->info = proto.info();
   return record;
 }
 

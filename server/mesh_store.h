@@ -24,6 +24,7 @@
 #include "absl/time/time.h"
 #include "geodex/locate.h"
 #include "geodex/triangle_mesh.h"
+#include "geodex/v1/geodex.pb.h"
 #include "mesh_disk.h"
 
 namespace geodex::server {
@@ -46,6 +47,7 @@ struct StoredMesh {
   uint64_t components = 0;
   uint64_t non_manifold_edges = 0;
   uint64_t degenerate_faces = 0;
+  v1::MeshInfo info;  // the rest of the report and the geometry summary
 };
 
 // Builds a StoredMesh (mesh + locator) from a built mesh; fills memory_bytes and counts.

@@ -52,6 +52,7 @@ void MeshToProto(const StoredMesh& mesh, v1::Mesh* out) {
   out->set_components(mesh.components);
   out->set_non_manifold_edges(mesh.non_manifold_edges);
   out->set_degenerate_faces(mesh.degenerate_faces);
+  *out->mutable_info() = mesh.info;
 }
 
 absl::StatusOr<SurfacePoint> ResolvePoint(const StoredMesh& mesh, const v1::SurfacePoint& point,
@@ -107,46 +108,8 @@ absl::StatusOr<SurfacePoint> ResolvePoint(const StoredMesh& mesh, const v1::Surf
   return p;
 }
 
-void SurfacePointToProto(const SurfacePoint& point, v1::SurfacePoint* out) {
-  switch (point.kind) {
-    case SurfacePoint::Kind::kVertex:
-      out->set_vertex(point.vertex);
-      break;
-    case SurfacePoint::Kind::kEdge: {
-      v1::EdgePoint* e = out->mutable_edge();
-      e->set_from(point.edge_from);
-      e->set_to(point.edge_to);
-      e->set_t(point.t);
-      break;
-    }
-    case SurfacePoint::Kind::kFace: {
-      v1::FacePoint* f = out->mutable_face();
-      f->set_face(point.face);
-      f->set_b0(point.bary[0]);
-      f->set_b1(point.bary[1]);
-      f->set_b2(point.bary[2]);
-      break;
-    }
-    case SurfacePoint::Kind::kPosition: {
-      v1::Position* q = out->mutable_position();
-      q->set_x(point.position[0]);
-      q->set_y(point.position[1]);
-      q->set_z(point.position[2]);
-      break;
-    }
-  }
-}
 
-void PositionToProto(const std::array<double, 3>& position, v1::Position* out) {
-  out->set_x(position[0]);
-  out->set_y(position[1]);
-  out->set_z(position[2]);
-}
 
-void PathPointToProto(const PathPoint& point, v1::PathPoint* out) {
-  PositionToProto(point.position, out->mutable_position());
-  SurfacePointToProto(point.where, out->mutable_where());
-}
 
 absl::StatusOr<GeodesicOptions> SolverOptionsFromProto(const v1::SolverOptions& options,
                                                        uint64_t max_windows,
@@ -180,16 +143,5 @@ absl::StatusOr<GeodesicOptions> SolverOptionsFromProto(const v1::SolverOptions& 
   return out;
 }
 
-void StatsToProto(const SolveStats& stats, v1::SolveStats* out) {
-  out->set_windows_created(stats.windows_created);
-  out->set_windows_processed(stats.windows_processed);
-  out->set_windows_filtered(stats.windows_filtered_at_creation + stats.windows_filtered_at_pop);
-  out->set_pseudo_sources(stats.pseudo_sources);
-  out->set_edge_relaxations(stats.edge_relaxations);
-  out->set_max_level(stats.max_level);
-  out->set_peak_live_windows(stats.peak_live_windows);
-  out->set_peak_bytes(stats.peak_bytes);
-  out->set_solve_ms(stats.solve_ms);
-}
 
 }  // namespace geodex::server

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "absl/status/statusor.h"
+#include "api_convert.h"
 #include "geodex/distance_field.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/shortest_path.h"
@@ -27,15 +28,16 @@ void MeshToProto(const StoredMesh& mesh, v1::Mesh* out);
 absl::StatusOr<SurfacePoint> ResolvePoint(const StoredMesh& mesh, const v1::SurfacePoint& point,
                                           const std::string& field);
 
-void SurfacePointToProto(const SurfacePoint& point, v1::SurfacePoint* out);
-void PositionToProto(const std::array<double, 3>& position, v1::Position* out);
-void PathPointToProto(const PathPoint& point, v1::PathPoint* out);
+// The plain conversions (shared with the client library).
+using api::PathPointToProto;
+using api::PositionToProto;
+using api::StatsToProto;
+using api::SurfacePointToProto;
 
 // Solver options (lambda, lambda_scale, max_distance); `max_windows` comes from the server limit.
 absl::StatusOr<GeodesicOptions> SolverOptionsFromProto(const v1::SolverOptions& options,
                                                        uint64_t max_windows,
                                                        const std::string& field);
 
-void StatsToProto(const SolveStats& stats, v1::SolveStats* out);
 
 }  // namespace geodex::server

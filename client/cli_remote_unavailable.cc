@@ -1,0 +1,14 @@
+// Remote mode when the binary is built without the gRPC API (GEODEX_BUILD_SERVER=OFF).
+
+#include "cli_common.h"
+#include "cli_remote.h"
+
+namespace geodex::cli {
+
+bool RemoteAvailable() { return false; }
+
+int RunRemote(const std::string&, const std::string&, const Args&) {
+  return Fail(kExitUsage, "this geodex was built without gRPC: --server is not available");
+}
+
+}  // namespace geodex::cli

@@ -1,0 +1,358 @@
+#include "geodex_client.h"
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <future>
+#include <thread>
+#include <utility>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "api_convert.h"
+#include "geodex/mesh_io.h"
+#include "geodex/samples.h"
+#include "grpcpp/create_channel.h"
+#include "grpcpp/generic/generic_stub.h"
+#include "grpcpp/security/credentials.h"
+#include "grpcpp/support/byte_buffer.h"
+#include "mesh_id.h"
+
+namespace geodex::client {
+namespace {
+
+absl::Status ToAbsl(const grpc::Status& status) {
+  if (status.ok()) return absl::OkStatus();
+  return absl::Status(static_cast<absl::StatusCode>(status.error_code()), status.error_message());
+}
+
+bool IsHexId(const std::string& s) {
+  if (s.size() != 64) return false;
+  for (char c : s) {
+    if (!((c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'))) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+std::string MeshToOffText(const MeshData& mesh) {
+  std::string out = absl::StrFormat("OFF\n%d %d 0\n", mesh.vertex_count(), mesh.face_count());
+  for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+    absl::StrAppendFormat(&out, "%.17g %.17g %.17g\n", mesh.positions[3 * v],
+                          mesh.positions[3 * v + 1], mesh.positions[3 * v + 2]);
+  }
+  for (size_t f = 0; f < mesh.face_count(); ++f) {
+    absl::StrAppendFormat(&out, "3 %d %d %d\n", mesh.faces[3 * f], mesh.faces[3 * f + 1],
+                          mesh.faces[3 * f + 2]);
+  }
+  return out;
+}
+
+GeodexClient::GeodexClient(ClientOptions options) : options_(std::move(options)) {
+  grpc::ChannelArguments args;
+  args.SetMaxReceiveMessageSize(4 << 20);  // gRPC's default, kept on purpose: the API streams
+  channel_ = grpc::CreateCustomChannel(options_.target, grpc::InsecureChannelCredentials(), args);
+  stub_ = v1::Geodex::NewStub(channel_);
+}
+
+grpc::Status GeodexClient::Call(const std::string& mesh_id,
+                                const std::function<grpc::Status(grpc::ClientContext*)>& call) {
+  double backoff = options_.initial_backoff_seconds;
+  grpc::Status status;
+  for (int attempt = 0; attempt < std::max(1, options_.max_attempts); ++attempt) {
+    if (attempt > 0) {
+      ++retries_;
+      std::this_thread::sleep_for(std::chrono::duration<double>(backoff));
+      backoff *= 2;
+    }
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() +
+                         std::chrono::microseconds(
+                             static_cast<int64_t>(options_.deadline_seconds * 1e6)));
+    if (!mesh_id.empty()) context.AddMetadata("x-mesh-id", mesh_id);
+    ++calls_;
+    status = call(&context);
+    if (status.error_code() != grpc::StatusCode::UNAVAILABLE) break;
+  }
+  return status;
+}
+
+grpc::Status GeodexClient::MeshCall(MeshRef& mesh,
+                                    const std::function<grpc::Status(grpc::ClientContext*)>& call) {
+  grpc::Status status = Call(mesh.id, call);
+  if (status.error_code() == grpc::StatusCode::NOT_FOUND && !mesh.file_bytes.empty() &&
+      status.error_message().rfind("mesh:", 0) == 0) {
+    // The server lost (or never had) the mesh: upload it again and retry once.
+    absl::StatusOr<v1::Mesh> uploaded = Upload(mesh.file_name, mesh.file_bytes, "", mesh.id);
+    if (!uploaded.ok()) {
+      return grpc::Status(static_cast<grpc::StatusCode>(uploaded.status().code()),
+                          std::string(uploaded.status().message()));
+    }
+    ++reuploads_;
+    status = Call(mesh.id, call);
+  }
+  return status;
+}
+
+absl::StatusOr<bool> GeodexClient::Health(const std::string& service) {
+  grpc::GenericStub generic(channel_);
+  std::string request;
+  if (!service.empty()) {
+    request.push_back(0x0a);
+    request.push_back(static_cast<char>(service.size()));
+    request += service;
+  }
+  std::string reply;
+  grpc::Status status = Call("", [&](grpc::ClientContext* context) {
+    grpc::Slice slice(request);
+    grpc::ByteBuffer in(&slice, 1), out;
+    std::promise<grpc::Status> done;
+    generic.UnaryCall(context, "/grpc.health.v1.Health/Check", grpc::StubOptions(), &in, &out,
+                      [&](grpc::Status s) { done.set_value(s); });
+    grpc::Status s = done.get_future().get();
+    std::vector<grpc::Slice> slices;
+    reply.clear();
+    if (s.ok() && out.Dump(&slices).ok()) {
+      for (const auto& piece : slices) {
+        reply.append(reinterpret_cast<const char*>(piece.begin()), piece.size());
+      }
+    }
+    return s;
+  });
+  if (!status.ok()) return ToAbsl(status);
+  return reply == std::string("\x08\x01", 2);  // HealthCheckResponse{status: SERVING}
+}
+
+absl::StatusOr<v1::Mesh> GeodexClient::Upload(const std::string& file_name,
+                                              const std::string& bytes, const std::string& alias,
+                                              const std::string& expected_id) {
+  v1::Mesh mesh;
+  grpc::Status status = Call(expected_id, [&](grpc::ClientContext* context) {
+    auto writer = stub_->CreateMesh(context, &mesh);
+    v1::CreateMeshRequest request;
+    v1::CreateMeshMetadata* metadata = request.mutable_metadata();
+    metadata->set_file_name(file_name);
+    metadata->set_display_name(alias);
+    metadata->set_expected_mesh_id(expected_id);
+    metadata->set_total_bytes(bytes.size());
+    bool ok = writer->Write(request);
+    for (size_t offset = 0; ok && offset < bytes.size(); offset += options_.upload_chunk_bytes) {
+      request.Clear();
+      request.set_chunk(bytes.substr(offset, options_.upload_chunk_bytes));
+      ok = writer->Write(request);
+      if (options_.upload_progress) {
+        options_.upload_progress(std::min<uint64_t>(bytes.size(), offset + request.chunk().size()),
+                                 bytes.size());
+      }
+    }
+    writer->WritesDone();
+    return writer->Finish();
+  });
+  if (!status.ok()) return ToAbsl(status);
+  return mesh;
+}
+
+absl::StatusOr<v1::Mesh> GeodexClient::GetMesh(const std::string& name) {
+  v1::GetMeshRequest request;
+  request.set_name(name);
+  v1::Mesh mesh;
+  const std::string id = name.size() == 71 && IsHexId(name.substr(7)) ? name.substr(7) : "";
+  grpc::Status status = Call(id, [&](grpc::ClientContext* context) {
+    return stub_->GetMesh(context, request, &mesh);
+  });
+  if (!status.ok()) return ToAbsl(status);
+  return mesh;
+}
+
+absl::StatusOr<std::vector<v1::Mesh>> GeodexClient::ListMeshes() {
+  std::vector<v1::Mesh> out;
+  std::string token;
+  do {
+    v1::ListMeshesRequest request;
+    request.set_page_size(1000);
+    request.set_page_token(token);
+    v1::ListMeshesResponse response;
+    grpc::Status status = Call("", [&](grpc::ClientContext* context) {
+      return stub_->ListMeshes(context, request, &response);
+    });
+    if (!status.ok()) return ToAbsl(status);
+    out.insert(out.end(), response.meshes().begin(), response.meshes().end());
+    token = response.next_page_token();
+  } while (!token.empty());
+  return out;
+}
+
+absl::Status GeodexClient::DeleteMesh(const std::string& name) {
+  v1::DeleteMeshRequest request;
+  request.set_name(name);
+  v1::DeleteMeshResponse response;
+  const std::string id = name.size() == 71 && IsHexId(name.substr(7)) ? name.substr(7) : "";
+  return ToAbsl(Call(id, [&](grpc::ClientContext* context) {
+    return stub_->DeleteMesh(context, request, &response);
+  }));
+}
+
+absl::StatusOr<MeshRef> GeodexClient::ResolveMesh(const std::string& mesh) {
+  MeshRef ref;
+  std::error_code ec;
+  const bool sample = mesh.rfind("sample:", 0) == 0;
+  if (sample || std::filesystem::is_regular_file(mesh, ec)) {
+    absl::StatusOr<MeshData> data = sample ? MakeSampleMesh(mesh) : ReadMeshFile(mesh);
+    if (!data.ok()) return data.status();
+    ref.id = server::ComputeMeshId(*data);
+    ref.name = absl::StrCat("meshes/", ref.id);
+    if (sample) {
+      ref.file_bytes = MeshToOffText(*data);
+      ref.file_name = mesh.substr(7) + ".off";
+    } else {
+      std::ifstream in(mesh, std::ios::binary);
+      ref.file_bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+      ref.file_name = std::filesystem::path(mesh).filename().string();
+    }
+    absl::StatusOr<v1::Mesh> existing = GetMesh(ref.name);
+    if (existing.ok()) return ref;
+    if (!absl::IsNotFound(existing.status())) return existing.status();
+    absl::StatusOr<v1::Mesh> uploaded = Upload(ref.file_name, ref.file_bytes, "", ref.id);
+    if (!uploaded.ok()) return uploaded.status();
+    ref.uploaded = true;
+    return ref;
+  }
+  const std::string key = mesh.rfind("meshes/", 0) == 0 ? mesh.substr(7) : mesh;
+  if (IsHexId(key)) {
+    ref.id = key;
+    ref.name = absl::StrCat("meshes/", key);
+    return ref;
+  }
+  absl::StatusOr<v1::Mesh> found = GetMesh(absl::StrCat("meshes/", key));
+  if (!found.ok()) {
+    if (absl::IsNotFound(found.status()) || absl::IsInvalidArgument(found.status())) {
+      return absl::NotFoundError(absl::StrCat(
+          mesh, ": no such file, and the server has no mesh with that id or name"));
+    }
+    return found.status();
+  }
+  ref.name = found->name();
+  ref.id = found->name().substr(7);
+  return ref;
+}
+
+absl::StatusOr<DistanceField> GeodexClient::Field(MeshRef& mesh,
+                                                          const std::vector<SurfacePoint>& sources,
+                                                          const v1::SolverOptions& options,
+                                                          bool* cached) {
+  v1::ComputeDistanceFieldRequest request;
+  request.set_mesh(mesh.name);
+  for (const SurfacePoint& p : sources) api::SurfacePointToProto(p, request.add_sources());
+  *request.mutable_options() = options;
+  request.set_want_stats(true);
+  geodex::DistanceField field;
+  grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
+    field = geodex::DistanceField();
+    auto reader = stub_->ComputeDistanceField(context, request);
+    v1::ComputeDistanceFieldResponse response;
+    while (reader->Read(&response)) {
+      if (field.distance.empty()) {
+        field.distance.reserve(response.vertex_count());
+        field.source.reserve(response.vertex_count());
+        for (const auto& p : response.resolved_sources()) {
+          field.sources.push_back(api::SurfacePointFromProto(p));
+        }
+      }
+      field.distance.insert(field.distance.end(), response.distances_f64().begin(),
+                            response.distances_f64().end());
+      field.source.insert(field.source.end(), response.labels().begin(), response.labels().end());
+      if (response.has_stats()) {
+        field.stats = api::StatsFromProto(response.stats());
+        if (cached != nullptr) *cached = response.stats().cached();
+      }
+    }
+    return reader->Finish();
+  });
+  if (!status.ok()) return ToAbsl(status);
+  return field;
+}
+
+absl::StatusOr<PathQueryResult> GeodexClient::ShortestPath(MeshRef& mesh, const SurfacePoint& from,
+                                                           const SurfacePoint& to,
+                                                           const v1::SolverOptions& options) {
+  v1::FindShortestPathRequest request;
+  request.set_mesh(mesh.name);
+  api::SurfacePointToProto(from, request.mutable_from());
+  api::SurfacePointToProto(to, request.mutable_to());
+  *request.mutable_options() = options;
+  request.set_want_stats(true);
+  v1::FindShortestPathResponse response;
+  grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
+    return stub_->FindShortestPath(context, request, &response);
+  });
+  if (!status.ok()) return ToAbsl(status);
+  PathQueryResult result;
+  result.distance = response.distance();
+  result.path.length = response.distance();
+  for (const auto& p : response.points()) result.path.points.push_back(api::PathPointFromProto(p));
+  result.stats = api::StatsFromProto(response.stats());
+  return result;
+}
+
+absl::StatusOr<DistanceMatrix> GeodexClient::Matrix(MeshRef& mesh,
+                                                    const std::vector<SurfacePoint>& sources,
+                                                    const std::vector<SurfacePoint>& targets,
+                                                    const v1::SolverOptions& options) {
+  v1::ComputeDistanceMatrixRequest request;
+  request.set_mesh(mesh.name);
+  for (const SurfacePoint& p : sources) api::SurfacePointToProto(p, request.add_sources());
+  for (const SurfacePoint& p : targets) api::SurfacePointToProto(p, request.add_targets());
+  *request.mutable_options() = options;
+  request.set_want_stats(true);
+  DistanceMatrix matrix;
+  grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
+    matrix = DistanceMatrix();
+    auto reader = stub_->ComputeDistanceMatrix(context, request);
+    v1::ComputeDistanceMatrixResponse response;
+    while (reader->Read(&response)) {
+      matrix.rows = response.rows();
+      matrix.cols = response.cols();
+      matrix.values.insert(matrix.values.end(), response.values_f64().begin(),
+                           response.values_f64().end());
+      if (response.has_stats()) matrix.stats = api::StatsFromProto(response.stats());
+    }
+    return reader->Finish();
+  });
+  if (!status.ok()) return ToAbsl(status);
+  return matrix;
+}
+
+absl::StatusOr<v1::EstimateDistancesResponse> GeodexClient::PointDistances(
+    MeshRef& mesh, const std::vector<SurfacePoint>& sources, const std::vector<SurfacePoint>& points,
+    v1::PointDistanceMode mode, const v1::SolverOptions& options) {
+  v1::EstimateDistancesRequest request;
+  request.set_mesh(mesh.name);
+  for (const SurfacePoint& p : sources) api::SurfacePointToProto(p, request.add_sources());
+  for (const SurfacePoint& p : points) api::SurfacePointToProto(p, request.add_points());
+  request.set_mode(mode);
+  *request.mutable_options() = options;
+  v1::EstimateDistancesResponse response;
+  grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
+    return stub_->EstimateDistances(context, request, &response);
+  });
+  if (!status.ok()) return ToAbsl(status);
+  return response;
+}
+
+absl::StatusOr<std::vector<SurfacePoint>> GeodexClient::Locate(
+    MeshRef& mesh, const std::vector<std::array<double, 3>>& xyz) {
+  v1::LocatePointsRequest request;
+  request.set_mesh(mesh.name);
+  for (const auto& q : xyz) api::PositionToProto(q, request.add_positions());
+  v1::LocatePointsResponse response;
+  grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
+    return stub_->LocatePoints(context, request, &response);
+  });
+  if (!status.ok()) return ToAbsl(status);
+  std::vector<SurfacePoint> out;
+  for (const auto& p : response.points()) out.push_back(api::SurfacePointFromProto(p.point()));
+  return out;
+}
+
+}  // namespace geodex::client

@@ -1,0 +1,109 @@
+#pragma once
+
+// The C++ client library of geodexd (what `geodex --server` uses).
+//
+// - Every call has a deadline and is retried with exponential backoff when the server answers
+//   UNAVAILABLE (not yet listening, restarting, draining).
+// - A mesh is named by a local file (or "sample:NAME"), a 64-hex mesh id or an alias. A file is
+//   parsed locally and its id computed with the server's content hash (mesh_id.h); it is uploaded
+//   only when the server does not have it, and uploaded again, transparently and once, when a
+//   query answers NOT_FOUND for it (a replica that restarted or a rebalanced gateway).
+// - Every mesh-scoped call carries the mesh id as `x-mesh-id` metadata, so a gateway can route by
+//   mesh (uploads included). An alias is resolved to its id first (GetMesh).
+// Errors come back as absl::Status with the server's code and message.
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "geodex/distance_field.h"
+#include "geodex/distance_matrix.h"
+#include "geodex/mesh_data.h"
+#include "geodex/shortest_path.h"
+#include "geodex/surface_point.h"
+#include "geodex/v1/geodex.grpc.pb.h"
+
+namespace geodex::client {
+
+struct ClientOptions {
+  std::string target = "127.0.0.1:50051";  // HOST:PORT
+  double deadline_seconds = 600;            // per call
+  int max_attempts = 4;                     // tries on UNAVAILABLE
+  double initial_backoff_seconds = 0.2;     // doubled after each UNAVAILABLE
+  size_t upload_chunk_bytes = 1 << 20;
+  // Called with (bytes sent, total) during uploads (the CLI's progress bar); may be empty.
+  std::function<void(uint64_t, uint64_t)> upload_progress;
+};
+
+// A mesh as the client knows it.
+struct MeshRef {
+  std::string name;  // "meshes/{id}" once known, else "meshes/{alias}"
+  std::string id;    // empty only for an alias that could not be resolved
+  // For a local file: its bytes (uploaded on demand) and name.
+  std::string file_bytes;
+  std::string file_name;
+  bool uploaded = false;  // this client uploaded it
+};
+
+class GeodexClient {
+ public:
+  explicit GeodexClient(ClientOptions options);
+
+  // grpc.health.v1 Check for `service` ("" = the server as a whole): true when SERVING.
+  absl::StatusOr<bool> Health(const std::string& service = "");
+
+  // MESH argument -> reference: a readable file or "sample:NAME" (uploaded if the server lacks
+  // it), a 64-hex id, or an alias.
+  absl::StatusOr<MeshRef> ResolveMesh(const std::string& mesh);
+  // Uploads file bytes (idempotent). `expected_id` is checked by the server when set.
+  absl::StatusOr<v1::Mesh> Upload(const std::string& file_name, const std::string& bytes,
+                                  const std::string& alias, const std::string& expected_id);
+  absl::StatusOr<v1::Mesh> GetMesh(const std::string& name);
+  absl::StatusOr<std::vector<v1::Mesh>> ListMeshes();  // every page
+  absl::Status DeleteMesh(const std::string& name);
+
+  // Queries (options: the proto's SolverOptions). Results in core's types.
+  absl::StatusOr<DistanceField> Field(MeshRef& mesh, const std::vector<SurfacePoint>& sources,
+                                              const v1::SolverOptions& options, bool* cached = nullptr);
+  absl::StatusOr<PathQueryResult> ShortestPath(MeshRef& mesh, const SurfacePoint& from,
+                                               const SurfacePoint& to,
+                                               const v1::SolverOptions& options);
+  absl::StatusOr<DistanceMatrix> Matrix(MeshRef& mesh, const std::vector<SurfacePoint>& sources,
+                                        const std::vector<SurfacePoint>& targets,
+                                        const v1::SolverOptions& options);
+  absl::StatusOr<v1::EstimateDistancesResponse> PointDistances(
+      MeshRef& mesh, const std::vector<SurfacePoint>& sources,
+      const std::vector<SurfacePoint>& points, v1::PointDistanceMode mode,
+      const v1::SolverOptions& options);
+  // Positions -> surface points (vertex, edge or face point) on the server's copy of the mesh.
+  absl::StatusOr<std::vector<SurfacePoint>> Locate(MeshRef& mesh,
+                                                   const std::vector<std::array<double, 3>>& xyz);
+
+  // Calls made, UNAVAILABLE retries and transparent re-uploads (for tests and --stats).
+  int calls() const { return calls_; }
+  int retries() const { return retries_; }
+  int reuploads() const { return reuploads_; }
+
+ private:
+  // Runs `call(context)` with a fresh context (deadline, x-mesh-id) per attempt, retrying on
+  // UNAVAILABLE.
+  grpc::Status Call(const std::string& mesh_id,
+                    const std::function<grpc::Status(grpc::ClientContext*)>& call);
+  // Runs a mesh-scoped query; on NOT_FOUND for a mesh this client has the file of, uploads it
+  // again and retries once.
+  grpc::Status MeshCall(MeshRef& mesh, const std::function<grpc::Status(grpc::ClientContext*)>& call);
+
+  ClientOptions options_;
+  std::shared_ptr<grpc::Channel> channel_;
+  std::unique_ptr<v1::Geodex::Stub> stub_;
+  int calls_ = 0, retries_ = 0, reuploads_ = 0;
+};
+
+// OFF text of a mesh with exactly round-tripping coordinates (%.17g): how samples are uploaded.
+std::string MeshToOffText(const MeshData& mesh);
+
+}  // namespace geodex::client

@@ -1,0 +1,29 @@
+#pragma once
+
+// Plain conversions between geodex.v1 messages and core types, used by both sides of the API (the
+// server's validating conversions are in server/proto_convert.h). No validation here: a proto
+// point with nothing set becomes a vertex 0.
+
+#include <array>
+
+#include "geodex/distance_field.h"
+#include "geodex/shortest_path.h"
+#include "geodex/surface_point.h"
+#include "geodex/v1/geodex.pb.h"
+
+namespace geodex::api {
+
+void SurfacePointToProto(const SurfacePoint& point, v1::SurfacePoint* out);
+SurfacePoint SurfacePointFromProto(const v1::SurfacePoint& point);
+
+void PositionToProto(const std::array<double, 3>& position, v1::Position* out);
+std::array<double, 3> PositionFromProto(const v1::Position& position);
+
+void PathPointToProto(const PathPoint& point, v1::PathPoint* out);
+PathPoint PathPointFromProto(const v1::PathPoint& point);
+
+void StatsToProto(const SolveStats& stats, v1::SolveStats* out);
+// The counters the API carries (windows_filtered goes to windows_filtered_at_pop).
+SolveStats StatsFromProto(const v1::SolveStats& stats);
+
+}  // namespace geodex::api

@@ -1,0 +1,102 @@
+#!/usr/bin/env bash
+# geodex in remote mode against a real geodexd (127.0.0.1, a port it picks): every command that
+# remote mode offers prints exactly what local mode prints (timing lines aside), on several meshes;
+# mesh management, health, one-line errors and exit codes. Bounded: every wait gives up.
+# Env: GEODEX, GEODEXD (the binaries), DATA (tests/data).
+set -u
+pass=0
+fail=0
+check() {
+  local name="$1"
+  shift
+  if "$@"; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAIL: $name"; fi
+}
+tmp=$(mktemp -d)
+"$GEODEXD" --listen 127.0.0.1:0 --data-dir "$tmp/data" --metrics_listen "" --pool-threads 2 \
+  --shutdown_grace_seconds 5 >"$tmp/server.log" 2>&1 &
+pid=$!
+cleanup() {
+  kill -TERM "$pid" 2>/dev/null
+  for _ in $(seq 1 100); do kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done
+  kill -KILL "$pid" 2>/dev/null
+  rm -rf "$tmp"
+}
+trap cleanup EXIT
+port=""
+for _ in $(seq 1 300); do
+  port=$(sed -n 's/.*listening on port \([0-9]*\).*/\1/p' "$tmp/server.log" | head -1)
+  [ -n "$port" ] && break
+  sleep 0.1
+done
+check "server started" test -n "$port"
+R=("$GEODEX" --server "127.0.0.1:$port")
+
+"${R[@]}" health >"$tmp/health.txt"
+check "health exit 0" test $? -eq 0
+check "health prints SERVING" grep -qx SERVING "$tmp/health.txt"
+
+# Local and remote print the same bytes (lines ending in _ms are timings).
+same() {  # same NAME ARGS...
+  local name="$1"
+  shift
+  "$GEODEX" "$@" >"$tmp/local.txt" 2>"$tmp/local.err"
+  local lrc=$?
+  GEODEX_SERVER="127.0.0.1:$port" "$GEODEX" "$@" >"$tmp/remote.txt" 2>"$tmp/remote.err"
+  local rrc=$?
+  check "$name: exit codes ($lrc local, $rrc remote)" test "$lrc" -eq "$rrc"
+  check "$name: output non-empty" test -s "$tmp/local.txt"
+  check "$name: identical output" diff <(grep -v '_ms' "$tmp/local.txt") <(grep -v '_ms' "$tmp/remote.txt")
+}
+for mesh in "$DATA/knight.off" "$DATA/kitten.off" "$DATA/three-peaks.off" sample:terrain; do
+  m=$(basename "$mesh")
+  same "info $m" info "$mesh"
+  same "info json $m" info "$mesh" --format json
+  same "distances $m" distances "$mesh" --sources 0,17
+  same "distances face source $m" distances "$mesh" --sources f:10:0.2:0.3:0.5
+  same "distances max-distance $m" distances "$mesh" --sources 5 --max-distance 0.5
+  same "path $m" path "$mesh" --from 3 --to 400
+  same "path face points $m" path "$mesh" --from f:1:0.3:0.3:0.4 --to f:300:0.1:0.2:0.7
+  same "matrix $m" matrix "$mesh" --sources 0,9,f:5:0.5:0.5:0 --targets 2,44,f:20:0.5:0.25:0.25
+  same "at $m" distances "$mesh" --sources 1 --at 7,f:30:0.2:0.2:0.6
+done
+same "lambda" distances "$DATA/kitten.off" --sources 0 --lambda 0.1 --lambda-scale mean
+same "position source" path "$DATA/kitten.off" --from p:0:0:0 --to 100
+"$GEODEX" distances "$DATA/knight.off" --sources 0 --output "$tmp/local-out.txt"
+"${R[@]}" distances "$DATA/knight.off" --sources 0 --output "$tmp/remote-out.txt"
+check "--output: 502 lines" test "$(wc -l <"$tmp/remote-out.txt")" -eq 502
+check "--output: identical files" cmp -s "$tmp/local-out.txt" "$tmp/remote-out.txt"
+
+# The file was uploaded once: the server lists each mesh once.
+"${R[@]}" mesh list >"$tmp/list.txt"
+check "mesh list exit 0" test $? -eq 0
+check "mesh list has the 3 files and 3 samples" test "$(wc -l <"$tmp/list.txt")" -eq 6
+check "mesh list names terrain" grep -q $'\tterrain\t' "$tmp/list.txt"
+"${R[@]}" mesh upload "$DATA/fertility.off" --name fert >"$tmp/up.txt"
+check "mesh upload exit 0" test $? -eq 0
+check "mesh upload shows the alias" grep -q $'\tfert\t4494 vertices' "$tmp/up.txt"
+"${R[@]}" mesh get fert --format json >"$tmp/get.json"
+check "mesh get json" /usr/bin/python3 -c "import json; d=json.load(open('$tmp/get.json')); assert d['display_name']=='fert' and d['vertices']==4494"
+check "query by alias" bash -c "'$GEODEX' --server 127.0.0.1:$port distances fert --sources 0 | wc -l | grep -qx 4494"
+"${R[@]}" mesh delete fert >/dev/null
+check "mesh delete exit 0" test $? -eq 0
+"${R[@]}" mesh get fert 2>"$tmp/err.txt"
+check "deleted mesh: exit 3" test $? -eq 3
+check "deleted mesh: one-line error" test "$(wc -l <"$tmp/err.txt")" -eq 1
+
+# Errors: one line, non-zero exit.
+"${R[@]}" distances "$DATA/knight.off" --sources 9999 2>"$tmp/err.txt"
+check "bad vertex: exit 2" test $? -eq 2
+check "bad vertex: names the field" grep -q "sources\[0\].vertex" "$tmp/err.txt"
+check "bad vertex: one line" test "$(wc -l <"$tmp/err.txt")" -eq 1
+"${R[@]}" distances no-such-mesh --sources 0 2>"$tmp/err.txt"
+check "unknown mesh: exit 3" test $? -eq 3
+"$GEODEX" --server 127.0.0.1:1 health 2>"$tmp/err.txt"
+check "no server: non-zero exit" test $? -ne 0
+check "no server: one line" test "$(wc -l <"$tmp/err.txt")" -eq 1
+"$GEODEX" health 2>"$tmp/err.txt"
+check "health without --server: exit 2" test $? -eq 2
+"${R[@]}" isolines "$DATA/knight.off" --sources 0 --count 4 2>"$tmp/err.txt"
+check "isolines remote: not yet, exit 2" test $? -eq 2
+
+echo "remote cli: $pass passed, $fail failed"
+test "$fail" -eq 0

@@ -1,0 +1,125 @@
+// The C++ client library against an in-process geodexd: mesh resolution by file, id and alias,
+// transparent re-upload when the server lost a mesh, retries on UNAVAILABLE, and results equal to
+// core's.
+
+#include <filesystem>
+#include <fstream>
+
+#include "geodex/geodesic_solver.h"
+#include "geodex/samples.h"
+#include "geodex_client.h"
+#include "mesh_id.h"
+#include "server_test_util.h"
+
+namespace geodex::server {
+namespace {
+
+using client::ClientOptions;
+using client::GeodexClient;
+using client::MeshRef;
+using testing::GridOff;
+
+class ClientTest : public testing::ServerFixture {
+ protected:
+  GeodexClient Client() {
+    ClientOptions options;
+    options.target = absl::StrCat("127.0.0.1:", server_->port());
+    options.deadline_seconds = 60;
+    return GeodexClient(options);
+  }
+  std::string WriteFile(const std::string& name, const std::string& text) {
+    const std::string path = ::testing::TempDir() + "/" + name;
+    std::ofstream(path) << text;
+    return path;
+  }
+};
+
+TEST_F(ClientTest, FileIsUploadedOnceByContentHashAndFieldsEqualCore) {
+  StartServer();
+  GeodexClient client = Client();
+  const std::string off = GridOff(9, 7, true);
+  const std::string path = WriteFile("client-hills.off", off);
+  absl::StatusOr<MeshRef> first = client.ResolveMesh(path);
+  ASSERT_TRUE(first.ok()) << first.status();
+  EXPECT_TRUE(first->uploaded);
+  EXPECT_EQ(first->id, ComputeMeshId(*ReadMeshFromBuffer(off, MeshFormat::kOff, "x.off")));
+  absl::StatusOr<MeshRef> second = client.ResolveMesh(path);
+  ASSERT_TRUE(second.ok());
+  EXPECT_FALSE(second->uploaded);  // the server had it: no second upload
+  EXPECT_EQ(server_->store().size(), 1u);
+
+  absl::StatusOr<DistanceField> field =
+      client.Field(*second, {SurfacePoint::AtVertex(4)}, v1::SolverOptions());
+  ASSERT_TRUE(field.ok()) << field.status();
+  DistanceField expected =
+      *ComputeDistanceField(testing::BuildLocal(off), {SurfacePoint::AtVertex(4)});
+  EXPECT_EQ(field->distance, expected.distance);
+  EXPECT_EQ(field->source, expected.source);
+
+  // By id and by alias.
+  ASSERT_TRUE(client.Upload("x.off", off, "hills", first->id).ok());
+  absl::StatusOr<MeshRef> by_alias = client.ResolveMesh("hills");
+  ASSERT_TRUE(by_alias.ok());
+  EXPECT_EQ(by_alias->id, first->id);
+  absl::StatusOr<MeshRef> by_id = client.ResolveMesh(first->id);
+  ASSERT_TRUE(by_id.ok());
+  EXPECT_EQ(by_id->name, first->name);
+  EXPECT_TRUE(absl::IsNotFound(client.ResolveMesh("no-such-mesh").status()));
+}
+
+TEST_F(ClientTest, SamplesResolveToTheServersBuiltInSamples) {
+  ServerOptions options;
+  options.samples = true;
+  StartServer(options);
+  GeodexClient client = Client();
+  absl::StatusOr<MeshRef> terrain = client.ResolveMesh("sample:terrain");
+  ASSERT_TRUE(terrain.ok()) << terrain.status();
+  EXPECT_FALSE(terrain->uploaded);  // same generator, same content hash
+  EXPECT_EQ(server_->store().size(), 3u);
+}
+
+TEST_F(ClientTest, AQueryForALostMeshReuploadsItOnce) {
+  StartServer();
+  GeodexClient client = Client();
+  const std::string path = WriteFile("client-lost.off", GridOff(6, 6, true));
+  absl::StatusOr<MeshRef> mesh = client.ResolveMesh(path);
+  ASSERT_TRUE(mesh.ok());
+  // The server loses the mesh (a restart elsewhere, a rebalanced gateway): the query still works.
+  ASSERT_TRUE(server_->store().Delete(mesh->id).ok());
+  absl::StatusOr<DistanceField> field =
+      client.Field(*mesh, {SurfacePoint::AtVertex(0)}, v1::SolverOptions());
+  ASSERT_TRUE(field.ok()) << field.status();
+  EXPECT_EQ(client.reuploads(), 1);
+  EXPECT_EQ(field->distance.size(), 49u);
+  // A mesh known only by id cannot be re-uploaded: NOT_FOUND comes back.
+  MeshRef by_id = *client.ResolveMesh(mesh->id);
+  ASSERT_TRUE(server_->store().Delete(mesh->id).ok());
+  EXPECT_TRUE(absl::IsNotFound(
+      client.Field(by_id, {SurfacePoint::AtVertex(0)}, v1::SolverOptions()).status()));
+}
+
+TEST(ClientRetryTest, UnavailableIsRetriedWithBackoffThenReported) {
+  // A port nothing listens on (bound, then closed).
+  int port = 0;
+  {
+    ServerOptions probe_options;
+    probe_options.listen = "127.0.0.1:0";
+    auto probe = GeodexServer::Start(probe_options);
+    ASSERT_TRUE(probe.ok());
+    port = (*probe)->port();
+    (*probe)->Shutdown(absl::Now());
+  }
+  ClientOptions options;
+  options.target = absl::StrCat("127.0.0.1:", port);
+  options.max_attempts = 3;
+  options.initial_backoff_seconds = 0.01;
+  options.deadline_seconds = 10;
+  GeodexClient client(options);
+  absl::StatusOr<bool> health = client.Health();
+  EXPECT_EQ(health.status().code(), absl::StatusCode::kUnavailable) << health.status();
+  EXPECT_EQ(client.calls(), 3);
+  EXPECT_EQ(client.retries(), 2);
+}
+
+}  // namespace
+}  // namespace geodex::server
