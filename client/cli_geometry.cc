@@ -1,9 +1,11 @@
 // geodex isolines / voronoi / delaunay: solve the multi-source field, derive the approximate
 // geometry (paper section 6) and write it as JSON (default, stdout), OBJ lines or an SVG top view.
+// With a server the geometry is computed there and written here exactly the same way.
 
 #include "cli_geometry.h"
 
 #include "cli_common.h"
+#include "cli_remote.h"
 
 #include <algorithm>
 #include <cmath>
@@ -61,6 +63,29 @@ int Prepare(const Args& args, const std::string& key, Solved* out) {
     return Fail(bad ? kExitUsage : kExitSolveFailed, std::string(field.status().message()));
   }
   out->field = *std::move(field);
+  return 0;
+}
+
+// Remote mode: the mesh is read locally too (its coordinates place the sites and draw the SVG), so
+// MESH must be a file or sample:NAME; the points are resolved and the geometry computed by the
+// server. Fills s.data and s.points; returns 0 or an exit code.
+int PrepareRemote(const Args& args, const std::string& key, RemoteGeometry& remote, Solved* s) {
+  absl::StatusOr<MeshData> data = LoadMeshData(args.positional[0]);
+  if (!data.ok()) {
+    return Fail(kExitInput, absl::StrFormat("%s (in remote mode isolines, voronoi and delaunay "
+                                            "need the mesh file or sample:NAME: its coordinates "
+                                            "place the sites)",
+                                            data.status().message()));
+  }
+  s->data = *std::move(data);
+  absl::StatusOr<std::vector<SurfacePoint>> points = ParseSurfacePoints(args.options.at(key));
+  if (!points.ok()) {
+    return Fail(kExitUsage, "--" + key + ": " + std::string(points.status().message()));
+  }
+  s->points = *std::move(points);
+  if (absl::Status st = remote.Prepare(args.positional[0], &s->points); !st.ok()) {
+    return FailRemote(st);
+  }
   return 0;
 }
 
@@ -282,7 +307,7 @@ int Usage(const std::string& command, const std::string& key, const std::string&
 
 }  // namespace
 
-int RunIsolines(const Args& args) {
+int RunIsolines(const Args& args, const std::string& server) {
   std::string error;
   if (!CheckKnown(args, {"sources", "levels", "count", "output"}, &error)) {
     return Fail(kExitUsage, error);
@@ -307,9 +332,18 @@ int RunIsolines(const Args& args) {
   Format format;
   if (!OutputFormat(args, &format, &error)) return Fail(kExitUsage, error);
   Solved s;
-  if (int code = Prepare(args, "sources", &s)) return code;
-  absl::StatusOr<Isolines> iso = ExtractIsolines(*s.mesh, s.field, options);
-  if (!iso.ok()) return Fail(kExitUsage, std::string(iso.status().message()));
+  absl::StatusOr<Isolines> iso;
+  if (!server.empty()) {
+    std::unique_ptr<RemoteGeometry> remote = ConnectRemoteGeometry(server);
+    if (remote == nullptr) return RunRemote(server, "isolines", args);
+    if (int code = PrepareRemote(args, "sources", *remote, &s)) return code;
+    iso = remote->ComputeIsolines(s.points, options);
+    if (!iso.ok()) return FailRemote(iso.status());
+  } else {
+    if (int code = Prepare(args, "sources", &s)) return code;
+    iso = ExtractIsolines(*s.mesh, s.field, options);
+    if (!iso.ok()) return Fail(kExitUsage, std::string(iso.status().message()));
+  }
 
   const double top = iso->levels.empty() ? 1 : std::max(iso->levels.back(), 1e-300);
   std::vector<Line> lines;
@@ -329,7 +363,7 @@ int RunIsolines(const Args& args) {
   return Emit(args, json);
 }
 
-int RunVoronoi(const Args& args) {
+int RunVoronoi(const Args& args, const std::string& server) {
   std::string error;
   if (!CheckKnown(args, {"sites", "output"}, &error)) return Fail(kExitUsage, error);
   if (args.positional.size() != 1 || !args.options.count("sites")) {
@@ -338,9 +372,18 @@ int RunVoronoi(const Args& args) {
   Format format;
   if (!OutputFormat(args, &format, &error)) return Fail(kExitUsage, error);
   Solved s;
-  if (int code = Prepare(args, "sites", &s)) return code;
-  absl::StatusOr<VoronoiDiagram> vd = BuildVoronoi(*s.mesh, s.field);
-  if (!vd.ok()) return Fail(kExitSolveFailed, std::string(vd.status().message()));
+  absl::StatusOr<VoronoiDiagram> vd;
+  if (!server.empty()) {
+    std::unique_ptr<RemoteGeometry> remote = ConnectRemoteGeometry(server);
+    if (remote == nullptr) return RunRemote(server, "voronoi", args);
+    if (int code = PrepareRemote(args, "sites", *remote, &s)) return code;
+    vd = remote->ComputeVoronoi(s.points);
+    if (!vd.ok()) return FailRemote(vd.status());
+  } else {
+    if (int code = Prepare(args, "sites", &s)) return code;
+    vd = BuildVoronoi(*s.mesh, s.field);
+    if (!vd.ok()) return Fail(kExitSolveFailed, std::string(vd.status().message()));
+  }
 
   std::vector<Line> lines;
   std::string json = absl::StrFormat(
@@ -392,7 +435,7 @@ std::string EdgeJson(const DelaunayEdge& e) {
 
 }  // namespace
 
-int RunDelaunay(const Args& args) {
+int RunDelaunay(const Args& args, const std::string& server) {
   std::string error;
   if (!CheckKnown(args, {"sites", "output"}, &error)) return Fail(kExitUsage, error);
   if (args.positional.size() != 1 || !args.options.count("sites")) {
@@ -401,9 +444,18 @@ int RunDelaunay(const Args& args) {
   Format format;
   if (!OutputFormat(args, &format, &error)) return Fail(kExitUsage, error);
   Solved s;
-  if (int code = Prepare(args, "sites", &s)) return code;
-  absl::StatusOr<DelaunayTriangulation> dt = BuildDelaunay(*s.mesh, s.field);
-  if (!dt.ok()) return Fail(kExitSolveFailed, std::string(dt.status().message()));
+  absl::StatusOr<DelaunayTriangulation> dt;
+  if (!server.empty()) {
+    std::unique_ptr<RemoteGeometry> remote = ConnectRemoteGeometry(server);
+    if (remote == nullptr) return RunRemote(server, "delaunay", args);
+    if (int code = PrepareRemote(args, "sites", *remote, &s)) return code;
+    dt = remote->ComputeDelaunay(s.points);
+    if (!dt.ok()) return FailRemote(dt.status());
+  } else {
+    if (int code = Prepare(args, "sites", &s)) return code;
+    dt = BuildDelaunay(*s.mesh, s.field);
+    if (!dt.ok()) return Fail(kExitSolveFailed, std::string(dt.status().message()));
+  }
 
   std::vector<Line> lines;
   std::string json = "{\"approximate\": true, \"kind\": \"delaunay\", \"sites\": " + SitesJson(s) +

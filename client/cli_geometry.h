@@ -3,15 +3,17 @@
 // The geodex commands for the approximate geometry of a distance field (paper section 6):
 // isolines, the Voronoi diagram and the Delaunay triangulation.
 
+#include <string>
+
 #include "cli_commands.h"
 
 namespace geodex::cli {
 
 // geodex isolines MESH --sources SPEC (--levels L1,L2,... | --count K) [--output FILE]
-int RunIsolines(const Args& args);
+int RunIsolines(const Args& args, const std::string& server = "");
 // geodex voronoi MESH --sites SPEC [--output FILE]
-int RunVoronoi(const Args& args);
+int RunVoronoi(const Args& args, const std::string& server = "");
 // geodex delaunay MESH --sites SPEC [--output FILE]
-int RunDelaunay(const Args& args);
+int RunDelaunay(const Args& args, const std::string& server = "");
 
 }  // namespace geodex::cli

@@ -36,6 +36,27 @@ int FailStatus(const absl::Status& status) {
   return Fail(Code(status), std::string(status.message()));
 }
 
+class RemoteGeometryImpl final : public RemoteGeometry {
+ public:
+  explicit RemoteGeometryImpl(std::unique_ptr<GeodexClient> client) : client_(std::move(client)) {}
+  absl::Status Prepare(const std::string& mesh, std::vector<SurfacePoint>* points) override;
+  absl::StatusOr<Isolines> ComputeIsolines(const std::vector<SurfacePoint>& sources,
+                                           const IsolineOptions& levels) override {
+    return client_->ComputeIsolines(mesh_, sources, levels, v1::SolverOptions());
+  }
+  absl::StatusOr<VoronoiDiagram> ComputeVoronoi(const std::vector<SurfacePoint>& sites) override {
+    return client_->ComputeVoronoi(mesh_, sites, v1::SolverOptions());
+  }
+  absl::StatusOr<DelaunayTriangulation> ComputeDelaunay(
+      const std::vector<SurfacePoint>& sites) override {
+    return client_->ComputeDelaunay(mesh_, sites, v1::SolverOptions());
+  }
+
+ private:
+  std::unique_ptr<GeodexClient> client_;
+  MeshRef mesh_;
+};
+
 // A progress bar on stderr for uploads, only when stderr is a terminal.
 void UploadProgress(uint64_t done, uint64_t total) {
   if (!::isatty(2) || total == 0) return;
@@ -108,6 +129,13 @@ absl::Status LocatePositions(GeodexClient& client, MeshRef& mesh, std::vector<Su
     if (p.kind == SurfacePoint::Kind::kPosition) p = (*located)[k++];
   }
   return absl::OkStatus();
+}
+
+absl::Status RemoteGeometryImpl::Prepare(const std::string& mesh, std::vector<SurfacePoint>* points) {
+  absl::StatusOr<MeshRef> ref = client_->ResolveMesh(mesh);
+  if (!ref.ok()) return ref.status();
+  mesh_ = *std::move(ref);
+  return LocatePositions(*client_, mesh_, points);
 }
 
 int RemoteInfo(GeodexClient& client, const Args& args) {
@@ -348,6 +376,12 @@ int RemoteHealth(GeodexClient& client, const Args& args) {
 
 bool RemoteAvailable() { return true; }
 
+std::unique_ptr<RemoteGeometry> ConnectRemoteGeometry(const std::string& target) {
+  return std::make_unique<RemoteGeometryImpl>(Connect(target));
+}
+
+int FailRemote(const absl::Status& status) { return FailStatus(status); }
+
 int RunRemote(const std::string& target, const std::string& command, const Args& args) {
   std::unique_ptr<GeodexClient> client = Connect(target);
   if (command == "info") return RemoteInfo(*client, args);
@@ -356,11 +390,6 @@ int RunRemote(const std::string& target, const std::string& command, const Args&
   if (command == "matrix") return RemoteMatrix(*client, args);
   if (command == "mesh") return RemoteMesh(*client, args);
   if (command == "health") return RemoteHealth(*client, args);
-  if (command == "isolines" || command == "voronoi" || command == "delaunay") {
-    return Fail(kExitUsage, absl::StrCat("'", command,
-                                         "' is not available in remote mode yet; run it locally "
-                                         "(without --server)"));
-  }
   return Fail(kExitUsage, absl::StrFormat("unknown command '%s' (see geodex --help)", command));
 }
 

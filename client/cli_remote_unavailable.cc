@@ -11,4 +11,10 @@ int RunRemote(const std::string&, const std::string&, const Args&) {
   return Fail(kExitUsage, "this geodex was built without gRPC: --server is not available");
 }
 
+std::unique_ptr<RemoteGeometry> ConnectRemoteGeometry(const std::string&) { return nullptr; }
+
+int FailRemote(const absl::Status& status) {
+  return Fail(kExitSolveFailed, std::string(status.message()));
+}
+
 }  // namespace geodex::cli

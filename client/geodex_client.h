@@ -21,10 +21,13 @@
 
 #include "absl/status/statusor.h"
 #include "geodex/distance_field.h"
+#include "geodex/delaunay.h"
 #include "geodex/distance_matrix.h"
+#include "geodex/isolines.h"
 #include "geodex/mesh_data.h"
 #include "geodex/shortest_path.h"
 #include "geodex/surface_point.h"
+#include "geodex/voronoi.h"
 #include "geodex/v1/geodex.grpc.pb.h"
 
 namespace geodex::client {
@@ -79,6 +82,17 @@ class GeodexClient {
       MeshRef& mesh, const std::vector<SurfacePoint>& sources,
       const std::vector<SurfacePoint>& points, v1::PointDistanceMode mode,
       const v1::SolverOptions& options);
+  // The approximate geometry of section 6, reassembled from the streamed pieces. `sources` get
+  // the server's resolved points (positions snapped) when non-null.
+  absl::StatusOr<Isolines> ComputeIsolines(MeshRef& mesh, const std::vector<SurfacePoint>& sources,
+                                           const IsolineOptions& levels,
+                                           const v1::SolverOptions& options);
+  absl::StatusOr<VoronoiDiagram> ComputeVoronoi(MeshRef& mesh,
+                                                const std::vector<SurfacePoint>& sites,
+                                                const v1::SolverOptions& options);
+  absl::StatusOr<DelaunayTriangulation> ComputeDelaunay(MeshRef& mesh,
+                                                        const std::vector<SurfacePoint>& sites,
+                                                        const v1::SolverOptions& options);
   // Positions -> surface points (vertex, edge or face point) on the server's copy of the mesh.
   absl::StatusOr<std::vector<SurfacePoint>> Locate(MeshRef& mesh,
                                                    const std::vector<std::array<double, 3>>& xyz);

@@ -24,7 +24,8 @@ a geodexd and prints the same output. There MESH may also be a mesh id or a name
 server; a file is uploaded once (only if the server does not have it, by content hash).
   mesh upload FILE [--name NAME] | mesh list | mesh get MESH | mesh delete MESH   [--format json]
   health [--service NAME]      prints SERVING (exit 0) or NOT_SERVING (exit 1)
-isolines, voronoi and delaunay run locally only, for now.
+isolines, voronoi and delaunay need MESH as a file or sample:NAME in remote mode too (its
+coordinates place the sites in the output).
 
 commands:
   info MESH [--format text|json] [--strict]
@@ -104,6 +105,10 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "geodex: %s\n", error.c_str());
     return kExitUsage;
   }
+  // The section-6 geometry is formatted by cli_geometry.cc in both modes.
+  if (command == "isolines") return RunIsolines(args, server);
+  if (command == "voronoi") return RunVoronoi(args, server);
+  if (command == "delaunay") return RunDelaunay(args, server);
   if (!server.empty()) return RunRemote(server, command, args);
   if (command == "mesh" || command == "health") {
     std::fprintf(stderr, "geodex: '%s' talks to a server: use --server HOST:PORT\n",

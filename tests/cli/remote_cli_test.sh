@@ -58,6 +58,16 @@ for mesh in "$DATA/knight.off" "$DATA/kitten.off" "$DATA/three-peaks.off" sample
   same "path face points $m" path "$mesh" --from f:1:0.3:0.3:0.4 --to f:300:0.1:0.2:0.7
   same "matrix $m" matrix "$mesh" --sources 0,9,f:5:0.5:0.5:0 --targets 2,44,f:20:0.5:0.25:0.25
   same "at $m" distances "$mesh" --sources 1 --at 7,f:30:0.2:0.2:0.6
+  same "isolines $m" isolines "$mesh" --sources 0,f:40:0.2:0.3:0.5 --count 6
+  same "isolines levels $m" isolines "$mesh" --sources 3 --levels 0.1,0.5,2
+  same "voronoi $m" voronoi "$mesh" --sites 0,100,200,300,f:60:0.3:0.3:0.4
+  same "delaunay $m" delaunay "$mesh" --sites 0,100,200,300,400
+done
+for ext in obj svg; do
+  "$GEODEX" voronoi sample:terrain --sites 0,2000,4000,4224 --output "$tmp/local.$ext"
+  "${R[@]}" voronoi sample:terrain --sites 0,2000,4000,4224 --output "$tmp/remote.$ext"
+  check "voronoi --output .$ext identical" cmp -s "$tmp/local.$ext" "$tmp/remote.$ext"
+  check "voronoi --output .$ext non-empty" test -s "$tmp/remote.$ext"
 done
 same "lambda" distances "$DATA/kitten.off" --sources 0 --lambda 0.1 --lambda-scale mean
 same "position source" path "$DATA/kitten.off" --from p:0:0:0 --to 100
@@ -95,8 +105,9 @@ check "no server: non-zero exit" test $? -ne 0
 check "no server: one line" test "$(wc -l <"$tmp/err.txt")" -eq 1
 "$GEODEX" health 2>"$tmp/err.txt"
 check "health without --server: exit 2" test $? -eq 2
-"${R[@]}" isolines "$DATA/knight.off" --sources 0 --count 4 2>"$tmp/err.txt"
-check "isolines remote: not yet, exit 2" test $? -eq 2
+"${R[@]}" isolines terrain --sources 0 --count 4 2>"$tmp/err.txt"
+check "isolines by name: exit 3" test $? -eq 3
+check "isolines by name: says why" grep -q "need the mesh file" "$tmp/err.txt"
 
 echo "remote cli: $pass passed, $fail failed"
 test "$fail" -eq 0
