@@ -49,6 +49,9 @@ bool ResolvePoints(const TriangleMesh& mesh, const std::string& option,
                    std::vector<SurfacePoint>* points, std::unique_ptr<SurfaceLocator>* locator,
                    std::string* error);
 
+// The position (file coordinates) of a vertex, edge or face point of `mesh`.
+std::array<double, 3> PositionOf(const MeshData& mesh, const SurfacePoint& p);
+
 // --- Output, shared by local and remote mode (so both print the same bytes) ---
 
 // What `geodex info` prints.

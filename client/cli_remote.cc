@@ -40,6 +40,13 @@ class RemoteGeometryImpl final : public RemoteGeometry {
  public:
   explicit RemoteGeometryImpl(std::unique_ptr<GeodexClient> client) : client_(std::move(client)) {}
   absl::Status Prepare(const std::string& mesh, std::vector<SurfacePoint>* points) override;
+  absl::StatusOr<DistanceField> ComputeField(const std::vector<SurfacePoint>& sources) override {
+    return client_->Field(mesh_, sources, v1::SolverOptions());
+  }
+  absl::StatusOr<PathQueryResult> ComputePath(const SurfacePoint& from,
+                                              const SurfacePoint& to) override {
+    return client_->ShortestPath(mesh_, from, to, v1::SolverOptions());
+  }
   absl::StatusOr<Isolines> ComputeIsolines(const std::vector<SurfacePoint>& sources,
                                            const IsolineOptions& levels) override {
     return client_->ComputeIsolines(mesh_, sources, levels, v1::SolverOptions());

@@ -12,7 +12,9 @@
 #include "absl/status/statusor.h"
 #include "cli_commands.h"
 #include "geodex/delaunay.h"
+#include "geodex/distance_field.h"
 #include "geodex/isolines.h"
+#include "geodex/shortest_path.h"
 #include "geodex/surface_point.h"
 #include "geodex/voronoi.h"
 
@@ -31,6 +33,9 @@ class RemoteGeometry {
   virtual ~RemoteGeometry() = default;
   // Resolves MESH on the server (uploading a file if needed) and snaps p:X:Y:Z points there.
   virtual absl::Status Prepare(const std::string& mesh, std::vector<SurfacePoint>* points) = 0;
+  virtual absl::StatusOr<DistanceField> ComputeField(const std::vector<SurfacePoint>& sources) = 0;
+  virtual absl::StatusOr<PathQueryResult> ComputePath(const SurfacePoint& from,
+                                                      const SurfacePoint& to) = 0;
   virtual absl::StatusOr<Isolines> ComputeIsolines(const std::vector<SurfacePoint>& sources,
                                                    const IsolineOptions& levels) = 0;
   virtual absl::StatusOr<VoronoiDiagram> ComputeVoronoi(const std::vector<SurfacePoint>& sites) = 0;

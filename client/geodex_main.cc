@@ -9,6 +9,7 @@
 #include "cli_commands.h"
 #include "cli_geometry.h"
 #include "cli_remote.h"
+#include "cli_render.h"
 
 namespace {
 
@@ -57,6 +58,13 @@ commands:
       These three print JSON ("approximate": true) unless --output names an .obj (lines) or
       .svg (top view) file; see docs/geometry.md.
 
+  render MESH --sources SPEC [--isolines K] [--voronoi] [--delaunay] [--path A B]
+         --output out.png|.ply|.gltf [--view iso|top|bottom|front|back|left|right] [--size WxH]
+      A picture of the field: the shaded mesh coloured by distance (viridis; grey where
+      unreachable), isolines (dark), Voronoi boundaries (white), Delaunay edges (orange), the path
+      (red) and the sources (black dots), framed automatically (z up; default view iso, 800x600).
+      .ply and .gltf write the coloured mesh for 3D viewers instead.
+
 SPEC: comma-separated points: 17 (vertex), e:V1:V2:T (the point (1-T)*V1 + T*V2 on an edge),
       f:FACE:B0:B1:B2 (barycentric in the face's vertex order as in the file).
 
@@ -100,13 +108,15 @@ int main(int argc, char** argv) {
   const std::string command = argv[first];
   Args args;
   std::string error;
-  if (!ParseArgs(argc, argv, first + 1, {"stats", "strict", "no-filter", "no-one-split"}, &args,
+  if (!ParseArgs(argc, argv, first + 1,
+                 {"stats", "strict", "no-filter", "no-one-split", "voronoi", "delaunay"}, &args,
                  &error)) {
     std::fprintf(stderr, "geodex: %s\n", error.c_str());
     return kExitUsage;
   }
   // The section-6 geometry is formatted by cli_geometry.cc in both modes.
   if (command == "isolines") return RunIsolines(args, server);
+  if (command == "render") return RunRender(args, server);
   if (command == "voronoi") return RunVoronoi(args, server);
   if (command == "delaunay") return RunDelaunay(args, server);
   if (!server.empty()) return RunRemote(server, command, args);

@@ -1,0 +1,191 @@
+// geodex render: a picture of a distance field (and optionally its isolines, Voronoi boundaries,
+// Delaunay edges and a shortest path) as PNG, or the coloured mesh as PLY or glTF. Local or, with
+// --server, computed by a geodexd (the mesh file is read here too: it is what gets drawn).
+
+#include <cstdio>
+#include <memory>
+
+#include "absl/strings/numbers.h"
+#include "absl/strings/str_format.h"
+#include "absl/strings/str_split.h"
+#include "cli_common.h"
+#include "cli_remote.h"
+#include "cli_render.h"
+#include "geodex/delaunay.h"
+#include "geodex/geodesic_solver.h"
+#include "geodex/isolines.h"
+#include "geodex/voronoi.h"
+#include "render.h"
+
+namespace geodex::cli {
+namespace {
+
+using render::Polyline;
+using render::Rgb;
+
+std::vector<render::Point3> Positions(const std::vector<PathPoint>& points) {
+  std::vector<render::Point3> out;
+  for (const PathPoint& p : points) out.push_back(p.position);
+  return out;
+}
+
+bool EndsWith(const std::string& s, const std::string& suffix) {
+  return s.size() > suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+// What the picture shows, computed locally or by a server.
+struct Layers {
+  DistanceField field;
+  Isolines isolines;
+  VoronoiDiagram voronoi;
+  DelaunayTriangulation delaunay;
+  PathQueryResult path;
+};
+
+}  // namespace
+
+int RunRender(const Args& args, const std::string& server) {
+  std::string error;
+  if (!CheckKnown(args, {"sources", "isolines", "voronoi", "delaunay", "path", "output", "view",
+                         "size"},
+                  &error)) {
+    return Fail(kExitUsage, error);
+  }
+  // --path A B: B arrives as a second positional argument; --path A,B works too.
+  std::vector<std::string> positional = args.positional;
+  std::string path_spec = args.options.count("path") ? args.options.at("path") : "";
+  if (!path_spec.empty() && path_spec.find(',') == std::string::npos && positional.size() == 2) {
+    path_spec += "," + positional[1];
+    positional.pop_back();
+  }
+  if (positional.size() != 1 || !args.options.count("sources") || !args.options.count("output")) {
+    return Fail(kExitUsage,
+                "usage: geodex render MESH --sources SPEC [--isolines K] [--voronoi] [--delaunay] "
+                "[--path A B] --output out.png|.ply|.gltf [--view iso|top|front|...] [--size WxH]");
+  }
+  const std::string output = args.options.at("output");
+  if (!EndsWith(output, ".png") && !EndsWith(output, ".ply") && !EndsWith(output, ".gltf")) {
+    return Fail(kExitUsage, absl::StrFormat("--output: '%s' must end in .png, .ply or .gltf", output));
+  }
+  absl::StatusOr<render::View> view =
+      render::ParseView(args.options.count("view") ? args.options.at("view") : "iso");
+  if (!view.ok()) return Fail(kExitUsage, std::string(view.status().message()));
+  int width = 800, height = 600;
+  if (args.options.count("size")) {
+    std::vector<std::string> wh = absl::StrSplit(args.options.at("size"), 'x');
+    if (wh.size() != 2 || !absl::SimpleAtoi(wh[0], &width) || !absl::SimpleAtoi(wh[1], &height) ||
+        width < 16 || height < 16 || width > 8192 || height > 8192) {
+      return Fail(kExitUsage, absl::StrFormat("--size: '%s' is not WxH with 16..8192 pixels each",
+                                              args.options.at("size")));
+    }
+  }
+  int isoline_count = 0;
+  if (args.options.count("isolines") &&
+      (!absl::SimpleAtoi(args.options.at("isolines"), &isoline_count) || isoline_count < 2)) {
+    return Fail(kExitUsage, "--isolines: expected an integer >= 2");
+  }
+  const bool voronoi = args.options.count("voronoi") > 0, delaunay = args.options.count("delaunay") > 0;
+
+  absl::StatusOr<MeshData> data = LoadMeshData(positional[0]);
+  if (!data.ok()) return Fail(kExitInput, std::string(data.status().message()));
+  absl::StatusOr<std::vector<SurfacePoint>> sources = ParseSurfacePoints(args.options.at("sources"));
+  if (!sources.ok()) return Fail(kExitUsage, "--sources: " + std::string(sources.status().message()));
+  std::vector<SurfacePoint> ends;
+  if (!path_spec.empty()) {
+    absl::StatusOr<std::vector<SurfacePoint>> p = ParseSurfacePoints(path_spec);
+    if (!p.ok() || p->size() != 2) {
+      return Fail(kExitUsage, "--path: expected two points (--path A B or --path A,B)");
+    }
+    ends = *std::move(p);
+  }
+
+  Layers layers;
+  IsolineOptions levels;
+  levels.count = isoline_count;
+  if (server.empty()) {
+    absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(*data);
+    if (!mesh.ok()) return Fail(kExitInput, std::string(mesh.status().message()));
+    std::unique_ptr<SurfaceLocator> locator;
+    if (!ResolvePoints(*mesh, "sources", &*sources, &locator, &error) ||
+        (!ends.empty() && !ResolvePoints(*mesh, "path", &ends, &locator, &error))) {
+      return Fail(kExitUsage, error);
+    }
+    absl::StatusOr<DistanceField> field = ComputeDistanceField(*mesh, *sources);
+    if (!field.ok()) return Fail(kExitSolveFailed, std::string(field.status().message()));
+    layers.field = *std::move(field);
+    if (isoline_count) layers.isolines = *ExtractIsolines(*mesh, layers.field, levels);
+    if (voronoi) layers.voronoi = *BuildVoronoi(*mesh, layers.field);
+    if (delaunay) {
+      absl::StatusOr<DelaunayTriangulation> d = BuildDelaunay(*mesh, layers.field);
+      if (!d.ok()) return Fail(kExitSolveFailed, std::string(d.status().message()));
+      layers.delaunay = *std::move(d);
+    }
+    if (!ends.empty()) {
+      absl::StatusOr<PathQueryResult> p = ComputeShortestPath(*mesh, ends[0], ends[1]);
+      if (!p.ok()) return Fail(kExitSolveFailed, std::string(p.status().message()));
+      layers.path = *std::move(p);
+    }
+  } else {
+    std::unique_ptr<RemoteGeometry> remote = ConnectRemoteGeometry(server);
+    if (remote == nullptr) return RunRemote(server, "render", args);
+    if (absl::Status s = remote->Prepare(positional[0], &*sources); !s.ok()) return FailRemote(s);
+    if (absl::Status s = ends.empty() ? absl::OkStatus() : remote->Prepare(positional[0], &ends);
+        !s.ok()) {
+      return FailRemote(s);
+    }
+    absl::StatusOr<DistanceField> field = remote->ComputeField(*sources);
+    if (!field.ok()) return FailRemote(field.status());
+    layers.field = *std::move(field);
+    if (isoline_count) {
+      absl::StatusOr<Isolines> iso = remote->ComputeIsolines(*sources, levels);
+      if (!iso.ok()) return FailRemote(iso.status());
+      layers.isolines = *std::move(iso);
+    }
+    if (voronoi) {
+      absl::StatusOr<VoronoiDiagram> v = remote->ComputeVoronoi(*sources);
+      if (!v.ok()) return FailRemote(v.status());
+      layers.voronoi = *std::move(v);
+    }
+    if (delaunay) {
+      absl::StatusOr<DelaunayTriangulation> d = remote->ComputeDelaunay(*sources);
+      if (!d.ok()) return FailRemote(d.status());
+      layers.delaunay = *std::move(d);
+    }
+    if (!ends.empty()) {
+      absl::StatusOr<PathQueryResult> p = remote->ComputePath(ends[0], ends[1]);
+      if (!p.ok()) return FailRemote(p.status());
+      layers.path = *std::move(p);
+    }
+  }
+
+  render::Scene scene;
+  scene.mesh = &*data;
+  scene.vertex_colors = render::FieldColors(layers.field.distance);
+  for (const IsolinePolyline& line : layers.isolines.polylines) {
+    scene.lines.push_back({Positions(line.points), line.closed, Rgb{25, 25, 25}, 1.5});
+  }
+  for (const VoronoiBoundary& b : layers.voronoi.boundaries) {
+    scene.lines.push_back({Positions(b.points), b.closed, Rgb{255, 255, 255}, 2.5});
+  }
+  for (const DelaunayEdge& e : layers.delaunay.edges) {
+    scene.lines.push_back({Positions(e.points), false, Rgb{255, 140, 0}, 2});
+  }
+  if (!layers.path.path.points.empty()) {
+    scene.lines.push_back({Positions(layers.path.path.points), false, Rgb{220, 20, 60}, 3});
+    for (const SurfacePoint& p : ends) scene.markers.push_back(PositionOf(*data, p));
+  }
+  for (const SurfacePoint& p : *sources) scene.markers.push_back(PositionOf(*data, p));
+
+  absl::Status written;
+  if (EndsWith(output, ".png")) {
+    written = render::WritePng(output, render::Render(scene, *view, width, height));
+  } else if (EndsWith(output, ".ply")) {
+    written = render::WriteColoredPly(output, *data, scene.vertex_colors, layers.field.distance);
+  } else {
+    written = render::WriteGltf(output, *data, scene.vertex_colors);
+  }
+  if (!written.ok()) return Fail(kExitInput, std::string(written.message()));
+  return kExitOk;
+}
+
+}  // namespace geodex::cli

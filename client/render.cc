@@ -1,0 +1,314 @@
+#include "render.h"
+
+#include <png.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <limits>
+
+#include "absl/strings/escaping.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "geodex/mesh_io.h"
+
+namespace geodex::render {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+Point3 Sub(const Point3& a, const Point3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+Point3 Cross(const Point3& a, const Point3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+double Dot(const Point3& a, const Point3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+Point3 Normalize(const Point3& a) {
+  const double n = std::sqrt(Dot(a, a));
+  return n > 0 ? Point3{a[0] / n, a[1] / n, a[2] / n} : Point3{0, 0, 1};
+}
+
+// The camera: screen right, screen up and the direction towards the viewer.
+struct Camera {
+  Point3 right, up, toward;
+};
+
+Camera CameraFor(View view) {
+  switch (view) {
+    case View::kTop:
+      return {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    case View::kBottom:
+      return {{1, 0, 0}, {0, -1, 0}, {0, 0, -1}};
+    case View::kFront:
+      return {{1, 0, 0}, {0, 0, 1}, {0, -1, 0}};
+    case View::kBack:
+      return {{-1, 0, 0}, {0, 0, 1}, {0, 1, 0}};
+    case View::kLeft:
+      return {{0, -1, 0}, {0, 0, 1}, {-1, 0, 0}};
+    case View::kRight:
+      return {{0, 1, 0}, {0, 0, 1}, {1, 0, 0}};
+    case View::kIso:
+      break;
+  }
+  const Point3 toward = Normalize({1, -1, 1.2});
+  const Point3 right = Normalize(Cross({0, 0, 1}, toward));
+  return {right, Cross(toward, right), toward};
+}
+
+// Projection of the scene into pixels: x right, y down, depth towards the viewer (larger = nearer).
+struct Projector {
+  Camera camera;
+  double scale = 1, offset_x = 0, offset_y = 0;
+  std::array<double, 3> operator()(const Point3& p) const {
+    return {Dot(p, camera.right) * scale + offset_x, -Dot(p, camera.up) * scale + offset_y,
+            Dot(p, camera.toward) * scale};
+  }
+};
+
+Point3 VertexOf(const MeshData& m, uint32_t v) {
+  return {m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]};
+}
+
+class Canvas {
+ public:
+  Canvas(int width, int height)
+      : width_(width), height_(height), depth_(size_t(width) * height, -kInf),
+        image_{width, height, std::vector<uint8_t>(size_t(width) * height * 3, 255)} {}
+
+  // A triangle with per-vertex colours, shaded by `light` (0..1).
+  void Triangle(const std::array<double, 3> p[3], const Rgb c[3], double light) {
+    const double min_x = std::max(0.0, std::floor(std::min({p[0][0], p[1][0], p[2][0]})));
+    const double max_x = std::min(width_ - 1.0, std::ceil(std::max({p[0][0], p[1][0], p[2][0]})));
+    const double min_y = std::max(0.0, std::floor(std::min({p[0][1], p[1][1], p[2][1]})));
+    const double max_y = std::min(height_ - 1.0, std::ceil(std::max({p[0][1], p[1][1], p[2][1]})));
+    const double area = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) -
+                        (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]);
+    if (std::abs(area) < 1e-12) return;
+    for (int y = static_cast<int>(min_y); y <= max_y; ++y) {
+      for (int x = static_cast<int>(min_x); x <= max_x; ++x) {
+        const double px = x + 0.5, py = y + 0.5;
+        double w[3];
+        for (int k = 0; k < 3; ++k) {
+          const auto& a = p[(k + 1) % 3];
+          const auto& b = p[(k + 2) % 3];
+          w[k] = ((b[0] - a[0]) * (py - a[1]) - (px - a[0]) * (b[1] - a[1])) / area;
+        }
+        if (w[0] < -1e-9 || w[1] < -1e-9 || w[2] < -1e-9) continue;
+        const double z = w[0] * p[0][2] + w[1] * p[1][2] + w[2] * p[2][2];
+        const size_t i = size_t(y) * width_ + x;
+        if (z <= depth_[i]) continue;
+        depth_[i] = z;
+        for (int ch = 0; ch < 3; ++ch) {
+          const double v = (w[0] * c[0][ch] + w[1] * c[1][ch] + w[2] * c[2][ch]) * light;
+          image_.rgb[3 * i + ch] = static_cast<uint8_t>(std::clamp(v, 0.0, 255.0));
+        }
+      }
+    }
+  }
+
+  // A disc of radius r at (x, y) when its centre is not hidden (depth with a bias).
+  void Dot(double x, double y, double z, double r, Rgb color, double bias) {
+    for (int py = static_cast<int>(y - r - 1); py <= y + r + 1; ++py) {
+      for (int px = static_cast<int>(x - r - 1); px <= x + r + 1; ++px) {
+        if (px < 0 || py < 0 || px >= width_ || py >= height_) continue;
+        const double dx = px + 0.5 - x, dy = py + 0.5 - y;
+        if (dx * dx + dy * dy > r * r) continue;
+        const size_t i = size_t(py) * width_ + px;
+        if (z + bias < depth_[i]) continue;
+        for (int ch = 0; ch < 3; ++ch) image_.rgb[3 * i + ch] = color[ch];
+      }
+    }
+  }
+
+  // A segment of the given width, depth-tested per sample.
+  void Segment(const std::array<double, 3>& a, const std::array<double, 3>& b, double width,
+               Rgb color, double bias) {
+    const double length = std::hypot(b[0] - a[0], b[1] - a[1]);
+    const int steps = std::max(1, static_cast<int>(std::ceil(length * 2)));
+    for (int s = 0; s <= steps; ++s) {
+      const double t = double(s) / steps;
+      Dot(a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2]),
+          width / 2, color, bias);
+    }
+  }
+
+  Image Take() { return std::move(image_); }
+
+ private:
+  int width_, height_;
+  std::vector<double> depth_;
+  Image image_;
+};
+
+}  // namespace
+
+Rgb ColorMap(double t) {
+  // Ten evenly spaced samples of the viridis colour map, interpolated linearly.
+  static constexpr uint8_t kStops[10][3] = {{68, 1, 84},    {72, 40, 120},  {62, 73, 137},
+                                            {49, 104, 142}, {38, 130, 142}, {31, 158, 137},
+                                            {53, 183, 121}, {110, 206, 88}, {181, 222, 43},
+                                            {253, 231, 37}};
+  t = std::clamp(std::isnan(t) ? 0.0 : t, 0.0, 1.0) * 9;
+  const int i = std::min(8, static_cast<int>(t));
+  const double f = t - i;
+  Rgb out;
+  for (int ch = 0; ch < 3; ++ch) {
+    out[ch] = static_cast<uint8_t>(std::lround(kStops[i][ch] + f * (kStops[i + 1][ch] - kStops[i][ch])));
+  }
+  return out;
+}
+
+std::vector<Rgb> FieldColors(const std::vector<double>& distances) {
+  double top = 0;
+  for (double d : distances) {
+    if (std::isfinite(d)) top = std::max(top, d);
+  }
+  std::vector<Rgb> out;
+  out.reserve(distances.size());
+  for (double d : distances) {
+    out.push_back(std::isfinite(d) ? ColorMap(top > 0 ? d / top : 0) : Rgb{170, 170, 170});
+  }
+  return out;
+}
+
+absl::StatusOr<View> ParseView(const std::string& name) {
+  if (name == "iso") return View::kIso;
+  if (name == "top") return View::kTop;
+  if (name == "bottom") return View::kBottom;
+  if (name == "front") return View::kFront;
+  if (name == "back") return View::kBack;
+  if (name == "left") return View::kLeft;
+  if (name == "right") return View::kRight;
+  return absl::InvalidArgumentError(absl::StrFormat(
+      "--view: '%s' is not one of iso, top, bottom, front, back, left, right", name));
+}
+
+Image Render(const Scene& scene, View view, int width, int height) {
+  const MeshData& m = *scene.mesh;
+  Projector project;
+  project.camera = CameraFor(view);
+  // Frame: the projected bounding box of the vertices used by faces, with a 5% margin.
+  double lo[2] = {kInf, kInf}, hi[2] = {-kInf, -kInf};
+  for (uint32_t v : m.faces) {
+    const Point3 p = VertexOf(m, v);
+    const double sx = Dot(p, project.camera.right), sy = -Dot(p, project.camera.up);
+    lo[0] = std::min(lo[0], sx), hi[0] = std::max(hi[0], sx);
+    lo[1] = std::min(lo[1], sy), hi[1] = std::max(hi[1], sy);
+  }
+  if (!(lo[0] <= hi[0])) lo[0] = lo[1] = 0, hi[0] = hi[1] = 1;
+  const double extent_x = std::max(hi[0] - lo[0], 1e-300), extent_y = std::max(hi[1] - lo[1], 1e-300);
+  project.scale = 0.9 * std::min(width / extent_x, height / extent_y);
+  project.offset_x = width / 2.0 - (lo[0] + hi[0]) / 2 * project.scale;
+  project.offset_y = height / 2.0 - (lo[1] + hi[1]) / 2 * project.scale;
+
+  Canvas canvas(width, height);
+  const Point3 light_dir = Normalize(
+      {project.camera.toward[0] + 0.3 * project.camera.up[0],
+       project.camera.toward[1] + 0.3 * project.camera.up[1],
+       project.camera.toward[2] + 0.3 * project.camera.up[2]});
+  for (size_t f = 0; f < m.face_count(); ++f) {
+    const uint32_t v[3] = {m.faces[3 * f], m.faces[3 * f + 1], m.faces[3 * f + 2]};
+    const Point3 a = VertexOf(m, v[0]), b = VertexOf(m, v[1]), c = VertexOf(m, v[2]);
+    const Point3 normal = Normalize(Cross(Sub(b, a), Sub(c, a)));
+    const double light = 0.35 + 0.65 * std::abs(Dot(normal, light_dir));  // two-sided
+    const std::array<double, 3> p[3] = {project(a), project(b), project(c)};
+    const Rgb colors[3] = {scene.vertex_colors[v[0]], scene.vertex_colors[v[1]],
+                           scene.vertex_colors[v[2]]};
+    canvas.Triangle(p, colors, light);
+  }
+  // Lines and markers lie on the surface: a depth bias of ~2 pixels keeps them visible on it.
+  const double bias = 2.0;
+  for (const Polyline& line : scene.lines) {
+    for (size_t i = 0; i + 1 < line.points.size() + (line.closed ? 1 : 0); ++i) {
+      const Point3& a = line.points[i];
+      const Point3& b = line.points[(i + 1) % line.points.size()];
+      canvas.Segment(project(a), project(b), line.width, line.color, bias);
+    }
+  }
+  for (const Point3& marker : scene.markers) {
+    const auto p = project(marker);
+    canvas.Dot(p[0], p[1], p[2], 6, {255, 255, 255}, bias * 3);
+    canvas.Dot(p[0], p[1], p[2], 4, {0, 0, 0}, bias * 3);
+  }
+  return canvas.Take();
+}
+
+absl::Status WritePng(const std::string& path, const Image& image) {
+  std::FILE* file = std::fopen(path.c_str(), "wb");
+  if (file == nullptr) return absl::InvalidArgumentError(absl::StrCat("cannot write ", path));
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  png_infop info = png != nullptr ? png_create_info_struct(png) : nullptr;
+  if (png == nullptr || info == nullptr || setjmp(png_jmpbuf(png))) {
+    png_destroy_write_struct(&png, &info);
+    std::fclose(file);
+    return absl::InternalError(absl::StrCat("libpng failed writing ", path));
+  }
+  png_init_io(png, file);
+  png_set_IHDR(png, info, image.width, image.height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_set_filter(png, 0, PNG_FILTER_NONE);
+  png_write_info(png, info);
+  for (int y = 0; y < image.height; ++y) {
+    png_write_row(png, const_cast<png_bytep>(image.rgb.data() + size_t(y) * image.width * 3));
+  }
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+  if (std::fclose(file) != 0) return absl::InternalError(absl::StrCat("cannot write ", path));
+  return absl::OkStatus();
+}
+
+absl::Status WriteColoredPly(const std::string& path, const MeshData& mesh,
+                             const std::vector<Rgb>& colors, const std::vector<double>& distances) {
+  VertexAttributes attributes;
+  attributes.scalar = distances;
+  for (const Rgb& c : colors) attributes.colors.insert(attributes.colors.end(), c.begin(), c.end());
+  return WriteMeshPly(path, mesh, attributes);
+}
+
+absl::Status WriteGltf(const std::string& path, const MeshData& mesh, const std::vector<Rgb>& colors) {
+  // Buffer: float32 positions, normalized uint8 RGBA colours, uint32 indices (4-byte aligned).
+  std::string buffer;
+  auto put = [&](const void* p, size_t n) { buffer.append(static_cast<const char*>(p), n); };
+  float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+    for (int k = 0; k < 3; ++k) {
+      const float x = static_cast<float>(mesh.positions[3 * v + k]);
+      lo[k] = std::min(lo[k], x), hi[k] = std::max(hi[k], x);
+      put(&x, 4);
+    }
+  }
+  const size_t colors_offset = buffer.size();
+  for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+    const uint8_t rgba[4] = {colors[v][0], colors[v][1], colors[v][2], 255};
+    put(rgba, 4);
+  }
+  const size_t indices_offset = buffer.size();
+  put(mesh.faces.data(), mesh.faces.size() * 4);
+  if (mesh.vertex_count() == 0) {
+    for (int k = 0; k < 3; ++k) lo[k] = hi[k] = 0;
+  }
+  const std::string json = absl::StrFormat(
+      R"({"asset": {"version": "2.0", "generator": "geodex render"},
+"scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+"meshes": [{"primitives": [{"attributes": {"POSITION": 0, "COLOR_0": 1}, "indices": 2}]}],
+"buffers": [{"byteLength": %d, "uri": "data:application/octet-stream;base64,%s"}],
+"bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": %d, "target": 34962},
+                {"buffer": 0, "byteOffset": %d, "byteLength": %d, "target": 34962},
+                {"buffer": 0, "byteOffset": %d, "byteLength": %d, "target": 34963}],
+"accessors": [{"bufferView": 0, "componentType": 5126, "count": %d, "type": "VEC3", "min": [%.9g, %.9g, %.9g], "max": [%.9g, %.9g, %.9g]},
+              {"bufferView": 1, "componentType": 5121, "normalized": true, "count": %d, "type": "VEC4"},
+              {"bufferView": 2, "componentType": 5125, "count": %d, "type": "SCALAR"}]}
+)",
+      buffer.size(), absl::Base64Escape(buffer), colors_offset, colors_offset,
+      indices_offset - colors_offset, indices_offset, buffer.size() - indices_offset,
+      mesh.vertex_count(), lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], mesh.vertex_count(),
+      mesh.faces.size());
+  std::ofstream out(path, std::ios::binary);
+  out << json;
+  out.close();
+  if (!out) return absl::InvalidArgumentError(absl::StrCat("cannot write ", path));
+  return absl::OkStatus();
+}
+
+}  // namespace geodex::render

@@ -1,0 +1,67 @@
+#pragma once
+
+// A small software renderer for `geodex render`: the mesh shaded and coloured by distance (a
+// perceptual colour map), with isolines, Voronoi boundaries, Delaunay edges, paths and sources drawn
+// over it, seen from a named direction and framed automatically; written as PNG (libpng). Also
+// coloured PLY and glTF 2.0 exports of the same colours for 3D viewers.
+//
+// Orthographic projection, a z-buffer, Lambert shading (two-sided) plus an ambient term; lines are
+// depth-tested against the surface with a small bias so they show on it but not through it.
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "geodex/mesh_data.h"
+
+namespace geodex::render {
+
+using Point3 = std::array<double, 3>;
+using Rgb = std::array<uint8_t, 3>;
+
+// Viridis-like perceptual map of t in [0, 1] (dark blue-violet -> green -> yellow).
+Rgb ColorMap(double t);
+// Per-vertex colours of a field: distance / (largest finite distance) through the colour map;
+// unreachable (+inf) vertices grey.
+std::vector<Rgb> FieldColors(const std::vector<double>& distances);
+
+struct Polyline {
+  std::vector<Point3> points;
+  bool closed = false;
+  Rgb color{0, 0, 0};
+  double width = 1.5;  // pixels
+};
+
+struct Scene {
+  const MeshData* mesh = nullptr;
+  std::vector<Rgb> vertex_colors;  // one per mesh vertex
+  std::vector<Polyline> lines;
+  std::vector<Point3> markers;     // sources: black dots with a white ring
+};
+
+enum class View { kIso, kTop, kBottom, kFront, kBack, kLeft, kRight };
+// "iso", "top", "bottom", "front", "back", "left", "right" (z is up: top looks down -z, front
+// looks along +y).
+absl::StatusOr<View> ParseView(const std::string& name);
+
+struct Image {
+  int width = 0, height = 0;
+  std::vector<uint8_t> rgb;  // row-major, 3 bytes per pixel
+};
+
+// Renders the scene into a width x height image (white background).
+Image Render(const Scene& scene, View view, int width, int height);
+
+// PNG, 8-bit RGB, rows written unfiltered (simple to read back in tests).
+absl::Status WritePng(const std::string& path, const Image& image);
+// Binary PLY with per-vertex colours (and the distance as a scalar).
+absl::Status WriteColoredPly(const std::string& path, const MeshData& mesh,
+                             const std::vector<Rgb>& colors, const std::vector<double>& distances);
+// glTF 2.0 (one .gltf JSON file with the buffer embedded as a base64 data URI): positions,
+// COLOR_0 and indices.
+absl::Status WriteGltf(const std::string& path, const MeshData& mesh, const std::vector<Rgb>& colors);
+
+}  // namespace geodex::render

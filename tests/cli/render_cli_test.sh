@@ -1,0 +1,96 @@
+#!/usr/bin/env bash
+# geodex render: the PNG has the requested size, is not blank, and shows the distance gradient
+# (the quadrant holding the source is darker: low distances are dark in the colour map, and moving
+# the source moves the dark corner); PLY and glTF exports are valid; local and remote renders are
+# the same bytes; bad arguments give one-line errors and exit 2.
+# Env: GEODEX, GEODEXD (the binaries), DATA (tests/data), PROBE (png_probe.py).
+set -u
+pass=0
+fail=0
+check() {
+  local name="$1"
+  shift
+  if "$@"; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAIL: $name"; fi
+}
+tmp=$(mktemp -d)
+pid=""
+cleanup() {
+  if [ -n "$pid" ]; then
+    kill -TERM "$pid" 2>/dev/null
+    for _ in $(seq 1 100); do kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done
+    kill -KILL "$pid" 2>/dev/null
+  fi
+  rm -rf "$tmp"
+}
+trap cleanup EXIT
+probe() { /usr/bin/python3 "$PROBE" "$1"; }
+value() { /usr/bin/python3 -c "import json,sys; d=json.load(open('$1')); print($2)"; }
+
+# Source in the bottom-left corner of the top view, then in the top-right corner.
+"$GEODEX" render sample:terrain --sources 0 --view top --size 320x200 --output "$tmp/a.png"
+check "render exits 0" test $? -eq 0
+probe "$tmp/a.png" >"$tmp/a.json"
+check "size 320x200" test "$(value "$tmp/a.json" "d['width'], d['height']")" = "320 200"
+check "not blank (many colours)" test "$(value "$tmp/a.json" "d['colours'] > 1000")" = True
+check "the mesh covers part of the picture" test "$(value "$tmp/a.json" "0.2 < d['painted'] < 0.95")" = True
+check "source corner darker than the far corner" \
+  test "$(value "$tmp/a.json" "d['brightness']['bl'] < d['brightness']['tr'] - 50")" = True
+"$GEODEX" render sample:terrain --sources 4224 --view top --size 320x200 --output "$tmp/b.png"
+probe "$tmp/b.png" >"$tmp/b.json"
+check "moving the source moves the dark corner" \
+  test "$(value "$tmp/b.json" "d['brightness']['tr'] < d['brightness']['bl'] - 50")" = True
+
+# Every layer and view.
+"$GEODEX" render "$DATA/kitten.off" --sources 0,1250 --isolines 12 --voronoi --delaunay \
+  --path 5 2000 --view front --output "$tmp/all.png"
+check "all layers: exit 0" test $? -eq 0
+probe "$tmp/all.png" >"$tmp/all.json"
+check "all layers: default size 800x600" test "$(value "$tmp/all.json" "d['width'], d['height']")" = "800 600"
+for view in iso top bottom front back left right; do
+  "$GEODEX" render "$DATA/knight.off" --sources 0 --view "$view" --size 64x48 --output "$tmp/v.png"
+  check "view $view" test $? -eq 0
+done
+
+# 3D exports.
+"$GEODEX" render "$DATA/knight.off" --sources 0 --output "$tmp/k.gltf"
+check "gltf: exit 0" test $? -eq 0
+check "gltf: valid, 502 vertices" /usr/bin/python3 -c "
+import json, base64
+d = json.load(open('$tmp/k.gltf'))
+assert d['asset']['version'] == '2.0'
+assert d['accessors'][0]['count'] == 502 and d['accessors'][2]['count'] == 3000
+buf = d['buffers'][0]
+assert len(base64.b64decode(buf['uri'].split(',', 1)[1])) == buf['byteLength']"
+"$GEODEX" render "$DATA/knight.off" --sources 0 --output "$tmp/k.ply"
+check "ply: colours and distances" bash -c "head -c 400 '$tmp/k.ply' | grep -a -q 'property uchar red' && head -c 400 '$tmp/k.ply' | grep -a -q 'property double distance'"
+
+# Remote mode renders the same picture.
+"$GEODEXD" --listen 127.0.0.1:0 --metrics_listen "" --pool-threads 2 --shutdown_grace_seconds 5 \
+  >"$tmp/server.log" 2>&1 &
+pid=$!
+port=""
+for _ in $(seq 1 300); do
+  port=$(sed -n 's/.*listening on port \([0-9]*\).*/\1/p' "$tmp/server.log" | head -1)
+  [ -n "$port" ] && break
+  sleep 0.1
+done
+check "server started" test -n "$port"
+"$GEODEX" --server "127.0.0.1:$port" render "$DATA/kitten.off" --sources 0,1250 --isolines 12 \
+  --voronoi --delaunay --path 5 2000 --view front --output "$tmp/remote.png"
+check "remote render: exit 0" test $? -eq 0
+check "remote render: same bytes as local" cmp -s "$tmp/all.png" "$tmp/remote.png"
+
+# Bad arguments.
+for bad in "--size 5x5" "--view sideways" "--isolines 1"; do
+  # shellcheck disable=SC2086
+  "$GEODEX" render "$DATA/knight.off" --sources 0 --output "$tmp/x.png" $bad 2>"$tmp/err.txt"
+  check "bad $bad: exit 2" test $? -eq 2
+  check "bad $bad: one line" test "$(wc -l <"$tmp/err.txt")" -eq 1
+done
+"$GEODEX" render "$DATA/knight.off" --sources 0 --output "$tmp/x.jpg" 2>"$tmp/err.txt"
+check "bad extension: exit 2" test $? -eq 2
+"$GEODEX" render "$DATA/knight.off" --sources 99999 --output "$tmp/x.png" 2>"$tmp/err.txt"
+check "bad source: exit 2" test $? -eq 2
+
+echo "render cli: $pass passed, $fail failed"
+test "$fail" -eq 0
