@@ -1,6 +1,11 @@
 #include "cli_common.h"
 
+#include <unistd.h>
+
+#include <condition_variable>
 #include <cstdio>
+#include <mutex>
+#include <thread>
 #include <fstream>
 
 #include "absl/strings/numbers.h"
@@ -10,12 +15,16 @@
 #include "geodex/samples.h"
 
 namespace geodex::cli {
+namespace {
+Progress* g_active_progress = nullptr;  // the one main shows, for Fail()
+}  // namespace
 
 double MsSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
 }
 
 int Fail(int code, const std::string& message) {
+  if (g_active_progress != nullptr) g_active_progress->Stop();
   std::fprintf(stderr, "geodex: %s\n", message.c_str());
   return code;
 }
@@ -93,6 +102,46 @@ bool ResolvePoints(const TriangleMesh& mesh, const std::string& option,
   return true;
 }
 
+
+struct Progress::State {
+  std::mutex mu;
+  std::condition_variable done_cv;
+  bool done = false;
+  bool shown = false;
+  std::thread thread;
+};
+
+Progress::Progress(std::string what) {
+  if (!::isatty(2)) return;
+  state_ = std::make_unique<State>();
+  State* s = state_.get();
+  g_active_progress = this;
+  s->thread = std::thread([s, what = std::move(what)] {
+    const auto start = std::chrono::steady_clock::now();
+    std::unique_lock<std::mutex> lock(s->mu);
+    if (s->done_cv.wait_for(lock, std::chrono::seconds(1), [s] { return s->done; })) return;
+    while (!s->done) {
+      std::fprintf(stderr, "\rgeodex: %s... %.1f s ", what.c_str(), MsSince(start) / 1e3);
+      std::fflush(stderr);
+      s->shown = true;
+      s->done_cv.wait_for(lock, std::chrono::milliseconds(200), [s] { return s->done; });
+    }
+  });
+}
+
+Progress::~Progress() { Stop(); }
+
+void Progress::Stop() {
+  if (g_active_progress == this) g_active_progress = nullptr;
+  if (state_ == nullptr || !state_->thread.joinable()) return;
+  {
+    std::lock_guard<std::mutex> lock(state_->mu);
+    state_->done = true;
+  }
+  state_->done_cv.notify_all();
+  state_->thread.join();
+  if (state_->shown) std::fputs("\r\033[K", stderr);  // clear the line
+}
 
 std::array<double, 3> PositionOf(const MeshData& m, const SurfacePoint& p) {
   using Point3 = std::array<double, 3>;

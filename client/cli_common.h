@@ -49,6 +49,22 @@ bool ResolvePoints(const TriangleMesh& mesh, const std::string& option,
                    std::vector<SurfacePoint>* points, std::unique_ptr<SurfaceLocator>* locator,
                    std::string* error);
 
+// While alive, shows "geodex: WHAT... 3.4 s" on stderr, refreshed, once the work has taken more than
+// a second, and only when stderr is a terminal (scripts and pipes see nothing). Cleared at the end.
+class Progress {
+ public:
+  explicit Progress(std::string what);
+  ~Progress();
+  // Stops and clears the line (Fail() calls this so that an error starts on a clean line).
+  void Stop();
+  Progress(const Progress&) = delete;
+  Progress& operator=(const Progress&) = delete;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
 // The position (file coordinates) of a vertex, edge or face point of `mesh`.
 std::array<double, 3> PositionOf(const MeshData& mesh, const SurfacePoint& p);
 

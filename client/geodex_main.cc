@@ -7,6 +7,7 @@
 #include <string>
 
 #include "cli_commands.h"
+#include "cli_common.h"
 #include "cli_geometry.h"
 #include "cli_remote.h"
 #include "cli_render.h"
@@ -114,6 +115,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "geodex: %s\n", error.c_str());
     return kExitUsage;
   }
+  // A terminal sees elapsed time for anything that takes more than a second.
+  Progress progress(server.empty() ? command : command + " on " + server);
   // The section-6 geometry is formatted by cli_geometry.cc in both modes.
   if (command == "isolines") return RunIsolines(args, server);
   if (command == "render") return RunRender(args, server);

@@ -18,6 +18,8 @@ packages=(
   zlib1g-dev libpng-dev
   # tests and benchmarks (CGAL is a test-only reference)
   libgtest-dev libgmock-dev libbenchmark-dev libcgal-dev libgmp-dev libmpfr-dev
+  # the Python client example and its test (Debian's gRPC for Python)
+  python3-grpcio python3-protobuf
 )
 
 # Skip apt entirely when everything is already there (fast re-runs).
