@@ -225,10 +225,12 @@ int RemoteDistances(GeodexClient& client, const Args& args) {
   if (int code = WriteOutput(args, text); code != kExitOk) return code;
   if (args.options.count("stats")) {
     std::fprintf(stderr,
-                 "{\"server\": true, \"mesh\": \"%s\", \"uploaded\": %s, \"cached\": %s, "
+                 "{\"server\": true, \"replica\": \"%s\", \"mesh\": \"%s\", \"uploaded\": %s, "
+                 "\"reuploads\": %d, \"cached\": %s, "
                  "\"windows_created\": %llu, \"windows_processed\": %llu, \"max_level\": %u, "
                  "\"peak_live_windows\": %llu, \"peak_bytes\": %llu, \"solve_ms\": %.3f}\n",
-                 mesh->name.c_str(), mesh->uploaded ? "true" : "false", cached ? "true" : "false",
+                 client.last_replica().c_str(), mesh->name.c_str(),
+                 mesh->uploaded ? "true" : "false", client.reuploads(), cached ? "true" : "false",
                  (unsigned long long)stats.windows_created,
                  (unsigned long long)stats.windows_processed, stats.max_level,
                  (unsigned long long)stats.peak_live_windows, (unsigned long long)stats.peak_bytes,
@@ -271,8 +273,9 @@ int RemotePath(GeodexClient& client, const Args& args) {
   std::fwrite(text.data(), 1, text.size(), stdout);
   if (args.options.count("stats")) {
     std::fprintf(stderr,
-                 "{\"server\": true, \"windows_created\": %llu, \"windows_processed\": %llu, "
-                 "\"path_points\": %zu, \"solve_ms\": %.3f}\n",
+                 "{\"server\": true, \"replica\": \"%s\", \"windows_created\": %llu, "
+                 "\"windows_processed\": %llu, \"path_points\": %zu, \"solve_ms\": %.3f}\n",
+                 client.last_replica().c_str(),
                  (unsigned long long)result->stats.windows_created,
                  (unsigned long long)result->stats.windows_processed, result->path.points.size(),
                  result->stats.solve_ms);

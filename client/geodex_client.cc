@@ -73,6 +73,11 @@ grpc::Status GeodexClient::Call(const std::string& mesh_id,
     if (!mesh_id.empty()) context.AddMetadata("x-mesh-id", mesh_id);
     ++calls_;
     status = call(&context);
+    last_replica_.clear();
+    const auto& metadata = context.GetServerInitialMetadata();
+    if (auto it = metadata.find("x-geodex-replica"); it != metadata.end()) {
+      last_replica_.assign(it->second.data(), it->second.size());
+    }
     if (status.error_code() != grpc::StatusCode::UNAVAILABLE) break;
   }
   return status;

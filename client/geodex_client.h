@@ -101,6 +101,8 @@ class GeodexClient {
   int calls() const { return calls_; }
   int retries() const { return retries_; }
   int reuploads() const { return reuploads_; }
+  // The replica that answered the last call (its x-geodex-replica metadata; "" if none).
+  const std::string& last_replica() const { return last_replica_; }
 
  private:
   // Runs `call(context)` with a fresh context (deadline, x-mesh-id) per attempt, retrying on
@@ -115,6 +117,7 @@ class GeodexClient {
   std::shared_ptr<grpc::Channel> channel_;
   std::unique_ptr<v1::Geodex::Stub> stub_;
   int calls_ = 0, retries_ = 0, reuploads_ = 0;
+  std::string last_replica_;
 };
 
 // OFF text of a mesh with exactly round-tripping coordinates (%.17g): how samples are uploaded.

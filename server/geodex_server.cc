@@ -54,7 +54,7 @@ absl::StatusOr<std::unique_ptr<GeodexServer>> GeodexServer::Start(const ServerOp
   absl::StatusOr<std::unique_ptr<ServerMetrics>> metrics = ServerMetrics::Start(
       options.metrics_listen,
       MetricSources{s->pool_.get(), s->store_.get(), s->cache_.get(), &s->service_->counters()},
-      options.log_requests);
+      options.log_requests, options.replica_name);
   if (!metrics.ok()) return metrics.status();
   s->metrics_ = *std::move(metrics);
 

@@ -42,6 +42,7 @@ struct ServerOptions {
   uint64_t result_cache_bytes = uint64_t{256} << 20;  // finished fields kept for reuse; 0 = off
   std::string metrics_listen;  // HOST:PORT of the Prometheus /metrics endpoint; "" = none
   bool log_requests = false;   // one spdlog line per call (geodexd: on)
+  std::string replica_name;    // sent as x-geodex-replica on every geodex.v1 call; "" = none
   ServiceLimits limits;
 };
 

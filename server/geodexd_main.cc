@@ -32,6 +32,8 @@ ABSL_FLAG(uint64_t, result_cache_bytes, uint64_t{256} << 20,
           "and options (0 = off)");
 ABSL_FLAG(std::string, metrics_listen, "127.0.0.1:9464",
           "HOST:PORT of the Prometheus /metrics HTTP endpoint (empty = off)");
+ABSL_FLAG(std::string, replica_name, "",
+          "Name sent to clients as x-geodex-replica metadata (default: the host name)");
 ABSL_FLAG(bool, log_requests, true, "Log one line per call (method, mesh, sources, time, status)");
 ABSL_FLAG(uint32_t, pool_threads, 0, "Compute worker threads (0 = one per hardware thread)");
 ABSL_FLAG(uint32_t, queue_capacity, 64,
@@ -105,6 +107,11 @@ int main(int argc, char** argv) {
   options.result_cache_bytes = absl::GetFlag(FLAGS_result_cache_bytes);
   options.metrics_listen = absl::GetFlag(FLAGS_metrics_listen);
   options.log_requests = absl::GetFlag(FLAGS_log_requests);
+  options.replica_name = absl::GetFlag(FLAGS_replica_name);
+  if (options.replica_name.empty()) {
+    char host[256] = {};
+    if (gethostname(host, sizeof host - 1) == 0) options.replica_name = host;
+  }
   options.pool_threads = absl::GetFlag(FLAGS_pool_threads);
   options.queue_capacity = absl::GetFlag(FLAGS_queue_capacity);
   options.max_receive_message_bytes = absl::GetFlag(FLAGS_max_receive_message_bytes);
@@ -138,12 +145,13 @@ int main(int argc, char** argv) {
   for (const auto& line : report.import_errors) spdlog::warn("import failed: {}", line);
   // The effective configuration, one line.
   spdlog::info(
-      "config listen={} data_dir={} samples={} mesh_budget_bytes={} result_cache_bytes={} "
+      "config replica={} listen={} data_dir={} samples={} mesh_budget_bytes={} result_cache_bytes={} "
       "pool_threads={} "
       "queue_capacity={} max_upload_bytes={} max_vertices={} max_faces={} max_sources={} "
       "max_targets={} max_levels={} max_output_values={} max_windows={} "
       "max_unary_response_bytes={} stream_chunk_bytes={} shutdown_grace_seconds={}",
-      options.listen, options.data_dir.empty() ? "(none)" : options.data_dir, options.samples,
+      options.replica_name, options.listen, options.data_dir.empty() ? "(none)" : options.data_dir,
+      options.samples,
       options.mesh_budget_bytes, options.result_cache_bytes, (*server)->pool().threads(), options.queue_capacity,
       options.limits.max_upload_bytes, options.limits.max_vertices, options.limits.max_faces,
       options.limits.max_sources, options.limits.max_targets, options.limits.max_levels,

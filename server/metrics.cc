@@ -127,6 +127,12 @@ class RequestInterceptor final : public grpc::experimental::Interceptor {
         }
       }
     }
+    if (ours_ && !metrics_->replica().empty() &&
+        methods->QueryInterceptionHookPoint(Hook::PRE_SEND_INITIAL_METADATA)) {
+      if (auto* metadata = methods->GetSendInitialMetadata()) {
+        metadata->insert({"x-geodex-replica", metrics_->replica()});
+      }
+    }
     if (ours_ && !described_ && methods->QueryInterceptionHookPoint(Hook::POST_RECV_MESSAGE)) {
       if (const void* message = methods->GetRecvMessage()) {
         Describe(*static_cast<const google::protobuf::Message*>(message));
@@ -200,9 +206,11 @@ class RequestInterceptorFactory final
 
 absl::StatusOr<std::unique_ptr<ServerMetrics>> ServerMetrics::Start(const std::string& listen,
                                                                      const MetricSources& sources,
-                                                                     bool log_requests) {
+                                                                     bool log_requests,
+                                                                     const std::string& replica) {
   std::unique_ptr<ServerMetrics> m(new ServerMetrics());
   m->log_requests_ = log_requests;
+  m->replica_ = replica;
   m->registry_ = std::make_shared<prometheus::Registry>();
   m->gauges_ = std::make_shared<GaugeCollector>(sources);
   m->requests_ = &prometheus::BuildCounter()

@@ -2,7 +2,8 @@
 
 // Prometheus metrics of geodexd (prometheus-cpp, served over HTTP on their own port) and the
 // per-request observer: a gRPC server interceptor that, for every call of every service, counts it
-// by method and status, records its latency and writes one structured log line.
+// by method and status, records its latency and writes one structured log line (and tags geodex.v1
+// responses with the replica's name).
 //
 // Metrics (all prefixed geodex_):
 //   requests_total{method,code}            calls finished, by gRPC method and status code
@@ -47,9 +48,12 @@ struct MetricSources {
 class ServerMetrics {
  public:
   // Without `listen` ("" = no HTTP endpoint) the metrics are still counted (and logged).
+  // `replica` (may be empty) is sent to clients as `x-geodex-replica` initial metadata on every
+  // geodex.v1 call, so that routing through a gateway is observable.
   static absl::StatusOr<std::unique_ptr<ServerMetrics>> Start(const std::string& listen,
                                                               const MetricSources& sources,
-                                                              bool log_requests);
+                                                              bool log_requests,
+                                                              const std::string& replica = "");
   ~ServerMetrics();
 
   // The HTTP port serving /metrics (0 when not listening).
@@ -60,6 +64,7 @@ class ServerMetrics {
   // Called once per finished call by the interceptor.
   void RecordRequest(const std::string& method, int code, double seconds);
   bool log_requests() const { return log_requests_; }
+  const std::string& replica() const { return replica_; }
 
   // The interceptor factory to install on the grpc::ServerBuilder.
   std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface> InterceptorFactory();
@@ -73,6 +78,7 @@ class ServerMetrics {
   prometheus::Family<prometheus::Histogram>* durations_ = nullptr;
   int port_ = 0;
   bool log_requests_ = true;
+  std::string replica_;
 };
 
 }  // namespace geodex::server
