@@ -16,6 +16,7 @@
 #include <set>
 
 #include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
 #include "geodex/delaunay.h"
@@ -246,13 +247,15 @@ std::string Svg(const std::string& title, const MeshData& mesh, const std::vecto
     const bool boundary = i + 1 == edges.size() || edges[i + 1] != edges[i];
     if (!all && !boundary) continue;
     const auto [a, b] = edges[i];
-    d += "M" + xy(mesh.positions[3 * a], mesh.positions[3 * a + 1]) + "L" +
-         xy(mesh.positions[3 * b], mesh.positions[3 * b + 1]);
+    // StrAppend rather than chains of operator+ (GCC 12 -O3 warns falsely on those, -Wrestrict).
+    absl::StrAppend(&d, "M", xy(mesh.positions[3 * a], mesh.positions[3 * a + 1]), "L",
+                    xy(mesh.positions[3 * b], mesh.positions[3 * b + 1]));
   }
-  s += "<path fill=\"none\" stroke=\"#d0d0d0\" stroke-width=\"0.5\" d=\"" + d + "\"/>\n";
+  absl::StrAppend(&s, "<path fill=\"none\" stroke=\"#d0d0d0\" stroke-width=\"0.5\" d=\"", d,
+                  "\"/>\n");
   for (const Line& l : lines) {
     std::string pts;
-    for (const Point3& p : l.points) pts += (pts.empty() ? "" : " ") + xy(p[0], p[1]);
+    for (const Point3& p : l.points) absl::StrAppend(&pts, pts.empty() ? "" : " ", xy(p[0], p[1]));
     s += absl::StrFormat(
         "<%s fill=\"none\" stroke=\"%s\" stroke-width=\"%.1f\"%s points=\"%s\"><title>%s</title>"
         "</%s>\n",

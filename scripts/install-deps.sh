@@ -20,6 +20,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev libcgal-dev libgmp-dev libmpfr-dev
   # the Python client example and its test (Debian's gRPC for Python)
   python3-grpcio python3-protobuf
+  # the Kubernetes manifest checks (tests/deploy)
+  python3-yaml
   # the mesh-affine gateway (deploy/gateway) and its end-to-end test
   nginx-light
 )
