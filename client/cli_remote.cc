@@ -5,7 +5,10 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <fstream>
 
+#include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "cli_common.h"
@@ -73,10 +76,25 @@ void UploadProgress(uint64_t done, uint64_t total) {
   if (done == total) std::fputs("\n", stderr);
 }
 
+RemoteOptions g_remote;
+
+std::string ReadText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
 std::unique_ptr<GeodexClient> Connect(const std::string& target) {
   client::ClientOptions options;
   options.target = target;
   options.upload_progress = UploadProgress;
+  options.tls = g_remote.tls || !g_remote.ca_file.empty();
+  if (!g_remote.ca_file.empty()) options.ca_pem = ReadText(g_remote.ca_file);
+  if (!g_remote.token_file.empty()) {
+    options.token = std::string(absl::StripAsciiWhitespace(ReadText(g_remote.token_file)));
+    options.token = options.token.substr(0, options.token.find('\n'));
+  } else if (const char* env = std::getenv("GEODEX_TOKEN")) {
+    options.token = env;
+  }
   return std::make_unique<GeodexClient>(options);
 }
 
@@ -385,6 +403,8 @@ int RemoteHealth(GeodexClient& client, const Args& args) {
 }  // namespace
 
 bool RemoteAvailable() { return true; }
+
+void SetRemoteOptions(const RemoteOptions& options) { g_remote = options; }
 
 std::unique_ptr<RemoteGeometry> ConnectRemoteGeometry(const std::string& target) {
   return std::make_unique<RemoteGeometryImpl>(Connect(target));

@@ -20,6 +20,16 @@
 
 namespace geodex::cli {
 
+// Connection settings of remote mode: global options before the command.
+struct RemoteOptions {
+  std::string target;      // --server HOST:PORT, or GEODEX_SERVER
+  bool tls = false;        // --tls
+  std::string ca_file;     // --ca FILE (PEM roots; implies --tls)
+  std::string token_file;  // --token-file FILE, or the token itself in GEODEX_TOKEN
+};
+// Set once by main before any command runs.
+void SetRemoteOptions(const RemoteOptions& options);
+
 // True when this binary was built with the gRPC API (remote mode available).
 bool RemoteAvailable();
 

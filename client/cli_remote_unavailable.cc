@@ -7,6 +7,8 @@ namespace geodex::cli {
 
 bool RemoteAvailable() { return false; }
 
+void SetRemoteOptions(const RemoteOptions&) {}
+
 int RunRemote(const std::string&, const std::string&, const Args&) {
   return Fail(kExitUsage, "this geodex was built without gRPC: --server is not available");
 }

@@ -52,7 +52,13 @@ std::string MeshToOffText(const MeshData& mesh) {
 GeodexClient::GeodexClient(ClientOptions options) : options_(std::move(options)) {
   grpc::ChannelArguments args;
   args.SetMaxReceiveMessageSize(4 << 20);  // gRPC's default, kept on purpose: the API streams
-  channel_ = grpc::CreateCustomChannel(options_.target, grpc::InsecureChannelCredentials(), args);
+  std::shared_ptr<grpc::ChannelCredentials> credentials = grpc::InsecureChannelCredentials();
+  if (options_.tls) {
+    grpc::SslCredentialsOptions ssl;
+    ssl.pem_root_certs = options_.ca_pem;
+    credentials = grpc::SslCredentials(ssl);
+  }
+  channel_ = grpc::CreateCustomChannel(options_.target, credentials, args);
   stub_ = v1::Geodex::NewStub(channel_);
 }
 
@@ -71,6 +77,7 @@ grpc::Status GeodexClient::Call(const std::string& mesh_id,
                          std::chrono::microseconds(
                              static_cast<int64_t>(options_.deadline_seconds * 1e6)));
     if (!mesh_id.empty()) context.AddMetadata("x-mesh-id", mesh_id);
+    if (!options_.token.empty()) context.AddMetadata("authorization", "Bearer " + options_.token);
     ++calls_;
     status = call(&context);
     last_replica_.clear();

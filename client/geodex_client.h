@@ -38,6 +38,11 @@ struct ClientOptions {
   int max_attempts = 4;                     // tries on UNAVAILABLE
   double initial_backoff_seconds = 0.2;     // doubled after each UNAVAILABLE
   size_t upload_chunk_bytes = 1 << 20;
+  // TLS: `tls` on, with `ca_pem` the PEM roots to trust ("" = the system's roots).
+  bool tls = false;
+  std::string ca_pem;
+  // Bearer token sent as "authorization: Bearer TOKEN" on every call ("" = none).
+  std::string token;
   // Called with (bytes sent, total) during uploads (the CLI's progress bar); may be empty.
   std::function<void(uint64_t, uint64_t)> upload_progress;
 };

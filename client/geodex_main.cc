@@ -21,7 +21,9 @@ usage: geodex [--server HOST:PORT] COMMAND MESH [options]
 MESH is a mesh file (OFF, OBJ, PLY, STL, optionally .gz) or a built-in sample:
 sample:terrain, sample:torus, sample:sphere.
 
-Local by default; remote with --server HOST:PORT (or GEODEX_SERVER=HOST:PORT): the command runs on
+Local by default; remote with --server HOST:PORT (or GEODEX_SERVER=HOST:PORT), plus --tls,
+--ca FILE (PEM roots; implies --tls) and --token-file FILE (or GEODEX_TOKEN) for a server with TLS
+and bearer tokens. The command runs on
 a geodexd and prints the same output. There MESH may also be a mesh id or a name known to the
 server; a file is uploaded once (only if the server does not have it, by content hash).
   mesh upload FILE [--name NAME] | mesh list | mesh get MESH | mesh delete MESH   [--format json]
@@ -87,25 +89,46 @@ int main(int argc, char** argv) {
     std::puts("geodex 0.1.0");
     return kExitOk;
   }
-  // --server HOST:PORT (or --server=HOST:PORT) before the command; else GEODEX_SERVER.
+  // Global options before the command: --server HOST:PORT (else GEODEX_SERVER), --tls, --ca FILE,
+  // --token-file FILE (else the token in GEODEX_TOKEN).
   int first = 1;
-  std::string server;
-  if (const char* env = std::getenv("GEODEX_SERVER")) server = env;
-  if (!std::strcmp(argv[1], "--server")) {
-    if (argc < 4) {
-      std::fputs("geodex: usage: geodex --server HOST:PORT COMMAND ...\n", stderr);
-      return kExitUsage;
+  RemoteOptions remote;
+  if (const char* env = std::getenv("GEODEX_SERVER")) remote.target = env;
+  while (first < argc) {
+    const std::string a = argv[first];
+    auto value = [&](const char* name, std::string* out) {
+      const std::string flag = std::string("--") + name;
+      if (a == flag && first + 1 < argc) {
+        *out = argv[first + 1];
+        first += 2;
+        return true;
+      }
+      if (a.rfind(flag + "=", 0) == 0) {
+        *out = a.substr(flag.size() + 1);
+        first += 1;
+        return true;
+      }
+      return false;
+    };
+    if (value("server", &remote.target) || value("ca", &remote.ca_file) ||
+        value("token-file", &remote.token_file)) {
+      continue;
     }
-    server = argv[2];
-    first = 3;
-  } else if (!std::strncmp(argv[1], "--server=", 9)) {
-    server = argv[1] + 9;
-    first = 2;
-    if (argc < 3) {
-      std::fputs("geodex: usage: geodex --server HOST:PORT COMMAND ...\n", stderr);
-      return kExitUsage;
+    if (a == "--tls") {
+      remote.tls = true;
+      ++first;
+      continue;
     }
+    break;
   }
+  if (first >= argc) {
+    std::fputs("geodex: usage: geodex [--server HOST:PORT [--tls] [--ca FILE] [--token-file FILE]] "
+               "COMMAND ...\n",
+               stderr);
+    return kExitUsage;
+  }
+  SetRemoteOptions(remote);
+  const std::string server = remote.target;
   const std::string command = argv[first];
   Args args;
   std::string error;

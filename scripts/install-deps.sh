@@ -24,6 +24,8 @@ packages=(
   python3-yaml
   # the mesh-affine gateway (deploy/gateway) and its end-to-end test
   nginx-light
+  # TLS tests make a self-signed certificate
+  openssl
 )
 
 # Skip apt entirely when everything is already there (fast re-runs).

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
+#include <fstream>
 #include <thread>
 
 #include "absl/strings/str_cat.h"
@@ -24,8 +25,29 @@ absl::StatusOr<std::unique_ptr<GeodexServer>> GeodexServer::Start(const ServerOp
   s->store_ = std::make_unique<MeshStore>(options.mesh_budget_bytes);
   s->pool_ = std::make_unique<ComputePool>(threads, options.queue_capacity);
   s->cache_ = std::make_unique<FieldCache>(options.result_cache_bytes);
+  std::vector<std::string> tokens;
+  if (!options.auth_token_file.empty()) {
+    absl::StatusOr<std::vector<std::string>> read = ReadTokenFile(options.auth_token_file);
+    if (!read.ok()) return read.status();
+    tokens = *std::move(read);
+  }
+  s->authenticated_ = !tokens.empty();
   s->service_ = std::make_unique<GeodexService>(s->store_.get(), s->pool_.get(), s->cache_.get(),
-                                                options.limits);
+                                                options.limits, TokenAuthenticator(std::move(tokens)));
+  std::shared_ptr<grpc::ServerCredentials> credentials = grpc::InsecureServerCredentials();
+  if (options.tls_cert_file.empty() != options.tls_key_file.empty()) {
+    return absl::InvalidArgumentError("--tls_cert and --tls_key go together");
+  }
+  if (!options.tls_cert_file.empty()) {
+    absl::StatusOr<std::string> cert = ReadSmallFile(options.tls_cert_file, "--tls_cert");
+    if (!cert.ok()) return cert.status();
+    absl::StatusOr<std::string> key = ReadSmallFile(options.tls_key_file, "--tls_key");
+    if (!key.ok()) return key.status();
+    grpc::SslServerCredentialsOptions ssl;
+    ssl.pem_key_cert_pairs.push_back({*key, *cert});
+    credentials = grpc::SslServerCredentials(ssl);
+    s->tls_ = true;
+  }
 
   // The store is complete before the port opens: health never says SERVING before the index is
   // read (and no call sees a half-read index).
@@ -63,7 +85,7 @@ absl::StatusOr<std::unique_ptr<GeodexServer>> GeodexServer::Start(const ServerOp
   grpc::ServerBuilder builder;
   builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
   builder.SetMaxReceiveMessageSize(options.max_receive_message_bytes);
-  builder.AddListeningPort(options.listen, grpc::InsecureServerCredentials(), &s->port_);
+  builder.AddListeningPort(options.listen, credentials, &s->port_);
   builder.RegisterService(s->service_.get());
   std::vector<std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>> interceptors;
   interceptors.push_back(s->metrics_->InterceptorFactory());
@@ -76,6 +98,16 @@ absl::StatusOr<std::unique_ptr<GeodexServer>> GeodexServer::Start(const ServerOp
   health->SetServingStatus("", true);
   health->SetServingStatus(v1::Geodex::service_full_name(), true);
   return s;
+}
+
+absl::StatusOr<std::string> ReadSmallFile(const std::string& path, const std::string& flag) {
+  std::ifstream in(path, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (!in.good() && !in.eof()) {
+    return absl::InvalidArgumentError(absl::StrCat(flag, " ", path, ": cannot read"));
+  }
+  if (bytes.empty()) return absl::InvalidArgumentError(absl::StrCat(flag, " ", path, ": empty or missing"));
+  return bytes;
 }
 
 absl::StatusOr<std::string> AddMesh(MeshStore& store, const MeshData& data,

@@ -43,6 +43,10 @@ struct ServerOptions {
   std::string metrics_listen;  // HOST:PORT of the Prometheus /metrics endpoint; "" = none
   bool log_requests = false;   // one spdlog line per call (geodexd: on)
   std::string replica_name;    // sent as x-geodex-replica on every geodex.v1 call; "" = none
+  // TLS: PEM files of the server certificate (chain) and its private key; both or neither.
+  std::string tls_cert_file, tls_key_file;
+  // Bearer tokens (auth.h): a file with one token per line; "" = no authentication.
+  std::string auth_token_file;
   ServiceLimits limits;
 };
 
@@ -51,13 +55,19 @@ struct ServerOptions {
 absl::StatusOr<std::string> AddMesh(MeshStore& store, const MeshData& data,
                                     const std::string& alias, uint64_t file_bytes);
 
+// A whole (small) file, e.g. a PEM certificate; InvalidArgument naming `flag` when unreadable/empty.
+absl::StatusOr<std::string> ReadSmallFile(const std::string& path, const std::string& flag);
+
 class GeodexServer {
  public:
-  // Builds and starts the server. Errors: InvalidArgument/Unavailable when it cannot listen.
+  // Builds and starts the server. Errors: InvalidArgument for unreadable TLS or token files,
+  // Unavailable when it cannot listen.
   static absl::StatusOr<std::unique_ptr<GeodexServer>> Start(const ServerOptions& options);
   ~GeodexServer();  // Shutdown(now) if not yet shut down
 
   const StartupReport& startup_report() const { return report_; }
+  bool tls() const { return tls_; }
+  bool authenticated() const { return authenticated_; }
   // The port actually bound (useful with port 0).
   int port() const { return port_; }
   // Health NOT_SERVING, then grpc::Server::Shutdown(deadline): calls still running at the deadline
@@ -84,6 +94,7 @@ class GeodexServer {
   std::unique_ptr<ComputePool> pool_;
   std::unique_ptr<grpc::Server> server_;
   int port_ = 0;
+  bool tls_ = false, authenticated_ = false;
   StartupReport report_;
   bool shut_down_ = false;
 };

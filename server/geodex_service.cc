@@ -205,6 +205,9 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<v1::CreateMeshReq
 
 grpc::ServerReadReactor<v1::CreateMeshRequest>* GeodexService::CreateMesh(
     grpc::CallbackServerContext* context, v1::Mesh* response) {
+  if (!auth_.Allows(*context)) {
+    return new RejectedReadReactor<v1::CreateMeshRequest>(UnauthenticatedStatus());
+  }
   return new CreateMeshReactor(this, context, response);
 }
 
@@ -214,6 +217,10 @@ grpc::ServerUnaryReactor* GeodexService::GetMesh(grpc::CallbackServerContext* co
                                                  const v1::GetMeshRequest* request,
                                                  v1::Mesh* response) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  if (!auth_.Allows(*context)) {
+    reactor->Finish(UnauthenticatedStatus());
+    return reactor;
+  }
   absl::StatusOr<std::string> key = ParseMeshName(request->name(), "name");
   absl::Status status = key.status();
   if (key.ok()) {
@@ -233,6 +240,10 @@ grpc::ServerUnaryReactor* GeodexService::ListMeshes(grpc::CallbackServerContext*
                                                     const v1::ListMeshesRequest* request,
                                                     v1::ListMeshesResponse* response) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  if (!auth_.Allows(*context)) {
+    reactor->Finish(UnauthenticatedStatus());
+    return reactor;
+  }
   if (request->page_size() < 0) {
     reactor->Finish(ToGrpcStatus(absl::InvalidArgumentError(
         absl::StrCat("page_size: must be >= 0, got ", request->page_size()))));
@@ -258,6 +269,10 @@ grpc::ServerUnaryReactor* GeodexService::DeleteMesh(grpc::CallbackServerContext*
                                                     const v1::DeleteMeshRequest* request,
                                                     v1::DeleteMeshResponse* /*response*/) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  if (!auth_.Allows(*context)) {
+    reactor->Finish(UnauthenticatedStatus());
+    return reactor;
+  }
   absl::StatusOr<std::string> key = ParseMeshName(request->name(), "name");
   absl::Status status = key.status();
   if (key.ok()) {
@@ -272,7 +287,10 @@ grpc::ServerUnaryReactor* GeodexService::DeleteMesh(grpc::CallbackServerContext*
 
 // Queries: the reactor templates run the query functions of queries.cc on the pool.
 grpc::ServerWriteReactor<v1::ComputeDistanceFieldResponse>* GeodexService::ComputeDistanceField(
-    grpc::CallbackServerContext* /*context*/, const v1::ComputeDistanceFieldRequest* request) {
+    grpc::CallbackServerContext* context, const v1::ComputeDistanceFieldRequest* request) {
+  if (!auth_.Allows(*context)) {
+    return new RejectedWriteReactor<v1::ComputeDistanceFieldResponse>(UnauthenticatedStatus());
+  }
   return StreamQueryReactor<v1::ComputeDistanceFieldRequest,
                             v1::ComputeDistanceFieldResponse>::Start(env(),
                                                                      &RunComputeDistanceField,
@@ -280,14 +298,22 @@ grpc::ServerWriteReactor<v1::ComputeDistanceFieldResponse>* GeodexService::Compu
 }
 
 grpc::ServerUnaryReactor* GeodexService::FindShortestPath(
-    grpc::CallbackServerContext* /*context*/, const v1::FindShortestPathRequest* request,
+    grpc::CallbackServerContext* context, const v1::FindShortestPathRequest* request,
     v1::FindShortestPathResponse* response) {
+  if (!auth_.Allows(*context)) {
+    grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+    reactor->Finish(UnauthenticatedStatus());
+    return reactor;
+  }
   return UnaryQueryReactor<v1::FindShortestPathRequest, v1::FindShortestPathResponse>::Start(
       env(), &RunFindShortestPath, request, response);
 }
 
 grpc::ServerWriteReactor<v1::ComputeDistanceMatrixResponse>* GeodexService::ComputeDistanceMatrix(
-    grpc::CallbackServerContext* /*context*/, const v1::ComputeDistanceMatrixRequest* request) {
+    grpc::CallbackServerContext* context, const v1::ComputeDistanceMatrixRequest* request) {
+  if (!auth_.Allows(*context)) {
+    return new RejectedWriteReactor<v1::ComputeDistanceMatrixResponse>(UnauthenticatedStatus());
+  }
   return StreamQueryReactor<v1::ComputeDistanceMatrixRequest,
                             v1::ComputeDistanceMatrixResponse>::Start(env(),
                                                                       &RunComputeDistanceMatrix,
@@ -295,33 +321,52 @@ grpc::ServerWriteReactor<v1::ComputeDistanceMatrixResponse>* GeodexService::Comp
 }
 
 grpc::ServerUnaryReactor* GeodexService::EstimateDistances(
-    grpc::CallbackServerContext* /*context*/, const v1::EstimateDistancesRequest* request,
+    grpc::CallbackServerContext* context, const v1::EstimateDistancesRequest* request,
     v1::EstimateDistancesResponse* response) {
+  if (!auth_.Allows(*context)) {
+    grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+    reactor->Finish(UnauthenticatedStatus());
+    return reactor;
+  }
   return UnaryQueryReactor<v1::EstimateDistancesRequest, v1::EstimateDistancesResponse>::Start(
       env(), &RunEstimateDistances, request, response);
 }
 
-grpc::ServerUnaryReactor* GeodexService::LocatePoints(grpc::CallbackServerContext* /*context*/,
+grpc::ServerUnaryReactor* GeodexService::LocatePoints(grpc::CallbackServerContext* context,
                                                       const v1::LocatePointsRequest* request,
                                                       v1::LocatePointsResponse* response) {
+  if (!auth_.Allows(*context)) {
+    grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+    reactor->Finish(UnauthenticatedStatus());
+    return reactor;
+  }
   return UnaryQueryReactor<v1::LocatePointsRequest, v1::LocatePointsResponse>::Start(
       env(), &RunLocatePoints, request, response);
 }
 
 grpc::ServerWriteReactor<v1::ComputeIsolinesResponse>* GeodexService::ComputeIsolines(
-    grpc::CallbackServerContext* /*context*/, const v1::ComputeIsolinesRequest* request) {
+    grpc::CallbackServerContext* context, const v1::ComputeIsolinesRequest* request) {
+  if (!auth_.Allows(*context)) {
+    return new RejectedWriteReactor<v1::ComputeIsolinesResponse>(UnauthenticatedStatus());
+  }
   return StreamQueryReactor<v1::ComputeIsolinesRequest, v1::ComputeIsolinesResponse>::Start(
       env(), &RunComputeIsolines, request);
 }
 
 grpc::ServerWriteReactor<v1::ComputeVoronoiResponse>* GeodexService::ComputeVoronoi(
-    grpc::CallbackServerContext* /*context*/, const v1::ComputeVoronoiRequest* request) {
+    grpc::CallbackServerContext* context, const v1::ComputeVoronoiRequest* request) {
+  if (!auth_.Allows(*context)) {
+    return new RejectedWriteReactor<v1::ComputeVoronoiResponse>(UnauthenticatedStatus());
+  }
   return StreamQueryReactor<v1::ComputeVoronoiRequest, v1::ComputeVoronoiResponse>::Start(
       env(), &RunComputeVoronoi, request);
 }
 
 grpc::ServerWriteReactor<v1::ComputeDelaunayResponse>* GeodexService::ComputeDelaunay(
-    grpc::CallbackServerContext* /*context*/, const v1::ComputeDelaunayRequest* request) {
+    grpc::CallbackServerContext* context, const v1::ComputeDelaunayRequest* request) {
+  if (!auth_.Allows(*context)) {
+    return new RejectedWriteReactor<v1::ComputeDelaunayResponse>(UnauthenticatedStatus());
+  }
   return StreamQueryReactor<v1::ComputeDelaunayRequest, v1::ComputeDelaunayResponse>::Start(
       env(), &RunComputeDelaunay, request);
 }

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 
+#include "auth.h"
 #include "compute_pool.h"
 #include "field_cache.h"
 #include "geodex/v1/geodex.grpc.pb.h"
@@ -21,8 +22,9 @@ class GeodexService final : public v1::Geodex::CallbackService {
   // `store` and `pool` must outlive the service; the pool must also outlive the grpc::Server's
   // Shutdown (its tasks finish the calls).
   // `cache` (the result cache) must outlive the service too.
-  GeodexService(MeshStore* store, ComputePool* pool, FieldCache* cache, const ServiceLimits& limits)
-      : store_(store), pool_(pool), cache_(cache), limits_(limits) {}
+  GeodexService(MeshStore* store, ComputePool* pool, FieldCache* cache, const ServiceLimits& limits,
+                TokenAuthenticator auth = TokenAuthenticator({}))
+      : store_(store), pool_(pool), cache_(cache), limits_(limits), auth_(std::move(auth)) {}
 
   grpc::ServerReadReactor<v1::CreateMeshRequest>* CreateMesh(grpc::CallbackServerContext* context,
                                                              v1::Mesh* response) override;
@@ -68,8 +70,9 @@ class GeodexService final : public v1::Geodex::CallbackService {
   MeshStore* store_;
   ComputePool* pool_;
   FieldCache* cache_;
-  ServiceCounters counters_;
   ServiceLimits limits_;
+  TokenAuthenticator auth_;
+  ServiceCounters counters_;
 };
 
 }  // namespace geodex::server

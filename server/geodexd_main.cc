@@ -34,6 +34,11 @@ ABSL_FLAG(std::string, metrics_listen, "127.0.0.1:9464",
           "HOST:PORT of the Prometheus /metrics HTTP endpoint (empty = off)");
 ABSL_FLAG(std::string, replica_name, "",
           "Name sent to clients as x-geodex-replica metadata (default: the host name)");
+ABSL_FLAG(std::string, tls_cert, "", "PEM certificate (chain) of the server: serve TLS (with --tls_key)");
+ABSL_FLAG(std::string, tls_key, "", "PEM private key of --tls_cert");
+ABSL_FLAG(std::string, auth_token_file, "",
+          "File of bearer tokens, one per line: geodex.v1 calls need 'authorization: Bearer TOKEN' "
+          "(health, reflection and metrics stay open)");
 ABSL_FLAG(bool, log_requests, true, "Log one line per call (method, mesh, sources, time, status)");
 ABSL_FLAG(uint32_t, pool_threads, 0, "Compute worker threads (0 = one per hardware thread)");
 ABSL_FLAG(uint32_t, queue_capacity, 64,
@@ -108,6 +113,9 @@ int main(int argc, char** argv) {
   options.metrics_listen = absl::GetFlag(FLAGS_metrics_listen);
   options.log_requests = absl::GetFlag(FLAGS_log_requests);
   options.replica_name = absl::GetFlag(FLAGS_replica_name);
+  options.tls_cert_file = absl::GetFlag(FLAGS_tls_cert);
+  options.tls_key_file = absl::GetFlag(FLAGS_tls_key);
+  options.auth_token_file = absl::GetFlag(FLAGS_auth_token_file);
   if (options.replica_name.empty()) {
     char host[256] = {};
     if (gethostname(host, sizeof host - 1) == 0) options.replica_name = host;
@@ -163,6 +171,10 @@ int main(int argc, char** argv) {
     spdlog::info("metrics on http://{}:{}/metrics", listen.substr(0, listen.rfind(':')),
                  (*server)->metrics().port());
   }
+  if ((*server)->authenticated() && !(*server)->tls()) {
+    spdlog::warn("bearer tokens without TLS travel in plaintext: use --tls_cert/--tls_key");
+  }
+  spdlog::info("security: tls={} bearer_tokens={}", (*server)->tls(), (*server)->authenticated());
   spdlog::info("geodexd listening on port {} ({} workers, queue {}, mesh budget {} bytes)",
                (*server)->port(), (*server)->pool().threads(), options.queue_capacity,
                options.mesh_budget_bytes);
