@@ -9,7 +9,10 @@
 //   2. a query mix (A* paths 40%, distance fields 20%, point distances 20%, locate 10%,
 //      isolines 10%; random vertices and points) from 1, 2 and 4 concurrent clients for S seconds
 //      each: throughput, p50/p99 latency, status counts;
-//   3. health checks while every worker is busy with full fields: p50/p99/max.
+//   3. health checks while every worker is busy with full fields: p50/p99/max;
+//   4. overload: 8 clients against the workers and a queue of 2 for S seconds, with health probes
+//      alongside: answered, refused (RESOURCE_EXHAUSTED, by design), other errors (must be 0),
+//      health latency, peak RSS against the mesh and cache budgets.
 // Results go to stdout as a table (docs/performance.md records them).
 
 #include <algorithm>
@@ -41,6 +44,19 @@ namespace geodex::server {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// Peak resident set of this process (VmHWM), in KiB.
+uint64_t PeakRssKb() {
+  std::FILE* f = std::fopen("/proc/self/status", "r");
+  if (f == nullptr) return 0;
+  char line[256];
+  uint64_t kb = 0;
+  while (std::fgets(line, sizeof line, f)) {
+    if (std::sscanf(line, "VmHWM: %lu kB", &kb) == 1) break;
+  }
+  std::fclose(f);
+  return kb;
+}
 
 double Ms(Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); }
 
@@ -336,6 +352,72 @@ int Main(int argc, char** argv) {
                 *std::max_element(health.begin(), health.end()), failures);
   }
   (*server)->Shutdown(absl::Now() + absl::Seconds(60));
+
+  // 4. Overload: 8 clients against 2 workers and a queue of 2, with health probes alongside.
+  //    Designed answer: RESOURCE_EXHAUSTED at once for what does not fit; nothing else fails.
+  {
+    ServerOptions load_options;
+    load_options.listen = "127.0.0.1:0";
+    load_options.pool_threads = threads;
+    load_options.queue_capacity = 2;
+    load_options.mesh_budget_bytes = uint64_t{256} << 20;
+    load_options.result_cache_bytes = uint64_t{64} << 20;
+    auto load_server = GeodexServer::Start(load_options);
+    if (!load_server.ok()) return 1;
+    auto load_channel = grpc::CreateChannel(absl::StrCat("127.0.0.1:", (*load_server)->port()),
+                                            grpc::InsecureChannelCredentials());
+    {
+      auto stub = v1::Geodex::NewStub(load_channel);
+      if (!Upload(*stub, bytes, mesh_path, "bench").ok()) return 1;
+    }
+    const uint64_t rss_before_kb = PeakRssKb();
+    std::atomic<bool> stop{false};
+    std::vector<std::future<MixResult>> futures;
+    for (int c = 0; c < 8; ++c) {
+      futures.push_back(std::async(std::launch::async, RunClient, load_channel, std::cref(mesh),
+                                   std::cref(data->positions), seed * 1000 + c, std::cref(stop)));
+    }
+    grpc::GenericStub generic(load_channel);
+    std::vector<double> health;
+    int health_failures = 0;
+    const auto start = Clock::now();
+    while (Ms(Clock::now() - start) < seconds * 1e3) {
+      const auto t0 = Clock::now();
+      health_failures += !HealthCheck(generic).ok();
+      health.push_back(Ms(Clock::now() - t0));
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    stop = true;
+    MixResult all;
+    for (auto& f : futures) {
+      MixResult r = f.get();
+      all.latencies_ms.insert(all.latencies_ms.end(), r.latencies_ms.begin(), r.latencies_ms.end());
+      for (const auto& [k, v] : r.statuses) all.statuses[k] += v;
+      all.queries += r.queries;
+    }
+    const double elapsed = Ms(Clock::now() - start) / 1e3;
+    std::string statuses;
+    for (const auto& [k, v] : all.statuses) absl::StrAppend(&statuses, k, "=", v, " ");
+    const int ok = all.statuses["OK"];
+    const int exhausted = all.statuses[absl::StrCat("code ", int{grpc::StatusCode::RESOURCE_EXHAUSTED})];
+    std::printf("\n4. overload for %.0f s: 8 clients, %d workers, queue 2 (mesh budget 256 MiB, "
+                "cache 64 MiB)\n",
+                seconds, threads);
+    std::printf("   answered %d (%.1f/s), refused at once with RESOURCE_EXHAUSTED %d, other errors %d\n",
+                ok, ok / elapsed, exhausted, all.queries - ok - exhausted);
+    std::printf("   statuses: %s\n", statuses.c_str());
+    std::printf("   health during overload: %zu checks, p50 %.2f ms, p99 %.2f ms, max %.2f ms, "
+                "failures %d\n",
+                health.size(), Percentile(health, 0.5), Percentile(health, 0.99),
+                health.empty() ? 0.0 : *std::max_element(health.begin(), health.end()),
+                health_failures);
+    std::printf("   peak RSS of the process %.0f MiB (before the overload %.0f MiB); store %.1f MiB "
+                "of 256, cache %.1f MiB of 64\n",
+                PeakRssKb() / 1024.0, rss_before_kb / 1024.0,
+                (*load_server)->store().used_bytes() / 1048576.0,
+                (*load_server)->cache().bytes() / 1048576.0);
+    (*load_server)->Shutdown(absl::Now() + absl::Seconds(60));
+  }
   return 0;
 }
 

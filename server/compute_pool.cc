@@ -12,14 +12,15 @@ ComputePool::ComputePool(size_t threads, size_t queue_capacity) : queue_capacity
 
 ComputePool::~ComputePool() {
   {
-    absl::MutexLock lock(&mu_);
+    std::lock_guard<std::mutex> lock(mu_);
     stopping_ = true;
   }
+  work_.notify_all();
   for (std::thread& t : workers_) t.join();
 }
 
 bool ComputePool::TrySubmit(std::function<void()> task) {
-  absl::MutexLock lock(&mu_);
+  std::unique_lock<std::mutex> lock(mu_);
   // A task may start at once only if a worker is idle; otherwise it waits in the queue.
   size_t idle = workers_.size() - busy_;
   size_t waiting_after = queue_.size() + 1 > idle ? queue_.size() + 1 - idle : 0;
@@ -28,6 +29,8 @@ bool ComputePool::TrySubmit(std::function<void()> task) {
     return false;
   }
   queue_.push_back(std::move(task));
+  lock.unlock();
+  work_.notify_one();
   return true;
 }
 
@@ -35,35 +38,33 @@ void ComputePool::WorkerLoop() {
   for (;;) {
     std::function<void()> task;
     {
-      absl::MutexLock lock(&mu_);
-      mu_.Await(absl::Condition(
-          +[](ComputePool* p) ABSL_EXCLUSIVE_LOCKS_REQUIRED(p->mu_) {
-            return p->stopping_ || !p->queue_.empty();
-          },
-          this));
+      std::unique_lock<std::mutex> lock(mu_);
+      work_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
       if (queue_.empty()) return;  // stopping and drained
       task = std::move(queue_.front());
       queue_.pop_front();
       ++busy_;
     }
     task();
-    absl::MutexLock lock(&mu_);
+    std::lock_guard<std::mutex> lock(mu_);
     --busy_;
   }
 }
 
+void ComputePool::Publish() { std::lock_guard<std::mutex> lock(mu_); }
+
 size_t ComputePool::queued() const {
-  absl::MutexLock lock(&mu_);
+  std::lock_guard<std::mutex> lock(mu_);
   return queue_.size();
 }
 
 size_t ComputePool::busy() const {
-  absl::MutexLock lock(&mu_);
+  std::lock_guard<std::mutex> lock(mu_);
   return busy_;
 }
 
 uint64_t ComputePool::rejected() const {
-  absl::MutexLock lock(&mu_);
+  std::lock_guard<std::mutex> lock(mu_);
   return rejected_;
 }
 

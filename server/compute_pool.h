@@ -11,8 +11,8 @@
 #include <thread>
 #include <vector>
 
-#include "absl/base/thread_annotations.h"
-#include "absl/synchronization/mutex.h"
+#include <condition_variable>
+#include <mutex>
 
 namespace geodex::server {
 
@@ -29,6 +29,11 @@ class ComputePool {
   // Queues `task`; false (task dropped) when the queue is full or the pool is shutting down.
   bool TrySubmit(std::function<void()> task);
 
+  // Orders everything this thread wrote before the call before every task a worker runs afterwards
+  // (a release of the queue's mutex). geodexd calls it once the service exists: the workers were
+  // started before it, and gRPC's own hand-off of calls is invisible to ThreadSanitizer.
+  void Publish();
+
   size_t threads() const { return workers_.size(); }
   size_t queue_capacity() const { return queue_capacity_; }
   size_t queued() const;
@@ -39,11 +44,14 @@ class ComputePool {
   void WorkerLoop();
 
   const size_t queue_capacity_;
-  mutable absl::Mutex mu_;
-  std::deque<std::function<void()>> queue_ ABSL_GUARDED_BY(mu_);
-  size_t busy_ ABSL_GUARDED_BY(mu_) = 0;
-  uint64_t rejected_ ABSL_GUARDED_BY(mu_) = 0;
-  bool stopping_ ABSL_GUARDED_BY(mu_) = false;
+  // std::mutex rather than absl::Mutex: Debian's Abseil is not built for ThreadSanitizer, so its
+  // mutexes would be invisible to the sanitizer tier.
+  mutable std::mutex mu_;
+  std::condition_variable work_;                // a task arrived, or stopping
+  std::deque<std::function<void()>> queue_;     // guarded by mu_
+  size_t busy_ = 0;                             // guarded by mu_
+  uint64_t rejected_ = 0;                       // guarded by mu_
+  bool stopping_ = false;                       // guarded by mu_
   std::vector<std::thread> workers_;
 };
 

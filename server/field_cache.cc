@@ -54,7 +54,7 @@ uint64_t FieldBytes(const DistanceField& field) {
 
 std::shared_ptr<const DistanceField> FieldCache::Find(const std::string& key) {
   if (!enabled()) return nullptr;
-  absl::MutexLock lock(&mu_);
+  std::lock_guard<std::mutex> lock(mu_);
   auto it = entries_.find(key);
   if (it == entries_.end()) {
     ++misses_;
@@ -68,7 +68,7 @@ std::shared_ptr<const DistanceField> FieldCache::Find(const std::string& key) {
 void FieldCache::Insert(const std::string& key, std::shared_ptr<const DistanceField> field) {
   const uint64_t bytes = FieldBytes(*field) + key.size();
   if (!enabled() || bytes > budget_bytes_) return;
-  absl::MutexLock lock(&mu_);
+  std::lock_guard<std::mutex> lock(mu_);
   if (entries_.contains(key)) return;
   while (bytes_ + bytes > budget_bytes_ && !lru_.empty()) {
     auto victim = entries_.find(lru_.back());
@@ -83,7 +83,7 @@ void FieldCache::Insert(const std::string& key, std::shared_ptr<const DistanceFi
 
 bool FieldCache::NotePathSource(const std::string& key) {
   if (!enabled()) return false;
-  absl::MutexLock lock(&mu_);
+  std::lock_guard<std::mutex> lock(mu_);
   if (path_sources_.contains(key)) return true;
   path_sources_[key] = 1;
   path_source_order_.push_back(key);
@@ -95,19 +95,19 @@ bool FieldCache::NotePathSource(const std::string& key) {
 }
 
 uint64_t FieldCache::bytes() const {
-  absl::MutexLock lock(&mu_);
+  std::lock_guard<std::mutex> lock(mu_);
   return bytes_;
 }
 size_t FieldCache::entries() const {
-  absl::MutexLock lock(&mu_);
+  std::lock_guard<std::mutex> lock(mu_);
   return entries_.size();
 }
 uint64_t FieldCache::hits() const {
-  absl::MutexLock lock(&mu_);
+  std::lock_guard<std::mutex> lock(mu_);
   return hits_;
 }
 uint64_t FieldCache::misses() const {
-  absl::MutexLock lock(&mu_);
+  std::lock_guard<std::mutex> lock(mu_);
   return misses_;
 }
 

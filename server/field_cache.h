@@ -8,12 +8,11 @@
 #include <cstdint>
 #include <list>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
-#include "absl/base/thread_annotations.h"
 #include "absl/container/flat_hash_map.h"
-#include "absl/synchronization/mutex.h"
 #include "geodex/distance_field.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/surface_point.h"
@@ -53,15 +52,15 @@ class FieldCache {
     std::list<std::string>::iterator lru;
   };
   const uint64_t budget_bytes_;
-  mutable absl::Mutex mu_;
-  absl::flat_hash_map<std::string, Entry> entries_ ABSL_GUARDED_BY(mu_);
-  std::list<std::string> lru_ ABSL_GUARDED_BY(mu_);  // most recent first
-  uint64_t bytes_ ABSL_GUARDED_BY(mu_) = 0;
-  uint64_t hits_ ABSL_GUARDED_BY(mu_) = 0;
-  uint64_t misses_ ABSL_GUARDED_BY(mu_) = 0;
+  mutable std::mutex mu_;  // (std::mutex: visible to ThreadSanitizer; members below are guarded by it)
+  absl::flat_hash_map<std::string, Entry> entries_;
+  std::list<std::string> lru_;  // most recent first
+  uint64_t bytes_ = 0;
+  uint64_t hits_ = 0;
+  uint64_t misses_ = 0;
   // Recent path sources (bounded FIFO of keys).
-  absl::flat_hash_map<std::string, uint64_t> path_sources_ ABSL_GUARDED_BY(mu_);
-  std::list<std::string> path_source_order_ ABSL_GUARDED_BY(mu_);
+  absl::flat_hash_map<std::string, uint64_t> path_sources_;
+  std::list<std::string> path_source_order_;
 };
 
 }  // namespace geodex::server

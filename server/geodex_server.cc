@@ -80,6 +80,8 @@ absl::StatusOr<std::unique_ptr<GeodexServer>> GeodexServer::Start(const ServerOp
   if (!metrics.ok()) return metrics.status();
   s->metrics_ = *std::move(metrics);
 
+  s->pool_->Publish();  // the service (and everything above) before any task runs
+
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;

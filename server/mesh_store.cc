@@ -75,7 +75,7 @@ std::shared_ptr<const StoredMesh> Strip(const StoredMesh& mesh) {
 }  // namespace
 
 void MeshStore::AttachDisk(MeshDisk disk, const MeshDisk::Index& index) {
-  absl::MutexLock lock(&mu_);
+  std::lock_guard<std::mutex> lock(mu_);
   disk_.emplace(std::move(disk));
   for (const MeshDisk::IndexEntry& entry : index.meshes) {
     std::shared_ptr<StoredMesh> record = RecordFromProto(entry.id, entry.header);
@@ -129,7 +129,7 @@ std::shared_ptr<const StoredMesh> MeshStore::AdmitLocked(std::shared_ptr<const S
 absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::Insert(
     std::shared_ptr<StoredMesh> mesh, const std::string& canonical) {
   {
-    absl::MutexLock lock(&mu_);
+    std::lock_guard<std::mutex> lock(mu_);
     if (!mesh->display_name.empty()) {
       auto alias = aliases_.find(mesh->display_name);
       if (alias != aliases_.end() && alias->second != mesh->id) {
@@ -170,7 +170,7 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::Insert(
     MeshToProto(*mesh, &header);
     if (absl::Status s = disk_->Write(mesh->id, header, canonical); !s.ok()) return s;
   }
-  absl::MutexLock lock(&mu_);
+  std::lock_guard<std::mutex> lock(mu_);
   if (auto existing = meshes_.find(mesh->id); existing != meshes_.end() && existing->second.resident) {
     return existing->second.mesh;  // a concurrent upload of the same mesh won
   }
@@ -221,7 +221,7 @@ void MeshStore::EvictLocked(const std::string& id) {
 absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::Get(const std::string& id_or_alias) {
   std::shared_ptr<const StoredMesh> record;
   {
-    absl::MutexLock lock(&mu_);
+    std::lock_guard<std::mutex> lock(mu_);
     Slot* slot = FindLocked(id_or_alias);
     if (slot == nullptr) {
       return absl::NotFoundError(absl::StrCat("mesh \"", id_or_alias, "\" not found"));
@@ -254,7 +254,7 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::Get(const std::stri
   loaded->upload_bytes = record->upload_bytes;
   loaded->create_time = record->create_time;
 
-  absl::MutexLock lock(&mu_);
+  std::lock_guard<std::mutex> lock(mu_);
   auto it = meshes_.find(record->id);
   if (it == meshes_.end()) {
     return absl::NotFoundError(absl::StrCat("mesh \"", id_or_alias, "\" was deleted"));
@@ -273,7 +273,7 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::Get(const std::stri
 
 absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::GetRecord(
     const std::string& id_or_alias) const {
-  absl::MutexLock lock(&mu_);
+  std::lock_guard<std::mutex> lock(mu_);
   const Slot* slot = FindLocked(id_or_alias);
   if (slot == nullptr) {
     return absl::NotFoundError(absl::StrCat("mesh \"", id_or_alias, "\" not found"));
@@ -282,12 +282,12 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::GetRecord(
 }
 
 bool MeshStore::Contains(const std::string& id) const {
-  absl::MutexLock lock(&mu_);
+  std::lock_guard<std::mutex> lock(mu_);
   return meshes_.contains(id);
 }
 
 absl::Status MeshStore::Delete(const std::string& id_or_alias) {
-  absl::MutexLock lock(&mu_);
+  std::lock_guard<std::mutex> lock(mu_);
   Slot* slot = FindLocked(id_or_alias);
   if (slot == nullptr) {
     return absl::NotFoundError(absl::StrCat("mesh \"", id_or_alias, "\" not found"));
@@ -302,7 +302,7 @@ absl::Status MeshStore::Delete(const std::string& id_or_alias) {
 
 std::vector<std::shared_ptr<const StoredMesh>> MeshStore::List(const std::string& after,
                                                                size_t limit, bool* more) const {
-  absl::MutexLock lock(&mu_);
+  std::lock_guard<std::mutex> lock(mu_);
   std::vector<std::shared_ptr<const StoredMesh>> out;
   auto it = after.empty() ? meshes_.begin() : meshes_.upper_bound(after);
   for (; it != meshes_.end() && out.size() < limit; ++it) out.push_back(it->second.mesh);
@@ -311,27 +311,27 @@ std::vector<std::shared_ptr<const StoredMesh>> MeshStore::List(const std::string
 }
 
 uint64_t MeshStore::used_bytes() const {
-  absl::MutexLock lock(&mu_);
+  std::lock_guard<std::mutex> lock(mu_);
   return used_bytes_;
 }
 
 size_t MeshStore::size() const {
-  absl::MutexLock lock(&mu_);
+  std::lock_guard<std::mutex> lock(mu_);
   return meshes_.size();
 }
 
 size_t MeshStore::resident_count() const {
-  absl::MutexLock lock(&mu_);
+  std::lock_guard<std::mutex> lock(mu_);
   return lru_.size();
 }
 
 uint64_t MeshStore::evictions() const {
-  absl::MutexLock lock(&mu_);
+  std::lock_guard<std::mutex> lock(mu_);
   return evictions_;
 }
 
 uint64_t MeshStore::disk_loads() const {
-  absl::MutexLock lock(&mu_);
+  std::lock_guard<std::mutex> lock(mu_);
   return disk_loads_;
 }
 

@@ -13,14 +13,13 @@
 #include <list>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "absl/base/thread_annotations.h"
 #include "absl/container/flat_hash_map.h"
 #include "absl/status/statusor.h"
-#include "absl/synchronization/mutex.h"
 #include "absl/time/time.h"
 #include "geodex/locate.h"
 #include "geodex/triangle_mesh.h"
@@ -104,28 +103,26 @@ class MeshStore {
     bool resident = false;
   };
   // The slot for an id or alias, or nullptr.
-  Slot* FindLocked(const std::string& id_or_alias) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
-  const Slot* FindLocked(const std::string& id_or_alias) const ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  Slot* FindLocked(const std::string& id_or_alias);
+  const Slot* FindLocked(const std::string& id_or_alias) const;
   // Removes the mesh entirely.
-  void RemoveLocked(const std::string& id) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  void RemoveLocked(const std::string& id);
   // Drops a resident mesh from memory (disk-backed) or removes it (RAM only).
-  void EvictLocked(const std::string& id) ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  void EvictLocked(const std::string& id);
   // Unpinned resident meshes to evict (oldest first) so that `bytes` more fit; error if impossible.
-  absl::StatusOr<std::vector<std::string>> VictimsLocked(uint64_t bytes) const
-      ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  absl::StatusOr<std::vector<std::string>> VictimsLocked(uint64_t bytes) const;
   // Makes `mesh` resident in a slot (new or existing record), evicting `victims`.
-  std::shared_ptr<const StoredMesh> AdmitLocked(std::shared_ptr<const StoredMesh> mesh)
-      ABSL_EXCLUSIVE_LOCKS_REQUIRED(mu_);
+  std::shared_ptr<const StoredMesh> AdmitLocked(std::shared_ptr<const StoredMesh> mesh);
 
   const uint64_t budget_bytes_;
   std::optional<MeshDisk> disk_;
-  mutable absl::Mutex mu_;
-  std::map<std::string, Slot> meshes_ ABSL_GUARDED_BY(mu_);  // ordered by id for List
-  absl::flat_hash_map<std::string, std::string> aliases_ ABSL_GUARDED_BY(mu_);  // alias -> id
-  std::list<std::string> lru_ ABSL_GUARDED_BY(mu_);  // resident meshes, most recently used first
-  uint64_t used_bytes_ ABSL_GUARDED_BY(mu_) = 0;
-  uint64_t evictions_ ABSL_GUARDED_BY(mu_) = 0;
-  uint64_t disk_loads_ ABSL_GUARDED_BY(mu_) = 0;
+  mutable std::mutex mu_;  // (std::mutex: visible to ThreadSanitizer; members below are guarded by it)
+  std::map<std::string, Slot> meshes_;  // ordered by id for List
+  absl::flat_hash_map<std::string, std::string> aliases_;  // alias -> id
+  std::list<std::string> lru_;  // resident meshes, most recently used first
+  uint64_t used_bytes_ = 0;
+  uint64_t evictions_ = 0;
+  uint64_t disk_loads_ = 0;
 };
 
 // A record from a Mesh resource (the disk header; MeshToProto in proto_convert.h is the reverse).

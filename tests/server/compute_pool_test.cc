@@ -1,8 +1,8 @@
 #include "compute_pool.h"
+#include "server_test_util.h"
 
 #include <atomic>
 
-#include "absl/synchronization/notification.h"
 #include "gtest/gtest.h"
 
 namespace geodex::server {
@@ -18,8 +18,8 @@ TEST(ComputePoolTest, RunsEveryTask) {
 }
 
 TEST(ComputePoolTest, RejectsWhenWorkersBusyAndQueueFull) {
+  testing::Notification started, release;  // outlive the pool, which joins its worker first
   ComputePool pool(1, 1);
-  absl::Notification started, release;
   ASSERT_TRUE(pool.TrySubmit([&] {
     started.Notify();
     release.WaitForNotification();

@@ -4,7 +4,6 @@
 #include <future>
 #include <thread>
 
-#include "absl/synchronization/notification.h"
 #include "absl/time/clock.h"
 #include "google/rpc/error_details.pb.h"
 #include "google/rpc/status.pb.h"
@@ -134,13 +133,14 @@ TEST_F(LifecycleTest, ShutdownLetsAQueuedCallFinishWithinTheGracePeriod) {
   testing::UploadResult up = Upload(*stub_, GridOff(10, 10, true));
   ASSERT_TRUE(up.status.ok());
 
-  auto blocker = std::make_unique<absl::Notification>();
-  absl::Notification blocking;
-  ASSERT_TRUE(server_->pool().TrySubmit([&] {
-    blocking.Notify();
+  // Shared with the task, so they live as long as it does.
+  auto blocker = std::make_shared<testing::Notification>();
+  auto blocking = std::make_shared<testing::Notification>();
+  ASSERT_TRUE(server_->pool().TrySubmit([blocker, blocking] {
+    blocking->Notify();
     blocker->WaitForNotification();
   }));
-  blocking.WaitForNotification();
+  blocking->WaitForNotification();
   // A field request waits in the queue behind the blocked worker.
   std::future<testing::FieldResult> call = std::async(std::launch::async, [&] {
     return ReadField(*stub_, FieldRequest(up.mesh.name(), {0}), 60);

@@ -4,6 +4,8 @@
 // 127.0.0.1:0 with a client stub, chunked uploads and streamed distance fields.
 
 #include <chrono>
+#include <condition_variable>
+#include <mutex>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -20,6 +22,29 @@
 #include "gtest/gtest.h"
 
 namespace geodex::server::testing {
+
+// A one-shot event on std::mutex (visible to ThreadSanitizer, unlike Debian's absl::Notification).
+class Notification {
+ public:
+  void Notify() {
+    std::lock_guard<std::mutex> lock(mu_);
+    notified_ = true;
+    cv_.notify_all();
+  }
+  void WaitForNotification() {
+    std::unique_lock<std::mutex> lock(mu_);
+    cv_.wait(lock, [this] { return notified_; });
+  }
+  bool HasBeenNotified() {
+    std::lock_guard<std::mutex> lock(mu_);
+    return notified_;
+  }
+
+ private:
+  std::mutex mu_;
+  std::condition_variable cv_;
+  bool notified_ = false;
+};
 
 // A (cells_x x cells_y)-cell grid over [0, cells_x] x [0, cells_y] as OFF text; `bumpy` lifts it
 // to a smooth terrain (so geodesics bend at saddles), otherwise it is flat.

@@ -4,7 +4,6 @@
 #include <future>
 #include <thread>
 
-#include "absl/synchronization/notification.h"
 #include "absl/time/clock.h"
 #include "geodex/distance_field.h"
 #include "geodex/geodesic_solver.h"
@@ -32,35 +31,48 @@ std::string LocalId(const std::string& off) {
   return ComputeMeshId(*ReadMeshFromBuffer(off, MeshFormat::kOff, "x.off"));
 }
 
-// Blocks every worker of `pool` until the returned notification is released.
+// Blocks every worker of `pool` until released; the destructor releases and waits until every
+// blocking task has returned (so nothing it uses is destroyed under a worker).
 class PoolBlocker {
  public:
   explicit PoolBlocker(ComputePool& pool) {
-    started_.resize(pool.threads());
-    for (auto& n : started_) n = std::make_unique<absl::Notification>();
-    for (size_t i = 0; i < pool.threads(); ++i) {
+    const size_t n = pool.threads();
+    for (size_t i = 0; i < n; ++i) {
       // A worker that just finished a call may not have counted itself idle yet: retry briefly.
       bool submitted = false;
       for (int attempt = 0; attempt < 10000 && !submitted; ++attempt) {
-        submitted = pool.TrySubmit([this, i] {
-          started_[i]->Notify();
-          release_.WaitForNotification();
+        submitted = pool.TrySubmit([this] {
+          std::unique_lock<std::mutex> lock(mu_);
+          ++running_;
+          cv_.notify_all();
+          cv_.wait(lock, [this] { return released_; });
+          --running_;
+          cv_.notify_all();
         });
         if (!submitted) absl::SleepFor(absl::Milliseconds(1));
       }
       EXPECT_TRUE(submitted);
-      if (!submitted) started_[i]->Notify();
+      if (submitted) ++submitted_;
     }
-    for (auto& n : started_) n->WaitForNotification();
+    std::unique_lock<std::mutex> lock(mu_);
+    cv_.wait(lock, [this] { return running_ == submitted_; });
   }
-  ~PoolBlocker() { Release(); }
+  ~PoolBlocker() {
+    Release();
+    std::unique_lock<std::mutex> lock(mu_);
+    cv_.wait(lock, [this] { return running_ == 0; });
+  }
   void Release() {
-    if (!release_.HasBeenNotified()) release_.Notify();
+    std::lock_guard<std::mutex> lock(mu_);
+    released_ = true;
+    cv_.notify_all();
   }
 
  private:
-  std::vector<std::unique_ptr<absl::Notification>> started_;
-  absl::Notification release_;
+  std::mutex mu_;
+  std::condition_variable cv_;
+  size_t submitted_ = 0, running_ = 0;
+  bool released_ = false;
 };
 
 class ServiceTest : public testing::ServerFixture {};

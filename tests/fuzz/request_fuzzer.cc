@@ -1,0 +1,101 @@
+// libFuzzer target: the query handlers of geodexd (server/queries.h) on arbitrary requests, against
+// an in-process mesh store with two small meshes ("meshes/hills" and its id). Byte 0 picks the
+// method; the rest is parsed as that method's request message. Every outcome must be an answer or
+// a status, never a crash; streamed results are drained. Solves are bounded by a window budget.
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "absl/strings/str_cat.h"
+#include "field_cache.h"
+#include "geodex/cancel.h"
+#include "geodex/mesh_io.h"
+#include "mesh_id.h"
+#include "mesh_store.h"
+#include "queries.h"
+#include "service_limits.h"
+
+namespace {
+
+using namespace geodex;
+using namespace geodex::server;
+
+std::string Grid(int n) {
+  std::string off = absl::StrCat("OFF\n", (n + 1) * (n + 1), " ", 2 * n * n, " 0\n");
+  for (int j = 0; j <= n; ++j) {
+    for (int i = 0; i <= n; ++i) absl::StrAppend(&off, i, " ", j, " ", (i * j) % 3 * 0.25, "\n");
+  }
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      const int a = j * (n + 1) + i;
+      absl::StrAppend(&off, "3 ", a, " ", a + 1, " ", a + n + 2, "\n3 ", a, " ", a + n + 2, " ",
+                      a + n + 1, "\n");
+    }
+  }
+  return off;
+}
+
+struct World {
+  MeshStore store{uint64_t{1} << 30};
+  FieldCache cache{uint64_t{16} << 20};
+  ServiceLimits limits;
+  ServiceCounters counters;
+  World() {
+    limits.max_windows = 100000;
+    limits.max_sources = 64;
+    limits.max_targets = 64;
+    limits.max_levels = 16;
+    limits.max_output_values = 10000;
+    limits.stream_chunk_bytes = 4096;
+    for (int n : {6, 9}) {
+      MeshData data = *ReadMeshFromBuffer(Grid(n), MeshFormat::kOff, "grid.off");
+      auto mesh = MakeStoredMesh(ComputeMeshId(data), *TriangleMesh::Build(data));
+      if (n == 6) mesh->display_name = "hills";
+      (void)store.Insert(std::move(mesh));
+    }
+  }
+};
+
+template <typename Request, typename Response>
+void RunUnary(const uint8_t* data, size_t size, const QueryEnv& env,
+              absl::Status (*run)(const QueryEnv&, const Request&, Response*)) {
+  Request request;
+  if (!request.ParseFromArray(data, static_cast<int>(size))) return;
+  Response response;
+  (void)run(env, request, &response);
+}
+
+template <typename Request, typename Response>
+void RunStream(const uint8_t* data, size_t size, const QueryEnv& env,
+               absl::StatusOr<MessageProducer<Response>> (*run)(const QueryEnv&, const Request&)) {
+  Request request;
+  if (!request.ParseFromArray(data, static_cast<int>(size))) return;
+  absl::StatusOr<MessageProducer<Response>> producer = run(env, request);
+  if (!producer.ok()) return;
+  Response message;
+  for (int i = 0; i < 100000 && (*producer)(&message); ++i) message.Clear();
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  static World* world = new World();
+  if (size < 1) return 0;
+  CancelToken cancel;
+  const QueryEnv env{&world->store, &world->limits, &cancel, &world->cache, &world->counters};
+  const uint8_t* body = data + 1;
+  const size_t n = size - 1;
+  switch (data[0] % 8) {
+    case 0: RunStream(body, n, env, &RunComputeDistanceField); break;
+    case 1: RunUnary(body, n, env, &RunFindShortestPath); break;
+    case 2: RunStream(body, n, env, &RunComputeDistanceMatrix); break;
+    case 3: RunUnary(body, n, env, &RunEstimateDistances); break;
+    case 4: RunUnary(body, n, env, &RunLocatePoints); break;
+    case 5: RunStream(body, n, env, &RunComputeIsolines); break;
+    case 6: RunStream(body, n, env, &RunComputeVoronoi); break;
+    case 7: RunStream(body, n, env, &RunComputeDelaunay); break;
+  }
+  return 0;
+}
