@@ -26,12 +26,9 @@ absl::Status ToAbsl(const grpc::Status& status) {
   return absl::Status(static_cast<absl::StatusCode>(status.error_code()), status.error_message());
 }
 
-bool IsHexId(const std::string& s) {
-  if (s.size() != 64) return false;
-  for (char c : s) {
-    if (!((c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'))) return false;
-  }
-  return true;
+// The mesh id in "meshes/{id}", or "" when the name holds an alias.
+std::string IdOfName(const std::string& name) {
+  return name.size() == 71 && server::IsMeshId(name.substr(7)) ? name.substr(7) : "";
 }
 
 }  // namespace
@@ -169,7 +166,7 @@ absl::StatusOr<v1::Mesh> GeodexClient::GetMesh(const std::string& name) {
   v1::GetMeshRequest request;
   request.set_name(name);
   v1::Mesh mesh;
-  const std::string id = name.size() == 71 && IsHexId(name.substr(7)) ? name.substr(7) : "";
+  const std::string id = IdOfName(name);
   grpc::Status status = Call(id, [&](grpc::ClientContext* context) {
     return stub_->GetMesh(context, request, &mesh);
   });
@@ -199,7 +196,7 @@ absl::Status GeodexClient::DeleteMesh(const std::string& name) {
   v1::DeleteMeshRequest request;
   request.set_name(name);
   v1::DeleteMeshResponse response;
-  const std::string id = name.size() == 71 && IsHexId(name.substr(7)) ? name.substr(7) : "";
+  const std::string id = IdOfName(name);
   return ToAbsl(Call(id, [&](grpc::ClientContext* context) {
     return stub_->DeleteMesh(context, request, &response);
   }));
@@ -231,7 +228,7 @@ absl::StatusOr<MeshRef> GeodexClient::ResolveMesh(const std::string& mesh) {
     return ref;
   }
   const std::string key = mesh.rfind("meshes/", 0) == 0 ? mesh.substr(7) : mesh;
-  if (IsHexId(key)) {
+  if (server::IsMeshId(key)) {
     ref.id = key;
     ref.name = absl::StrCat("meshes/", key);
     return ref;
