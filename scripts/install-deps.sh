@@ -11,6 +11,8 @@ fi
 packages=(
   # toolchain
   g++ cmake ninja-build pkgconf ccache
+  # the libFuzzer tier (scripts/fuzz.sh): clang and its sanitizer/fuzzer runtimes
+  clang libclang-rt-14-dev
   # runtime libraries of the service (gRPC, Protobuf, Abseil, spdlog)
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler libabsl-dev libspdlog-dev prometheus-cpp-dev
   grpc-proto
