@@ -34,6 +34,19 @@ bool ComputePool::TrySubmit(std::function<void()> task) {
   return true;
 }
 
+namespace {
+// Whether the task running on this worker thread already gave back its place (ReleaseWorker).
+thread_local bool t_in_task = false;
+thread_local bool t_released = false;
+}  // namespace
+
+void ComputePool::ReleaseWorker() {
+  if (!t_in_task || t_released) return;
+  t_released = true;
+  std::lock_guard<std::mutex> lock(mu_);
+  --busy_;
+}
+
 void ComputePool::WorkerLoop() {
   for (;;) {
     std::function<void()> task;
@@ -45,7 +58,11 @@ void ComputePool::WorkerLoop() {
       queue_.pop_front();
       ++busy_;
     }
+    t_in_task = true;
+    t_released = false;
     task();
+    t_in_task = false;
+    if (t_released) continue;
     std::lock_guard<std::mutex> lock(mu_);
     --busy_;
   }

@@ -34,6 +34,12 @@ class ComputePool {
   // started before it, and gRPC's own hand-off of calls is invisible to ThreadSanitizer.
   void Publish();
 
+  // Called by a running task just before it hands its result to gRPC (Finish or a first write).
+  // It frees the task's place in the busy count at once: the client's next call may arrive before
+  // this thread returns from the task, and must not be refused for a place whose work is done.
+  // A no-op outside a task, and after the first call within one.
+  void ReleaseWorker();
+
   size_t threads() const { return workers_.size(); }
   size_t queue_capacity() const { return queue_capacity_; }
   size_t queued() const;

@@ -130,10 +130,13 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<v1::CreateMeshReq
   // On the pool.
   void Build() {
     if (cancel_.IsCancelled()) {
+      service_->pool()->ReleaseWorker();
       Finish(CancelledStatus());
       return;
     }
-    Finish(ToGrpcStatus(BuildAndStore()));
+    const absl::Status status = BuildAndStore();
+    service_->pool()->ReleaseWorker();  // before Finish (see ComputePool::ReleaseWorker)
+    Finish(ToGrpcStatus(status));
   }
 
   absl::Status BuildAndStore() {

@@ -62,11 +62,13 @@ class UnaryQueryReactor final : public grpc::ServerUnaryReactor {
 
   void Compute() {
     if (cancel_.IsCancelled()) {
+      env_.pool->ReleaseWorker();
       Finish(CancelledStatus());
       return;
     }
     absl::Status status = run_(QueryEnv{env_.store, env_.limits, &cancel_, env_.cache, env_.counters}, *request_, response_);
     if (!status.ok()) response_->Clear();
+    env_.pool->ReleaseWorker();  // before Finish: the client may send its next call at once
     Finish(ToGrpcStatus(status));
   }
 
@@ -108,11 +110,13 @@ class StreamQueryReactor final : public grpc::ServerWriteReactor<Response> {
 
   void Compute() {
     if (cancel_.IsCancelled()) {
+      env_.pool->ReleaseWorker();
       this->Finish(CancelledStatus());
       return;
     }
     absl::StatusOr<MessageProducer<Response>> producer =
         run_(QueryEnv{env_.store, env_.limits, &cancel_, env_.cache, env_.counters}, *request_);
+    env_.pool->ReleaseWorker();  // before any Finish or write: see ComputePool::ReleaseWorker
     if (!producer.ok()) {
       this->Finish(ToGrpcStatus(producer.status()));
       return;
