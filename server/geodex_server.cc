@@ -18,7 +18,52 @@
 
 namespace geodex::server {
 
+absl::Status ValidateServerOptions(const ServerOptions& options) {
+  auto at_least = [](const char* flag, uint64_t value, uint64_t min, const char* why) {
+    return value >= min ? absl::OkStatus()
+                        : absl::InvalidArgumentError(absl::StrCat("--", flag, "=", value,
+                                                                  ": must be at least ", min, why));
+  };
+  if (options.pool_threads > kMaxPoolThreads) {
+    return absl::InvalidArgumentError(absl::StrCat("--pool_threads=", options.pool_threads,
+                                                   ": at most ", kMaxPoolThreads,
+                                                   " (0 = one per hardware thread)"));
+  }
+  if (options.queue_capacity > kMaxQueueCapacity) {
+    return absl::InvalidArgumentError(absl::StrCat("--queue_capacity=", options.queue_capacity,
+                                                   ": at most ", kMaxQueueCapacity));
+  }
+  const ServiceLimits& l = options.limits;
+  const uint64_t stream_chunk = l.stream_chunk_bytes;
+  for (absl::Status status : {
+           at_least("mesh_budget_bytes", options.mesh_budget_bytes, 1, ""),
+           at_least("max_receive_message_bytes",
+                    options.max_receive_message_bytes < 0
+                        ? 0
+                        : static_cast<uint64_t>(options.max_receive_message_bytes),
+                    uint64_t{1} << 16, " (uploads arrive in chunks of up to 1 MiB by default)"),
+           at_least("max_upload_bytes", l.max_upload_bytes, 1, ""),
+           at_least("max_vertices", l.max_vertices, 1, ""),
+           at_least("max_faces", l.max_faces, 1, ""),
+           at_least("max_sources", l.max_sources, 1, ""),
+           at_least("max_targets", l.max_targets, 1, ""),
+           at_least("max_levels", l.max_levels, 1, ""),
+           at_least("max_output_values", l.max_output_values, 1, ""),
+           at_least("max_unary_response_bytes", l.max_unary_response_bytes, 1, ""),
+           at_least("stream_chunk_bytes", stream_chunk, 256, ""),
+       }) {
+    if (!status.ok()) return status;
+  }
+  if (stream_chunk > kMaxStreamChunkBytes) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--stream_chunk_bytes=", stream_chunk, ": at most ", kMaxStreamChunkBytes,
+                     " (clients keep gRPC's default 4 MiB receive limit)"));
+  }
+  return absl::OkStatus();
+}
+
 absl::StatusOr<std::unique_ptr<GeodexServer>> GeodexServer::Start(const ServerOptions& options) {
+  if (absl::Status valid = ValidateServerOptions(options); !valid.ok()) return valid;
   std::unique_ptr<GeodexServer> s(new GeodexServer());
   size_t threads = options.pool_threads;
   if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());

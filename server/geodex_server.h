@@ -55,6 +55,14 @@ struct ServerOptions {
 absl::StatusOr<std::string> AddMesh(MeshStore& store, const MeshData& data,
                                     const std::string& alias, uint64_t file_bytes);
 
+// Checks the settings before anything starts: InvalidArgument naming the flag and its allowed
+// range for a value that cannot work (no thread pool of 100,000 threads, no zero-byte messages,
+// no budget of zero). GeodexServer::Start calls it first.
+absl::Status ValidateServerOptions(const ServerOptions& options);
+inline constexpr size_t kMaxPoolThreads = 1024;
+inline constexpr size_t kMaxQueueCapacity = 1'000'000;
+inline constexpr uint64_t kMaxStreamChunkBytes = 3 << 20;
+
 // A whole (small) file, e.g. a PEM certificate; InvalidArgument naming `flag` when unreadable/empty.
 absl::StatusOr<std::string> ReadSmallFile(const std::string& path, const std::string& flag);
 

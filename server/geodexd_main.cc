@@ -133,6 +133,11 @@ int main(int argc, char** argv) {
   options.limits.max_unary_response_bytes = absl::GetFlag(FLAGS_max_unary_response_bytes);
   options.limits.stream_chunk_bytes = absl::GetFlag(FLAGS_stream_chunk_bytes);
   options.limits.max_windows = absl::GetFlag(FLAGS_max_windows);
+  const double grace = absl::GetFlag(FLAGS_shutdown_grace_seconds);
+  if (!(grace >= 0 && grace <= 24 * 3600)) {
+    spdlog::error("--shutdown_grace_seconds={}: must be between 0 and 86400", grace);
+    return 1;
+  }
   auto server = geodex::server::GeodexServer::Start(options);
   if (!server.ok()) {
     spdlog::error("{}", std::string(server.status().message()));

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The geodexd binary as an operator runs it: starts on 127.0.0.1 (a port it picks), reports
-# where it listens (flags spelled with dashes or underscores), and on SIGTERM drains and exits 0. Bounded: gives up after 30 s.
+# where it listens (flags spelled with dashes or underscores), and on SIGTERM drains and exits 0;
+# settings that cannot work make it exit 1 naming the flag. Bounded: gives up after 30 s.
 # Env: GEODEXD (the binary).
 set -u
 pass=0
@@ -36,6 +37,16 @@ done
 if [ "$rc" -eq 124 ]; then kill -KILL "$pid" 2>/dev/null; fi
 check "SIGTERM exits 0" test "$rc" -eq 0
 check "logs the shutdown" grep -q "shutting down" "$tmp/log"
+# Settings that cannot work: exit 1 at once with one line naming the flag, never a crash.
+for bad in --pool_threads=100000 --stream_chunk_bytes=0 --mesh_budget_bytes=0 \
+           --shutdown_grace_seconds=-5 --max_receive_message_bytes=0; do
+  flag=${bad%%=*}
+  timeout 30 "$GEODEXD" --listen 127.0.0.1:0 --metrics_listen= --samples=false "$bad" \
+    >"$tmp/bad.log" 2>&1
+  rc=$?
+  check "$bad exits 1" test "$rc" -eq 1
+  check "$bad is named in the error" grep -q -- "$flag" "$tmp/bad.log"
+done
 rm -rf "$tmp"
 echo "geodexd smoke: $pass passed, $fail failed"
 test "$fail" -eq 0

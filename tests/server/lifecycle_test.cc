@@ -186,5 +186,41 @@ TEST_F(LifecycleTest, ShutdownCancelsALongSolveAtTheGraceDeadline) {
   EXPECT_LT(absl::Now() - start, absl::Seconds(120));
 }
 
+// Settings that cannot work are refused before anything starts, naming the flag; geodexd prints
+// the message and exits 1. (--pool_threads=100000 used to abort with std::system_error.)
+TEST(ServerOptionsTest, SettingsThatCannotWorkFailToStartNamingTheFlag) {
+  ServerOptions defaults;
+  defaults.listen = "127.0.0.1:0";
+  EXPECT_TRUE(ValidateServerOptions(defaults).ok());
+  struct Case {
+    const char* flag;
+    void (*set)(ServerOptions&);
+  };
+  const Case cases[] = {
+      {"--pool_threads", [](ServerOptions& o) { o.pool_threads = 100000; }},
+      {"--queue_capacity", [](ServerOptions& o) { o.queue_capacity = size_t{1} << 40; }},
+      {"--mesh_budget_bytes", [](ServerOptions& o) { o.mesh_budget_bytes = 0; }},
+      {"--max_receive_message_bytes", [](ServerOptions& o) { o.max_receive_message_bytes = 0; }},
+      {"--max_receive_message_bytes", [](ServerOptions& o) { o.max_receive_message_bytes = -5; }},
+      {"--max_upload_bytes", [](ServerOptions& o) { o.limits.max_upload_bytes = 0; }},
+      {"--max_vertices", [](ServerOptions& o) { o.limits.max_vertices = 0; }},
+      {"--max_faces", [](ServerOptions& o) { o.limits.max_faces = 0; }},
+      {"--max_sources", [](ServerOptions& o) { o.limits.max_sources = 0; }},
+      {"--max_targets", [](ServerOptions& o) { o.limits.max_targets = 0; }},
+      {"--max_levels", [](ServerOptions& o) { o.limits.max_levels = 0; }},
+      {"--max_output_values", [](ServerOptions& o) { o.limits.max_output_values = 0; }},
+      {"--max_unary_response_bytes", [](ServerOptions& o) { o.limits.max_unary_response_bytes = 0; }},
+      {"--stream_chunk_bytes", [](ServerOptions& o) { o.limits.stream_chunk_bytes = 0; }},
+      {"--stream_chunk_bytes", [](ServerOptions& o) { o.limits.stream_chunk_bytes = 64u << 20; }},
+  };
+  for (const Case& c : cases) {
+    ServerOptions options = defaults;
+    c.set(options);
+    absl::StatusOr<std::unique_ptr<GeodexServer>> server = GeodexServer::Start(options);
+    EXPECT_EQ(server.status().code(), absl::StatusCode::kInvalidArgument) << c.flag;
+    EXPECT_NE(server.status().message().find(c.flag), std::string::npos) << server.status();
+  }
+}
+
 }  // namespace
 }  // namespace geodex::server
