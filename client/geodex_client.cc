@@ -12,6 +12,8 @@
 #include "api_convert.h"
 #include "geodex/mesh_io.h"
 #include "geodex/samples.h"
+#include "google/rpc/error_details.pb.h"
+#include "google/rpc/status.pb.h"
 #include "grpcpp/create_channel.h"
 #include "grpcpp/generic/generic_stub.h"
 #include "grpcpp/security/credentials.h"
@@ -59,6 +61,21 @@ GeodexClient::GeodexClient(ClientOptions options) : options_(std::move(options))
   stub_ = v1::Geodex::NewStub(channel_);
 }
 
+namespace {
+// RESOURCE_EXHAUSTED because every worker was busy and the queue full (ErrorInfo reason QUEUE_FULL,
+// see server/status_convert.h), as opposed to a request over a limit.
+bool IsQueueFull(const grpc::Status& status) {
+  if (status.error_code() != grpc::StatusCode::RESOURCE_EXHAUSTED) return false;
+  google::rpc::Status details;
+  if (!details.ParseFromString(status.error_details())) return false;
+  for (const google::protobuf::Any& any : details.details()) {
+    google::rpc::ErrorInfo info;
+    if (any.UnpackTo(&info) && info.reason() == "QUEUE_FULL") return true;
+  }
+  return false;
+}
+}  // namespace
+
 grpc::Status GeodexClient::Call(const std::string& mesh_id,
                                 const std::function<grpc::Status(grpc::ClientContext*)>& call) {
   double backoff = options_.initial_backoff_seconds;
@@ -82,7 +99,10 @@ grpc::Status GeodexClient::Call(const std::string& mesh_id,
     if (auto it = metadata.find("x-geodex-replica"); it != metadata.end()) {
       last_replica_.assign(it->second.data(), it->second.size());
     }
-    if (status.error_code() != grpc::StatusCode::UNAVAILABLE) break;
+    if (status.error_code() != grpc::StatusCode::UNAVAILABLE &&
+        !(options_.retry_queue_full && IsQueueFull(status))) {
+      break;
+    }
   }
   return status;
 }

@@ -3,7 +3,9 @@
 // The C++ client library of geodexd (what `geodex --server` uses).
 //
 // - Every call has a deadline and is retried with exponential backoff when the server answers
-//   UNAVAILABLE (not yet listening, restarting, draining).
+//   UNAVAILABLE (not yet listening, restarting, draining), or RESOURCE_EXHAUSTED with the
+//   ErrorInfo reason QUEUE_FULL (every worker busy and the queue full: a moment later it may
+//   fit). RESOURCE_EXHAUSTED for a limit (reason LIMIT) is never retried: it would fail again.
 // - A mesh is named by a local file (or "sample:NAME"), a 64-hex mesh id or an alias. A file is
 //   parsed locally and its id computed with the server's content hash (mesh_id.h); it is uploaded
 //   only when the server does not have it, and uploaded again, transparently and once, when a
@@ -35,8 +37,9 @@ namespace geodex::client {
 struct ClientOptions {
   std::string target = "127.0.0.1:50051";  // HOST:PORT
   double deadline_seconds = 600;            // per call
-  int max_attempts = 4;                     // tries on UNAVAILABLE
-  double initial_backoff_seconds = 0.2;     // doubled after each UNAVAILABLE
+  int max_attempts = 4;                     // tries on UNAVAILABLE or a full queue
+  double initial_backoff_seconds = 0.2;     // doubled after each retry
+  bool retry_queue_full = true;             // retry RESOURCE_EXHAUSTED reason QUEUE_FULL
   size_t upload_chunk_bytes = 1 << 20;
   // TLS: `tls` on, with `ca_pem` the PEM roots to trust ("" = the system's roots).
   bool tls = false;
@@ -102,7 +105,8 @@ class GeodexClient {
   absl::StatusOr<std::vector<SurfacePoint>> Locate(MeshRef& mesh,
                                                    const std::vector<std::array<double, 3>>& xyz);
 
-  // Calls made, UNAVAILABLE retries and transparent re-uploads (for tests and --stats).
+  // Calls made, retries (UNAVAILABLE, full queue) and transparent re-uploads (for tests and
+  // --stats).
   int calls() const { return calls_; }
   int retries() const { return retries_; }
   int reuploads() const { return reuploads_; }
@@ -111,7 +115,7 @@ class GeodexClient {
 
  private:
   // Runs `call(context)` with a fresh context (deadline, x-mesh-id) per attempt, retrying on
-  // UNAVAILABLE.
+  // UNAVAILABLE and on a full queue.
   grpc::Status Call(const std::string& mesh_id,
                     const std::function<grpc::Status(grpc::ClientContext*)>& call);
   // Runs a mesh-scoped query; on NOT_FOUND for a mesh this client has the file of, uploads it

@@ -4,7 +4,9 @@
 
 #include <filesystem>
 #include <fstream>
+#include <thread>
 
+#include "absl/time/clock.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/samples.h"
 #include "geodex_client.h"
@@ -96,6 +98,54 @@ TEST_F(ClientTest, AQueryForALostMeshReuploadsItOnce) {
   ASSERT_TRUE(server_->store().Delete(mesh->id).ok());
   EXPECT_TRUE(absl::IsNotFound(
       client.Field(by_id, {SurfacePoint::AtVertex(0)}, v1::SolverOptions()).status()));
+}
+
+// A full queue (every worker busy, no room to wait) is worth retrying a moment later; a request
+// over a limit is not. The worker is held by a task of the test's own, released after the first
+// refusal, so the first attempt is refused for certain and a later one succeeds.
+TEST_F(ClientTest, QueueFullIsRetriedWithBackoffButALimitIsNot) {
+  ServerOptions options;
+  options.pool_threads = 1;
+  options.queue_capacity = 0;
+  options.limits.max_targets = 1;
+  StartServer(options);
+  ClientOptions client_options;
+  client_options.target = absl::StrCat("127.0.0.1:", server_->port());
+  client_options.deadline_seconds = 60;
+  client_options.max_attempts = 10;  // backoff 0.05 s doubling: up to 25 s in all
+  client_options.initial_backoff_seconds = 0.05;
+  GeodexClient client(client_options);
+  const std::string off = GridOff(6, 6, true);
+  MeshRef mesh = *client.ResolveMesh(WriteFile("client-queue.off", off));
+
+  testing::Notification release;
+  ASSERT_TRUE(server_->pool().TrySubmit([&release] { release.WaitForNotification(); }));
+  for (int i = 0; i < 6000 && server_->pool().busy() == 0; ++i) absl::SleepFor(absl::Milliseconds(5));
+  ASSERT_EQ(server_->pool().busy(), 1u);
+  const uint64_t rejected_before = server_->pool().rejected();
+  std::thread releaser([&] {
+    for (int i = 0; i < 6000 && server_->pool().rejected() == rejected_before; ++i) {
+      absl::SleepFor(absl::Milliseconds(5));
+    }
+    release.Notify();
+  });
+  const int retries_before = client.retries();
+  absl::StatusOr<DistanceField> field =
+      client.Field(mesh, {SurfacePoint::AtVertex(3)}, v1::SolverOptions());
+  releaser.join();
+  ASSERT_TRUE(field.ok()) << field.status();
+  EXPECT_GE(client.retries() - retries_before, 1);
+  EXPECT_GE(server_->pool().rejected(), rejected_before + 1);
+  EXPECT_EQ(field->distance,
+            ComputeDistanceField(testing::BuildLocal(off), {SurfacePoint::AtVertex(3)})->distance);
+
+  // Two targets with --max_targets=1: RESOURCE_EXHAUSTED (reason LIMIT) at once, no retry.
+  const int retries_mid = client.retries();
+  absl::StatusOr<DistanceMatrix> matrix = client.Matrix(
+      mesh, {SurfacePoint::AtVertex(0)}, {SurfacePoint::AtVertex(1), SurfacePoint::AtVertex(2)},
+      v1::SolverOptions());
+  EXPECT_EQ(matrix.status().code(), absl::StatusCode::kResourceExhausted) << matrix.status();
+  EXPECT_EQ(client.retries(), retries_mid);
 }
 
 TEST(ClientRetryTest, UnavailableIsRetriedWithBackoffThenReported) {
