@@ -24,9 +24,7 @@
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
-#include <signal.h>
 #include <sys/socket.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -48,6 +46,7 @@
 #include "grpcpp/security/credentials.h"
 #include "grpcpp/support/channel_arguments.h"
 #include "query_mix.h"
+#include "util/geodexd_child.h"
 
 namespace geodex::bench {
 namespace {
@@ -102,73 +101,21 @@ double MetricValue(const std::string& text, const std::string& name) {
   return std::regex_search(text, m, line) ? std::stod(m[2]) : -1;
 }
 
-class Child {
+// geodexd on DIR/data with no samples, both ports picked by it, plus `flags`.
+class Child : public testing_support::GeodexdChild {
  public:
   Child(const fs::path& dir, const std::string& binary, std::vector<std::string> flags)
-      : log_(dir / "geodexd.log") {
-    fs::create_directories(dir);
+      : GeodexdChild(Args(dir, binary, std::move(flags)), dir / "geodexd.log") {}
+
+ private:
+  static std::vector<std::string> Args(const fs::path& dir, const std::string& binary,
+                                       std::vector<std::string> flags) {
     std::vector<std::string> args = {binary, "--listen", "127.0.0.1:0", "--metrics_listen",
                                      "127.0.0.1:0", "--data-dir", (dir / "data").string(),
                                      "--samples=false"};
     args.insert(args.end(), flags.begin(), flags.end());
-    pid_ = ::fork();
-    if (pid_ == 0) {
-      std::FILE* out = std::freopen(log_.c_str(), "w", stdout);
-      ::dup2(::fileno(out), 2);
-      std::vector<char*> argv;
-      for (std::string& a : args) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      ::execv(argv[0], argv.data());
-      ::_exit(127);
-    }
-    const std::regex grpc_port("listening on port ([0-9]+)");
-    const std::regex metrics_port("127.0.0.1:([0-9]+)/metrics");
-    for (int i = 0; i < 1200 && (port_ == 0 || metrics_port_ == 0) && Running(); ++i) {
-      const std::string text = Log();
-      std::smatch m;
-      if (std::regex_search(text, m, grpc_port)) port_ = std::stoi(m[1]);
-      if (std::regex_search(text, m, metrics_port)) metrics_port_ = std::stoi(m[1]);
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    }
+    return args;
   }
-  ~Child() {
-    if (!exited_) {
-      ::kill(pid_, SIGKILL);
-      ::waitpid(pid_, nullptr, 0);
-    }
-  }
-  bool Running() {
-    int status = 0;
-    if (!exited_ && ::waitpid(pid_, &status, WNOHANG) == pid_) exited_ = true;
-    return !exited_;
-  }
-  // SIGTERM; the exit status, or -1 if it had not exited after `seconds` (then SIGKILL).
-  int Terminate(double seconds) {
-    ::kill(pid_, SIGTERM);
-    for (int i = 0; i < seconds * 20; ++i) {
-      int status = 0;
-      if (::waitpid(pid_, &status, WNOHANG) == pid_) {
-        exited_ = true;
-        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    }
-    return -1;
-  }
-  std::string Log() const {
-    std::ifstream in(log_);
-    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  }
-  pid_t pid() const { return pid_; }
-  int port() const { return port_; }
-  int metrics_port() const { return metrics_port_; }
-
- private:
-  fs::path log_;
-  pid_t pid_ = -1;
-  bool exited_ = false;
-  int port_ = 0;
-  int metrics_port_ = 0;
 };
 
 struct PhaseReport {

@@ -2,18 +2,16 @@
 // SIGTERM with a call in flight drains and exits 0, and a restart on the same data directory keeps
 // every mesh and its answers. Every wait is bounded; only the children started here are signalled.
 
-#include <signal.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 #include <future>
-#include <regex>
 
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
 #include "server_test_util.h"
+#include "util/geodexd_child.h"
 
 namespace geodex::server {
 namespace {
@@ -25,72 +23,30 @@ using testing::Upload;
 
 namespace fs = std::filesystem;
 
+// The binary (tests/util/geodexd_child.h) on DIR/data, one worker, with a client stub.
 class Geodexd {
  public:
   Geodexd(const fs::path& dir, std::vector<std::string> extra)
-      : log_(dir / absl::StrCat("geodexd-", next_log_++, ".log")) {
+      : child_(Args(dir, std::move(extra)), dir / absl::StrCat("geodexd-", next_log_++, ".log")) {
+    channel_ = grpc::CreateChannel(absl::StrCat("127.0.0.1:", child_.port()),
+                                   grpc::InsecureChannelCredentials());
+    stub_ = v1::Geodex::NewStub(channel_);
+  }
+  int Terminate(double seconds) { return child_.Terminate(seconds); }
+  std::string Log() const { return child_.Log(); }
+  int port() const { return child_.port(); }
+  v1::Geodex::Stub& stub() { return *stub_; }
+
+ private:
+  static std::vector<std::string> Args(const fs::path& dir, std::vector<std::string> extra) {
     std::vector<std::string> args = {GEODEXD_BINARY, "--listen", "127.0.0.1:0", "--data-dir",
                                      (dir / "data").string(), "--metrics_listen", "127.0.0.1:0",
                                      "--pool_threads", "1"};
     args.insert(args.end(), extra.begin(), extra.end());
-    pid_ = ::fork();
-    if (pid_ == 0) {
-      std::FILE* out = std::freopen(log_.c_str(), "w", stdout);
-      ::dup2(::fileno(out), 2);
-      std::vector<char*> argv;
-      for (std::string& a : args) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      ::execv(argv[0], argv.data());
-      ::_exit(127);
-    }
-    // Wait (bounded) for both ports in the log.
-    const std::regex grpc_port("listening on port ([0-9]+)"), metrics_port("127.0.0.1:([0-9]+)/metrics");
-    for (int i = 0; i < 600 && (port_ == 0 || metrics_port_ == 0); ++i) {
-      std::ifstream in(log_);
-      std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-      std::smatch m;
-      if (std::regex_search(text, m, grpc_port)) port_ = std::stoi(m[1]);
-      if (std::regex_search(text, m, metrics_port)) metrics_port_ = std::stoi(m[1]);
-      if (port_ == 0) absl::SleepFor(absl::Milliseconds(50));
-    }
-    channel_ = grpc::CreateChannel(absl::StrCat("127.0.0.1:", port_),
-                                   grpc::InsecureChannelCredentials());
-    stub_ = v1::Geodex::NewStub(channel_);
+    return args;
   }
-  ~Geodexd() {
-    if (pid_ > 0 && !exited_) {
-      ::kill(pid_, SIGKILL);
-      ::waitpid(pid_, nullptr, 0);
-    }
-  }
-  // SIGTERM, then the exit status (-1 if it did not exit within `seconds`; then SIGKILL).
-  int Terminate(double seconds) {
-    ::kill(pid_, SIGTERM);
-    for (int i = 0; i < seconds * 20; ++i) {
-      int status = 0;
-      if (::waitpid(pid_, &status, WNOHANG) == pid_) {
-        exited_ = true;
-        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-      }
-      absl::SleepFor(absl::Milliseconds(50));
-    }
-    return -1;
-  }
-  std::string Log() const {
-    std::ifstream in(log_);
-    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  }
-
-  int port() const { return port_; }
-  v1::Geodex::Stub& stub() { return *stub_; }
-
- private:
   static inline int next_log_ = 0;  // a fresh log per process: never read a previous one's port
-  fs::path log_;
-  pid_t pid_ = -1;
-  bool exited_ = false;
-  int port_ = 0;
-  int metrics_port_ = 0;
+  testing_support::GeodexdChild child_;
   std::shared_ptr<grpc::Channel> channel_;
   std::unique_ptr<v1::Geodex::Stub> stub_;
 };
