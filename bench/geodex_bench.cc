@@ -97,7 +97,13 @@ struct Config {
   int sources = 2;
   int repeat = 0;  // 0: 3 below 100k faces, 1 from 100k faces on
   uint64_t cgal_max_faces = 100'000;
-  bool run_ich = true, run_dijkstra = true, run_cgal = true;
+  // run_ich: geodex's default exact engine (Method::kExact, "exact" in --methods); run_paper: the
+  // paper's ICH with its window tree (Method::kIch, "ich").
+  bool run_ich = true, run_dijkstra = true, run_cgal = true, run_paper = false;
+  // --terrain: DEM-like grids made here (bumpy, and half exactly flat); --large: also 1M faces.
+  bool terrain = false, large = false;
+  // --peer NAME=COMMAND: another exact code, run as `COMMAND MESH SOURCE OUT` (see kUsage).
+  std::vector<std::pair<std::string, std::string>> peers;
   std::string markdown;
   double timeout_s = 300;
   double wait_idle_s = 0;
@@ -132,7 +138,8 @@ bool PointQueryMode(const Config& config) {
 
 constexpr char kUsage[] =
     "usage: geodex_bench [--meshes DIR] [--mesh FILE ...] [--sources N] [--repeat R]\n"
-    "                    [--cgal-max-faces F] [--methods ich,dijkstra,cgal] [--markdown OUT.md]\n"
+    "                    [--cgal-max-faces F] [--methods exact,ich,dijkstra,cgal]\n"
+    "                    [--terrain] [--large] [--peer NAME=COMMAND] [--markdown OUT.md]\n"
     "                    [--timeout-s T] [--wait-idle S] [--ablation] [--lambda]\n"
     "                    [--astar] [--matrix] [--estimate] [--seed N] [--per-group N]\n"
     "                    [--points N] [--batch N]\n"
@@ -145,7 +152,14 @@ constexpr char kUsage[] =
     "  --repeat R          repeats per measurement, the median is reported (default: 3 below\n"
     "                      100k faces, 1 above)\n"
     "  --cgal-max-faces F  run CGAL only on meshes with at most F faces (default 100000)\n"
-    "  --methods LIST      any of ich,dijkstra,cgal (default all)\n"
+    "  --methods LIST      any of exact (geodex's default engine), ich (the paper's ICH with its\n"
+    "                      window tree), dijkstra, cgal (default exact,dijkstra,cgal)\n"
+    "  --terrain           add DEM-like grids made at run time: a bumpy terrain and the same\n"
+    "                      with half of it exactly flat (a lake at its median height), ~89k faces\n"
+    "  --large             with --terrain: also their 1M-face versions (707 x 707 vertices)\n"
+    "  --peer NAME=CMD     also time another exact code: `CMD MESH SOURCE OUT` must write the\n"
+    "                      distances of every file vertex as raw doubles to OUT and print a line\n"
+    "                      with ms=<propagation ms>; its peak RSS comes from wait4 (repeatable)\n"
     "  --markdown OUT.md   also write the tables as Markdown\n"
     "  --timeout-s T       kill a measurement after T seconds (default 300)\n"
     "  --wait-idle S       before each measurement wait up to S seconds until the other\n"
@@ -204,10 +218,15 @@ absl::StatusOr<Config> ParseArgs(int argc, char** argv) {
       config.matrix = true;
     } else if (arg == "--estimate") {
       config.estimate = true;
+    } else if (arg == "--terrain") {
+      config.terrain = true;
+    } else if (arg == "--large") {
+      config.large = true;
     } else if (arg == "--meshes" || arg == "--mesh" || arg == "--sources" || arg == "--repeat" ||
                arg == "--cgal-max-faces" || arg == "--methods" || arg == "--markdown" ||
                arg == "--timeout-s" || arg == "--wait-idle" || arg == "--seed" ||
-               arg == "--per-group" || arg == "--points" || arg == "--batch") {
+               arg == "--per-group" || arg == "--points" || arg == "--batch" ||
+               arg == "--peer") {
       absl::StatusOr<std::string> v = next();
       if (!v.ok()) return v.status();
       if (arg == "--meshes") {
@@ -224,11 +243,17 @@ absl::StatusOr<Config> ParseArgs(int argc, char** argv) {
         if (!absl::SimpleAtoi(*v, &config.repeat) || config.repeat < 1) return bad(*v);
       } else if (arg == "--cgal-max-faces") {
         if (!absl::SimpleAtoi(*v, &config.cgal_max_faces)) return bad(*v);
+      } else if (arg == "--peer") {
+        const size_t eq = v->find('=');
+        if (eq == std::string::npos || eq == 0 || eq + 1 == v->size()) return bad(*v);
+        config.peers.emplace_back(v->substr(0, eq), v->substr(eq + 1));
       } else if (arg == "--methods") {
-        config.run_ich = config.run_dijkstra = config.run_cgal = false;
+        config.run_ich = config.run_dijkstra = config.run_cgal = config.run_paper = false;
         for (absl::string_view m : absl::StrSplit(*v, ',', absl::SkipEmpty())) {
-          if (m == "ich") {
+          if (m == "exact") {
             config.run_ich = true;
+          } else if (m == "ich") {
+            config.run_paper = true;
           } else if (m == "dijkstra") {
             config.run_dijkstra = true;
           } else if (m == "cgal") {
@@ -335,6 +360,95 @@ std::string UtcNow() {
   char buf[64];
   std::strftime(buf, sizeof(buf), "%Y-%m-%d %H:%M UTC", &tm);
   return buf;
+}
+
+// ------------------------------------------------------------------------------------------------
+// DEM-like grids (--terrain)
+
+// A height field on n x n grid points over the unit square, like a DEM: vertex (row, col) has id
+// row * n + col, every cell split into two triangles along the same diagonal. The relief is 60
+// Gaussian bumps and pits (seeded, so every run makes the same grid). With `flat_share` > 0 every
+// height below the flat_share quantile becomes exactly that quantile: a lake or sea stored at one
+// level, the flat areas real DEMs have.
+MeshData MakeDemGrid(int n, double flat_share, uint64_t seed) {
+  struct Bump {
+    double x, y, amplitude, width;
+  };
+  std::vector<Bump> bumps;
+  uint64_t state = seed;
+  auto uniform = [&]() {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return static_cast<double>(state >> 11) * 0x1.0p-53;
+  };
+  for (int k = 0; k < 60; ++k) {
+    Bump b;
+    b.x = uniform();
+    b.y = uniform();
+    b.amplitude = (uniform() < 0.5 ? -1 : 1) * (0.02 + 0.06 * uniform());
+    b.width = 0.03 + 0.07 * uniform();
+    bumps.push_back(b);
+  }
+  MeshData m;
+  m.positions.reserve(3 * size_t(n) * n);
+  std::vector<double> heights;
+  for (int row = 0; row < n; ++row) {
+    for (int col = 0; col < n; ++col) {
+      const double x = col / double(n - 1), y = row / double(n - 1);
+      double z = 0;
+      for (const Bump& b : bumps) {
+        const double r2 = (x - b.x) * (x - b.x) + (y - b.y) * (y - b.y);
+        z += b.amplitude * std::exp(-r2 / (2 * b.width * b.width));
+      }
+      m.positions.insert(m.positions.end(), {x, y, z});
+      heights.push_back(z);
+    }
+  }
+  if (flat_share > 0) {
+    std::vector<double> sorted = heights;
+    const size_t k = static_cast<size_t>(flat_share * (sorted.size() - 1));
+    std::nth_element(sorted.begin(), sorted.begin() + k, sorted.end());
+    const double level = sorted[k];
+    for (size_t v = 0; v < heights.size(); ++v) {
+      m.positions[3 * v + 2] = std::max(heights[v], level);
+    }
+  }
+  m.faces.reserve(6 * size_t(n - 1) * (n - 1));
+  for (int row = 0; row + 1 < n; ++row) {
+    for (int col = 0; col + 1 < n; ++col) {
+      const uint32_t a = row * n + col, b = a + 1, c = a + n, d = c + 1;
+      m.faces.insert(m.faces.end(), {a, b, d});
+      m.faces.insert(m.faces.end(), {a, d, c});
+    }
+  }
+  return m;
+}
+
+// Writes the --terrain grids as OFF files (full double precision, readable by peers) into a fresh
+// directory under /tmp; returns their paths.
+std::vector<std::string> WriteDemGrids(const Config& config, std::string* dir) {
+  char templ[] = "/tmp/geodex_bench_dem_XXXXXX";
+  if (mkdtemp(templ) == nullptr) return {};
+  *dir = templ;
+  struct Grid {
+    std::string name;
+    int n;
+    double flat;
+  };
+  std::vector<Grid> grids = {{"dem-bumpy-88k", 211, 0}, {"dem-half-flat-88k", 211, 0.5}};
+  if (config.large) {
+    grids.push_back({"dem-bumpy-997k", 707, 0});
+    grids.push_back({"dem-half-flat-997k", 707, 0.5});
+  }
+  std::vector<std::string> paths;
+  for (const Grid& g : grids) {
+    const std::string path = *dir + "/" + g.name + ".off";
+    if (absl::Status st = WriteMeshOff(path, MakeDemGrid(g.n, g.flat, 2010)); !st.ok()) {
+      std::fprintf(stderr, "geodex_bench: %s\n", std::string(st.message()).c_str());
+      continue;
+    }
+    paths.push_back(path);
+  }
+  return paths;
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -1372,6 +1486,107 @@ Outcome RunGeodex(const MeshInfo& mesh, const std::vector<uint32_t>& sources,
   return RunChild(job, config.timeout_s, config.wait_idle_s);
 }
 
+// VTP's single-source time over Dijkstra's, measured next to geodex on this machine kind
+// (../shared/notes/anchors.md, 2026-11-24), by mesh name: the line to beat. 0 when unknown.
+double AnchorVtpOverDijkstra(const std::string& mesh) {
+  static const std::vector<std::pair<std::string, double>> anchors = {
+      {"gargoyle", 36}, {"armadillo", 29}, {"jacksboro-terrain", 39}, {"dragon-vrip", 35}};
+  for (const auto& [name, ratio] : anchors) {
+    if (name == mesh) return ratio;
+  }
+  return 0;
+}
+
+// Runs a peer's command `COMMAND MESH SOURCE OUT` `repeat` times in its own process (exec'd by
+// sh, so wait4's peak RSS is the peer's): the median of its ms=<value> lines is solve_ms, and the
+// distances it wrote to OUT (raw doubles, one per file vertex) come back for comparison.
+Outcome RunPeer(const std::string& command, const MeshInfo& mesh, uint32_t source, int repeat,
+                const Config& config) {
+  Outcome outcome;
+  char out_path[] = "/tmp/geodex_bench_peer_XXXXXX";
+  const int out_fd = mkstemp(out_path);
+  if (out_fd < 0) {
+    outcome.message = absl::StrCat("mkstemp: ", std::strerror(errno));
+    return outcome;
+  }
+  close(out_fd);
+  std::vector<double> times;
+  for (int r = 0; r < repeat; ++r) {
+    WaitForIdle(config.wait_idle_s);
+    int fds[2];
+    if (pipe2(fds, O_CLOEXEC) != 0) break;
+    const std::string line =
+        absl::StrCat("exec ", command, " '", mesh.path, "' ", source, " '", out_path, "'");
+    const auto start = std::chrono::steady_clock::now();
+    const pid_t pid = fork();
+    if (pid == 0) {
+      dup2(fds[1], STDOUT_FILENO);
+      execl("/bin/sh", "sh", "-c", line.c_str(), static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    close(fds[1]);
+    std::string text;
+    char buf[4096];
+    bool timed_out = false;
+    while (true) {
+      const double left_ms = config.timeout_s * 1000 - MsSince(start);
+      if (left_ms <= 0) {
+        timed_out = true;
+        if (pid > 0) kill(pid, SIGKILL);
+        break;
+      }
+      struct pollfd p = {fds[0], POLLIN, 0};
+      const int ready = poll(&p, 1, static_cast<int>(std::min(left_ms + 1, 60'000.0)));
+      if (ready < 0 && errno != EINTR) break;
+      if (ready <= 0) continue;
+      const ssize_t n = read(fds[0], buf, sizeof buf);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) break;
+      text.append(buf, static_cast<size_t>(n));
+    }
+    close(fds[0]);
+    int status = 0;
+    struct rusage usage;
+    std::memset(&usage, 0, sizeof usage);
+    while (pid > 0 && wait4(pid, &status, 0, &usage) < 0 && errno == EINTR) {
+    }
+    outcome.elapsed_s = MsSince(start) / 1000;
+    outcome.maxrss_kb = std::max<int64_t>(outcome.maxrss_kb, usage.ru_maxrss);
+    const size_t at = text.find("ms=");
+    double ms = 0;
+    if (timed_out) {
+      outcome.kind = Outcome::kTimeout;
+      outcome.message = absl::StrFormat("timeout (killed after %g s)", config.timeout_s);
+      break;
+    }
+    if (pid < 0 || !WIFEXITED(status) || WEXITSTATUS(status) != 0 || at == std::string::npos ||
+        !absl::SimpleAtod(absl::string_view(text).substr(at + 3).substr(
+                              0, text.find_first_of(" \n", at) - at - 3),
+                          &ms)) {
+      outcome.kind = Outcome::kCrashed;
+      outcome.message = absl::StrCat("peer failed (status ", status, "): ", text.substr(0, 200));
+      break;
+    }
+    times.push_back(ms);
+  }
+  if (!times.empty() && static_cast<int>(times.size()) == repeat) {
+    outcome.kind = Outcome::kOk;
+    outcome.report.ok = 1;
+    outcome.report.runs = repeat;
+    outcome.report.solve_ms = Median(times);
+    outcome.report.wall_ms = outcome.report.solve_ms;
+    std::ifstream in(out_path, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    outcome.distance.resize(bytes.size() / sizeof(double));
+    std::memcpy(outcome.distance.data(), bytes.data(), outcome.distance.size() * sizeof(double));
+    for (double& d : outcome.distance) {
+      if (!(d < 1e300)) d = kInf;  // peers mark unreachable vertices in their own ways
+    }
+  }
+  unlink(out_path);
+  return outcome;
+}
+
 // Below 50 ms the /proc/stat sample (10 ms ticks) says nothing.
 std::string OtherLoad(const Outcome& o) {
   return o.elapsed_s >= 0.05 ? absl::StrFormat("%.2f", o.other_load) : "-";
@@ -1446,7 +1661,8 @@ Section MainSection(const Config& config, const std::vector<MeshInfo>& meshes) {
       const std::vector<uint32_t> src = {source};
       std::fprintf(stderr, "%s (%llu faces), source %u, R = %d\n", mesh.name.c_str(),
                    static_cast<unsigned long long>(mesh.report.faces), source, repeat);
-      std::optional<Outcome> dijkstra, ich, cgal_run;
+      std::optional<Outcome> dijkstra, ich, paper, cgal_run;
+      std::vector<std::pair<std::string, Outcome>> peer_runs;
       if (config.run_dijkstra) {
         GeodesicOptions options;
         options.method = Method::kDijkstra;
@@ -1454,8 +1670,18 @@ Section MainSection(const Config& config, const std::vector<MeshInfo>& meshes) {
         Progress("dijkstra", *dijkstra);
       }
       if (config.run_ich) {
-        ich = RunGeodex(mesh, src, GeodesicOptions{}, repeat, cgal || config.run_dijkstra, config);
-        Progress("ich", *ich);
+        ich = RunGeodex(mesh, src, GeodesicOptions{}, repeat, true, config);
+        Progress("exact", *ich);
+      }
+      if (config.run_paper) {
+        GeodesicOptions options;
+        options.method = Method::kIch;
+        paper = RunGeodex(mesh, src, options, repeat, true, config);
+        Progress("ich (paper)", *paper);
+      }
+      for (const auto& [name, command] : config.peers) {
+        peer_runs.emplace_back(name, RunPeer(command, mesh, source, repeat, config));
+        Progress(name, peer_runs.back().second);
       }
 #ifdef GEODEX_BENCH_WITH_CGAL
       if (cgal) {
@@ -1471,7 +1697,6 @@ Section MainSection(const Config& config, const std::vector<MeshInfo>& meshes) {
 #endif
       const double dijkstra_ms =
           dijkstra && dijkstra->ok() ? dijkstra->report.solve_ms : std::nan("");
-      const double ich_ms = ich && ich->ok() ? ich->report.solve_ms : std::nan("");
       const double cgal_ms = cgal_run && cgal_run->ok() ? cgal_run->report.solve_ms : std::nan("");
       auto row = [&](const std::string& method, const Outcome& o) {
         std::vector<std::string> cells = {mesh.name, Count(mesh.report.faces), Count(source),
@@ -1489,47 +1714,74 @@ Section MainSection(const Config& config, const std::vector<MeshInfo>& meshes) {
           return cells;
         }
         const ChildReport& r = o.report;
-        const bool windows = method == "ICH";
+        const bool windows = method == "exact" || method == "ICH (paper)";
         cells.push_back(Ms(r.solve_ms));
         cells.push_back(Ms(r.wall_ms));
         cells.push_back(Ms(r.cpu_ms));
         cells.push_back(Ratio(r.solve_ms / dijkstra_ms));
-        cells.push_back(windows ? Ratio(cgal_ms / ich_ms) : "");
+        cells.push_back(method != "Dijkstra" && method != "CGAL" ? Ratio(cgal_ms / r.solve_ms) : "");
         cells.push_back(windows ? Count(r.stats.windows_created) : "");
         cells.push_back(windows ? Count(FilteredWindows(r.stats)) : "");
         cells.push_back(windows ? Count(r.stats.windows_processed) : "");
         cells.push_back(windows ? Count(r.stats.max_level) : "");
         cells.push_back(windows ? Count(r.stats.peak_live_windows) : "");
-        cells.push_back(method == "CGAL" ? ""
-                                         : MiBOfBytes(static_cast<double>(r.stats.peak_bytes)));
+        cells.push_back(windows || method == "Dijkstra"
+                            ? MiBOfBytes(static_cast<double>(r.stats.peak_bytes))
+                            : "");
         cells.push_back(MiBOfKb(o.maxrss_kb));
         cells.push_back(DeltaMiB(o, mesh));
         cells.insert(cells.end(), {"", "", OtherLoad(o)});
         return cells;
       };
       if (dijkstra) s.table.AddRow(row("Dijkstra", *dijkstra));
-      if (ich) {
-        std::vector<std::string> cells = row("ICH", *ich);
-        if (ich->ok() && cgal_run && cgal_run->ok()) {
-          const FieldDiff d = Compare(ich->distance, cgal_run->distance);
+      // An exact method's row, with its difference from CGAL (or, without CGAL, from geodex's
+      // default engine) and a check against Dijkstra's upper bound.
+      auto exact_row = [&](const std::string& method, const Outcome& o) {
+        std::vector<std::string> cells = row(method, o);
+        const Outcome* reference = cgal_run && cgal_run->ok() ? &*cgal_run
+                                   : ich && ich->ok() && &o != &*ich ? &*ich
+                                                                      : nullptr;
+        if (o.ok() && reference != nullptr && o.distance.size() == reference->distance.size()) {
+          const FieldDiff d = Compare(o.distance, reference->distance);
           cells[cells.size() - 3] = Sci(d.max_abs);
           cells[cells.size() - 2] = Sci(d.max_rel);
+          if (reference != &*cgal_run) {
+            cells[cells.size() - 3] += " (vs exact)";
+          }
           if (d.finiteness_mismatch > 0) {
-            s.notes.push_back(absl::StrCat(mesh.name, " source ", source, ": ",
+            s.notes.push_back(absl::StrCat(mesh.name, " source ", source, " ", method, ": ",
                                            d.finiteness_mismatch,
-                                           " vertices finite in one of ICH/CGAL only"));
+                                           " vertices finite in only one of it and the reference"));
           }
         }
-        if (ich->ok() && dijkstra && dijkstra->ok()) {
+        if (o.ok() && dijkstra && dijkstra->ok() &&
+            o.distance.size() == dijkstra->distance.size()) {
           // Dijkstra's edge paths are real paths: exact distances can only be shorter or equal.
-          const FieldDiff d = Compare(dijkstra->distance, ich->distance);
+          const FieldDiff d = Compare(dijkstra->distance, o.distance);
           if (d.below_reference > 0) {
-            s.notes.push_back(absl::StrCat(mesh.name, " source ", source,
-                                           ": ICH exceeds Dijkstra at ", d.below_reference,
+            s.notes.push_back(absl::StrCat(mesh.name, " source ", source, ": ", method,
+                                           " exceeds Dijkstra at ", d.below_reference,
                                            " vertices (not exact there)"));
           }
         }
         s.table.AddRow(cells);
+      };
+      if (ich) exact_row("exact", *ich);
+      if (paper) exact_row("ICH (paper)", *paper);
+      for (const auto& [name, o] : peer_runs) {
+        exact_row(name, o);
+        if (o.ok() && ich && ich->ok()) {
+          s.notes.push_back(absl::StrFormat(
+              "%s source %u: geodex exact / %s = %.2f in time, %.2f in peak RSS", mesh.name,
+              source, name, ich->report.solve_ms / o.report.solve_ms,
+              static_cast<double>(ich->maxrss_kb) / std::max<int64_t>(1, o.maxrss_kb)));
+        }
+      }
+      if (const double vtp = AnchorVtpOverDijkstra(mesh.name); vtp > 0 && ich && ich->ok()) {
+        s.notes.push_back(absl::StrFormat(
+            "%s: the line to beat, VTP at %.0fx Dijkstra (../shared/notes/anchors.md); geodex "
+            "exact here at %.1fx",
+            mesh.name, vtp, ich->report.solve_ms / dijkstra_ms));
       }
       if (cgal_run) {
         s.table.AddRow(row("CGAL", *cgal_run));
@@ -2167,6 +2419,10 @@ int Main(int argc, char** argv) {
     });
   }
   for (const std::string& f : config.mesh_files) paths.push_back(f);
+  std::string dem_dir;
+  if (config.terrain) {
+    for (const std::string& f : WriteDemGrids(config, &dem_dir)) paths.push_back(f);
+  }
   if (paths.empty()) {
     std::printf("geodex_bench: no meshes given (see --help); skipping\n");
     return 0;
@@ -2242,6 +2498,10 @@ int Main(int argc, char** argv) {
       return 1;
     }
     std::printf("\nwrote %s\n", config.markdown.c_str());
+  }
+  if (!dem_dir.empty()) {
+    std::error_code ignored;
+    std::filesystem::remove_all(dem_dir, ignored);
   }
   return 0;
 }

@@ -87,13 +87,15 @@ int RunDistances(const Args& args) {
     return Fail(kExitUsage, "usage: geodex distances MESH --sources SPEC [options]");
   }
   GeodesicOptions options;
-  const std::string method = args.options.count("method") ? args.options.at("method") : "ich";
-  if (method == "ich") {
+  const std::string method = args.options.count("method") ? args.options.at("method") : "exact";
+  if (method == "exact") {
+    options.method = Method::kExact;
+  } else if (method == "ich") {
     options.method = Method::kIch;
   } else if (method == "dijkstra") {
     options.method = Method::kDijkstra;
   } else {
-    return Fail(kExitUsage, "--method must be ich or dijkstra");
+    return Fail(kExitUsage, "--method must be exact, ich or dijkstra");
   }
   if (!GetDouble(args, "lambda", &options.lambda, &error) ||
       !GetDouble(args, "max-distance", &options.max_distance, &error) ||

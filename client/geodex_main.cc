@@ -36,7 +36,7 @@ commands:
       One 'key: value' line per property (vertices, faces, boundary_loops, components,
       isolated_vertices, non_manifold_edges, non_manifold_vertices, degenerate_faces,
       saddle_vertices, bytes, ...). Reports on any readable mesh, valid or messy.
-  distances MESH --sources SPEC [--method ich|dijkstra] [--lambda L] [--lambda-scale max|mean]
+  distances MESH --sources SPEC [--method exact|ich|dijkstra] [--lambda L] [--lambda-scale max|mean]
                  [--max-distance D] [--max-windows N] [--stats] [--output FILE]
       One distance per vertex in the file's vertex order (%.17g; 'inf' if unreachable).
       --stats prints one JSON object with counters and times (*_ms) on stderr.

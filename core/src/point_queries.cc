@@ -17,8 +17,8 @@ namespace geodex {
 namespace {
 
 absl::Status CheckOptions(const GeodesicOptions& options) {
-  if (options.method != Method::kIch) {
-    return absl::InvalidArgumentError("point queries and paths need method ich");
+  if (!IsExactMethod(options.method)) {
+    return absl::InvalidArgumentError("point queries and paths need an exact method (exact or ich)");
   }
   return ValidateSolveOptions(options);
 }

@@ -13,9 +13,18 @@
 namespace geodex {
 
 enum class Method {
-  kIch,       // exact: improved Chen-Han (Xin & Wang 2009/2010)
+  // Exact, the default: ICH's rules (the filter theorem, one angle one split, pseudo-sources, the
+  // A* key) without the paper's window tree. A window is freed as soon as it is processed, so
+  // memory follows the wavefront; Lemma 1 then prunes forward only (docs/engine.md).
+  kExact,
+  // Exact: the paper's improved Chen-Han as published (Xin & Wang 2009/2010), with the window
+  // tree and Lemma 1's retroactive subtree deletion. For the ablation and the paper's tables.
+  kIch,
   kDijkstra,  // shortest paths along mesh edges (an upper bound; the baseline)
 };
+
+// True for the two exact engines.
+inline bool IsExactMethod(Method m) { return m == Method::kExact || m == Method::kIch; }
 
 enum class LambdaScale {
   kMaxEdge,   // epsilon = lambda * longest edge: lambda = 1 reproduces Dijkstra (Theorem 8)
@@ -23,7 +32,7 @@ enum class LambdaScale {
 };
 
 struct GeodesicOptions {
-  Method method = Method::kIch;
+  Method method = Method::kExact;
   // Precision knob of section 7: 0 = exact ICH; larger values over-filter (faster, less exact).
   double lambda = 0;
   LambdaScale lambda_scale = LambdaScale::kMaxEdge;

@@ -48,7 +48,10 @@ inline double RayHitParam(double ix, double iy, double b, double px, double py, 
 }  // namespace
 
 IchSolver::IchSolver(const TriangleMesh& mesh, const GeodesicOptions& options, double key_cap)
-    : mesh_(mesh), options_(options), key_cap_(std::min(key_cap, options.max_distance)) {
+    : mesh_(mesh),
+      options_(options),
+      key_cap_(std::min(key_cap, options.max_distance)),
+      keep_tree_(options.method == Method::kIch) {
   if (options.lambda > 0) {
     const double scale = options.lambda_scale == LambdaScale::kMaxEdge ? mesh.MaxEdgeLength()
                                                                        : mesh.MeanEdgeLength();
@@ -149,7 +152,7 @@ bool IchSolver::UpdateVertex(uint32_t v, double d, uint32_t parent, uint32_t hal
     const uint32_t level = pool_[parent].level + 1;
     const uint32_t id = NewPseudoSourceWindow(v, d, pool_[parent].source, level);
     stats_.max_level = std::max(stats_.max_level, level);
-    pool_.AddChild(parent, id);
+    if (keep_tree_) pool_.AddChild(parent, id);
     ++stats_.pseudo_sources;
     Push(id, VertexKey(v, d));
   }
@@ -319,7 +322,7 @@ void IchSolver::MakeInterval(uint32_t parent, uint32_t he, double b0, double b1,
   w.source = source;
   w.level = level;
   stats_.max_level = std::max(stats_.max_level, level);
-  pool_.AddChild(parent, id);
+  if (keep_tree_) pool_.AddChild(parent, id);
   Push(id, key);
 }
 

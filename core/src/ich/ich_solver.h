@@ -139,6 +139,10 @@ class IchSolver {
   const TriangleMesh& mesh_;
   const GeodesicOptions& options_;
   double key_cap_;
+  // The paper's window tree (Method::kIch): children are linked to their parents so Lemma 1 can
+  // delete an old winner's subtree. Without it (Method::kExact) a window is freed as soon as it is
+  // processed (ReleaseIfDone finds no children) and Lemma 1 prunes forward only.
+  bool keep_tree_;
   double epsilon_ = 0;  // over-filtering margin lambda * L (section 7)
 
   std::vector<double> dist_;
