@@ -159,7 +159,8 @@ constexpr char kUsage[] =
     "  --large             with --terrain: also their 1M-face versions (707 x 707 vertices)\n"
     "  --peer NAME=CMD     also time another exact code: `CMD MESH SOURCE OUT` must write the\n"
     "                      distances of every file vertex as raw doubles to OUT and print a line\n"
-    "                      with ms=<propagation ms>; its peak RSS comes from wait4 (repeatable)\n"
+    "                      starting ms=<propagation ms>; its peak RSS comes from wait4 (the\n"
+    "                      largest of its processes); repeatable\n"
     "  --markdown OUT.md   also write the tables as Markdown\n"
     "  --timeout-s T       kill a measurement after T seconds (default 300)\n"
     "  --wait-idle S       before each measurement wait up to S seconds until the other\n"
@@ -1552,7 +1553,11 @@ Outcome RunPeer(const std::string& command, const MeshInfo& mesh, uint32_t sourc
     }
     outcome.elapsed_s = MsSince(start) / 1000;
     outcome.maxrss_kb = std::max<int64_t>(outcome.maxrss_kb, usage.ru_maxrss);
-    const size_t at = text.find("ms=");
+    // The last line that starts with "ms=".
+    size_t at = std::string::npos;
+    for (size_t pos = text.find("ms="); pos != std::string::npos; pos = text.find("ms=", pos + 1)) {
+      if (pos == 0 || text[pos - 1] == '\n') at = pos;
+    }
     double ms = 0;
     if (timed_out) {
       outcome.kind = Outcome::kTimeout;

@@ -51,7 +51,8 @@ IchSolver::IchSolver(const TriangleMesh& mesh, const GeodesicOptions& options, d
     : mesh_(mesh),
       options_(options),
       key_cap_(std::min(key_cap, options.max_distance)),
-      keep_tree_(options.method == Method::kIch) {
+      keep_tree_(options.method == Method::kIch),
+      pool_(keep_tree_) {
   if (options.lambda > 0) {
     const double scale = options.lambda_scale == LambdaScale::kMaxEdge ? mesh.MaxEdgeLength()
                                                                        : mesh.MeanEdgeLength();
@@ -60,7 +61,7 @@ IchSolver::IchSolver(const TriangleMesh& mesh, const GeodesicOptions& options, d
 }
 
 void IchSolver::Push(uint32_t id, double key) {
-  queue_.Push({key, id, pool_.links(id).generation});
+  queue_.Push({key, id, keep_tree_ ? pool_.links(id).generation : 0});
 }
 
 void IchSolver::SeedVertex(uint32_t v, uint32_t label) {
@@ -90,7 +91,7 @@ uint32_t IchSolver::NewPseudoSourceWindow(uint32_t vertex, double sigma, uint32_
 void IchSolver::SeedFacePoint(const ResolvedSource& s) {
   // A root window so the seed's children have a parent (kept for the tree's sake).
   const uint32_t root = NewPseudoSourceWindow(kNoIndex, 0, s.label, 0);
-  pool_.links(root).state = WindowState::kProcessed;
+  MarkProcessed(root);
   EmitFromPointInFace(root, 3 * s.face, s.px, s.py, 0, kNoIndex, s.label);
   ReleaseIfDone(root);
 }
@@ -326,7 +327,15 @@ void IchSolver::MakeInterval(uint32_t parent, uint32_t he, double b0, double b1,
   Push(id, key);
 }
 
+void IchSolver::MarkProcessed(uint32_t id) {
+  if (keep_tree_) pool_.links(id).state = WindowState::kProcessed;
+}
+
 void IchSolver::ReleaseIfDone(uint32_t id) {
+  if (!keep_tree_) {  // no tree: nothing can refer to a processed window
+    pool_.Free(id);
+    return;
+  }
   // Frees processed windows that have no children left, walking up: the tree keeps only what
   // Lemma 1 may still need to prune.
   while (id != kNoIndex) {
@@ -367,11 +376,11 @@ void IchSolver::ProcessPseudoSource(uint32_t id) {
   const Window w = pool_[id];
   const uint32_t v = w.element;
   if (w.sigma != dist_[v]) {  // superseded by a shorter path to v
-    pool_.links(id).state = WindowState::kProcessed;
+    MarkProcessed(id);
     ReleaseIfDone(id);
     return;
   }
-  pool_.links(id).state = WindowState::kProcessed;
+  MarkProcessed(id);
   if (!face_target_head_.empty()) {
     // Paths to a target point may bend here and then run straight inside a face around v.
     for (const uint32_t* c = mesh_.CornersBegin(v); c != mesh_.CornersEnd(v); ++c) {
@@ -523,10 +532,13 @@ void IchSolver::PassThroughDegenerate(uint32_t id, const Window& w) {
 
 void IchSolver::ProcessInterval(uint32_t id, double popped_key) {
   Window w = pool_[id];  // copy: the pool may grow below
-  const WindowLinks& links = pool_.links(id);
-  const uint32_t generation = links.generation;
-  // ReleaseIfDone below walks up to the parent; start fetching its links now.
-  if (links.parent != kNoIndex) pool_.PrefetchLinks(links.parent);
+  uint32_t generation = 0;
+  if (keep_tree_) {
+    const WindowLinks& links = pool_.links(id);
+    generation = links.generation;
+    // ReleaseIfDone below walks up to the parent; start fetching its links now.
+    if (links.parent != kNoIndex) pool_.PrefetchLinks(links.parent);
+  }
   const uint32_t h = w.element;
   // With over-filtering (lambda > 0), test the window again: vertex distances have dropped since
   // it was made. In exact mode this is skipped: measured on gargoyle, armadillo and a terrain it
@@ -540,7 +552,7 @@ void IchSolver::ProcessInterval(uint32_t id, double popped_key) {
     double ra, rb;
     if (!TrimByEndpoints(h, &w.b0, &w.b1, w.ix, w.iy, w.sigma, &ra, &rb)) {
       ++stats_.windows_filtered_at_pop;
-      pool_.links(id).state = WindowState::kProcessed;
+      MarkProcessed(id);
       ReleaseIfDone(id);
       return;
     }
@@ -561,11 +573,11 @@ void IchSolver::ProcessInterval(uint32_t id, double popped_key) {
        IsFiltered(h, w.b0, w.b1, w.ix, w.iy, w.sigma, Hypot(w.b0 - w.ix, w.iy),
                   Hypot(w.b1 - w.ix, w.iy), w.side, epsilon_))) {
     ++stats_.windows_filtered_at_pop;
-    pool_.links(id).state = WindowState::kProcessed;
+    MarkProcessed(id);
     ReleaseIfDone(id);
     return;
   }
-  pool_.links(id).state = WindowState::kProcessed;
+  MarkProcessed(id);
   ++stats_.windows_processed;
   if (mesh_.FaceDegenerate(TriangleMesh::FaceOf(h))) {
     PassThroughDegenerate(id, w);
@@ -594,40 +606,42 @@ void IchSolver::ProcessInterval(uint32_t id, double popped_key) {
       // Lemma 1 (one angle one split): of the windows on this directed edge that see v3, only the
       // one giving v3 the smallest distance keeps both children; a loser keeps the child on the
       // side where its own ray to v3 crosses the edge relative to the winner's.
-      SplitOwner& owner = owner_[h];
+      SplitRecord& best = split_[h];
       const double tie = kSplitTieRel * d3;
-      const bool has_owner = owner.window != kNoIndex;
-      if (!has_owner || d3 < owner.distance - tie) {
-        if (has_owner && pool_.links(owner.window).generation == owner.generation &&
-            pool_.links(owner.window).state != WindowState::kFree) {
-          const bool old_is_right = owner.cross_x > cross_x + cover_tol;
-          const bool old_is_left = owner.cross_x < cross_x - cover_tol;
-          if (old_is_right || old_is_left) {
-            const WindowSide doomed = old_is_right ? WindowSide::kLeft : WindowSide::kRight;
-            for (uint32_t c = pool_.links(owner.window).first_child; c != kNoIndex;) {
-              const uint32_t next = pool_.links(c).next_sibling;
-              if (pool_.links(c).kind == WindowKind::kInterval && pool_.links(c).side == doomed) {
-                DeleteSubtree(c);
-                break;
+      if (d3 < best.distance - tie) {
+        if (keep_tree_) {
+          // The paper's retroactive rule: the old winner's child on the far side is useless.
+          const SplitOwner& owner = split_owner_[h];
+          if (owner.window != kNoIndex && pool_.links(owner.window).generation == owner.generation &&
+              pool_.links(owner.window).state != WindowState::kFree) {
+            const bool old_is_right = best.cross_x > cross_x + cover_tol;
+            const bool old_is_left = best.cross_x < cross_x - cover_tol;
+            if (old_is_right || old_is_left) {
+              const WindowSide doomed = old_is_right ? WindowSide::kLeft : WindowSide::kRight;
+              for (uint32_t c = pool_.links(owner.window).first_child; c != kNoIndex;) {
+                const uint32_t next = pool_.links(c).next_sibling;
+                if (pool_.links(c).kind == WindowKind::kInterval && pool_.links(c).side == doomed) {
+                  DeleteSubtree(c);
+                  break;
+                }
+                c = next;
               }
-              c = next;
             }
           }
+          // A pathological unfolding may revisit this edge inside the deleted subtree.
+          if (pool_.links(id).state != WindowState::kProcessed ||
+              pool_.links(id).generation != generation) {
+            return;
+          }
+          split_owner_[h] = SplitOwner{id, generation};
         }
-        // A pathological unfolding may revisit this edge inside the deleted subtree.
-        if (pool_.links(id).state != WindowState::kProcessed ||
-            pool_.links(id).generation != generation) {
-          return;
-        }
-        owner.window = id;
-        owner.generation = generation;
-        owner.distance = d3;
-        owner.cross_x = cross_x;
-      } else if (d3 > owner.distance + tie) {
-        if (cross_x > owner.cross_x + cover_tol) {
+        best.distance = d3;
+        best.cross_x = cross_x;
+      } else if (d3 > best.distance + tie) {
+        if (cross_x > best.cross_x + cover_tol) {
           if (make_left) ++stats_.children_skipped_one_split;
           make_left = false;
-        } else if (cross_x < owner.cross_x - cover_tol) {
+        } else if (cross_x < best.cross_x - cover_tol) {
           if (make_right) ++stats_.children_skipped_one_split;
           make_right = false;
         }
@@ -842,7 +856,10 @@ absl::Status IchSolver::SolveForTargets(const std::vector<ResolvedSource>& sourc
   label_.assign(nv, kNoIndex);
   origin_.assign(nv, VertexOrigin{});
   straight_through_.assign(nv, 0);
-  if (options_.use_one_angle_one_split) owner_.assign(3 * size_t{mesh_.face_count()}, SplitOwner{});
+  if (options_.use_one_angle_one_split) {
+    split_.assign(3 * size_t{mesh_.face_count()}, SplitRecord{});
+    if (keep_tree_) split_owner_.assign(3 * size_t{mesh_.face_count()}, SplitOwner{});
+  }
   queue_.clear();
   queue_.reserve(4 * size_t{nv});
 
@@ -860,8 +877,10 @@ absl::Status IchSolver::SolveForTargets(const std::vector<ResolvedSource>& sourc
     const QueueEntry e = queue_.Pop();
     // The next window is most likely the new top: fetch it while this one is processed.
     if (const QueueEntry* next = queue_.Peek()) pool_.Prefetch(next->window);
-    if (pool_.links(e.window).generation != e.generation ||
-        pool_.links(e.window).state != WindowState::kQueued) {
+    // Only the paper's tree deletes queued windows (Lemma 1's subtrees); without it every entry
+    // is a live queued window, and its links are not even read.
+    if (keep_tree_ && (pool_.links(e.window).generation != e.generation ||
+                       pool_.links(e.window).state != WindowState::kQueued)) {
       continue;  // deleted (Lemma 1) or recycled since it was queued
     }
     if (e.key > options_.max_distance) break;
@@ -891,7 +910,8 @@ absl::Status IchSolver::SolveForTargets(const std::vector<ResolvedSource>& sourc
 
   stats_.peak_live_windows = pool_.peak_live();
   stats_.peak_bytes = pool_.CapacityBytes() + queue_.CapacityBytes() +
-                      owner_.capacity() * sizeof(SplitOwner) +
+                      split_.capacity() * sizeof(SplitRecord) +
+                      split_owner_.capacity() * sizeof(SplitOwner) +
                       nv * (sizeof(double) + sizeof(uint32_t) + sizeof(VertexOrigin));
   if (!status.ok()) return status;
   if (std::isfinite(options_.max_distance)) {

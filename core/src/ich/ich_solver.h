@@ -109,6 +109,8 @@ class IchSolver {
   // Removes `id`'s subtree (pseudo-source windows are kept and become roots), then frees any
   // processed ancestor left without children.
   void DeleteSubtree(uint32_t id);
+  void MarkProcessed(uint32_t id);
+  // Frees a processed window (with the tree: once its subtree is gone, walking up).
   void ReleaseIfDone(uint32_t id);
   void RelaxNeighbors(uint32_t v, double d, uint32_t source);
 
@@ -151,7 +153,8 @@ class IchSolver {
   // Per vertex: which sides of its best incoming ray continue straight (bit 1 left, bit 2 right;
   // 3 = both, see ProcessInterval). Reset whenever the vertex's distance improves.
   std::vector<uint8_t> straight_through_;
-  HugeVector<SplitOwner> owner_;
+  HugeVector<SplitRecord> split_;        // Lemma 1, per half-edge
+  HugeVector<SplitOwner> split_owner_;   // Lemma 1's winners, the paper's tree only
   WindowPool pool_;
   WindowQueue queue_;
   std::vector<uint32_t> scratch_;  // reused stack for subtree deletion

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstdlib>
+#include <limits>
 #include <new>
 #include <vector>
 
@@ -84,8 +85,12 @@ struct WindowLinks {
 };
 
 // A pool of windows with a free list: no heap allocation per window once the pool has grown.
+// Links (parents, children, generations, states) are kept only for the paper's window tree
+// (`with_links`); without them a window is just its geometry, freed right after processing.
 class WindowPool {
  public:
+  explicit WindowPool(bool with_links) : with_links_(with_links) {}
+
   uint32_t Allocate() {
     uint32_t id;
     if (!free_.empty()) {
@@ -94,30 +99,37 @@ class WindowPool {
     } else {
       id = static_cast<uint32_t>(windows_.size());
       windows_.emplace_back();
-      links_.emplace_back();
-      links_.back().generation = 0;
+      if (with_links_) {
+        links_.emplace_back();
+        links_.back().generation = 0;
+      }
     }
+    ++live_;
+    if (live_ > peak_live_) peak_live_ = live_;
+    if (!with_links_) return id;
     WindowLinks& l = links_[id];
     l.parent = l.first_child = l.prev_sibling = l.next_sibling = kNoIndex;
     l.state = WindowState::kQueued;
-    ++live_;
-    if (live_ > peak_live_) peak_live_ = live_;
     return id;
   }
   // Records kind and side (call once the window's fields are set).
   void SetKind(uint32_t id, WindowKind kind, WindowSide side) {
     windows_[id].kind = kind;
     windows_[id].side = side;
+    if (!with_links_) return;
     links_[id].kind = kind;
     links_[id].side = side;
   }
   void Free(uint32_t id) {
-    WindowLinks& l = links_[id];
-    l.state = WindowState::kFree;
-    ++l.generation;
+    if (with_links_) {
+      WindowLinks& l = links_[id];
+      l.state = WindowState::kFree;
+      ++l.generation;
+    }
     free_.push_back(id);
     --live_;
   }
+  bool with_links() const { return with_links_; }
   Window& operator[](uint32_t id) { return windows_[id]; }
   const Window& operator[](uint32_t id) const { return windows_[id]; }
   WindowLinks& links(uint32_t id) { return links_[id]; }
@@ -125,7 +137,7 @@ class WindowPool {
   void PrefetchLinks(uint32_t id) const { __builtin_prefetch(&links_[id]); }
   void Prefetch(uint32_t id) const {
     __builtin_prefetch(&windows_[id]);
-    __builtin_prefetch(&links_[id]);
+    if (with_links_) __builtin_prefetch(&links_[id]);
   }
 
   // Tree links (doubly linked sibling lists: unlinking is O(1) even under a pseudo-source).
@@ -158,6 +170,7 @@ class WindowPool {
   }
 
  private:
+  bool with_links_;
   HugeVector<Window> windows_;
   HugeVector<WindowLinks> links_;
   std::vector<uint32_t> free_;
@@ -252,13 +265,17 @@ class WindowQueue {
   size_t size_ = 0;
 };
 
-// Lemma 1 bookkeeping per half-edge: the window on it that gave its opposite vertex the smallest
-// distance, where its ray to that vertex crosses the edge, and that distance.
+// Lemma 1 bookkeeping per half-edge: the smallest distance a window on it gave its opposite
+// vertex (+inf: none yet), and where that window's ray to the vertex crosses the edge.
+struct SplitRecord {
+  double distance = std::numeric_limits<double>::infinity();
+  double cross_x = 0;
+};
+// The paper's ICH (window tree) also remembers which window that was, to delete a subtree of it
+// when a better one arrives.
 struct SplitOwner {
   uint32_t window = kNoIndex;
   uint32_t generation = 0;
-  double distance = 0;  // meaningful only when window != kNoIndex
-  double cross_x = 0;
 };
 
 }  // namespace geodex::ich
