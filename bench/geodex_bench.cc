@@ -102,6 +102,7 @@ struct Config {
   bool run_ich = true, run_dijkstra = true, run_cgal = true, run_paper = false;
   // --terrain: DEM-like grids made here (bumpy, and half exactly flat); --large: also 1M faces.
   bool terrain = false, large = false;
+  std::string terrain_dir;  // --terrain-dir: write the grids there and keep them
   // --peer NAME=COMMAND: another exact code, run as `COMMAND MESH SOURCE OUT` (see kUsage).
   std::vector<std::pair<std::string, std::string>> peers;
   std::string markdown;
@@ -157,6 +158,7 @@ constexpr char kUsage[] =
     "  --terrain           add DEM-like grids made at run time: a bumpy terrain and the same\n"
     "                      with half of it exactly flat (a lake at its median height), ~89k faces\n"
     "  --large             with --terrain: also their 1M-face versions (707 x 707 vertices)\n"
+    "  --terrain-dir DIR   with --terrain: write the grids (OFF) into DIR and keep them\n"
     "  --peer NAME=CMD     also time another exact code: `CMD MESH SOURCE OUT` must write the\n"
     "                      distances of every file vertex as raw doubles to OUT and print a line\n"
     "                      starting ms=<propagation ms>; its peak RSS comes from wait4 (the\n"
@@ -227,7 +229,7 @@ absl::StatusOr<Config> ParseArgs(int argc, char** argv) {
                arg == "--cgal-max-faces" || arg == "--methods" || arg == "--markdown" ||
                arg == "--timeout-s" || arg == "--wait-idle" || arg == "--seed" ||
                arg == "--per-group" || arg == "--points" || arg == "--batch" ||
-               arg == "--peer") {
+               arg == "--peer" || arg == "--terrain-dir") {
       absl::StatusOr<std::string> v = next();
       if (!v.ok()) return v.status();
       if (arg == "--meshes") {
@@ -244,6 +246,8 @@ absl::StatusOr<Config> ParseArgs(int argc, char** argv) {
         if (!absl::SimpleAtoi(*v, &config.repeat) || config.repeat < 1) return bad(*v);
       } else if (arg == "--cgal-max-faces") {
         if (!absl::SimpleAtoi(*v, &config.cgal_max_faces)) return bad(*v);
+      } else if (arg == "--terrain-dir") {
+        config.terrain_dir = *v;
       } else if (arg == "--peer") {
         const size_t eq = v->find('=');
         if (eq == std::string::npos || eq == 0 || eq + 1 == v->size()) return bad(*v);
@@ -427,9 +431,15 @@ MeshData MakeDemGrid(int n, double flat_share, uint64_t seed) {
 // Writes the --terrain grids as OFF files (full double precision, readable by peers) into a fresh
 // directory under /tmp; returns their paths.
 std::vector<std::string> WriteDemGrids(const Config& config, std::string* dir) {
-  char templ[] = "/tmp/geodex_bench_dem_XXXXXX";
-  if (mkdtemp(templ) == nullptr) return {};
-  *dir = templ;
+  std::string out_dir = config.terrain_dir;
+  if (out_dir.empty()) {
+    char templ[] = "/tmp/geodex_bench_dem_XXXXXX";
+    if (mkdtemp(templ) == nullptr) return {};
+    out_dir = *dir = templ;  // removed at the end
+  } else {
+    std::error_code error;
+    std::filesystem::create_directories(out_dir, error);
+  }
   struct Grid {
     std::string name;
     int n;
@@ -442,7 +452,7 @@ std::vector<std::string> WriteDemGrids(const Config& config, std::string* dir) {
   }
   std::vector<std::string> paths;
   for (const Grid& g : grids) {
-    const std::string path = *dir + "/" + g.name + ".off";
+    const std::string path = out_dir + "/" + g.name + ".off";
     if (absl::Status st = WriteMeshOff(path, MakeDemGrid(g.n, g.flat, 2010)); !st.ok()) {
       std::fprintf(stderr, "geodex_bench: %s\n", std::string(st.message()).c_str());
       continue;

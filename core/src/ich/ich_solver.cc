@@ -24,6 +24,9 @@ constexpr double kTinyWindowRel = 1e-13;
 constexpr double kGrazingRel = 1e-13;
 // Lemma 1 treats distances or crossing points this close as ties and then keeps both children.
 constexpr double kSplitTieRel = 1e-12;
+// Windows whose keys differ by less than this fraction of the mean edge length are processed in
+// any (deterministic) order: see WindowQueue.
+constexpr double kQueueResolutionEdges = 0.5;
 // Cancellation is polled every this many dequeued windows.
 constexpr uint32_t kCancelPollInterval = 1024;
 
@@ -860,7 +863,7 @@ absl::Status IchSolver::SolveForTargets(const std::vector<ResolvedSource>& sourc
     split_.assign(3 * size_t{mesh_.face_count()}, SplitRecord{});
     if (keep_tree_) split_owner_.assign(3 * size_t{mesh_.face_count()}, SplitOwner{});
   }
-  queue_.clear();
+  queue_.Reset(kQueueResolutionEdges * mesh_.MeanEdgeLength());
   queue_.reserve(4 * size_t{nv});
 
   for (const ResolvedSource& s : sources) {
@@ -883,10 +886,12 @@ absl::Status IchSolver::SolveForTargets(const std::vector<ResolvedSource>& sourc
                        pool_.links(e.window).state != WindowState::kQueued)) {
       continue;  // deleted (Lemma 1) or recycled since it was queued
     }
-    if (e.key > options_.max_distance) break;
+    // Every queued key is at least LowerBound() (entries of near-equal keys pop in any order).
+    const double floor = queue_.LowerBound();
+    if (floor > options_.max_distance) break;
     // Every path not yet accounted for is at least as long as this key (keys are lower bounds,
     // and never decrease along a path): targets whose distance is at most the key are final.
-    if (target_results_ != nullptr && stop_early_ && e.key >= TargetsBound()) break;
+    if (target_results_ != nullptr && stop_early_ && floor >= TargetsBound()) break;
     if (++polls == kCancelPollInterval) {
       polls = 0;
       if (options_.cancel != nullptr && options_.cancel->IsCancelled()) {
