@@ -94,6 +94,11 @@ class IchSolver {
   bool TrimByEndpoints(uint32_t half_edge, double* b0, double* b1, double ix, double iy,
                        double sigma, double* ra, double* rb) const;
 
+  // Lemma 1 for a window `id` on half-edge h that sees the opposite vertex at distance d3, its ray
+  // crossing the edge at cross_x: clears *make_left or *make_right for a loser; records a winner
+  // (with the tree, deleting the old winner's doomed subtree). False when that deleted `id` itself.
+  bool OneAngleOneSplit(uint32_t id, uint32_t generation, uint32_t h, double d3, double cross_x,
+                        double cover_tol, bool* make_left, bool* make_right);
   // Lower a vertex's distance if `d` is smaller; spawns a pseudo-source window where paths may bend.
   bool UpdateVertex(uint32_t v, double d, uint32_t parent, uint32_t half_edge, double ix, double iy);
   // Creates an interval window on `half_edge` (propagating into its face) unless Lemma 2 or size
@@ -109,7 +114,9 @@ class IchSolver {
   // Removes `id`'s subtree (pseudo-source windows are kept and become roots), then frees any
   // processed ancestor left without children.
   void DeleteSubtree(uint32_t id);
-  void MarkProcessed(uint32_t id);
+  void MarkProcessed(uint32_t id) {
+    if (keep_tree_) pool_.links(id).state = WindowState::kProcessed;
+  }
   // Frees a processed window (with the tree: once its subtree is gone, walking up).
   void ReleaseIfDone(uint32_t id);
   void RelaxNeighbors(uint32_t v, double d, uint32_t source);
