@@ -1235,6 +1235,28 @@ void ChildMain(const Job& job, int fd) {
 int busy_measurements = 0, all_measurements = 0;
 double max_other_load = 0;
 
+// Reads `fd` into *out until EOF; kills `pid` and returns true once `timeout_s` since `start` has
+// passed.
+bool ReadUntilEof(int fd, pid_t pid, std::chrono::steady_clock::time_point start, double timeout_s,
+                  std::string* out) {
+  std::vector<char> buf(1 << 16);
+  while (true) {
+    const double left_ms = timeout_s * 1000 - MsSince(start);
+    if (left_ms <= 0) {
+      kill(pid, SIGKILL);
+      return true;
+    }
+    struct pollfd p = {fd, POLLIN, 0};
+    const int ready = poll(&p, 1, static_cast<int>(std::min(left_ms + 1, 60'000.0)));
+    if (ready < 0 && errno != EINTR) return false;
+    if (ready <= 0) continue;
+    const ssize_t n = read(fd, buf.data(), buf.size());
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;  // EOF: the child has sent everything
+    out->append(buf.data(), static_cast<size_t>(n));
+  }
+}
+
 Outcome RunChild(const Job& job, double timeout_s, double wait_idle_s) {
   Outcome outcome;
   if (job.task != Task::kInfo) WaitForIdle(wait_idle_s);
@@ -1262,24 +1284,7 @@ Outcome RunChild(const Job& job, double timeout_s, double wait_idle_s) {
   }
   close(fds[1]);
   std::string bytes;
-  bool timed_out = false;
-  std::vector<char> buf(1 << 16);
-  while (true) {
-    const double left_ms = timeout_s * 1000 - MsSince(start);
-    if (left_ms <= 0) {
-      timed_out = true;
-      kill(pid, SIGKILL);
-      break;
-    }
-    struct pollfd p = {fds[0], POLLIN, 0};
-    const int ready = poll(&p, 1, static_cast<int>(std::min(left_ms + 1, 60'000.0)));
-    if (ready < 0 && errno != EINTR) break;
-    if (ready <= 0) continue;
-    const ssize_t n = read(fds[0], buf.data(), buf.size());
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) break;  // EOF: the child has sent everything
-    bytes.append(buf.data(), static_cast<size_t>(n));
-  }
+  const bool timed_out = ReadUntilEof(fds[0], pid, start, timeout_s, &bytes);
   close(fds[0]);
   int status = 0;
   struct rusage usage;
@@ -1537,24 +1542,7 @@ Outcome RunPeer(const std::string& command, const MeshInfo& mesh, uint32_t sourc
     }
     close(fds[1]);
     std::string text;
-    char buf[4096];
-    bool timed_out = false;
-    while (true) {
-      const double left_ms = config.timeout_s * 1000 - MsSince(start);
-      if (left_ms <= 0) {
-        timed_out = true;
-        if (pid > 0) kill(pid, SIGKILL);
-        break;
-      }
-      struct pollfd p = {fds[0], POLLIN, 0};
-      const int ready = poll(&p, 1, static_cast<int>(std::min(left_ms + 1, 60'000.0)));
-      if (ready < 0 && errno != EINTR) break;
-      if (ready <= 0) continue;
-      const ssize_t n = read(fds[0], buf, sizeof buf);
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) break;
-      text.append(buf, static_cast<size_t>(n));
-    }
+    const bool timed_out = pid > 0 && ReadUntilEof(fds[0], pid, start, config.timeout_s, &text);
     close(fds[0]);
     int status = 0;
     struct rusage usage;

@@ -12,8 +12,9 @@ check() {
   if "$@"; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAIL: $name"; fi
 }
 tmp=$(mktemp -d)
-"$GEODEXD" --listen 127.0.0.1:0 --data-dir "$tmp/data" --pool-threads 1 --shutdown_grace_seconds 2 \
-  >"$tmp/log" 2>&1 &
+# Every socket on a port of its own (port 0): a quickstart server may hold the default ports.
+"$GEODEXD" --listen 127.0.0.1:0 --metrics_listen 127.0.0.1:0 --data-dir "$tmp/data" \
+  --pool-threads 1 --shutdown_grace_seconds 2 >"$tmp/log" 2>&1 &
 pid=$!
 port=""
 for _ in $(seq 1 300); do  # up to 30 s for the listening line

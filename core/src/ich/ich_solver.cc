@@ -17,8 +17,7 @@ IchSolver::IchSolver(const TriangleMesh& mesh, const GeodesicOptions& options, d
     : mesh_(mesh),
       options_(options),
       key_cap_(std::min(key_cap, options.max_distance)),
-      keep_tree_(options.method == Method::kIch),
-      pool_(keep_tree_) {
+      pool_(/*with_links=*/options.method == Method::kIch) {
   if (options.lambda > 0) {
     const double scale = options.lambda_scale == LambdaScale::kMaxEdge ? mesh.MaxEdgeLength()
                                                                        : mesh.MeanEdgeLength();
@@ -27,7 +26,7 @@ IchSolver::IchSolver(const TriangleMesh& mesh, const GeodesicOptions& options, d
 }
 
 void IchSolver::Push(uint32_t id, double key) {
-  queue_.Push({key, id, keep_tree_ ? pool_.links(id).generation : 0});
+  queue_.Push({key, id, pool_.generation(id)});
 }
 
 void IchSolver::SeedVertex(uint32_t v, uint32_t label) {
@@ -43,7 +42,7 @@ void IchSolver::SeedVertex(uint32_t v, uint32_t label) {
 void IchSolver::SeedFacePoint(const ResolvedSource& s) {
   // A root window so the seed's children have a parent (kept for the tree's sake).
   const uint32_t root = NewPseudoSourceWindow(kNoIndex, 0, s.label, 0);
-  MarkProcessed(root);
+  pool_.MarkProcessed(root);
   EmitFromPointInFace(root, 3 * s.face, s.px, s.py, 0, kNoIndex, s.label);
   ReleaseIfDone(root);
 }
@@ -105,7 +104,7 @@ bool IchSolver::UpdateVertex(uint32_t v, double d, uint32_t parent, uint32_t hal
     const uint32_t level = pool_[parent].level + 1;
     const uint32_t id = NewPseudoSourceWindow(v, d, pool_[parent].source, level);
     stats_.max_level = std::max(stats_.max_level, level);
-    if (keep_tree_) pool_.AddChild(parent, id);
+    pool_.AddChild(parent, id);
     ++stats_.pseudo_sources;
     Push(id, VertexKey(v, d));
   }
@@ -176,7 +175,7 @@ void IchSolver::MakeInterval(uint32_t parent, uint32_t he, double b0, double b1,
   w.source = source;
   w.level = level;
   stats_.max_level = std::max(stats_.max_level, level);
-  if (keep_tree_) pool_.AddChild(parent, id);
+  pool_.AddChild(parent, id);
   Push(id, key);
 }
 
@@ -189,12 +188,10 @@ double IchSolver::IntervalKey(double b0, double b1, double ix, double iy, double
 
 void IchSolver::ProcessInterval(uint32_t id, double popped_key) {
   Window w = pool_[id];  // copy: the pool may grow below
-  uint32_t generation = 0;
-  if (keep_tree_) {
-    const WindowLinks& links = pool_.links(id);
-    generation = links.generation;
+  const uint32_t generation = pool_.generation(id);
+  if (keep_tree() && pool_.links(id).parent != kNoIndex) {
     // ReleaseIfDone below walks up to the parent; start fetching its links now.
-    if (links.parent != kNoIndex) pool_.PrefetchLinks(links.parent);
+    pool_.PrefetchLinks(pool_.links(id).parent);
   }
   const uint32_t h = w.element;
   // With over-filtering (lambda > 0), test the window again: vertex distances have dropped since
@@ -209,7 +206,7 @@ void IchSolver::ProcessInterval(uint32_t id, double popped_key) {
     double ra, rb;
     if (!TrimByEndpoints(h, &w.b0, &w.b1, w.ix, w.iy, w.sigma, &ra, &rb)) {
       ++stats_.windows_filtered_at_pop;
-      MarkProcessed(id);
+      pool_.MarkProcessed(id);
       ReleaseIfDone(id);
       return;
     }
@@ -230,11 +227,11 @@ void IchSolver::ProcessInterval(uint32_t id, double popped_key) {
        IsFiltered(h, w.b0, w.b1, w.ix, w.iy, w.sigma, Hypot(w.b0 - w.ix, w.iy),
                   Hypot(w.b1 - w.ix, w.iy), w.side, epsilon_))) {
     ++stats_.windows_filtered_at_pop;
-    MarkProcessed(id);
+    pool_.MarkProcessed(id);
     ReleaseIfDone(id);
     return;
   }
-  MarkProcessed(id);
+  pool_.MarkProcessed(id);
   ++stats_.windows_processed;
   if (mesh_.FaceDegenerate(TriangleMesh::FaceOf(h))) {
     PassThroughDegenerate(id, w);
@@ -373,7 +370,7 @@ absl::Status IchSolver::SolveForTargets(const std::vector<ResolvedSource>& sourc
   straight_through_.assign(nv, 0);
   if (options_.use_one_angle_one_split) {
     split_.assign(3 * size_t{mesh_.face_count()}, SplitRecord{});
-    if (keep_tree_) split_owner_.assign(3 * size_t{mesh_.face_count()}, SplitOwner{});
+    if (keep_tree()) split_owner_.assign(3 * size_t{mesh_.face_count()}, SplitOwner{});
   }
   queue_.Reset(kQueueResolutionEdges * mesh_.MeanEdgeLength());
   queue_.reserve(4 * size_t{nv});
@@ -394,8 +391,7 @@ absl::Status IchSolver::SolveForTargets(const std::vector<ResolvedSource>& sourc
     if (const QueueEntry* next = queue_.Peek()) pool_.Prefetch(next->window);
     // Only the paper's tree deletes queued windows (Lemma 1's subtrees); without it every entry
     // is a live queued window, and its links are not even read.
-    if (keep_tree_ && (pool_.links(e.window).generation != e.generation ||
-                       pool_.links(e.window).state != WindowState::kQueued)) {
+    if (pool_.IsStale(e.window, e.generation)) {
       continue;  // deleted (Lemma 1) or recycled since it was queued
     }
     // Every queued key is at least LowerBound() (entries of near-equal keys pop in any order).

@@ -114,9 +114,6 @@ class IchSolver {
   // Removes `id`'s subtree (pseudo-source windows are kept and become roots), then frees any
   // processed ancestor left without children.
   void DeleteSubtree(uint32_t id);
-  void MarkProcessed(uint32_t id) {
-    if (keep_tree_) pool_.links(id).state = WindowState::kProcessed;
-  }
   // Frees a processed window (with the tree: once its subtree is gone, walking up).
   void ReleaseIfDone(uint32_t id);
   void RelaxNeighbors(uint32_t v, double d, uint32_t source);
@@ -148,10 +145,6 @@ class IchSolver {
   const TriangleMesh& mesh_;
   const GeodesicOptions& options_;
   double key_cap_;
-  // The paper's window tree (Method::kIch): children are linked to their parents so Lemma 1 can
-  // delete an old winner's subtree. Without it (Method::kExact) a window is freed as soon as it is
-  // processed (ReleaseIfDone finds no children) and Lemma 1 prunes forward only.
-  bool keep_tree_;
   double epsilon_ = 0;  // over-filtering margin lambda * L (section 7)
 
   std::vector<double> dist_;
@@ -162,7 +155,11 @@ class IchSolver {
   std::vector<uint8_t> straight_through_;
   HugeVector<SplitRecord> split_;        // Lemma 1, per half-edge
   HugeVector<SplitOwner> split_owner_;   // Lemma 1's winners, the paper's tree only
+  // The paper's window tree (Method::kIch) is the pool's links: children are linked to their
+  // parents so Lemma 1 can delete an old winner's subtree. Without them (Method::kExact) a window
+  // is freed as soon as it is processed and Lemma 1 prunes forward only.
   WindowPool pool_;
+  bool keep_tree() const { return pool_.with_links(); }
   WindowQueue queue_;
   std::vector<uint32_t> scratch_;  // reused stack for subtree deletion
   SolveStats stats_;

@@ -19,7 +19,7 @@ bool IchSolver::OneAngleOneSplit(uint32_t id, uint32_t generation, uint32_t h, d
   SplitRecord& best = split_[h];
   const double tie = kSplitTieRel * d3;
   if (d3 < best.distance - tie) {
-    if (keep_tree_) {
+    if (keep_tree()) {
       // The paper's retroactive rule: the old winner's child on the far side is useless.
       const SplitOwner& owner = split_owner_[h];
       if (owner.window != kNoIndex && pool_.links(owner.window).generation == owner.generation &&

@@ -27,11 +27,11 @@ void IchSolver::ProcessPseudoSource(uint32_t id) {
   const Window w = pool_[id];
   const uint32_t v = w.element;
   if (w.sigma != dist_[v]) {  // superseded by a shorter path to v
-    MarkProcessed(id);
+    pool_.MarkProcessed(id);
     ReleaseIfDone(id);
     return;
   }
-  MarkProcessed(id);
+  pool_.MarkProcessed(id);
   if (!face_target_head_.empty()) {
     // Paths to a target point may bend here and then run straight inside a face around v.
     for (const uint32_t* c = mesh_.CornersBegin(v); c != mesh_.CornersEnd(v); ++c) {

@@ -130,6 +130,17 @@ class WindowPool {
     --live_;
   }
   bool with_links() const { return with_links_; }
+  // Without links these are no-ops (generation 0, never stale): no window is ever deleted while
+  // queued, and nothing refers to a processed one.
+  uint32_t generation(uint32_t id) const { return with_links_ ? links_[id].generation : 0; }
+  void MarkProcessed(uint32_t id) {
+    if (with_links_) links_[id].state = WindowState::kProcessed;
+  }
+  // A queue entry made at `generation` no longer names a queued window (deleted or recycled).
+  bool IsStale(uint32_t id, uint32_t generation) const {
+    return with_links_ &&
+           (links_[id].generation != generation || links_[id].state != WindowState::kQueued);
+  }
   Window& operator[](uint32_t id) { return windows_[id]; }
   const Window& operator[](uint32_t id) const { return windows_[id]; }
   WindowLinks& links(uint32_t id) { return links_[id]; }
@@ -142,6 +153,7 @@ class WindowPool {
 
   // Tree links (doubly linked sibling lists: unlinking is O(1) even under a pseudo-source).
   void AddChild(uint32_t parent, uint32_t child) {
+    if (!with_links_) return;
     WindowLinks& c = links_[child];
     WindowLinks& p = links_[parent];
     c.parent = parent;

@@ -11,7 +11,7 @@
 namespace geodex::ich {
 
 void IchSolver::ReleaseIfDone(uint32_t id) {
-  if (!keep_tree_) {  // no tree: nothing can refer to a processed window
+  if (!keep_tree()) {  // no tree: nothing can refer to a processed window
     pool_.Free(id);
     return;
   }
