@@ -10,8 +10,15 @@
 
 namespace geodex {
 
+// What a backtrace reads per internal vertex: a DistanceField's arrays, or a targeted solve's
+// still in its workspace.
+struct VertexPaths {
+  const double* distance;
+  const VertexOrigin* origin;
+};
+
 // The path from the target (`where` names it in file terms) to its nearest source.
-absl::StatusOr<GeodesicPath> TraceFromTarget(const TriangleMesh& mesh, const DistanceField& field,
+absl::StatusOr<GeodesicPath> TraceFromTarget(const TriangleMesh& mesh, const VertexPaths& field,
                                              const ich::TargetResult& result,
                                              const SurfacePoint& where);
 

@@ -71,13 +71,7 @@ absl::Status SolveUntilTargetsFinal(const TriangleMesh& mesh, const GeodesicOpti
                                     const std::vector<ich::ResolvedTarget>& targets,
                                     std::vector<ich::TargetResult>* results, SolveStats* stats) {
   ich::IchSolver solver(mesh, options);
-  DistanceField field;
-  if (absl::Status s = solver.SolveForTargets(sources, targets, false, true, &field, results);
-      !s.ok()) {
-    return s;
-  }
-  *stats = field.stats;
-  return absl::OkStatus();
+  return solver.SolveForTargets(sources, targets, false, true, results, stats);
 }
 
 void AddStats(const SolveStats& s, SolveStats* total) {
@@ -105,16 +99,16 @@ absl::StatusOr<PathQueryResult> ComputeShortestPath(const TriangleMesh& mesh,
   if (!target.ok()) return target.status();
   const std::vector<ich::ResolvedTarget> targets = {*std::move(target)};
   ich::IchSolver solver(mesh, options.solver);
-  DistanceField field;
   std::vector<ich::TargetResult> results;
+  SolveStats stats;
   const bool early = !options.full_field;
   if (absl::Status s = solver.SolveForTargets(*sources, targets, options.use_heuristic && early,
-                                              early, &field, &results);
+                                              early, &results, &stats);
       !s.ok()) {
     return s;
   }
-  field.sources = {from};
-  absl::StatusOr<GeodesicPath> path = TraceFromTarget(mesh, field, results[0], to);
+  absl::StatusOr<GeodesicPath> path = TraceFromTarget(
+      mesh, VertexPaths{solver.distances().data(), solver.origins().data()}, results[0], to);
   if (!path.ok()) {
     if (path.status().code() == absl::StatusCode::kNotFound) {
       return absl::NotFoundError(absl::StrFormat("%s is unreachable from %s",
@@ -129,7 +123,7 @@ absl::StatusOr<PathQueryResult> ComputeShortestPath(const TriangleMesh& mesh,
   PathQueryResult result;
   result.distance = results[0].distance;
   result.path = *std::move(path);
-  result.stats = field.stats;
+  result.stats = stats;
   return result;
 }
 

@@ -62,7 +62,7 @@ Vec2 ToSiblingFrame(const TriangleMesh& mesh, uint32_t from, uint32_t to, Vec2 q
 
 class Tracer {
  public:
-  Tracer(const TriangleMesh& mesh, const DistanceField& field) : mesh_(mesh), field_(field) {}
+  Tracer(const TriangleMesh& mesh, const VertexPaths& field) : mesh_(mesh), field_(field) {}
 
   absl::Status FromVertex(uint32_t v, GeodesicPath* path) {
     path_ = path;
@@ -93,8 +93,8 @@ class Tracer {
   absl::Status Chain(uint32_t v) {
     // Every leg ends at a pseudo-source; a chain is at most as long as the vertex count.
     for (uint32_t legs = 0; legs <= mesh_.vertex_count(); ++legs) {
-      const VertexOrigin& o = field_.internal_origin[v];
-      if (field_.internal_distance[v] == 0 && o.half_edge == kNoIndex) return absl::OkStatus();
+      const VertexOrigin& o = field_.origin[v];
+      if (field_.distance[v] == 0 && o.half_edge == kNoIndex) return absl::OkStatus();
       if (o.half_edge == kNoIndex) {
         // Along an edge from a neighbour (edge relaxation), or v is a source vertex.
         if (o.pseudo_source == kNoIndex || o.pseudo_source == v) return absl::OkStatus();
@@ -224,13 +224,13 @@ class Tracer {
   }
 
   const TriangleMesh& mesh_;
-  const DistanceField& field_;
+  const VertexPaths field_;  // two pointers: held by value
   GeodesicPath* path_ = nullptr;
 };
 
 }  // namespace
 
-absl::StatusOr<GeodesicPath> TraceFromTarget(const TriangleMesh& mesh, const DistanceField& field,
+absl::StatusOr<GeodesicPath> TraceFromTarget(const TriangleMesh& mesh, const VertexPaths& field,
                                              const ich::TargetResult& result,
                                              const SurfacePoint& where) {
   if (!std::isfinite(result.distance)) {
@@ -268,7 +268,7 @@ absl::StatusOr<GeodesicPath> TracePathFromVertex(const TriangleMesh& mesh,
   }
   GeodesicPath path;
   path.source = field.internal_source[start];
-  Tracer tracer(mesh, field);
+  Tracer tracer(mesh, VertexPaths{field.internal_distance.data(), field.internal_origin.data()});
   if (absl::Status s = tracer.FromVertex(start, &path); !s.ok()) return s;
   return path;
 }

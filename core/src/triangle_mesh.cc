@@ -8,6 +8,7 @@
 
 #include "absl/status/status.h"
 #include "absl/strings/str_format.h"
+#include "ich/solve_workspace.h"
 
 namespace geodex {
 namespace {
@@ -520,7 +521,9 @@ class MeshBuilder {
 
 absl::StatusOr<TriangleMesh> TriangleMesh::Build(const MeshData& data,
                                                  const MeshBuildOptions& options) {
-  return MeshBuilder(data, options).Run();
+  absl::StatusOr<TriangleMesh> mesh = MeshBuilder(data, options).Run();
+  if (mesh.ok()) mesh->workspaces_ = std::make_shared<ich::WorkspaceCache>();
+  return mesh;
 }
 
 uint64_t TriangleMesh::MemoryBytes() const {

@@ -3,12 +3,17 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <vector>
 
 #include "absl/status/statusor.h"
 #include "geodex/mesh_data.h"
 
 namespace geodex {
+
+namespace ich {
+class WorkspaceCache;  // private to core (src/ich/solve_workspace.h)
+}
 
 inline constexpr uint32_t kNoIndex = std::numeric_limits<uint32_t>::max();
 
@@ -133,6 +138,9 @@ class TriangleMesh {
   double MeanEdgeLength() const { return mean_edge_length_; }
   double MaxEdgeLength() const { return max_edge_length_; }
   uint64_t MemoryBytes() const;
+  // The engine's idle per-solve arrays, reused so a targeted solve costs what it touches (null in
+  // a moved-from mesh). Thread-safe; not counted in MemoryBytes (at most one per concurrent solve).
+  ich::WorkspaceCache* workspaces() const { return workspaces_.get(); }
 
  private:
   TriangleMesh() = default;
@@ -166,6 +174,7 @@ class TriangleMesh {
   std::vector<double> neighbor_length_;
   double mean_edge_length_ = 0, max_edge_length_ = 0;
   MeshReport report_;
+  std::shared_ptr<ich::WorkspaceCache> workspaces_;
 };
 
 }  // namespace geodex

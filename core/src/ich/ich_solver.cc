@@ -13,16 +13,42 @@
 
 namespace geodex::ich {
 
+namespace {
+std::unique_ptr<SolveWorkspace> AcquireWorkspace(const TriangleMesh& mesh) {
+  return mesh.workspaces() != nullptr ? mesh.workspaces()->Acquire()
+                                      : std::make_unique<SolveWorkspace>();
+}
+}  // namespace
+
 IchSolver::IchSolver(const TriangleMesh& mesh, const GeodesicOptions& options, double key_cap)
-    : mesh_(mesh),
+    : workspace_(AcquireWorkspace(mesh)),
+      mesh_(mesh),
       options_(options),
       key_cap_(std::min(key_cap, options.max_distance)),
-      pool_(/*with_links=*/options.method == Method::kIch) {
+      face_target_head_(workspace_->face_target_head),
+      face_target_next_(workspace_->face_target_next),
+      face_target_entry_(workspace_->face_target_entry),
+      vertex_is_target_(workspace_->vertex_is_target),
+      dist_(workspace_->dist),
+      label_(workspace_->label),
+      origin_(workspace_->origin),
+      straight_through_(workspace_->straight_through),
+      split_(workspace_->split),
+      split_owner_(workspace_->split_owner),
+      pool_(workspace_->pool),
+      queue_(workspace_->queue),
+      scratch_(workspace_->scratch) {
+  workspace_->Prepare(mesh, /*with_links=*/options.method == Method::kIch,
+                      /*with_split_owner=*/options.method == Method::kIch);
   if (options.lambda > 0) {
     const double scale = options.lambda_scale == LambdaScale::kMaxEdge ? mesh.MaxEdgeLength()
                                                                        : mesh.MeanEdgeLength();
     epsilon_ = options.lambda * scale;
   }
+}
+
+IchSolver::~IchSolver() {
+  if (mesh_.workspaces() != nullptr) mesh_.workspaces()->Release(std::move(workspace_));
 }
 
 void IchSolver::Push(uint32_t id, double key) {
@@ -31,6 +57,7 @@ void IchSolver::Push(uint32_t id, double key) {
 
 void IchSolver::SeedVertex(uint32_t v, uint32_t label) {
   if (dist_[v] <= 0) return;  // the same vertex given twice: the first label wins
+  if (dist_[v] == kUnreachable) TouchVertex(v);
   dist_[v] = 0;
   label_[v] = label;
   origin_[v] = VertexOrigin{kNoIndex, v, 0, 0};
@@ -64,7 +91,7 @@ void IchSolver::EmitFromPointInFace(uint32_t parent, uint32_t frame_edge, double
     px = cx[k] + x * ux - y * uy;
     py = cy[k] + x * uy + y * ux;
   }
-  if (!face_target_head_.empty() && face_target_head_[f] != kNoIndex) {
+  if (has_targets_ && face_target_head_[f] != kNoIndex) {
     // A target in this very face is reached straight from the point.
     const uint32_t source_label = pool_[parent].source;
     OfferPointToTargets(f, px, py, sigma, source_label, pseudo_source, 3 * f, px, py);
@@ -90,9 +117,10 @@ bool IchSolver::UpdateVertex(uint32_t v, double d, uint32_t parent, uint32_t hal
                              double iy) {
   if (!(d < dist_[v])) return false;
   const Window& p = pool_[parent];
+  if (dist_[v] == kUnreachable) TouchVertex(v);
   dist_[v] = d;
   straight_through_[v] = 0;
-  if (!vertex_is_target_.empty() && vertex_is_target_[v]) targets_dirty_ = true;
+  if (has_targets_ && vertex_is_target_[v]) targets_dirty_ = true;
   label_[v] = p.source;
   origin_[v] = VertexOrigin{half_edge, p.kind == WindowKind::kPseudoSource ? p.element
                                                                             : p.pseudo_source,
@@ -117,9 +145,10 @@ void IchSolver::RelaxNeighbors(uint32_t v, double d, uint32_t source) {
     const double du = d + mesh_.NeighborLength(i);
     if (!(du < dist_[u])) continue;
     ++stats_.edge_relaxations;
+    if (dist_[u] == kUnreachable) TouchVertex(u);
     dist_[u] = du;
     straight_through_[u] = 0;
-    if (!vertex_is_target_.empty() && vertex_is_target_[u]) targets_dirty_ = true;
+    if (has_targets_ && vertex_is_target_[u]) targets_dirty_ = true;
     label_[u] = source;
     origin_[u] = VertexOrigin{kNoIndex, v, 0, 0};
     if ((mesh_.IsPseudoSourceCandidate(u) || epsilon_ > 0) && du <= options_.max_distance) {
@@ -239,7 +268,7 @@ void IchSolver::ProcessInterval(uint32_t id, double popped_key) {
     return;
   }
 
-  if (!face_target_head_.empty() && face_target_head_[TriangleMesh::FaceOf(h)] != kNoIndex) {
+  if (has_targets_ && face_target_head_[TriangleMesh::FaceOf(h)] != kNoIndex) {
     OfferWindowToTargets(h, w);
   }
   const double len = mesh_.Length(h);
@@ -334,28 +363,65 @@ void IchSolver::ProcessInterval(uint32_t id, double popped_key) {
 }
 
 absl::Status IchSolver::Solve(const std::vector<ResolvedSource>& sources, DistanceField* out) {
-  return SolveForTargets(sources, {}, false, false, out, nullptr);
+  if (absl::Status s = Run(sources, nullptr, false, false, nullptr); !s.ok()) return s;
+  if (std::isfinite(options_.max_distance)) {
+    for (uint32_t v : workspace_->touched_vertices) {
+      if (dist_[v] > options_.max_distance) {
+        dist_[v] = kUnreachable;
+        label_[v] = kNoIndex;
+        origin_[v] = VertexOrigin{};
+      }
+    }
+  }
+  // The whole field is the answer: hand the arrays over (the workspace refills them next time).
+  out->internal_distance = std::move(dist_);
+  out->internal_source = std::move(label_);
+  out->internal_origin = std::move(origin_);
+  out->stats = stats_;
+  return absl::OkStatus();
 }
 
 absl::Status IchSolver::SolveForTargets(const std::vector<ResolvedSource>& sources,
                                         const std::vector<ResolvedTarget>& targets,
-                                        bool use_heuristic, bool stop_early, DistanceField* out,
-                                        std::vector<TargetResult>* results) {
+                                        bool use_heuristic, bool stop_early,
+                                        std::vector<TargetResult>* results, SolveStats* stats) {
+  absl::Status status = Run(sources, &targets, use_heuristic, stop_early, results);
+  if (stats != nullptr) *stats = stats_;
+  if (!status.ok()) return status;
+  for (uint32_t t = 0; t < targets.size(); ++t) {
+    TargetResult& r = (*results)[t];
+    if (r.distance > options_.max_distance) r = TargetResult{};
+    for (uint32_t v : targets[t].vertices) {
+      if (dist_[v] < r.distance && dist_[v] <= options_.max_distance) {
+        r.distance = dist_[v];
+        r.label = label_[v];
+        r.vertex = v;
+      }
+    }
+  }
+  return absl::OkStatus();
+}
+
+absl::Status IchSolver::Run(const std::vector<ResolvedSource>& sources,
+                            const std::vector<ResolvedTarget>* targets, bool use_heuristic,
+                            bool stop_early, std::vector<TargetResult>* results) {
   const auto start = std::chrono::steady_clock::now();
-  if (results != nullptr) {
-    targets_ = &targets;
+  stats_ = SolveStats{};
+  has_targets_ = targets != nullptr;
+  if (has_targets_) {
+    targets_ = targets;
     target_results_ = results;
-    results->assign(targets.size(), TargetResult{});
+    results->assign(targets->size(), TargetResult{});
     stop_early_ = stop_early;
-    heuristic_ = use_heuristic && targets.size() == 1;
-    face_target_head_.assign(mesh_.face_count(), kNoIndex);
-    vertex_is_target_.assign(mesh_.vertex_count(), 0);
-    face_target_next_.clear();
-    face_target_entry_.clear();
-    for (uint32_t t = 0; t < targets.size(); ++t) {
-      for (uint32_t v : targets[t].vertices) vertex_is_target_[v] = 1;
-      for (uint32_t k = 0; k < targets[t].placements.size(); ++k) {
-        const uint32_t f = targets[t].placements[k].face;
+    heuristic_ = use_heuristic && targets->size() == 1;
+    for (uint32_t t = 0; t < targets->size(); ++t) {
+      for (uint32_t v : (*targets)[t].vertices) {
+        vertex_is_target_[v] = 1;
+        workspace_->target_vertices.push_back(v);
+      }
+      for (uint32_t k = 0; k < (*targets)[t].placements.size(); ++k) {
+        const uint32_t f = (*targets)[t].placements[k].face;
+        if (face_target_head_[f] == kNoIndex) workspace_->target_faces.push_back(f);
         face_target_entry_.push_back({t, k});
         face_target_next_.push_back(face_target_head_[f]);
         face_target_head_[f] = static_cast<uint32_t>(face_target_entry_.size() - 1);
@@ -364,14 +430,6 @@ absl::Status IchSolver::SolveForTargets(const std::vector<ResolvedSource>& sourc
     targets_dirty_ = true;
   }
   const uint32_t nv = mesh_.vertex_count();
-  dist_.assign(nv, kUnreachable);
-  label_.assign(nv, kNoIndex);
-  origin_.assign(nv, VertexOrigin{});
-  straight_through_.assign(nv, 0);
-  if (options_.use_one_angle_one_split) {
-    split_.assign(3 * size_t{mesh_.face_count()}, SplitRecord{});
-    if (keep_tree()) split_owner_.assign(3 * size_t{mesh_.face_count()}, SplitOwner{});
-  }
   queue_.Reset(kQueueResolutionEdges * mesh_.MeanEdgeLength());
   queue_.reserve(4 * size_t{nv});
 
@@ -426,35 +484,9 @@ absl::Status IchSolver::SolveForTargets(const std::vector<ResolvedSource>& sourc
                       split_.capacity() * sizeof(SplitRecord) +
                       split_owner_.capacity() * sizeof(SplitOwner) +
                       nv * (sizeof(double) + sizeof(uint32_t) + sizeof(VertexOrigin));
-  if (!status.ok()) return status;
-  if (std::isfinite(options_.max_distance)) {
-    for (uint32_t v = 0; v < nv; ++v) {
-      if (dist_[v] > options_.max_distance) {
-        dist_[v] = kUnreachable;
-        label_[v] = kNoIndex;
-        origin_[v] = VertexOrigin{};
-      }
-    }
-  }
-  if (target_results_ != nullptr) {
-    for (uint32_t t = 0; t < targets_->size(); ++t) {
-      TargetResult& r = (*target_results_)[t];
-      for (uint32_t v : (*targets_)[t].vertices) {
-        if (dist_[v] < r.distance) {
-          r.distance = dist_[v];
-          r.label = label_[v];
-          r.vertex = v;
-        }
-      }
-    }
-  }
-  out->internal_distance = std::move(dist_);
-  out->internal_source = std::move(label_);
-  out->internal_origin = std::move(origin_);
   stats_.solve_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  out->stats = stats_;
-  return absl::OkStatus();
+  return status;
 }
 
 }  // namespace geodex::ich

@@ -5,12 +5,14 @@
 
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <vector>
 
 #include "absl/status/status.h"
 #include "geodex/distance_field.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/triangle_mesh.h"
+#include "ich/solve_workspace.h"
 #include "ich/window.h"
 
 namespace geodex::ich {
@@ -59,20 +61,35 @@ class IchSolver {
   // callers that switch the filter off pass an upper bound of every distance here.
   IchSolver(const TriangleMesh& mesh, const GeodesicOptions& options,
             double key_cap = std::numeric_limits<double>::infinity());
+  // Gives the workspace back to the mesh, restoring only what the solve touched.
+  ~IchSolver();
+  IchSolver(const IchSolver&) = delete;
+  IchSolver& operator=(const IchSolver&) = delete;
 
   // Fills out->internal_distance/_source/_origin and out->stats.
   absl::Status Solve(const std::vector<ResolvedSource>& sources, DistanceField* out);
 
-  // Same, answering `targets` exactly and stopping as soon as every target's distance is final.
-  // With `use_heuristic` (one target only) windows are ordered by the paper's section 5 key,
-  // sigma + min over the interval of (|I p| + |p t|), which never exceeds the length of a path
-  // through the window. Only the targets' results are meaningful then, not the whole field.
+  // Answers `targets` exactly, stopping as soon as every target's distance is final (with
+  // `stop_early`). With `use_heuristic` (one target only) windows are ordered by the paper's
+  // section 5 key, sigma + min over the interval of (|I p| + |p t|), which never exceeds the
+  // length of a path through the window. Only the targets' results are meaningful then, not the
+  // whole field. The per-vertex arrays stay in the workspace (read them with the accessors below
+  // until the solver goes): no O(V) copy, and `stats` (if given) receives the counters.
   absl::Status SolveForTargets(const std::vector<ResolvedSource>& sources,
                                const std::vector<ResolvedTarget>& targets, bool use_heuristic,
-                               bool stop_early, DistanceField* out,
-                               std::vector<TargetResult>* results);
+                               bool stop_early, std::vector<TargetResult>* results,
+                               SolveStats* stats);
+
+  // The last solve's per-vertex arrays (internal ids), for backtracing paths.
+  const std::vector<double>& distances() const { return dist_; }
+  const std::vector<uint32_t>& labels() const { return label_; }
+  const std::vector<VertexOrigin>& origins() const { return origin_; }
 
  private:
+  absl::Status Run(const std::vector<ResolvedSource>& sources,
+                   const std::vector<ResolvedTarget>* targets, bool use_heuristic,
+                   bool stop_early, std::vector<TargetResult>* results);
+  void TouchVertex(uint32_t v) { workspace_->touched_vertices.push_back(v); }
   void SeedVertex(uint32_t v, uint32_t label);
   // A pseudo-source window at `vertex` (kNoIndex: a source point's root), not yet queued.
   uint32_t NewPseudoSourceWindow(uint32_t vertex, double sigma, uint32_t source, uint32_t level);
@@ -132,36 +149,40 @@ class IchSolver {
              double tx, double ty);
   double TargetsBound();  // the largest current target distance (+inf while any is unknown)
 
-  const std::vector<ResolvedTarget>* targets_ = nullptr;
-  std::vector<TargetResult>* target_results_ = nullptr;
-  bool heuristic_ = false;
-  bool stop_early_ = false;
-  std::vector<uint32_t> face_target_head_;   // per face: first (target, placement) entry
-  std::vector<uint32_t> face_target_next_;   // entry -> next entry in the same face
-  std::vector<std::pair<uint32_t, uint32_t>> face_target_entry_;  // entry -> (target, placement)
-  std::vector<uint8_t> vertex_is_target_;
-  bool targets_dirty_ = true;
-  double targets_bound_ = kUnreachable;
+  // First: the references below point into it. From the mesh's cache (or owned, for a mesh that
+  // has none).
+  std::unique_ptr<SolveWorkspace> workspace_;
   const TriangleMesh& mesh_;
   const GeodesicOptions& options_;
   double key_cap_;
   double epsilon_ = 0;  // over-filtering margin lambda * L (section 7)
 
-  std::vector<double> dist_;
-  std::vector<uint32_t> label_;
-  std::vector<VertexOrigin> origin_;
-  // Per vertex: which sides of its best incoming ray continue straight (bit 1 left, bit 2 right;
-  // 3 = both, see ProcessInterval). Reset whenever the vertex's distance improves.
-  std::vector<uint8_t> straight_through_;
-  HugeVector<SplitRecord> split_;        // Lemma 1, per half-edge
-  HugeVector<SplitOwner> split_owner_;   // Lemma 1's winners, the paper's tree only
+  const std::vector<ResolvedTarget>* targets_ = nullptr;
+  std::vector<TargetResult>* target_results_ = nullptr;
+  bool heuristic_ = false;
+  bool stop_early_ = false;
+  bool targets_dirty_ = true;
+  double targets_bound_ = kUnreachable;
+  bool has_targets_ = false;
+
+  // The workspace's arrays under the names the rules use (see SolveWorkspace).
+  std::vector<uint32_t>& face_target_head_;
+  std::vector<uint32_t>& face_target_next_;
+  std::vector<std::pair<uint32_t, uint32_t>>& face_target_entry_;
+  std::vector<uint8_t>& vertex_is_target_;
+  std::vector<double>& dist_;
+  std::vector<uint32_t>& label_;
+  std::vector<VertexOrigin>& origin_;
+  std::vector<uint8_t>& straight_through_;
+  HugeVector<SplitRecord>& split_;        // Lemma 1, per half-edge
+  HugeVector<SplitOwner>& split_owner_;   // Lemma 1's winners, the paper's tree only
   // The paper's window tree (Method::kIch) is the pool's links: children are linked to their
   // parents so Lemma 1 can delete an old winner's subtree. Without them (Method::kExact) a window
   // is freed as soon as it is processed and Lemma 1 prunes forward only.
-  WindowPool pool_;
+  WindowPool& pool_;
   bool keep_tree() const { return pool_.with_links(); }
-  WindowQueue queue_;
-  std::vector<uint32_t> scratch_;  // reused stack for subtree deletion
+  WindowQueue& queue_;
+  std::vector<uint32_t>& scratch_;  // reused stack for subtree deletion
   SolveStats stats_;
 };
 

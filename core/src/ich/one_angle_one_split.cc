@@ -45,6 +45,7 @@ bool IchSolver::OneAngleOneSplit(uint32_t id, uint32_t generation, uint32_t h, d
       }
       split_owner_[h] = SplitOwner{id, generation};
     }
+    if (best.distance == kUnreachable) workspace_->touched_half_edges.push_back(h);
     best.distance = d3;
     best.cross_x = cross_x;
   } else if (d3 > best.distance + tie) {

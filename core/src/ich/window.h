@@ -89,7 +89,22 @@ struct WindowLinks {
 // (`with_links`); without them a window is just its geometry, freed right after processing.
 class WindowPool {
  public:
-  explicit WindowPool(bool with_links) : with_links_(with_links) {}
+  explicit WindowPool(bool with_links = false) : with_links_(with_links) {}
+
+  // Empties the pool for a new solve, keeping its capacity.
+  void Reset(bool with_links) {
+    with_links_ = with_links;
+    windows_.clear();
+    links_.clear();
+    free_.clear();
+    live_ = peak_live_ = 0;
+  }
+  // Returns the pool's memory (after a solve that needed far more windows than the next may).
+  void ReleaseMemory() {
+    HugeVector<Window>().swap(windows_);
+    HugeVector<WindowLinks>().swap(links_);
+    std::vector<uint32_t>().swap(free_);
+  }
 
   uint32_t Allocate() {
     uint32_t id;
@@ -225,6 +240,10 @@ class WindowQueue {
     inverse_ = 1 / resolution;
   }
   void reserve(size_t n) { buckets_[0].reserve(n / 8); }
+  void ReleaseMemory() {
+    for (auto& b : buckets_) std::vector<QueueEntry>().swap(b);
+    size_ = 0;
+  }
   uint64_t CapacityBytes() const {
     uint64_t bytes = 0;
     for (const auto& b : buckets_) bytes += b.capacity() * sizeof(QueueEntry);
