@@ -9,6 +9,8 @@
 #include <memory>
 #include <set>
 
+#include <unistd.h>
+
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_format.h"
 #include "geodex/distance_matrix.h"
@@ -76,6 +78,72 @@ int RunInfo(const Args& args) {
   return kExitOk;
 }
 
+// --lambda, --lambda-scale, --max-distance and --max-windows, shared by distances, path and matrix.
+bool GetSolverFlags(const Args& args, GeodesicOptions* options, std::string* error) {
+  if (!GetDouble(args, "lambda", &options->lambda, error) ||
+      !GetDouble(args, "max-distance", &options->max_distance, error) ||
+      !GetUint(args, "max-windows", &options->max_windows, error)) {
+    return false;
+  }
+  if (!(options->lambda >= 0 && options->lambda <= 1)) {
+    *error = absl::StrFormat("--lambda must be in [0, 1], got %g", options->lambda);
+    return false;
+  }
+  if (!(options->max_distance > 0)) {
+    *error = "--max-distance must be positive";
+    return false;
+  }
+  if (args.options.count("lambda-scale")) {
+    const std::string& s = args.options.at("lambda-scale");
+    if (s == "max") {
+      options->lambda_scale = LambdaScale::kMaxEdge;
+    } else if (s == "mean") {
+      options->lambda_scale = LambdaScale::kMeanEdge;
+    } else {
+      *error = "--lambda-scale must be max or mean";
+      return false;
+    }
+  }
+  return true;
+}
+
+// A progress bar on stderr for row-by-row work, shown only on a terminal and only once the call
+// has run for a second.
+class RowProgress {
+ public:
+  RowProgress() : enabled_(isatty(fileno(stderr)) != 0), start_(Clock::now()) {}
+  ~RowProgress() { Finish(); }
+  // Clears the bar (before the answer is printed).
+  void Finish() {
+    if (shown_) std::fputs("\r\033[K", stderr);
+    shown_ = false;
+    enabled_ = false;
+  }
+  void Update(size_t done, size_t total) {
+    if (!enabled_) return;
+    const auto now = Clock::now();
+    const double elapsed = std::chrono::duration<double>(now - start_).count();
+    if (elapsed < 1 || (shown_ && now - last_ < std::chrono::milliseconds(100) && done < total)) {
+      return;
+    }
+    last_ = now;
+    shown_ = true;
+    constexpr int kWidth = 30;
+    const int filled = static_cast<int>(kWidth * done / std::max<size_t>(total, 1));
+    const double left = done > 0 ? elapsed * (total - done) / done : 0;
+    std::fprintf(stderr, "\r[%s%s] %zu/%zu rows, %.1f s, ~%.0f s left\033[K",
+                 std::string(filled, '#').c_str(), std::string(kWidth - filled, '.').c_str(), done,
+                 total, elapsed, left);
+    std::fflush(stderr);
+  }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  bool enabled_;
+  bool shown_ = false;
+  Clock::time_point start_, last_;
+};
+
 int RunDistances(const Args& args) {
   std::string error;
   if (!CheckKnown(args, {"sources", "method", "lambda", "lambda-scale", "max-distance",
@@ -97,27 +165,7 @@ int RunDistances(const Args& args) {
   } else {
     return Fail(kExitUsage, "--method must be exact, ich or dijkstra");
   }
-  if (!GetDouble(args, "lambda", &options.lambda, &error) ||
-      !GetDouble(args, "max-distance", &options.max_distance, &error) ||
-      !GetUint(args, "max-windows", &options.max_windows, &error)) {
-    return Fail(kExitUsage, error);
-  }
-  if (!(options.lambda >= 0 && options.lambda <= 1)) {
-    return Fail(kExitUsage, absl::StrFormat("--lambda must be in [0, 1], got %g", options.lambda));
-  }
-  if (!(options.max_distance > 0)) {
-    return Fail(kExitUsage, "--max-distance must be positive");
-  }
-  if (args.options.count("lambda-scale")) {
-    const std::string& s = args.options.at("lambda-scale");
-    if (s == "max") {
-      options.lambda_scale = LambdaScale::kMaxEdge;
-    } else if (s == "mean") {
-      options.lambda_scale = LambdaScale::kMeanEdge;
-    } else {
-      return Fail(kExitUsage, "--lambda-scale must be max or mean");
-    }
-  }
+  if (!GetSolverFlags(args, &options, &error)) return Fail(kExitUsage, error);
   options.use_filter = !args.options.count("no-filter");
   options.use_one_angle_one_split = !args.options.count("no-one-split");
 
@@ -208,7 +256,9 @@ bool OnePoint(const Args& args, const std::string& key, const TriangleMesh& mesh
 
 int RunPath(const Args& args) {
   std::string error;
-  if (!CheckKnown(args, {"from", "to", "method", "stats", "lambda", "max-windows"}, &error)) {
+  if (!CheckKnown(args, {"from", "to", "method", "stats", "lambda", "lambda-scale", "max-distance",
+                         "max-windows"},
+                  &error)) {
     return Fail(kExitUsage, error);
   }
   if (args.positional.size() != 1 || !args.options.count("from") || !args.options.count("to")) {
@@ -223,10 +273,7 @@ int RunPath(const Args& args) {
   } else {
     return Fail(kExitUsage, "--method must be astar or full");
   }
-  if (!GetDouble(args, "lambda", &options.solver.lambda, &error) ||
-      !GetUint(args, "max-windows", &options.solver.max_windows, &error)) {
-    return Fail(kExitUsage, error);
-  }
+  if (!GetSolverFlags(args, &options.solver, &error)) return Fail(kExitUsage, error);
   absl::StatusOr<LoadedMesh> loaded = LoadMesh(args.positional[0], MeshBuildOptions{});
   if (!loaded.ok()) return Fail(kExitInput, std::string(loaded.status().message()));
   SurfacePoint from, to;
@@ -258,15 +305,28 @@ int RunPath(const Args& args) {
 
 int RunMatrix(const Args& args) {
   std::string error;
-  if (!CheckKnown(args, {"sources", "targets", "stats", "max-windows"}, &error)) {
+  if (!CheckKnown(args, {"sources", "targets", "stats", "lambda", "lambda-scale", "max-distance",
+                         "max-windows", "k-nearest", "threads"},
+                  &error)) {
     return Fail(kExitUsage, error);
   }
   if (args.positional.size() != 1 || !args.options.count("sources") ||
       !args.options.count("targets")) {
     return Fail(kExitUsage, "usage: geodex matrix MESH --sources SPEC --targets SPEC");
   }
-  GeodesicOptions options;
-  if (!GetUint(args, "max-windows", &options.max_windows, &error)) return Fail(kExitUsage, error);
+  MatrixOptions options;
+  uint64_t k_nearest = 0, threads = 0;
+  if (!GetSolverFlags(args, &options.solver, &error) ||
+      !GetUint(args, "k-nearest", &k_nearest, &error) ||
+      !GetUint(args, "threads", &threads, &error)) {
+    return Fail(kExitUsage, error);
+  }
+  if (k_nearest > UINT32_MAX) return Fail(kExitUsage, "--k-nearest is too large");
+  if (threads > 1024) return Fail(kExitUsage, "--threads must be at most 1024");
+  options.k_nearest = static_cast<uint32_t>(k_nearest);
+  options.threads = static_cast<unsigned>(threads);
+  RowProgress progress;
+  options.on_row = [&progress](size_t done, size_t total) { progress.Update(done, total); };
   absl::StatusOr<LoadedMesh> loaded = LoadMesh(args.positional[0], MeshBuildOptions{});
   if (!loaded.ok()) return Fail(kExitInput, std::string(loaded.status().message()));
   std::vector<SurfacePoint> lists[2];
@@ -281,6 +341,7 @@ int RunMatrix(const Args& args) {
     lists[i] = *std::move(p);
   }
   absl::StatusOr<DistanceMatrix> m = ComputeDistanceMatrix(loaded->mesh, lists[0], lists[1], options);
+  progress.Finish();
   if (!m.ok()) {
     const int code = m.status().code() == absl::StatusCode::kInvalidArgument ? kExitUsage
                                                                               : kExitSolveFailed;
@@ -289,8 +350,11 @@ int RunMatrix(const Args& args) {
   const std::string text = FormatMatrix(*m);
   std::fwrite(text.data(), 1, text.size(), stdout);
   if (args.options.count("stats")) {
-    std::fprintf(stderr, "{\"rows\": %zu, \"cols\": %zu, \"windows_created\": %llu, \"solve_ms\": %.3f}\n",
-                 m->rows, m->cols, (unsigned long long)m->stats.windows_created, m->stats.solve_ms);
+    std::fprintf(stderr,
+                 "{\"rows\": %zu, \"cols\": %zu, \"windows_created\": %llu, \"solve_ms\": %.3f, "
+                 "\"threads\": %u}\n",
+                 m->rows, m->cols, (unsigned long long)m->stats.windows_created, m->stats.solve_ms,
+                 options.threads > 0 ? options.threads : UsableCores());
   }
   return kExitOk;
 }

@@ -43,12 +43,20 @@ commands:
       --no-filter / --no-one-split switch off Lemma 2 / Lemma 1 (slower; same answer).
       --at SPEC: instead, one line per surface point: its unfolding estimate (paper section 4)
       and its exact distance ('POINT<TAB>estimate D<TAB>exact D<TAB>source I').
-  path MESH --from SPEC --to SPEC [--method astar|full] [--stats]
+  path MESH --from SPEC --to SPEC [--method astar|full] [--stats] [--lambda L]
+       [--max-distance D]
       The exact shortest path: line 1 its length; then one line per polyline point,
       'x y z' and the simplex it lies on ('v ID', 'e V1 V2 T' or 'f FACE B0 B1 B2').
       astar (default) uses the paper's section 5 heuristic and stops at the target.
-  matrix MESH --sources SPEC --targets SPEC [--stats]
-      Exact distances, one row per source, tab-separated.
+      --lambda L (as for distances) trades exactness for speed; --max-distance D: a target
+      farther than D is unreachable.
+  matrix MESH --sources SPEC --targets SPEC [--stats] [--lambda L] [--max-distance D]
+         [--k-nearest K] [--threads N]
+      Exact distances, one row per source, tab-separated. Rows run in parallel on every usable
+      core (--threads N to limit). The same points as sources and targets give a symmetric
+      matrix, each pair solved once. --max-distance D: entries beyond D are inf. --k-nearest K:
+      per source only its K nearest targets are filled in, the rest inf. A progress bar shows
+      on a terminal for calls longer than a second.
   isolines MESH --sources SPEC (--levels L1,L2,... | --count K) [--output FILE.json|.obj|.svg]
       Approximate geodesic offsets (paper section 6.1; linear along edges): polylines of edge
       points per level. --count K: the levels D*j/K, j = 1..K-1, D the largest distance.

@@ -1,9 +1,17 @@
 // Queries answered by targeted solves: single source / single target paths (paper section 5),
 // distance matrices and exact distances at surface points.
 
+#include <sched.h>
+
 #include <algorithm>
+#include <atomic>
+#include <condition_variable>
+#include <functional>
 #include <map>
+#include <memory>
+#include <mutex>
 #include <string>
+#include <thread>
 
 #include "absl/strings/str_format.h"
 #include "geodex/distance_matrix.h"
@@ -65,13 +73,14 @@ absl::StatusOr<std::vector<ich::ResolvedTarget>> ResolveTargets(
   return out;
 }
 
-// One targeted solve without the heuristic, stopping once every target is final.
+// One targeted solve (A* towards the targets when they are close together), stopping once every
+// target is final.
 absl::Status SolveUntilTargetsFinal(const TriangleMesh& mesh, const GeodesicOptions& options,
                                     const std::vector<ich::ResolvedSource>& sources,
                                     const std::vector<ich::ResolvedTarget>& targets,
                                     std::vector<ich::TargetResult>* results, SolveStats* stats) {
   ich::IchSolver solver(mesh, options);
-  return solver.SolveForTargets(sources, targets, false, true, results, stats);
+  return solver.SolveForTargets(sources, targets, /*use_heuristic=*/true, true, results, stats);
 }
 
 void AddStats(const SolveStats& s, SolveStats* total) {
@@ -127,39 +136,221 @@ absl::StatusOr<PathQueryResult> ComputeShortestPath(const TriangleMesh& mesh,
   return result;
 }
 
+unsigned UsableCores() {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (sched_getaffinity(0, sizeof(set), &set) == 0) {
+    const int n = CPU_COUNT(&set);
+    if (n > 0) return static_cast<unsigned>(n);
+  }
+  return std::max(1u, std::thread::hardware_concurrency());
+}
+
+namespace {
+
+// Row indices handed out to the calling thread and its helpers. Shared, so a helper that starts
+// after the call returned finds nothing left and touches nothing else.
+struct RowQueue {
+  std::atomic<size_t> next{0};
+  size_t total = 0;
+  std::function<void(size_t)> run;  // valid while the call waits; only reached for rows < total
+  std::mutex mu;
+  std::condition_variable done_cv;
+  size_t done = 0;  // guarded by mu
+};
+
+void WorkRows(const std::shared_ptr<RowQueue>& q) {
+  for (;;) {
+    const size_t i = q->next.fetch_add(1);
+    if (i >= q->total) return;
+    q->run(i);
+    std::lock_guard<std::mutex> lock(q->mu);
+    if (++q->done == q->total) q->done_cv.notify_all();
+  }
+}
+
+// Runs run(0..total-1) on the calling thread and up to threads - 1 helpers; returns when all ran.
+void RunRows(size_t total, unsigned threads, const std::function<void(std::function<void()>)>& spawn,
+             std::function<void(size_t)> run) {
+  auto q = std::make_shared<RowQueue>();
+  q->total = total;
+  q->run = std::move(run);
+  const size_t helpers = std::min<size_t>(threads > 0 ? threads - 1 : 0, total > 0 ? total - 1 : 0);
+  std::vector<std::thread> own;
+  for (size_t h = 0; h < helpers; ++h) {
+    if (spawn) {
+      spawn([q] { WorkRows(q); });
+    } else {
+      own.emplace_back([q] { WorkRows(q); });
+    }
+  }
+  WorkRows(q);
+  {
+    std::unique_lock<std::mutex> lock(q->mu);
+    q->done_cv.wait(lock, [&] { return q->done == q->total; });
+  }
+  for (std::thread& t : own) t.join();
+}
+
+}  // namespace
+
 absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
                                                      const std::vector<SurfacePoint>& sources,
                                                      const std::vector<SurfacePoint>& targets,
                                                      const GeodesicOptions& options) {
-  if (absl::Status s = CheckOptions(options); !s.ok()) return s;
+  MatrixOptions m;
+  m.solver = options;
+  return ComputeDistanceMatrix(mesh, sources, targets, m);
+}
+
+absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
+                                                     const std::vector<SurfacePoint>& sources,
+                                                     const std::vector<SurfacePoint>& targets,
+                                                     const MatrixOptions& options) {
+  if (absl::Status s = CheckOptions(options.solver); !s.ok()) return s;
   if (sources.empty() || targets.empty()) {
     return absl::InvalidArgumentError("a distance matrix needs at least one source and one target");
   }
-  absl::StatusOr<std::vector<ich::ResolvedTarget>> resolved = ResolveTargets(mesh, targets);
+  // Distinct points: a point given twice is solved once (and a symmetric matrix stays symmetric).
+  std::vector<std::string> source_keys, target_keys;
+  for (const SurfacePoint& p : sources) source_keys.push_back(SurfacePointToString(p));
+  for (const SurfacePoint& p : targets) target_keys.push_back(SurfacePointToString(p));
+  const bool symmetric = options.k_nearest == 0 && source_keys == target_keys;
+  std::vector<size_t> source_row(sources.size());  // source -> its distinct row
+  std::vector<size_t> distinct;                    // distinct row -> first source index
+  {
+    std::map<std::string, size_t> seen;
+    for (size_t i = 0; i < sources.size(); ++i) {
+      auto [it, fresh] = seen.emplace(source_keys[i], distinct.size());
+      if (fresh) distinct.push_back(i);
+      source_row[i] = it->second;
+    }
+  }
+  // Columns solved: every target, or (symmetric) the distinct points.
+  std::vector<size_t> column_of(targets.size());  // target -> solved column
+  std::vector<SurfacePoint> solved_targets;
+  if (symmetric) {
+    for (size_t j = 0; j < targets.size(); ++j) column_of[j] = source_row[j];
+    for (size_t r : distinct) solved_targets.push_back(targets[r]);
+  } else {
+    for (size_t j = 0; j < targets.size(); ++j) column_of[j] = j;
+    solved_targets = targets;
+  }
+  absl::StatusOr<std::vector<ich::ResolvedTarget>> resolved = ResolveTargets(mesh, solved_targets);
   if (!resolved.ok()) return resolved.status();
+  std::vector<std::vector<ich::ResolvedSource>> row_sources(distinct.size());
+  for (size_t r = 0; r < distinct.size(); ++r) {
+    absl::StatusOr<std::vector<ich::ResolvedSource>> src = ResolveSources(mesh, {sources[distinct[r]]});
+    if (!src.ok()) return src.status();
+    row_sources[r] = *std::move(src);
+  }
+
+  const size_t rows = distinct.size(), cols = solved_targets.size();
+  // Symmetric: pair (r, c) is solved by whichever of the two comes first in a sweep along the
+  // points' longest extent, so later rows need only targets on one side of them, close together
+  // (a small A* ball).
+  std::vector<size_t> rank(rows);
+  if (symmetric) {
+    double lo[3], hi[3];
+    for (int k = 0; k < 3; ++k) lo[k] = hi[k] = (*resolved)[0].position[k];
+    for (const ich::ResolvedTarget& t : *resolved) {
+      for (int k = 0; k < 3; ++k) {
+        lo[k] = std::min(lo[k], t.position[k]);
+        hi[k] = std::max(hi[k], t.position[k]);
+      }
+    }
+    int axis = 0;
+    for (int k = 1; k < 3; ++k) {
+      if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
+    }
+    std::vector<size_t> order(rows);
+    for (size_t r = 0; r < rows; ++r) order[r] = r;
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+      return (*resolved)[a].position[axis] < (*resolved)[b].position[axis];
+    });
+    for (size_t n = 0; n < rows; ++n) rank[order[n]] = n;
+  }
+  std::vector<double> solved(rows * cols, kUnreachable);
+  SolveStats total_stats;
+  absl::Status first_error = absl::OkStatus();
+  std::atomic<bool> failed{false};
+  std::mutex mu;  // guards total_stats, first_error, rows_done and on_row
+  size_t rows_done = 0;
+  const uint32_t k = options.k_nearest;
+  auto solve_row = [&](size_t r) {
+    if (failed.load(std::memory_order_relaxed)) return;
+    // Symmetric: row r needs only the columns after it in the sweep; d(r, r) = 0.
+    std::vector<size_t> columns;
+    std::vector<ich::ResolvedTarget> subset;
+    const std::vector<ich::ResolvedTarget>* row_targets = &*resolved;
+    if (symmetric) {
+      for (size_t c = 0; c < cols; ++c) {
+        if (rank[c] > rank[r]) {
+          columns.push_back(c);
+          subset.push_back((*resolved)[c]);
+        }
+      }
+      row_targets = &subset;
+    } else {
+      for (size_t c = 0; c < cols; ++c) columns.push_back(c);
+    }
+    absl::Status status = absl::OkStatus();
+    SolveStats stats;
+    if (!columns.empty()) {
+      std::vector<ich::TargetResult> results;
+      try {
+        ich::IchSolver solver(mesh, options.solver);
+        solver.set_final_needed(k);
+        status = solver.SolveForTargets(row_sources[r], *row_targets, /*use_heuristic=*/true,
+                                        true, &results, &stats);
+      } catch (const std::bad_alloc&) {
+        status = absl::ResourceExhaustedError(
+            "out of memory for geodesic windows; set a window budget, a max_distance or lambda > 0");
+      }
+      if (status.ok()) {
+        double* row = &solved[r * cols];
+        for (size_t j = 0; j < results.size(); ++j) row[columns[j]] = results[j].distance;
+        if (k > 0 && k < results.size()) {
+          // Only the k nearest are exact: keep them (ties: lower index), the rest are +inf.
+          std::vector<size_t> order(results.size());
+          for (size_t j = 0; j < order.size(); ++j) order[j] = j;
+          std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+            return results[a].distance < results[b].distance;
+          });
+          for (size_t n = k; n < order.size(); ++n) row[columns[order[n]]] = kUnreachable;
+        }
+      }
+    }
+    if (symmetric) solved[r * cols + r] = 0;
+    std::lock_guard<std::mutex> lock(mu);
+    if (!status.ok()) {
+      if (first_error.ok()) first_error = status;
+      failed.store(true, std::memory_order_relaxed);
+      return;
+    }
+    AddStats(stats, &total_stats);
+    ++rows_done;
+    if (options.on_row) options.on_row(rows_done, rows);
+  };
+  const unsigned threads = options.threads > 0 ? options.threads : UsableCores();
+  RunRows(rows, threads, options.spawn, solve_row);
+  if (!first_error.ok()) return first_error;
+  if (symmetric) {
+    for (size_t r = 0; r < rows; ++r) {
+      for (size_t c = 0; c < cols; ++c) {
+        if (rank[c] > rank[r]) solved[c * cols + r] = solved[r * cols + c];
+      }
+    }
+  }
   DistanceMatrix m;
   m.rows = sources.size();
   m.cols = targets.size();
-  m.values.assign(m.rows * m.cols, kUnreachable);
-  std::map<std::string, size_t> solved;  // a source given twice is solved once
-  for (size_t i = 0; i < sources.size(); ++i) {
-    const std::string key = SurfacePointToString(sources[i]);
-    if (auto it = solved.find(key); it != solved.end()) {
-      std::copy_n(m.values.begin() + it->second * m.cols, m.cols, m.values.begin() + i * m.cols);
-      continue;
-    }
-    absl::StatusOr<std::vector<ich::ResolvedSource>> src = ResolveSources(mesh, {sources[i]});
-    if (!src.ok()) return src.status();
-    std::vector<ich::TargetResult> results;
-    SolveStats stats;
-    if (absl::Status s = SolveUntilTargetsFinal(mesh, options, *src, *resolved, &results, &stats);
-        !s.ok()) {
-      return s;
-    }
-    for (size_t j = 0; j < m.cols; ++j) m.values[i * m.cols + j] = results[j].distance;
-    AddStats(stats, &m.stats);
-    solved.emplace(key, i);
+  m.values.resize(m.rows * m.cols);
+  for (size_t i = 0; i < m.rows; ++i) {
+    const double* row = &solved[source_row[i] * cols];
+    for (size_t j = 0; j < m.cols; ++j) m.values[i * m.cols + j] = row[column_of[j]];
   }
+  m.stats = total_stats;
   return m;
 }
 

@@ -3,6 +3,8 @@
 #include <cstdint>
 #include <vector>
 
+#include <functional>
+
 #include "absl/status/statusor.h"
 #include "geodex/distance_field.h"
 #include "geodex/geodesic_solver.h"
@@ -21,10 +23,41 @@ struct DistanceMatrix {
   SolveStats stats;  // summed over the solves (solve_ms: total)
 };
 
+struct MatrixOptions {
+  // Per row: lambda, max_distance (entries beyond it are +inf and each row stops there), the
+  // window budget (per row) and the cancel token (stops every row).
+  GeodesicOptions solver;
+  // > 0: per source only its k nearest targets get their exact distance (ties: the lower target
+  // index), the rest +inf, and each row stops as soon as those k are final.
+  uint32_t k_nearest = 0;
+  // Rows solved at once: 0 = every core this process may run on (sched_getaffinity).
+  unsigned threads = 0;
+  // Runs a helper on another thread (a server's compute pool: queued behind other calls' work, so
+  // a large matrix takes a fair share, not every worker). Empty: std::thread. The calling thread
+  // always solves rows too, so a helper that starts late (or never) only costs parallelism; it
+  // may also start after the call returned, and then does nothing.
+  std::function<void(std::function<void()>)> spawn;
+  // Called after each solved row with (rows done, rows to solve), one call at a time, from any of
+  // the threads. For progress bars; keep it cheap.
+  std::function<void(size_t, size_t)> on_row;
+};
+
+// Rows (one targeted solve per distinct source) run in parallel. When sources and targets are the
+// same points (the planner's case) each pair is solved once and d(i, j) = d(j, i) bit for bit:
+// row i solves only targets j > i, d(i, i) = 0. Every entry equals the distance
+// ComputeShortestPath gives for that pair (exact, up to round-off) whatever the matrix's size or
+// order.
+absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
+                                                     const std::vector<SurfacePoint>& sources,
+                                                     const std::vector<SurfacePoint>& targets,
+                                                     const MatrixOptions& options);
 absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
                                                      const std::vector<SurfacePoint>& sources,
                                                      const std::vector<SurfacePoint>& targets,
                                                      const GeodesicOptions& options = {});
+
+// The number of cores this process may run on (at least 1).
+unsigned UsableCores();
 
 // Exact distances from the nearest of `sources` to each of `points`, with the nearest source's
 // index: one multi-source solve that stops once every point's distance is final. `stats`, when

@@ -1,5 +1,8 @@
-// The A* key of section 5 (single-target queries): a window's key is a lower bound of the
-// length of any path through it to the target, so the search stops once the target is final.
+// The A* key of section 5: a window's key is a lower bound of the length of any path through it
+// to the target, so the search stops once the target is final. With several targets (a matrix
+// row, distances at points) the target is a ball (centre c, radius r) holding them all: for any
+// target t, |p t| >= |p c| - r, so the single-target key towards c, less r, still bounds every
+// path through the window to any of them, and never decreases along a path (as the paper's).
 
 #include "ich/ich_solver.h"
 
@@ -9,6 +12,11 @@
 #include "ich/numerics.h"
 
 namespace geodex::ich {
+namespace {
+// Several targets get the A* key only when their ball's radius is at most this fraction of the
+// mesh's bounding-box diagonal (waypoints of a local plan, not points spread over the mesh).
+constexpr double kGoalBallMaxRel = 0.25;
+}  // namespace
 
 double IchSolver::WindowKey(uint32_t h, double b0, double b1, double ix, double iy, double sigma,
                            double plain_key) const {
@@ -19,7 +27,7 @@ double IchSolver::WindowKey(uint32_t h, double b0, double b1, double ix, double 
   const double* pos = mesh_.positions();
   const double* a = pos + 3 * mesh_.From(h);
   const double* b = pos + 3 * mesh_.To(h);
-  const double* t = (*targets_)[0].position;
+  const double* t = goal_;
   const double len = mesh_.Length(h);
   const double d[3] = {t[0] - a[0], t[1] - a[1], t[2] - a[2]};
   const double tx = (d[0] * (b[0] - a[0]) + d[1] * (b[1] - a[1]) + d[2] * (b[2] - a[2])) / len;
@@ -31,15 +39,44 @@ double IchSolver::WindowKey(uint32_t h, double b0, double b1, double ix, double 
   } else {
     best = std::min(Hypot(b0 - ix, iy) + Hypot(tx - b0, ty), Hypot(b1 - ix, iy) + Hypot(tx - b1, ty));
   }
-  return std::max(plain_key, sigma + best);
+  return std::max(plain_key, sigma + best - goal_radius_);
 }
 
 double IchSolver::VertexKey(uint32_t v, double d) const {
   if (!heuristic_) return d;
   const double* p = mesh_.positions() + 3 * v;
-  const double* t = (*targets_)[0].position;
-  return d + std::sqrt((p[0] - t[0]) * (p[0] - t[0]) + (p[1] - t[1]) * (p[1] - t[1]) +
-                       (p[2] - t[2]) * (p[2] - t[2]));
+  const double* t = goal_;
+  return d + std::max(0.0, std::sqrt((p[0] - t[0]) * (p[0] - t[0]) + (p[1] - t[1]) * (p[1] - t[1]) +
+                                     (p[2] - t[2]) * (p[2] - t[2])) -
+                               goal_radius_);
+}
+
+bool IchSolver::SetGoal(const std::vector<ResolvedTarget>& targets) {
+  if (targets.empty()) return false;
+  double lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) lo[k] = hi[k] = targets[0].position[k];
+  for (const ResolvedTarget& t : targets) {
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], t.position[k]);
+      hi[k] = std::max(hi[k], t.position[k]);
+    }
+  }
+  for (int k = 0; k < 3; ++k) goal_[k] = 0.5 * (lo[k] + hi[k]);
+  double r2 = 0;
+  for (const ResolvedTarget& t : targets) {
+    double d2 = 0;
+    for (int k = 0; k < 3; ++k) d2 += (t.position[k] - goal_[k]) * (t.position[k] - goal_[k]);
+    r2 = std::max(r2, d2);
+  }
+  // Round the radius up: the bound must hold for every target despite round-off.
+  goal_radius_ = targets.size() == 1 ? 0 : std::sqrt(r2) * (1 + 1e-12);
+  // A ball reaching over much of the mesh steers nothing and costs a key per window.
+  double diagonal2 = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double e = mesh_.BoundsMax()[k] - mesh_.BoundsMin()[k];
+    diagonal2 += e * e;
+  }
+  return targets.size() == 1 || goal_radius_ <= kGoalBallMaxRel * std::sqrt(diagonal2);
 }
 
 }  // namespace geodex::ich

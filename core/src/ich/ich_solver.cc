@@ -413,7 +413,7 @@ absl::Status IchSolver::Run(const std::vector<ResolvedSource>& sources,
     target_results_ = results;
     results->assign(targets->size(), TargetResult{});
     stop_early_ = stop_early;
-    heuristic_ = use_heuristic && targets->size() == 1;
+    heuristic_ = use_heuristic && SetGoal(*targets);
     for (uint32_t t = 0; t < targets->size(); ++t) {
       for (uint32_t v : (*targets)[t].vertices) {
         vertex_is_target_[v] = 1;

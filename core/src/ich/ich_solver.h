@@ -80,6 +80,10 @@ class IchSolver {
                                bool stop_early, std::vector<TargetResult>* results,
                                SolveStats* stats);
 
+  // With k > 0, a targeted solve with stop_early stops once the k nearest targets are final (the
+  // other targets' results are then upper bounds, or +inf).
+  void set_final_needed(uint32_t k) { final_needed_ = k; }
+
   // The last solve's per-vertex arrays (internal ids), for backtracing paths.
   const std::vector<double>& distances() const { return dist_; }
   const std::vector<uint32_t>& labels() const { return label_; }
@@ -140,6 +144,8 @@ class IchSolver {
   double WindowKey(uint32_t half_edge, double b0, double b1, double ix, double iy, double sigma,
                    double plain_key) const;
   double VertexKey(uint32_t v, double d) const;
+  // The A* goal: the target, or a ball around several. False when the ball is too large to help.
+  bool SetGoal(const std::vector<ResolvedTarget>& targets);
   // Offers target candidates from a window entering face(h), and from a point (a pseudo-source
   // vertex, or a source point) seen straight inside face f.
   void OfferWindowToTargets(uint32_t h, const Window& w);
@@ -164,6 +170,10 @@ class IchSolver {
   bool targets_dirty_ = true;
   double targets_bound_ = kUnreachable;
   bool has_targets_ = false;
+  double goal_[3] = {0, 0, 0};  // A*: the target, or the centre of a ball holding the targets
+  double goal_radius_ = 0;
+  uint32_t final_needed_ = 0;          // 0: every target
+  std::vector<double> bound_scratch_;  // TargetsBound's k-th smallest, k < targets
 
   // The workspace's arrays under the names the rules use (see SolveWorkspace).
   std::vector<uint32_t>& face_target_head_;
