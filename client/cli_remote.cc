@@ -303,18 +303,29 @@ int RemotePath(GeodexClient& client, const Args& args) {
 
 int RemoteMatrix(GeodexClient& client, const Args& args) {
   std::string error;
-  if (!CheckKnown(args, {"sources", "targets", "stats"}, &error)) return Fail(kExitUsage, error);
+  if (!CheckKnown(args, {"sources", "targets", "stats", "lambda", "lambda-scale", "max-distance",
+                         "k-nearest"},
+                  &error)) {
+    return Fail(kExitUsage, error);
+  }
   if (args.positional.size() != 1 || !args.options.count("sources") ||
       !args.options.count("targets")) {
     return Fail(kExitUsage, "usage: geodex matrix MESH --sources SPEC --targets SPEC");
   }
+  v1::SolverOptions options;
+  uint64_t k_nearest = 0;
+  if (!SolverOptions(args, &options, &error) || !GetUint(args, "k-nearest", &k_nearest, &error)) {
+    return Fail(kExitUsage, error);
+  }
+  if (k_nearest > UINT32_MAX) return Fail(kExitUsage, "--k-nearest is too large");
   std::vector<SurfacePoint> sources, targets;
   if (!Points(args, "sources", &sources, &error) || !Points(args, "targets", &targets, &error)) {
     return Fail(kExitUsage, error);
   }
   absl::StatusOr<MeshRef> mesh = client.ResolveMesh(args.positional[0]);
   if (!mesh.ok()) return FailStatus(mesh.status());
-  absl::StatusOr<DistanceMatrix> m = client.Matrix(*mesh, sources, targets, v1::SolverOptions());
+  absl::StatusOr<DistanceMatrix> m =
+      client.Matrix(*mesh, sources, targets, options, static_cast<uint32_t>(k_nearest));
   if (!m.ok()) return FailStatus(m.status());
   const std::string text = FormatMatrix(*m);
   std::fwrite(text.data(), 1, text.size(), stdout);

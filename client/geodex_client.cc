@@ -327,9 +327,11 @@ absl::StatusOr<PathQueryResult> GeodexClient::ShortestPath(MeshRef& mesh, const 
 absl::StatusOr<DistanceMatrix> GeodexClient::Matrix(MeshRef& mesh,
                                                     const std::vector<SurfacePoint>& sources,
                                                     const std::vector<SurfacePoint>& targets,
-                                                    const v1::SolverOptions& options) {
+                                                    const v1::SolverOptions& options,
+                                                    uint32_t k_nearest) {
   v1::ComputeDistanceMatrixRequest request;
   request.set_mesh(mesh.name);
+  request.set_k_nearest(k_nearest);
   for (const SurfacePoint& p : sources) api::SurfacePointToProto(p, request.add_sources());
   for (const SurfacePoint& p : targets) api::SurfacePointToProto(p, request.add_targets());
   *request.mutable_options() = options;

@@ -382,8 +382,22 @@ absl::StatusOr<MessageProducer<v1::ComputeDistanceMatrixResponse>> RunComputeDis
   }
   absl::StatusOr<GeodesicOptions> solver = Options(env, request.options());
   if (!solver.ok()) return solver.status();
+  MatrixOptions matrix_options;
+  matrix_options.solver = *solver;
+  matrix_options.k_nearest = request.k_nearest();
+  if (env.pool != nullptr) {
+    // Rows beyond the calling worker's go to the shared pool, behind work already queued; a
+    // refused helper (queue full) only means fewer rows at once.
+    ComputePool* pool = env.pool;
+    matrix_options.threads = static_cast<unsigned>(pool->threads());
+    matrix_options.spawn = [pool](std::function<void()> helper) {
+      pool->TrySubmit(std::move(helper));
+    };
+  } else {
+    matrix_options.threads = 1;
+  }
   absl::StatusOr<DistanceMatrix> matrix =
-      ComputeDistanceMatrix(*(*mesh)->mesh, *sources, *targets, *solver);
+      ComputeDistanceMatrix(*(*mesh)->mesh, *sources, *targets, matrix_options);
   if (!matrix.ok()) return NameSolveError(matrix.status(), "sources/targets");
   env.counters->solves.fetch_add(1, std::memory_order_relaxed);
   env.counters->windows_processed.fetch_add(matrix->stats.windows_processed,

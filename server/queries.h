@@ -11,6 +11,7 @@
 #include "absl/status/statusor.h"
 #include "geodex/cancel.h"
 #include "geodex/v1/geodex.pb.h"
+#include "compute_pool.h"
 #include "mesh_store.h"
 #include "stream_chunker.h"
 
@@ -32,6 +33,9 @@ struct QueryEnv {
   const CancelToken* cancel;
   FieldCache* cache;
   ServiceCounters* counters;
+  // Where a matrix's rows get helpers (queued behind other calls' work: a fair share); null: the
+  // calling worker solves every row.
+  ComputePool* pool = nullptr;
 };
 
 // Unary queries.

@@ -66,7 +66,7 @@ class UnaryQueryReactor final : public grpc::ServerUnaryReactor {
       Finish(CancelledStatus());
       return;
     }
-    absl::Status status = run_(QueryEnv{env_.store, env_.limits, &cancel_, env_.cache, env_.counters}, *request_, response_);
+    absl::Status status = run_(QueryEnv{env_.store, env_.limits, &cancel_, env_.cache, env_.counters, env_.pool}, *request_, response_);
     if (!status.ok()) response_->Clear();
     env_.pool->ReleaseWorker();  // before Finish: the client may send its next call at once
     Finish(ToGrpcStatus(status));
@@ -115,7 +115,7 @@ class StreamQueryReactor final : public grpc::ServerWriteReactor<Response> {
       return;
     }
     absl::StatusOr<MessageProducer<Response>> producer =
-        run_(QueryEnv{env_.store, env_.limits, &cancel_, env_.cache, env_.counters}, *request_);
+        run_(QueryEnv{env_.store, env_.limits, &cancel_, env_.cache, env_.counters, env_.pool}, *request_);
     env_.pool->ReleaseWorker();  // before any Finish or write: see ComputePool::ReleaseWorker
     if (!producer.ok()) {
       this->Finish(ToGrpcStatus(producer.status()));

@@ -100,6 +100,44 @@ class QueriesTest : public testing::ServerFixture {
   std::unique_ptr<TriangleMesh> local_;
 };
 
+TEST_F(QueriesTest, SymmetricAndKNearestMatricesEqualCore) {
+  // Rows run on the server's pool; answers are deterministic, so they equal core's bit for bit.
+  std::vector<SurfacePoint> points = Sites();
+  for (int v = 5; v < 475; v += 37) points.push_back(SurfacePoint::AtVertex(v));
+  for (uint32_t k : {0u, 3u}) {
+    v1::ComputeDistanceMatrixRequest request;
+    request.set_mesh("meshes/hills");
+    for (const SurfacePoint& p : points) {
+      SurfacePointToProto(p, request.add_sources());
+      SurfacePointToProto(p, request.add_targets());
+    }
+    request.set_k_nearest(k);
+    std::vector<v1::ComputeDistanceMatrixResponse> messages;
+    grpc::Status status = ReadAll<v1::ComputeDistanceMatrixResponse>(
+        [&](grpc::ClientContext* c, const auto& r) { return stub_->ComputeDistanceMatrix(c, r); },
+        request, &messages);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    std::vector<double> values;
+    for (const auto& m : messages) {
+      values.insert(values.end(), m.values_f64().begin(), m.values_f64().end());
+    }
+    MatrixOptions options;
+    options.k_nearest = k;
+    const DistanceMatrix expected = *ComputeDistanceMatrix(*local_, points, points, options);
+    ASSERT_EQ(values.size(), expected.values.size());
+    const size_t n = points.size();
+    size_t finite = 0;
+    for (size_t i = 0; i < values.size(); ++i) {
+      EXPECT_TRUE(BitEqual(values[i], expected.values[i])) << "k " << k << " entry " << i;
+      if (std::isfinite(values[i])) ++finite;
+      if (k == 0) {
+        EXPECT_TRUE(BitEqual(values[i], values[(i % n) * n + i / n])) << i;  // symmetric
+      }
+    }
+    EXPECT_EQ(finite, k == 0 ? n * n : n * k);
+  }
+}
+
 TEST_F(QueriesTest, DistanceMatrixEqualsCoreBitForBit) {
   std::vector<SurfacePoint> sources = Sites();
   sources.push_back(SurfacePoint::AtVertex(3));  // repeated row
