@@ -220,12 +220,7 @@ TEST(DistanceMatrixRunTest, ProgressCancellationAndLateHelpers) {
 
 INSTANTIATE_TEST_SUITE_P(CommittedMeshes, DistanceMatrixTest,
                          ::testing::Values("knight.off", "kitten.off", "bump-domain.off"),
-                         [](const ::testing::TestParamInfo<std::string>& info) {
-                           std::string name = info.param;
-                           std::replace_if(name.begin(), name.end(),
-                                           [](char c) { return !std::isalnum(c); }, '_');
-                           return name;
-                         });
+                         MeshFileParamName());
 
 }  // namespace
 }  // namespace geodex

@@ -185,12 +185,7 @@ TEST_P(SolveWorkspaceTest, IdleMemoryFollowsTheMeshNotTheWork) {
 
 INSTANTIATE_TEST_SUITE_P(CommittedMeshes, SolveWorkspaceTest,
                          ::testing::Values("knight.off", "kitten.off", "bump-domain.off"),
-                         [](const ::testing::TestParamInfo<std::string>& info) {
-                           std::string name = info.param;
-                           std::replace_if(name.begin(), name.end(),
-                                           [](char c) { return !std::isalnum(c); }, '_');
-                           return name;
-                         });
+                         MeshFileParamName());
 
 }  // namespace
 }  // namespace geodex

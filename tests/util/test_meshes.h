@@ -3,6 +3,7 @@
 // The committed test meshes in tests/data, loaded through the project's own reader.
 
 #include <cstddef>  // geodex/mesh_data.h uses size_t without including it
+#include <cctype>
 #include <string>
 #include <vector>
 
@@ -24,5 +25,18 @@ absl::StatusOr<MeshData> LoadTestMeshData(const std::string& name);
 
 // Reads and builds (default MeshBuildOptions).
 absl::StatusOr<TriangleMesh> LoadTestMesh(const std::string& name);
+
+// A test name for a mesh file parameter ("bump-domain.off" -> "bump_domain_off"), for
+// INSTANTIATE_TEST_SUITE_P.
+struct MeshFileParamName {
+  template <typename Info>
+  std::string operator()(const Info& info) const {
+    std::string name = info.param;
+    for (char& c : name) {
+      if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+    }
+    return name;
+  }
+};
 
 }  // namespace geodex

@@ -25,6 +25,10 @@ void SolveWorkspace::Prepare(const TriangleMesh& mesh, bool with_links, bool wit
     faces_ = nf;
   }
   pool.Reset(with_links);
+  ClearLists();
+}
+
+void SolveWorkspace::ClearLists() {
   touched_vertices.clear();
   touched_half_edges.clear();
   target_vertices.clear();
@@ -54,12 +58,7 @@ void SolveWorkspace::Clear() {
     if (owners) split_owner[h] = SplitOwner{};
   }
   for (uint32_t f : target_faces) face_target_head[f] = kNoIndex;
-  touched_vertices.clear();
-  touched_half_edges.clear();
-  target_vertices.clear();
-  target_faces.clear();
-  face_target_next.clear();
-  face_target_entry.clear();
+  ClearLists();
   pool.Reset(pool.with_links());
 }
 

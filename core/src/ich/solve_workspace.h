@@ -60,6 +60,8 @@ class SolveWorkspace {
   std::vector<uint32_t> target_faces;
 
  private:
+  void ClearLists();  // the touched and target lists, and the target entries
+
   uint32_t vertices_ = 0;  // the sizes Prepare made the arrays
   size_t half_edges_ = 0;
   uint32_t faces_ = 0;
