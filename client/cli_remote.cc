@@ -281,8 +281,8 @@ int RemotePath(GeodexClient& client, const Args& args) {
   if (!mesh.ok()) return FailStatus(mesh.status());
   absl::StatusOr<PathQueryResult> result = client.ShortestPath(*mesh, from[0], to[0], options);
   if (!result.ok()) {
-    return Fail(result.status().code() == absl::StatusCode::kNotFound &&
-                        result.status().message().rfind("to:", 0) == 0
+    // FAILED_PRECONDITION (ErrorInfo UNREACHABLE): the target is not reachable, as locally.
+    return Fail(result.status().code() == absl::StatusCode::kFailedPrecondition
                     ? kExitSolveFailed
                     : Code(result.status()),
                 std::string(result.status().message()));

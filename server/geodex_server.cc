@@ -9,11 +9,11 @@
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
 #include "grpcpp/ext/proto_server_reflection_plugin.h"
-#include "grpcpp/health_check_service_interface.h"
 #include "grpcpp/security/server_credentials.h"
 #include "grpcpp/server_builder.h"
 #include "geodex/mesh_io.h"
 #include "geodex/samples.h"
+#include "listen_address.h"
 #include "mesh_id.h"
 
 namespace geodex::server {
@@ -28,6 +28,23 @@ absl::Status ValidateServerOptions(const ServerOptions& options) {
     return absl::InvalidArgumentError(absl::StrCat("--pool_threads=", options.pool_threads,
                                                    ": at most ", kMaxPoolThreads,
                                                    " (0 = one per hardware thread)"));
+  }
+  if (options.quick_threads > kMaxQuickThreads) {
+    return absl::InvalidArgumentError(absl::StrCat("--quick_threads=", options.quick_threads,
+                                                   ": at most ", kMaxQuickThreads,
+                                                   " (0 = no quick lane)"));
+  }
+  if (absl::Status s = ValidateListenAddress(options.listen, "listen"); !s.ok()) return s;
+  if (!options.metrics_listen.empty()) {
+    if (absl::Status s = ValidateListenAddress(options.metrics_listen, "metrics_listen"); !s.ok()) {
+      return s;
+    }
+  }
+  if (!options.auth_token_file.empty() && options.tls_cert_file.empty() &&
+      !options.allow_plaintext_tokens) {
+    return absl::InvalidArgumentError(
+        "--auth_token_file without --tls_cert/--tls_key would send bearer tokens in plaintext; "
+        "serve TLS, or pass --allow_plaintext_tokens when a TLS-terminating proxy is in front");
   }
   if (options.queue_capacity > kMaxQueueCapacity) {
     return absl::InvalidArgumentError(absl::StrCat("--queue_capacity=", options.queue_capacity,
@@ -46,6 +63,7 @@ absl::Status ValidateServerOptions(const ServerOptions& options) {
            at_least("max_vertices", l.max_vertices, 1, ""),
            at_least("max_faces", l.max_faces, 1, ""),
            at_least("max_sources", l.max_sources, 1, ""),
+           at_least("max_names_per_mesh", l.max_names_per_mesh, 1, ""),
            at_least("max_targets", l.max_targets, 1, ""),
            at_least("max_levels", l.max_levels, 1, ""),
            at_least("max_output_values", l.max_output_values, 1, ""),
@@ -69,6 +87,9 @@ absl::StatusOr<std::unique_ptr<GeodexServer>> GeodexServer::Start(const ServerOp
   if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
   s->store_ = std::make_unique<MeshStore>(options.mesh_budget_bytes);
   s->pool_ = std::make_unique<ComputePool>(threads, options.queue_capacity);
+  if (options.quick_threads > 0) {
+    s->quick_pool_ = std::make_unique<ComputePool>(options.quick_threads, options.queue_capacity);
+  }
   s->cache_ = std::make_unique<FieldCache>(options.result_cache_bytes);
   std::vector<std::string> tokens;
   if (!options.auth_token_file.empty()) {
@@ -77,8 +98,9 @@ absl::StatusOr<std::unique_ptr<GeodexServer>> GeodexServer::Start(const ServerOp
     tokens = *std::move(read);
   }
   s->authenticated_ = !tokens.empty();
-  s->service_ = std::make_unique<GeodexService>(s->store_.get(), s->pool_.get(), s->cache_.get(),
-                                                options.limits, TokenAuthenticator(std::move(tokens)));
+  s->service_ = std::make_unique<GeodexService>(
+      s->store_.get(), s->pool_.get(), s->quick_pool_.get(), s->cache_.get(), options.limits,
+      TokenAuthenticator(std::move(tokens)), &s->descriptions_);
   std::shared_ptr<grpc::ServerCredentials> credentials = grpc::InsecureServerCredentials();
   if (options.tls_cert_file.empty() != options.tls_key_file.empty()) {
     return absl::InvalidArgumentError("--tls_cert and --tls_key go together");
@@ -120,30 +142,38 @@ absl::StatusOr<std::unique_ptr<GeodexServer>> GeodexServer::Start(const ServerOp
 
   absl::StatusOr<std::unique_ptr<ServerMetrics>> metrics = ServerMetrics::Start(
       options.metrics_listen,
-      MetricSources{s->pool_.get(), s->store_.get(), s->cache_.get(), &s->service_->counters()},
+      MetricSources{s->pool_.get(), s->store_.get(), s->cache_.get(), &s->service_->counters(),
+                    &s->descriptions_},
       options.log_requests, options.replica_name);
   if (!metrics.ok()) return metrics.status();
   s->metrics_ = *std::move(metrics);
 
   s->pool_->Publish();  // the service (and everything above) before any task runs
+  if (s->quick_pool_) s->quick_pool_->Publish();
 
-  grpc::EnableDefaultHealthCheckService(true);
+  grpc::EnableDefaultHealthCheckService(false);  // ours (health_service.h) ends Watch streams
+  s->health_ = std::make_unique<HealthService>();
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   grpc::ServerBuilder builder;
   builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
   builder.SetMaxReceiveMessageSize(options.max_receive_message_bytes);
   builder.AddListeningPort(options.listen, credentials, &s->port_);
   builder.RegisterService(s->service_.get());
+  builder.RegisterService(s->health_.get());
   std::vector<std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>> interceptors;
   interceptors.push_back(s->metrics_->InterceptorFactory());
   builder.experimental().SetInterceptorCreators(std::move(interceptors));
   s->server_ = builder.BuildAndStart();
   if (s->server_ == nullptr || s->port_ == 0) {
-    return absl::UnavailableError(absl::StrCat("cannot listen on ", options.listen));
+    if (AddressInUse(options.listen)) {
+      return absl::UnavailableError(absl::StrCat(
+          "--listen=", options.listen,
+          ": address in use (another geodexd?); choose another port, or port 0 for a free one"));
+    }
+    return absl::UnavailableError(absl::StrCat("--listen=", options.listen, ": cannot listen"));
   }
-  grpc::HealthCheckServiceInterface* health = s->server_->GetHealthCheckService();
-  health->SetServingStatus("", true);
-  health->SetServingStatus(v1::Geodex::service_full_name(), true);
+  s->health_->SetServing("", true);
+  s->health_->SetServing(v1::Geodex::service_full_name(), true);
   return s;
 }
 
@@ -212,7 +242,7 @@ void GeodexServer::ImportDirectory(const std::string& dir) {
 void GeodexServer::Shutdown(absl::Time deadline) {
   if (shut_down_) return;
   shut_down_ = true;
-  if (auto* health = server_->GetHealthCheckService()) health->Shutdown();
+  health_->Shutdown();  // NOT_SERVING; Watch streams end now, not at the deadline
   server_->Shutdown(absl::ToChronoTime(deadline));
 }
 

@@ -13,6 +13,7 @@
 #include "absl/time/time.h"
 #include "compute_pool.h"
 #include "geodex_service.h"
+#include "health_service.h"
 #include "grpcpp/server.h"
 #include "mesh_store.h"
 #include "metrics.h"
@@ -37,6 +38,9 @@ struct ServerOptions {
   std::string import_dir;   // meshes to import at start (server-side files; never request paths)
   uint64_t mesh_budget_bytes = uint64_t{4} << 30;
   size_t pool_threads = 0;    // 0 = hardware concurrency
+  // Workers of the quick lane: calls that need no solve (locate, cached fields and traces) never
+  // wait behind full solves (query_reactors.h). 0 = no quick lane (the behaviour before it).
+  size_t quick_threads = 2;
   size_t queue_capacity = 64;
   int max_receive_message_bytes = 4 << 20;  // per message; uploads are chunked below this
   uint64_t result_cache_bytes = uint64_t{256} << 20;  // finished fields kept for reuse; 0 = off
@@ -45,8 +49,10 @@ struct ServerOptions {
   std::string replica_name;    // sent as x-geodex-replica on every geodex.v1 call; "" = none
   // TLS: PEM files of the server certificate (chain) and its private key; both or neither.
   std::string tls_cert_file, tls_key_file;
-  // Bearer tokens (auth.h): a file with one token per line; "" = no authentication.
+  // Bearer tokens (auth.h): a file with one token per line; "" = no authentication. Refused
+  // without TLS unless allow_plaintext_tokens (a TLS-terminating proxy in front).
   std::string auth_token_file;
+  bool allow_plaintext_tokens = false;
   ServiceLimits limits;
 };
 
@@ -60,6 +66,7 @@ absl::StatusOr<std::string> AddMesh(MeshStore& store, const MeshData& data,
 // no budget of zero). GeodexServer::Start calls it first.
 absl::Status ValidateServerOptions(const ServerOptions& options);
 inline constexpr size_t kMaxPoolThreads = 1024;
+inline constexpr size_t kMaxQuickThreads = 64;
 inline constexpr size_t kMaxQueueCapacity = 1'000'000;
 inline constexpr uint64_t kMaxStreamChunkBytes = 3 << 20;
 
@@ -85,6 +92,7 @@ class GeodexServer {
 
   MeshStore& store() { return *store_; }
   ComputePool& pool() { return *pool_; }
+  ComputePool* quick_pool() { return quick_pool_.get(); }  // null with quick_threads = 0
   FieldCache& cache() { return *cache_; }
   ServerMetrics& metrics() { return *metrics_; }
   GeodexService& service() { return *service_; }
@@ -97,9 +105,12 @@ class GeodexServer {
   // its workers), the service and the store.
   std::unique_ptr<MeshStore> store_;
   std::unique_ptr<FieldCache> cache_;
+  CallDescriptions descriptions_;  // written by the service, read by the interceptor
   std::unique_ptr<ServerMetrics> metrics_;  // the interceptor records into it: outlives server_
   std::unique_ptr<GeodexService> service_;
+  std::unique_ptr<HealthService> health_;
   std::unique_ptr<ComputePool> pool_;
+  std::unique_ptr<ComputePool> quick_pool_;
   std::unique_ptr<grpc::Server> server_;
   int port_ = 0;
   bool tls_ = false, authenticated_ = false;

@@ -1,6 +1,5 @@
 #include "geodex_service.h"
 
-#include <algorithm>
 #include <memory>
 #include <string>
 #include <utility>
@@ -9,6 +8,8 @@
 #include "absl/strings/str_cat.h"
 #include "geodex/cancel.h"
 #include "geodex/mesh_io.h"
+#include "google/protobuf/descriptor.h"
+#include "grpcpp/support/server_callback.h"
 #include "mesh_id.h"
 #include "proto_convert.h"
 #include "queries.h"
@@ -17,9 +18,6 @@
 
 namespace geodex::server {
 namespace {
-
-constexpr int kDefaultPageSize = 50;
-constexpr int kMaxPageSize = 1000;
 
 absl::Status ValidateDisplayName(const std::string& name) {
   if (name.empty()) return absl::OkStatus();
@@ -30,14 +28,16 @@ absl::Status ValidateDisplayName(const std::string& name) {
   }
   if (!ok) {
     return absl::InvalidArgumentError(
-        absl::StrCat("metadata.display_name: \"", name,
-                     "\" must be 1-63 characters of [A-Za-z0-9._-] and not a 64-digit hex id"));
+        absl::StrCat("metadata.display_name: ", QuoteInput(name),
+                     " must be 1-63 characters of [A-Za-z0-9._-] and not a 64-digit hex id"));
   }
   return absl::OkStatus();
 }
 
-MeshFormat FormatFromProto(v1::MeshFormat format) {
+absl::StatusOr<MeshFormat> FormatFromProto(int format) {
   switch (format) {
+    case v1::MESH_FORMAT_UNSPECIFIED:
+      return MeshFormat::kAuto;
     case v1::MESH_FORMAT_OFF:
       return MeshFormat::kOff;
     case v1::MESH_FORMAT_OBJ:
@@ -47,18 +47,24 @@ MeshFormat FormatFromProto(v1::MeshFormat format) {
     case v1::MESH_FORMAT_STL:
       return MeshFormat::kStl;
     default:
-      return MeshFormat::kAuto;
+      return absl::InvalidArgumentError(absl::StrCat("metadata.format: unknown value ", format));
   }
 }
 
 // ------------------------------------------------------------------------------------------
 // CreateMesh: reads chunks on gRPC's threads (appending bytes only), parses and builds on the pool.
-class CreateMeshReactor final : public grpc::ServerReadReactor<v1::CreateMeshRequest> {
+// Nothing is stored unless the whole stream arrived intact: every message parses, the first and
+// only the first carries metadata, and the byte count matches metadata.total_bytes when given.
+class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer> {
  public:
-  CreateMeshReactor(GeodexService* service, grpc::CallbackServerContext* context,
-                    v1::Mesh* response)
-      : service_(service), context_(context), response_(response) {
-    StartRead(&request_);
+  CreateMeshReactor(const ReactorEnv& env, grpc::CallbackServerContext* context,
+                    grpc::ByteBuffer* response)
+      : env_(env), context_(context), response_(response) {
+    if (!env_.auth->Allows(*context)) {
+      Finish(UnauthenticatedStatus());
+      return;
+    }
+    StartRead(&message_);
   }
 
   void OnReadDone(bool ok) override {
@@ -66,52 +72,85 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<v1::CreateMeshReq
       EndOfUpload();
       return;
     }
-    if (!have_metadata_) {
-      if (!request_.has_metadata()) {
-        Finish(ToGrpcStatus(absl::InvalidArgumentError(
-            "metadata: the first CreateMeshRequest must carry metadata")));
-        return;
-      }
-      metadata_ = request_.metadata();
-      have_metadata_ = true;
-      absl::Status valid = ValidateDisplayName(metadata_.display_name());
-      if (!valid.ok()) {
-        Finish(ToGrpcStatus(valid));
-        return;
-      }
-      if (!metadata_.expected_mesh_id().empty() && !IsMeshId(metadata_.expected_mesh_id())) {
-        Finish(ToGrpcStatus(absl::InvalidArgumentError(
-            "metadata.expected_mesh_id: must be 64 lowercase hex digits")));
-        return;
-      }
-      if (metadata_.total_bytes() > service_->limits().max_upload_bytes) {
-        Finish(TooLarge(metadata_.total_bytes()));
-        return;
-      }
-      bytes_.reserve(metadata_.total_bytes());
-    } else if (request_.has_metadata()) {
-      Finish(ToGrpcStatus(absl::InvalidArgumentError(
-          "metadata: only the first CreateMeshRequest may carry metadata")));
+    ++messages_;
+    v1::CreateMeshRequest request;
+    const std::string what = absl::StrCat("message ", messages_, " of the upload stream");
+    if (absl::Status parsed = ParseRequest(message_, &request, what.c_str()); !parsed.ok()) {
+      Fail(absl::InvalidArgumentError(
+          absl::StrCat(parsed.message(), "; nothing was stored, upload the mesh again")));
       return;
-    } else {
-      const std::string& chunk = request_.chunk();
-      if (bytes_.size() + chunk.size() > service_->limits().max_upload_bytes) {
-        Finish(TooLarge(bytes_.size() + chunk.size()));
-        return;
-      }
-      bytes_.append(chunk);
     }
-    StartRead(&request_);
+    message_.Clear();
+    if (absl::Status s = Accept(request); !s.ok()) {
+      Fail(s);
+      return;
+    }
+    StartRead(&message_);
   }
 
   void OnCancel() override { cancel_.Cancel(); }
   void OnDone() override { delete this; }
 
  private:
-  grpc::Status TooLarge(uint64_t bytes) const {
-    return ToGrpcStatus(absl::ResourceExhaustedError(
-        absl::StrCat("upload of ", bytes,
-                     " bytes exceeds --max_upload_bytes=", service_->limits().max_upload_bytes)));
+  void Fail(const absl::Status& status) {
+    bytes_.clear();
+    bytes_.shrink_to_fit();
+    Finish(ToGrpcStatus(status));
+  }
+
+  absl::Status Accept(const v1::CreateMeshRequest& request) {
+    const ServiceLimits& limits = *env_.limits;
+    if (!have_metadata_) {
+      if (!request.has_metadata()) {
+        return absl::InvalidArgumentError(
+            "metadata: the first CreateMeshRequest must carry metadata");
+      }
+      metadata_ = request.metadata();
+      have_metadata_ = true;
+      if (env_.descriptions != nullptr) {
+        env_.descriptions->SetMesh(context_, metadata_.display_name());
+      }
+      if (absl::Status valid = ValidateDisplayName(metadata_.display_name()); !valid.ok()) {
+        return valid;
+      }
+      if (absl::StatusOr<MeshFormat> format = FormatFromProto(metadata_.format()); !format.ok()) {
+        return format.status();
+      }
+      if (!metadata_.expected_mesh_id().empty() && !IsMeshId(metadata_.expected_mesh_id())) {
+        return absl::InvalidArgumentError(
+            "metadata.expected_mesh_id: must be 64 lowercase hex digits");
+      }
+      if (metadata_.total_bytes() > limits.max_upload_bytes) {
+        return TooLarge(metadata_.total_bytes());
+      }
+      bytes_.reserve(metadata_.total_bytes());
+      return absl::OkStatus();
+    }
+    if (request.has_metadata()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("metadata: message ", messages_,
+                       " carries metadata again; only the first CreateMeshRequest may"));
+    }
+    if (request.payload_case() != v1::CreateMeshRequest::kChunk) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "chunk: message ", messages_, " of the upload stream carries neither metadata nor a chunk"));
+    }
+    const std::string& chunk = request.chunk();
+    const uint64_t total = bytes_.size() + chunk.size();
+    if (total > limits.max_upload_bytes) return TooLarge(total);
+    if (metadata_.total_bytes() != 0 && total > metadata_.total_bytes()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("metadata.total_bytes: declared ", metadata_.total_bytes(),
+                       " bytes, but message ", messages_, " brings the upload to ", total));
+    }
+    bytes_.append(chunk);
+    return absl::OkStatus();
+  }
+
+  absl::Status TooLarge(uint64_t bytes) const {
+    return absl::ResourceExhaustedError(absl::StrCat("upload of ", bytes,
+                                                     " bytes exceeds --max_upload_bytes=",
+                                                     env_.limits->max_upload_bytes));
   }
 
   void EndOfUpload() {
@@ -120,33 +159,57 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<v1::CreateMeshReq
       return;
     }
     if (!have_metadata_) {
-      Finish(ToGrpcStatus(absl::InvalidArgumentError("metadata: the upload stream was empty")));
+      Fail(absl::InvalidArgumentError("metadata: the upload stream was empty"));
       return;
     }
-    if (!service_->pool()->TrySubmit([this] { Build(); }))
-      Finish(PoolFullStatus(*service_->pool()));
+    if (metadata_.total_bytes() != 0 && bytes_.size() != metadata_.total_bytes()) {
+      Fail(absl::InvalidArgumentError(
+          absl::StrCat("metadata.total_bytes: declared ", metadata_.total_bytes(), " bytes, but ",
+                       bytes_.size(), " arrived; nothing was stored")));
+      return;
+    }
+    if (bytes_.empty()) {
+      Fail(absl::InvalidArgumentError(
+          absl::StrCat("chunk: the upload stream ended after the metadata without any bytes (",
+                       messages_, " messages)")));
+      return;
+    }
+    if (!env_.pool->TrySubmit([this] { Build(); })) {
+      Fail(absl::ResourceExhaustedError(absl::StrCat(
+          "compute queue full (", env_.pool->threads(), " workers busy, ",
+          env_.pool->queue_capacity(), " queued; --pool_threads/--queue_capacity); retry later")));
+    }
   }
 
   // On the pool.
   void Build() {
     if (cancel_.IsCancelled()) {
-      service_->pool()->ReleaseWorker();
+      env_.pool->ReleaseWorker();
       Finish(CancelledStatus());
       return;
     }
-    const absl::Status status = BuildAndStore();
-    service_->pool()->ReleaseWorker();  // before Finish (see ComputePool::ReleaseWorker)
+    v1::Mesh mesh;
+    const absl::Status status = BuildAndStore(&mesh);
+    bytes_.clear();
+    bytes_.shrink_to_fit();
+    if (status.ok()) SerializeResponse(mesh, response_);
+    env_.pool->ReleaseWorker();  // before Finish (see ComputePool::ReleaseWorker)
     Finish(ToGrpcStatus(status));
   }
 
-  absl::Status BuildAndStore() {
-    const ServiceLimits& limits = service_->limits();
+  absl::Status BuildAndStore(v1::Mesh* response) {
+    const ServiceLimits& limits = *env_.limits;
     ReadLimits read_limits;
     read_limits.max_vertices = limits.max_vertices;
     read_limits.max_faces = limits.max_faces;
-    std::string file_name = metadata_.file_name().empty() ? "upload" : metadata_.file_name();
+    // A gzip upload inflates at most to the upload limit (checked while inflating).
+    read_limits.max_decompressed_bytes = limits.max_upload_bytes;
+    const std::string file_name =
+        metadata_.file_name().empty()
+            ? "upload"
+            : std::string(metadata_.file_name().substr(0, kMaxEchoBytes));
     absl::StatusOr<MeshData> data = ReadMeshFromBuffer(
-        absl::string_view(bytes_), FormatFromProto(metadata_.format()), file_name, read_limits);
+        absl::string_view(bytes_), *FormatFromProto(metadata_.format()), file_name, read_limits);
     if (!data.ok()) {
       if (data.status().code() == absl::StatusCode::kResourceExhausted) return data.status();
       return absl::InvalidArgumentError(absl::StrCat("chunk: ", data.status().message()));
@@ -167,8 +230,8 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<v1::CreateMeshReq
                        " differs from the uploaded mesh's id ", id));
     }
     std::shared_ptr<StoredMesh> candidate;
-    if (service_->store()->Contains(id)) {
-      // Idempotent re-upload: no rebuild. (Insert adds a new alias to the stored mesh.)
+    if (env_.store->Contains(id)) {
+      // Idempotent re-upload: no rebuild. (Insert adds the new alias to the stored mesh.)
       candidate = std::make_shared<StoredMesh>();
       candidate->id = id;
     } else {
@@ -185,193 +248,120 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<v1::CreateMeshReq
     }
     candidate->display_name = metadata_.display_name();
     const std::string canonical =
-        service_->store()->has_disk() && candidate->mesh != nullptr ? CanonicalMeshEncoding(*data)
-                                                                    : std::string();
+        env_.store->has_disk() && candidate->mesh != nullptr ? CanonicalMeshEncoding(*data)
+                                                             : std::string();
     absl::StatusOr<std::shared_ptr<const StoredMesh>> stored =
-        service_->store()->Insert(std::move(candidate), canonical);
+        env_.store->Insert(std::move(candidate), canonical, limits.max_names_per_mesh);
     if (!stored.ok()) return stored.status();
-    MeshToProto(**stored, response_);
+    MeshToProto(**stored, response);
+    if (env_.descriptions != nullptr) env_.descriptions->SetMesh(context_, response->name());
     return absl::OkStatus();
   }
 
-  GeodexService* service_;
+  ReactorEnv env_;
   grpc::CallbackServerContext* context_;
-  v1::Mesh* response_;
-  v1::CreateMeshRequest request_;
+  grpc::ByteBuffer* response_;
+  grpc::ByteBuffer message_;
+  uint64_t messages_ = 0;
   v1::CreateMeshMetadata metadata_;
   bool have_metadata_ = false;
   std::string bytes_;
   CancelToken cancel_;
 };
 
+// ------------------------------------------------------------------------------------------
+// The method table.
+
+using Installer = grpc::internal::MethodHandler* (*)(const ReactorEnv* env, Lane lane);
+
+template <typename Request, typename Response,
+          absl::Status (*kRun)(const QueryEnv&, const Request&, Response*)>
+grpc::internal::MethodHandler* Unary(const ReactorEnv* env, Lane lane) {
+  return new grpc::internal::CallbackUnaryHandler<grpc::ByteBuffer, grpc::ByteBuffer>(
+      [env, lane](grpc::CallbackServerContext* context, const grpc::ByteBuffer* request,
+                  grpc::ByteBuffer* response) {
+        return UnaryQueryReactor<Request, Response>::Start(*env, kRun, lane, context, request,
+                                                           response);
+      });
+}
+
+template <typename Request, typename Response,
+          absl::StatusOr<MessageProducer<Response>> (*kRun)(const QueryEnv&, const Request&)>
+grpc::internal::MethodHandler* Stream(const ReactorEnv* env, Lane lane) {
+  return new grpc::internal::CallbackServerStreamingHandler<grpc::ByteBuffer, grpc::ByteBuffer>(
+      [env, lane](grpc::CallbackServerContext* context, const grpc::ByteBuffer* request) {
+        return StreamQueryReactor<Request, Response>::Start(*env, kRun, lane, context, request);
+      });
+}
+
+grpc::internal::MethodHandler* Upload(const ReactorEnv* env, Lane /*lane*/) {
+  return new grpc::internal::CallbackClientStreamingHandler<grpc::ByteBuffer, grpc::ByteBuffer>(
+      [env](grpc::CallbackServerContext* context, grpc::ByteBuffer* response) {
+        return new CreateMeshReactor(*env, context, response);
+      });
+}
+
+struct MethodRow {
+  GeodexService::MethodInfo info;
+  Installer install;
+};
+
+const std::vector<MethodRow>& MethodTable() {
+  static const auto* table = new std::vector<MethodRow>{
+      {{"CreateMesh", Lane::kSolve}, &Upload},
+      {{"GetMesh", Lane::kInline}, &Unary<v1::GetMeshRequest, v1::Mesh, &RunGetMesh>},
+      {{"ListMeshes", Lane::kInline},
+       &Unary<v1::ListMeshesRequest, v1::ListMeshesResponse, &RunListMeshes>},
+      {{"DeleteMesh", Lane::kInline},
+       &Unary<v1::DeleteMeshRequest, v1::DeleteMeshResponse, &RunDeleteMesh>},
+      {{"ComputeDistanceField", Lane::kQuick},
+       &Stream<v1::ComputeDistanceFieldRequest, v1::ComputeDistanceFieldResponse,
+               &RunComputeDistanceField>},
+      {{"FindShortestPath", Lane::kQuick},
+       &Unary<v1::FindShortestPathRequest, v1::FindShortestPathResponse, &RunFindShortestPath>},
+      {{"ComputeDistanceMatrix", Lane::kSolve},
+       &Stream<v1::ComputeDistanceMatrixRequest, v1::ComputeDistanceMatrixResponse,
+               &RunComputeDistanceMatrix>},
+      {{"EstimateDistances", Lane::kQuick},
+       &Unary<v1::EstimateDistancesRequest, v1::EstimateDistancesResponse,
+              &RunEstimateDistances>},
+      {{"LocatePoints", Lane::kQuick},
+       &Unary<v1::LocatePointsRequest, v1::LocatePointsResponse, &RunLocatePoints>},
+      {{"ComputeIsolines", Lane::kQuick},
+       &Stream<v1::ComputeIsolinesRequest, v1::ComputeIsolinesResponse, &RunComputeIsolines>},
+      {{"ComputeVoronoi", Lane::kQuick},
+       &Stream<v1::ComputeVoronoiRequest, v1::ComputeVoronoiResponse, &RunComputeVoronoi>},
+      {{"ComputeDelaunay", Lane::kQuick},
+       &Stream<v1::ComputeDelaunayRequest, v1::ComputeDelaunayResponse, &RunComputeDelaunay>},
+  };
+  return *table;
+}
+
 }  // namespace
 
-grpc::ServerReadReactor<v1::CreateMeshRequest>* GeodexService::CreateMesh(
-    grpc::CallbackServerContext* context, v1::Mesh* response) {
-  if (!auth_.Allows(*context)) {
-    return new RejectedReadReactor<v1::CreateMeshRequest>(UnauthenticatedStatus());
-  }
-  return new CreateMeshReactor(this, context, response);
+const std::vector<GeodexService::MethodInfo>& GeodexService::Methods() {
+  static const auto* methods = [] {
+    auto* out = new std::vector<MethodInfo>;
+    for (const MethodRow& row : MethodTable()) out->push_back(row.info);
+    return out;
+  }();
+  return *methods;
 }
 
-// Get/List/Delete are map look-ups under the store's mutex (Delete also unlinks a file): answered
-// inline.
-grpc::ServerUnaryReactor* GeodexService::GetMesh(grpc::CallbackServerContext* context,
-                                                 const v1::GetMeshRequest* request,
-                                                 v1::Mesh* response) {
-  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
-  if (!auth_.Allows(*context)) {
-    reactor->Finish(UnauthenticatedStatus());
-    return reactor;
+GeodexService::GeodexService(MeshStore* store, ComputePool* pool, ComputePool* quick_pool,
+                             FieldCache* cache, const ServiceLimits& limits,
+                             TokenAuthenticator auth, CallDescriptions* descriptions)
+    : store_(store), pool_(pool), limits_(limits), auth_(std::move(auth)) {
+  env_ = ReactorEnv{store_, &limits_, pool_, quick_pool, cache, &counters_, &auth_, descriptions};
+  // The generated base registered every method typed; each is replaced by its raw handler, by its
+  // index in the service's descriptor (the order the base registered them in).
+  const google::protobuf::ServiceDescriptor* service =
+      google::protobuf::DescriptorPool::generated_pool()->FindServiceByName(
+          v1::Geodex::service_full_name());
+  for (const MethodRow& row : MethodTable()) {
+    const google::protobuf::MethodDescriptor* method = service->FindMethodByName(row.info.name);
+    MarkMethodRawCallback(method->index(), row.install(&env_, row.info.lane));
   }
-  absl::StatusOr<std::string> key = ParseMeshName(request->name(), "name");
-  absl::Status status = key.status();
-  if (key.ok()) {
-    // The record: a mesh that is only on disk is described without loading it.
-    absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh = store_->GetRecord(*key);
-    if (mesh.ok()) {
-      MeshToProto(**mesh, response);
-    } else {
-      status = absl::NotFoundError(absl::StrCat("name: mesh \"", request->name(), "\" not found"));
-    }
-  }
-  reactor->Finish(ToGrpcStatus(status));
-  return reactor;
-}
-
-grpc::ServerUnaryReactor* GeodexService::ListMeshes(grpc::CallbackServerContext* context,
-                                                    const v1::ListMeshesRequest* request,
-                                                    v1::ListMeshesResponse* response) {
-  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
-  if (!auth_.Allows(*context)) {
-    reactor->Finish(UnauthenticatedStatus());
-    return reactor;
-  }
-  if (request->page_size() < 0) {
-    reactor->Finish(ToGrpcStatus(absl::InvalidArgumentError(
-        absl::StrCat("page_size: must be >= 0, got ", request->page_size()))));
-    return reactor;
-  }
-  if (!request->page_token().empty() && !IsMeshId(request->page_token())) {
-    reactor->Finish(
-        ToGrpcStatus(absl::InvalidArgumentError("page_token: not a token returned by ListMeshes")));
-    return reactor;
-  }
-  int page_size =
-      request->page_size() == 0 ? kDefaultPageSize : std::min(request->page_size(), kMaxPageSize);
-  bool more = false;
-  std::vector<std::shared_ptr<const StoredMesh>> page =
-      store_->List(request->page_token(), static_cast<size_t>(page_size), &more);
-  for (const auto& mesh : page) MeshToProto(*mesh, response->add_meshes());
-  if (more && !page.empty()) response->set_next_page_token(page.back()->id);
-  reactor->Finish(grpc::Status::OK);
-  return reactor;
-}
-
-grpc::ServerUnaryReactor* GeodexService::DeleteMesh(grpc::CallbackServerContext* context,
-                                                    const v1::DeleteMeshRequest* request,
-                                                    v1::DeleteMeshResponse* /*response*/) {
-  grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
-  if (!auth_.Allows(*context)) {
-    reactor->Finish(UnauthenticatedStatus());
-    return reactor;
-  }
-  absl::StatusOr<std::string> key = ParseMeshName(request->name(), "name");
-  absl::Status status = key.status();
-  if (key.ok()) {
-    status = store_->Delete(*key);
-    if (absl::IsNotFound(status)) {
-      status = absl::NotFoundError(absl::StrCat("name: mesh \"", request->name(), "\" not found"));
-    }
-  }
-  reactor->Finish(ToGrpcStatus(status));
-  return reactor;
-}
-
-// Queries: the reactor templates run the query functions of queries.cc on the pool.
-grpc::ServerWriteReactor<v1::ComputeDistanceFieldResponse>* GeodexService::ComputeDistanceField(
-    grpc::CallbackServerContext* context, const v1::ComputeDistanceFieldRequest* request) {
-  if (!auth_.Allows(*context)) {
-    return new RejectedWriteReactor<v1::ComputeDistanceFieldResponse>(UnauthenticatedStatus());
-  }
-  return StreamQueryReactor<v1::ComputeDistanceFieldRequest,
-                            v1::ComputeDistanceFieldResponse>::Start(env(),
-                                                                     &RunComputeDistanceField,
-                                                                     request);
-}
-
-grpc::ServerUnaryReactor* GeodexService::FindShortestPath(
-    grpc::CallbackServerContext* context, const v1::FindShortestPathRequest* request,
-    v1::FindShortestPathResponse* response) {
-  if (!auth_.Allows(*context)) {
-    grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
-    reactor->Finish(UnauthenticatedStatus());
-    return reactor;
-  }
-  return UnaryQueryReactor<v1::FindShortestPathRequest, v1::FindShortestPathResponse>::Start(
-      env(), &RunFindShortestPath, request, response);
-}
-
-grpc::ServerWriteReactor<v1::ComputeDistanceMatrixResponse>* GeodexService::ComputeDistanceMatrix(
-    grpc::CallbackServerContext* context, const v1::ComputeDistanceMatrixRequest* request) {
-  if (!auth_.Allows(*context)) {
-    return new RejectedWriteReactor<v1::ComputeDistanceMatrixResponse>(UnauthenticatedStatus());
-  }
-  return StreamQueryReactor<v1::ComputeDistanceMatrixRequest,
-                            v1::ComputeDistanceMatrixResponse>::Start(env(),
-                                                                      &RunComputeDistanceMatrix,
-                                                                      request);
-}
-
-grpc::ServerUnaryReactor* GeodexService::EstimateDistances(
-    grpc::CallbackServerContext* context, const v1::EstimateDistancesRequest* request,
-    v1::EstimateDistancesResponse* response) {
-  if (!auth_.Allows(*context)) {
-    grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
-    reactor->Finish(UnauthenticatedStatus());
-    return reactor;
-  }
-  return UnaryQueryReactor<v1::EstimateDistancesRequest, v1::EstimateDistancesResponse>::Start(
-      env(), &RunEstimateDistances, request, response);
-}
-
-grpc::ServerUnaryReactor* GeodexService::LocatePoints(grpc::CallbackServerContext* context,
-                                                      const v1::LocatePointsRequest* request,
-                                                      v1::LocatePointsResponse* response) {
-  if (!auth_.Allows(*context)) {
-    grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
-    reactor->Finish(UnauthenticatedStatus());
-    return reactor;
-  }
-  return UnaryQueryReactor<v1::LocatePointsRequest, v1::LocatePointsResponse>::Start(
-      env(), &RunLocatePoints, request, response);
-}
-
-grpc::ServerWriteReactor<v1::ComputeIsolinesResponse>* GeodexService::ComputeIsolines(
-    grpc::CallbackServerContext* context, const v1::ComputeIsolinesRequest* request) {
-  if (!auth_.Allows(*context)) {
-    return new RejectedWriteReactor<v1::ComputeIsolinesResponse>(UnauthenticatedStatus());
-  }
-  return StreamQueryReactor<v1::ComputeIsolinesRequest, v1::ComputeIsolinesResponse>::Start(
-      env(), &RunComputeIsolines, request);
-}
-
-grpc::ServerWriteReactor<v1::ComputeVoronoiResponse>* GeodexService::ComputeVoronoi(
-    grpc::CallbackServerContext* context, const v1::ComputeVoronoiRequest* request) {
-  if (!auth_.Allows(*context)) {
-    return new RejectedWriteReactor<v1::ComputeVoronoiResponse>(UnauthenticatedStatus());
-  }
-  return StreamQueryReactor<v1::ComputeVoronoiRequest, v1::ComputeVoronoiResponse>::Start(
-      env(), &RunComputeVoronoi, request);
-}
-
-grpc::ServerWriteReactor<v1::ComputeDelaunayResponse>* GeodexService::ComputeDelaunay(
-    grpc::CallbackServerContext* context, const v1::ComputeDelaunayRequest* request) {
-  if (!auth_.Allows(*context)) {
-    return new RejectedWriteReactor<v1::ComputeDelaunayResponse>(UnauthenticatedStatus());
-  }
-  return StreamQueryReactor<v1::ComputeDelaunayRequest, v1::ComputeDelaunayResponse>::Start(
-      env(), &RunComputeDelaunay, request);
 }
 
 }  // namespace geodex::server

@@ -39,13 +39,21 @@ ABSL_FLAG(std::string, tls_key, "", "PEM private key of --tls_cert");
 ABSL_FLAG(std::string, auth_token_file, "",
           "File of bearer tokens, one per line: geodex.v1 calls need 'authorization: Bearer TOKEN' "
           "(health, reflection and metrics stay open)");
+ABSL_FLAG(bool, allow_plaintext_tokens, false,
+          "Allow --auth_token_file without TLS (only behind a TLS-terminating proxy: tokens then "
+          "cross the proxy's link in plaintext)");
 ABSL_FLAG(bool, log_requests, true, "Log one line per call (method, mesh, sources, time, status)");
 ABSL_FLAG(uint32_t, pool_threads, 0, "Compute worker threads (0 = one per hardware thread)");
+ABSL_FLAG(uint32_t, quick_threads, 2,
+          "Workers for calls that need no solve (metadata, locate, cached fields, traces and "
+          "estimates from them), so that they never wait behind full solves (0 = no quick lane)");
 ABSL_FLAG(uint32_t, queue_capacity, 64,
           "Queries that may wait for a worker; beyond that calls get RESOURCE_EXHAUSTED at once");
 ABSL_FLAG(uint64_t, max_upload_bytes, uint64_t{1} << 30, "Largest mesh file accepted by CreateMesh");
 ABSL_FLAG(uint64_t, max_vertices, 20'000'000, "Most vertices in an uploaded mesh");
 ABSL_FLAG(uint64_t, max_faces, 40'000'000, "Most faces in an uploaded mesh");
+ABSL_FLAG(uint32_t, max_names_per_mesh, 16,
+          "Most names (display name and aliases from re-uploads under other names) one mesh may have");
 ABSL_FLAG(uint32_t, max_sources, 100'000, "Most sources in one query");
 ABSL_FLAG(uint32_t, max_targets, 50'000,
           "Most targets (matrix columns, EstimateDistances points, LocatePoints positions) per query");
@@ -116,17 +124,20 @@ int main(int argc, char** argv) {
   options.tls_cert_file = absl::GetFlag(FLAGS_tls_cert);
   options.tls_key_file = absl::GetFlag(FLAGS_tls_key);
   options.auth_token_file = absl::GetFlag(FLAGS_auth_token_file);
+  options.allow_plaintext_tokens = absl::GetFlag(FLAGS_allow_plaintext_tokens);
   if (options.replica_name.empty()) {
     char host[256] = {};
     if (gethostname(host, sizeof host - 1) == 0) options.replica_name = host;
   }
   options.pool_threads = absl::GetFlag(FLAGS_pool_threads);
+  options.quick_threads = absl::GetFlag(FLAGS_quick_threads);
   options.queue_capacity = absl::GetFlag(FLAGS_queue_capacity);
   options.max_receive_message_bytes = absl::GetFlag(FLAGS_max_receive_message_bytes);
   options.limits.max_upload_bytes = absl::GetFlag(FLAGS_max_upload_bytes);
   options.limits.max_vertices = absl::GetFlag(FLAGS_max_vertices);
   options.limits.max_faces = absl::GetFlag(FLAGS_max_faces);
   options.limits.max_sources = absl::GetFlag(FLAGS_max_sources);
+  options.limits.max_names_per_mesh = absl::GetFlag(FLAGS_max_names_per_mesh);
   options.limits.max_targets = absl::GetFlag(FLAGS_max_targets);
   options.limits.max_levels = absl::GetFlag(FLAGS_max_levels);
   options.limits.max_output_values = absl::GetFlag(FLAGS_max_output_values);
@@ -159,14 +170,14 @@ int main(int argc, char** argv) {
   // The effective configuration, one line.
   spdlog::info(
       "config replica={} listen={} data_dir={} samples={} mesh_budget_bytes={} result_cache_bytes={} "
-      "pool_threads={} "
+      "pool_threads={} quick_threads={} "
       "queue_capacity={} max_upload_bytes={} max_vertices={} max_faces={} max_sources={} "
       "max_targets={} max_levels={} max_output_values={} max_windows={} "
       "max_unary_response_bytes={} stream_chunk_bytes={} shutdown_grace_seconds={}",
       options.replica_name, options.listen, options.data_dir.empty() ? "(none)" : options.data_dir,
       options.samples,
-      options.mesh_budget_bytes, options.result_cache_bytes, (*server)->pool().threads(), options.queue_capacity,
-      options.limits.max_upload_bytes, options.limits.max_vertices, options.limits.max_faces,
+      options.mesh_budget_bytes, options.result_cache_bytes, (*server)->pool().threads(),
+      options.quick_threads, options.queue_capacity, options.limits.max_upload_bytes, options.limits.max_vertices, options.limits.max_faces,
       options.limits.max_sources, options.limits.max_targets, options.limits.max_levels,
       options.limits.max_output_values, options.limits.max_windows,
       options.limits.max_unary_response_bytes, options.limits.stream_chunk_bytes,
@@ -177,7 +188,9 @@ int main(int argc, char** argv) {
                  (*server)->metrics().port());
   }
   if ((*server)->authenticated() && !(*server)->tls()) {
-    spdlog::warn("bearer tokens without TLS travel in plaintext: use --tls_cert/--tls_key");
+    spdlog::warn(
+        "--allow_plaintext_tokens: bearer tokens arrive without TLS; only safe behind a "
+        "TLS-terminating proxy on a trusted link");
   }
   spdlog::info("security: tls={} bearer_tokens={}", (*server)->tls(), (*server)->authenticated());
   spdlog::info("geodexd listening on port {} ({} workers, queue {}, mesh budget {} bytes)",

@@ -251,16 +251,18 @@ absl::Status MeshDisk::Write(const std::string& id, const v1::Mesh& header,
 }
 
 absl::Status MeshDisk::Read(const std::string& id, v1::Mesh* header, std::string* canonical) const {
+  // Messages name the mesh, never the server's paths (they reach clients).
   const std::string path = PathOf(id);
+  const std::string mesh = absl::StrCat("stored mesh meshes/", id);
   absl::StatusOr<std::string> bytes = ReadWholeFile(path);
-  if (!bytes.ok()) return absl::DataLossError(absl::StrCat("stored mesh ", path, ": missing"));
+  if (!bytes.ok()) return absl::DataLossError(absl::StrCat(mesh, ": its file is missing"));
   absl::StatusOr<Parsed> parsed = ParseFile(*bytes, /*verify=*/true);
   if (!parsed.ok()) {
-    return absl::DataLossError(absl::StrCat("stored mesh ", path, ": ", parsed.status().message()));
+    return absl::DataLossError(absl::StrCat(mesh, ": ", parsed.status().message()));
   }
   canonical->assign(*bytes, parsed->payload_offset, parsed->payload_size);
   if (Sha256Hex(*canonical) != id) {
-    return absl::DataLossError(absl::StrCat("stored mesh ", path, ": content does not hash to its id"));
+    return absl::DataLossError(absl::StrCat(mesh, ": content does not hash to its id"));
   }
   *header = std::move(parsed->header);
   return absl::OkStatus();

@@ -1,5 +1,6 @@
 #include "mesh_store.h"
 
+#include <algorithm>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
@@ -47,6 +48,7 @@ std::shared_ptr<StoredMesh> RecordFromProto(const std::string& id, const v1::Mes
   auto record = std::make_shared<StoredMesh>();
   record->id = id;
   record->display_name = proto.display_name();
+  record->aliases.assign(proto.aliases().begin(), proto.aliases().end());
   record->vertex_count = proto.vertex_count();
   record->face_count = proto.face_count();
   record->upload_bytes = proto.upload_bytes();
@@ -87,6 +89,14 @@ void MeshStore::AttachDisk(MeshDisk disk, const MeshDisk::Index& index) {
         aliases_[record->display_name] = entry.id;
       }
     }
+    std::vector<std::string> kept;
+    for (const std::string& alias : record->aliases) {
+      if (!alias.empty() && !aliases_.contains(alias)) {
+        aliases_[alias] = entry.id;
+        kept.push_back(alias);
+      }
+    }
+    record->aliases = std::move(kept);
     meshes_[entry.id].mesh = std::move(record);
   }
 }
@@ -127,7 +137,7 @@ std::shared_ptr<const StoredMesh> MeshStore::AdmitLocked(std::shared_ptr<const S
 }
 
 absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::Insert(
-    std::shared_ptr<StoredMesh> mesh, const std::string& canonical) {
+    std::shared_ptr<StoredMesh> mesh, const std::string& canonical, uint32_t max_names) {
   {
     std::lock_guard<std::mutex> lock(mu_);
     if (!mesh->display_name.empty()) {
@@ -142,9 +152,23 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::Insert(
     if (existing != meshes_.end()) {
       Slot& slot = existing->second;
       if (slot.resident) lru_.splice(lru_.begin(), lru_, slot.lru);
-      if (!mesh->display_name.empty() && slot.mesh->display_name.empty()) {
-        auto updated = std::make_shared<StoredMesh>(*slot.mesh);
-        updated->display_name = mesh->display_name;
+      const std::string& name = mesh->display_name;
+      const StoredMesh& old = *slot.mesh;
+      const bool known = name.empty() || old.display_name == name ||
+                         std::find(old.aliases.begin(), old.aliases.end(), name) != old.aliases.end();
+      if (!known) {
+        const size_t names = (old.display_name.empty() ? 0 : 1) + old.aliases.size();
+        if (names >= max_names) {
+          return absl::ResourceExhaustedError(absl::StrCat(
+              "metadata.display_name: mesh ", mesh->id, " already has ", names,
+              " names, the most a mesh may have (--max_names_per_mesh=", max_names, ")"));
+        }
+        auto updated = std::make_shared<StoredMesh>(old);
+        if (updated->display_name.empty()) {
+          updated->display_name = name;
+        } else {
+          updated->aliases.push_back(name);
+        }
         if (disk_) {
           v1::Mesh header;
           MeshToProto(*Strip(*updated), &header);
@@ -198,6 +222,7 @@ void MeshStore::RemoveLocked(const std::string& id) {
   if (it == meshes_.end()) return;
   const StoredMesh& mesh = *it->second.mesh;
   if (!mesh.display_name.empty()) aliases_.erase(mesh.display_name);
+  for (const std::string& alias : mesh.aliases) aliases_.erase(alias);
   if (it->second.resident) {
     used_bytes_ -= mesh.memory_bytes;
     lru_.erase(it->second.lru);
@@ -239,17 +264,18 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::Get(const std::stri
   if (absl::Status s = disk_->Read(record->id, &header, &canonical); !s.ok()) return s;
   absl::StatusOr<MeshData> data = DecodeCanonicalMesh(canonical);
   if (!data.ok()) {
-    return absl::DataLossError(absl::StrCat("stored mesh ", disk_->PathOf(record->id), ": ",
-                                            data.status().message()));
+    return absl::DataLossError(
+        absl::StrCat("stored mesh meshes/", record->id, ": ", data.status().message()));
   }
   canonical.clear();
   absl::StatusOr<TriangleMesh> built = TriangleMesh::Build(*data);
   if (!built.ok()) {
-    return absl::DataLossError(absl::StrCat("stored mesh ", disk_->PathOf(record->id), ": ",
-                                            built.status().message()));
+    return absl::DataLossError(
+        absl::StrCat("stored mesh meshes/", record->id, ": ", built.status().message()));
   }
   std::shared_ptr<StoredMesh> loaded = MakeStoredMesh(record->id, *std::move(built));
   loaded->display_name = record->display_name;
+  loaded->aliases = record->aliases;
   loaded->pinned = record->pinned;
   loaded->upload_bytes = record->upload_bytes;
   loaded->create_time = record->create_time;
@@ -264,6 +290,7 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::Get(const std::stri
     return it->second.mesh;
   }
   loaded->display_name = it->second.mesh->display_name;  // an alias may have been added meanwhile
+  loaded->aliases = it->second.mesh->aliases;
   absl::StatusOr<std::vector<std::string>> victims = VictimsLocked(loaded->memory_bytes);
   if (!victims.ok()) return victims.status();
   for (const std::string& id : *victims) EvictLocked(id);

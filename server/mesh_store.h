@@ -33,6 +33,7 @@ namespace geodex::server {
 struct StoredMesh {
   std::string id;            // SHA-256 hex (see mesh_id.h)
   std::string display_name;  // optional alias
+  std::vector<std::string> aliases;  // further aliases (re-uploads under other names)
   std::shared_ptr<const TriangleMesh> mesh;
   std::shared_ptr<const SurfaceLocator> locator;  // points into *mesh
   uint64_t vertex_count = 0;  // file vertices
@@ -64,11 +65,12 @@ class MeshStore {
   // Adds `mesh` (built), persisting `canonical` (its canonical encoding) first when a data
   // directory is attached, and evicting least-recently-used unpinned meshes from memory as needed.
   // If a mesh with the same id is stored already, returns that one (re-uploads are idempotent; a
-  // new alias is added to it when it has none). Errors: ResourceExhausted when the mesh is larger
-  // than the budget, cannot fit beside the pinned meshes, or the disk is full; InvalidArgument
-  // when the alias belongs to another mesh; Internal for other I/O errors.
+  // new alias is added to its names). Errors: ResourceExhausted when the mesh is larger than the
+  // budget, cannot fit beside the pinned meshes, already has `max_names` names, or the disk is
+  // full; InvalidArgument when the alias belongs to another mesh; Internal for other I/O errors.
   absl::StatusOr<std::shared_ptr<const StoredMesh>> Insert(std::shared_ptr<StoredMesh> mesh,
-                                                           const std::string& canonical = "");
+                                                           const std::string& canonical = "",
+                                                           uint32_t max_names = 16);
 
   // The mesh with this id or alias, loaded (from disk if needed; that can take a while: call it on
   // a compute thread). Marks it recently used. NotFound when unknown, DataLoss when its file does

@@ -1,5 +1,7 @@
 #include "metrics.h"
 
+#include "listen_address.h"
+
 #include <algorithm>
 #include <cctype>
 #include <exception>
@@ -109,12 +111,15 @@ std::string Sanitize(absl::string_view text) {
 class RequestInterceptor final : public grpc::experimental::Interceptor {
  public:
   RequestInterceptor(grpc::experimental::ServerRpcInfo* info, ServerMetrics* metrics)
-      : metrics_(metrics), method_(info->method() != nullptr ? info->method() : ""),
-        start_(absl::Now()) {
+      : metrics_(metrics), call_(info->server_context()),
+        method_(info->method() != nullptr ? info->method() : ""), start_(absl::Now()) {
     if (!method_.empty() && method_[0] == '/') method_.erase(0, 1);
-    // Only geodex's own methods carry protobuf messages the interceptor can read (the default
-    // health service works on raw bytes).
+    // geodex's own methods are raw (bytes): the service describes each call once it has parsed
+    // the request (CallDescriptions), after the token check.
     ours_ = method_.rfind("geodex.v1.Geodex/", 0) == 0;
+  }
+  ~RequestInterceptor() override {
+    if (ours_ && metrics_->descriptions() != nullptr) metrics_->descriptions()->Forget(call_);
   }
 
   void Intercept(grpc::experimental::InterceptorBatchMethods* methods) override {
@@ -133,19 +138,12 @@ class RequestInterceptor final : public grpc::experimental::Interceptor {
         metadata->insert({"x-geodex-replica", metrics_->replica()});
       }
     }
-    if (ours_ && !described_ && methods->QueryInterceptionHookPoint(Hook::POST_RECV_MESSAGE)) {
-      if (const void* message = methods->GetRecvMessage()) {
-        Describe(*static_cast<const google::protobuf::Message*>(message));
-        described_ = true;
-      }
-    }
-    if (ours_ && mesh_.empty() && methods->QueryInterceptionHookPoint(Hook::PRE_SEND_MESSAGE)) {
-      if (const void* message = methods->GetSendMessage()) {  // CreateMesh: the Mesh resource
-        const auto& m = *static_cast<const google::protobuf::Message*>(message);
-        if (m.GetDescriptor()->full_name() == "geodex.v1.Mesh") mesh_ = StringField(m, "name");
-      }
-    }
     if (methods->QueryInterceptionHookPoint(Hook::PRE_SEND_STATUS)) {
+      if (ours_ && metrics_->descriptions() != nullptr) {
+        CallDescriptions::Entry entry = metrics_->descriptions()->Find(call_);
+        mesh_ = std::move(entry.mesh);
+        sources_ = entry.sources;
+      }
       const grpc::Status status = methods->GetSendStatus();
       const double seconds = absl::ToDoubleSeconds(absl::Now() - start_);
       metrics_->RecordRequest(method_, status.error_code(), seconds);
@@ -159,31 +157,11 @@ class RequestInterceptor final : public grpc::experimental::Interceptor {
   }
 
  private:
-  static std::string StringField(const google::protobuf::Message& m, const char* name) {
-    const google::protobuf::FieldDescriptor* field = m.GetDescriptor()->FindFieldByName(name);
-    if (field == nullptr || field->is_repeated() ||
-        field->type() != google::protobuf::FieldDescriptor::TYPE_STRING) {
-      return "";
-    }
-    return m.GetReflection()->GetString(m, field);
-  }
-
-  void Describe(const google::protobuf::Message& m) {
-    mesh_ = StringField(m, "mesh");
-    if (mesh_.empty()) mesh_ = StringField(m, "name");
-    const google::protobuf::FieldDescriptor* sources = m.GetDescriptor()->FindFieldByName("sources");
-    if (sources != nullptr && sources->is_repeated()) {
-      sources_ = m.GetReflection()->FieldSize(m, sources);
-    } else if (m.GetDescriptor()->FindFieldByName("from") != nullptr) {
-      sources_ = 1;
-    }
-  }
-
   ServerMetrics* metrics_;
+  const void* call_;
   std::string method_;
   absl::Time start_;
   bool ours_ = false;
-  bool described_ = false;
   std::string mesh_;
   int sources_ = 0;
   std::string request_id_ = "-";
@@ -211,6 +189,7 @@ absl::StatusOr<std::unique_ptr<ServerMetrics>> ServerMetrics::Start(const std::s
   std::unique_ptr<ServerMetrics> m(new ServerMetrics());
   m->log_requests_ = log_requests;
   m->replica_ = replica;
+  m->descriptions_ = sources.descriptions;
   m->registry_ = std::make_shared<prometheus::Registry>();
   m->gauges_ = std::make_shared<GaugeCollector>(sources);
   m->requests_ = &prometheus::BuildCounter()
@@ -225,8 +204,14 @@ absl::StatusOr<std::unique_ptr<ServerMetrics>> ServerMetrics::Start(const std::s
     try {
       m->exposer_ = std::make_unique<prometheus::Exposer>(listen);
     } catch (const std::exception& e) {
+      if (AddressInUse(listen)) {
+        return absl::UnavailableError(absl::StrCat(
+            "--metrics_listen=", listen,
+            ": address in use (another geodexd?); choose another port, 0 for a free one, or \"\" "
+            "for no metrics endpoint"));
+      }
       return absl::UnavailableError(
-          absl::StrCat("cannot serve metrics on ", listen, " (--metrics_listen): ", e.what()));
+          absl::StrCat("--metrics_listen=", listen, ": cannot serve metrics (", e.what(), ")"));
     }
     m->exposer_->RegisterCollectable(m->registry_);
     m->exposer_->RegisterCollectable(m->gauges_);

@@ -43,6 +43,7 @@ struct MetricSources {
   const MeshStore* store;
   const FieldCache* cache;
   const ServiceCounters* counters;
+  CallDescriptions* descriptions;  // what each call is about, for its log line (may be null)
 };
 
 class ServerMetrics {
@@ -65,6 +66,7 @@ class ServerMetrics {
   void RecordRequest(const std::string& method, int code, double seconds);
   bool log_requests() const { return log_requests_; }
   const std::string& replica() const { return replica_; }
+  CallDescriptions* descriptions() const { return descriptions_; }
 
   // The interceptor factory to install on the grpc::ServerBuilder.
   std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface> InterceptorFactory();
@@ -79,6 +81,7 @@ class ServerMetrics {
   int port_ = 0;
   bool log_requests_ = true;
   std::string replica_;
+  CallDescriptions* descriptions_ = nullptr;
 };
 
 }  // namespace geodex::server

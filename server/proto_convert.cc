@@ -4,6 +4,7 @@
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "status_convert.h"
 #include "google/protobuf/util/time_util.h"
 
 namespace geodex::server {
@@ -32,8 +33,8 @@ absl::StatusOr<std::string> ParseMeshName(const std::string& name, const std::st
   if (!absl::StartsWith(name, kPrefix) || name.size() == kPrefix.size() ||
       name.find('/', kPrefix.size()) != std::string::npos) {
     return absl::InvalidArgumentError(
-        absl::StrCat(field, ": expected \"meshes/{mesh_id}\" or \"meshes/{display_name}\", got \"",
-                     name, "\""));
+        absl::StrCat(field, ": expected \"meshes/{mesh_id}\" or \"meshes/{display_name}\", got ",
+                     QuoteInput(name)));
   }
   return name.substr(kPrefix.size());
 }
@@ -41,6 +42,7 @@ absl::StatusOr<std::string> ParseMeshName(const std::string& name, const std::st
 void MeshToProto(const StoredMesh& mesh, v1::Mesh* out) {
   out->set_name(absl::StrCat("meshes/", mesh.id));
   out->set_display_name(mesh.display_name);
+  for (const std::string& alias : mesh.aliases) out->add_aliases(alias);
   out->set_vertex_count(mesh.vertex_count);
   out->set_face_count(mesh.face_count);
   out->set_upload_bytes(mesh.upload_bytes);
@@ -115,9 +117,9 @@ absl::StatusOr<GeodesicOptions> SolverOptionsFromProto(const v1::SolverOptions& 
                                                        uint64_t max_windows,
                                                        const std::string& field) {
   GeodesicOptions out;
-  if (!std::isfinite(options.lambda()) || options.lambda() < 0) {
+  if (!(options.lambda() >= 0 && options.lambda() <= 1)) {  // also NaN
     return absl::InvalidArgumentError(
-        absl::StrCat(field, ".lambda: must be finite and >= 0, got ", options.lambda()));
+        absl::StrCat(field, ".lambda: must be in [0, 1], got ", options.lambda()));
   }
   out.lambda = options.lambda();
   switch (options.lambda_scale()) {

@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "absl/strings/cord.h"
 #include "absl/strings/str_cat.h"
 #include "geodex/delaunay.h"
 #include "geodex/distance_matrix.h"
@@ -16,8 +17,10 @@
 #include "geodex/shortest_path.h"
 #include "geodex/voronoi.h"
 #include "field_cache.h"
+#include "mesh_id.h"
 #include "proto_convert.h"
 #include "service_limits.h"
+#include "status_convert.h"
 
 namespace geodex::server {
 namespace {
@@ -99,6 +102,7 @@ absl::StatusOr<std::shared_ptr<const DistanceField>> CachedField(
     return hit;
   }
   *cached = false;
+  if (env.quick) return SolveLaneNeeded();
   absl::StatusOr<DistanceField> field = ComputeDistanceField(*mesh.mesh, sources, options);
   if (!field.ok()) return NameSolveError(field.status(), "sources");
   env.counters->solves.fetch_add(1, std::memory_order_relaxed);
@@ -127,7 +131,7 @@ absl::StatusOr<SolvedField> SolveField(const QueryEnv& env, const std::string& m
                                        const v1::SolverOptions& options) {
   SolvedField out;
   absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh =
-      LookupMesh(*env.store, mesh_name, "mesh");
+      LookupMesh(env, mesh_name, "mesh");
   if (!mesh.ok()) return mesh.status();
   out.mesh = *std::move(mesh);
   if (absl::Status s = CheckFieldSize(env, *out.mesh); !s.ok()) return s;
@@ -145,16 +149,80 @@ absl::StatusOr<SolvedField> SolveField(const QueryEnv& env, const std::string& m
 
 }  // namespace
 
-absl::StatusOr<std::shared_ptr<const StoredMesh>> LookupMesh(MeshStore& store,
+absl::Status SolveLaneNeeded() {
+  absl::Status status = absl::UnavailableError("internal: needs the compute pool");
+  status.SetPayload("geodex/lane", absl::Cord("solve"));
+  return status;
+}
+
+bool IsSolveLaneNeeded(const absl::Status& status) {
+  return status.GetPayload("geodex/lane").has_value();
+}
+
+absl::StatusOr<std::shared_ptr<const StoredMesh>> LookupMesh(const QueryEnv& env,
                                                              const std::string& name,
                                                              const std::string& field) {
   absl::StatusOr<std::string> key = ParseMeshName(name, field);
   if (!key.ok()) return key.status();
-  absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh = store.Get(*key);
+  if (env.quick) {
+    absl::StatusOr<std::shared_ptr<const StoredMesh>> record = env.store->GetRecord(*key);
+    if (record.ok() && (*record)->mesh == nullptr) return SolveLaneNeeded();  // on disk only
+  }
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh = env.store->Get(*key);
   if (absl::IsNotFound(mesh.status())) {
-    return absl::NotFoundError(absl::StrCat(field, ": mesh \"", name, "\" not found"));
+    return absl::NotFoundError(absl::StrCat(field, ": mesh ", QuoteInput(name), " not found"));
   }
   return mesh;  // or DataLoss (a corrupt file), ResourceExhausted (cannot be loaded back)
+}
+
+// ------------------------------------------------------------------------------------------
+// Mesh resources
+
+absl::Status RunGetMesh(const QueryEnv& env, const v1::GetMeshRequest& request,
+                        v1::Mesh* response) {
+  absl::StatusOr<std::string> key = ParseMeshName(request.name(), "name");
+  if (!key.ok()) return key.status();
+  // The record: a mesh that is only on disk is described without loading it.
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh = env.store->GetRecord(*key);
+  if (!mesh.ok()) {
+    return absl::NotFoundError(
+        absl::StrCat("name: mesh ", QuoteInput(request.name()), " not found"));
+  }
+  MeshToProto(**mesh, response);
+  return absl::OkStatus();
+}
+
+absl::Status RunListMeshes(const QueryEnv& env, const v1::ListMeshesRequest& request,
+                           v1::ListMeshesResponse* response) {
+  constexpr int kDefaultPageSize = 50;
+  constexpr int kMaxPageSize = 1000;
+  if (request.page_size() < 0) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("page_size: must be >= 0, got ", request.page_size()));
+  }
+  if (!request.page_token().empty() && !IsMeshId(request.page_token())) {
+    return absl::InvalidArgumentError("page_token: not a token returned by ListMeshes");
+  }
+  const int page_size =
+      request.page_size() == 0 ? kDefaultPageSize : std::min(request.page_size(), kMaxPageSize);
+  bool more = false;
+  std::vector<std::shared_ptr<const StoredMesh>> page =
+      env.store->List(request.page_token(), static_cast<size_t>(page_size), &more);
+  for (const auto& mesh : page) MeshToProto(*mesh, response->add_meshes());
+  if (more && !page.empty()) response->set_next_page_token(page.back()->id);
+  return absl::OkStatus();
+}
+
+absl::Status RunDeleteMesh(const QueryEnv& env, const v1::DeleteMeshRequest& request,
+                           v1::DeleteMeshResponse* /*response*/) {
+  absl::StatusOr<std::string> key = ParseMeshName(request.name(), "name");
+  if (!key.ok()) return key.status();
+  absl::Status status = env.store->Delete(*key);
+  if (absl::IsNotFound(status)) {
+    return absl::NotFoundError(
+        absl::StrCat("name: mesh ", QuoteInput(request.name()), " not found"));
+  }
+  return status;
 }
 
 // ------------------------------------------------------------------------------------------
@@ -163,7 +231,7 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> LookupMesh(MeshStore& store,
 absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPathRequest& request,
                                  v1::FindShortestPathResponse* response) {
   absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh =
-      LookupMesh(*env.store, request.mesh(), "mesh");
+      LookupMesh(env, request.mesh(), "mesh");
   if (!mesh.ok()) return mesh.status();
   absl::StatusOr<SurfacePoint> from = ResolvePoint(**mesh, request.from(), "from");
   if (!from.ok()) return from.status();
@@ -177,6 +245,7 @@ absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPath
     const std::string key = FieldCacheKey((*mesh)->id, {*from}, *solver);
     std::shared_ptr<const DistanceField> field = env.cache->Find(key);
     bool cached = field != nullptr;
+    if (field == nullptr && env.quick) return SolveLaneNeeded();
     if (field == nullptr && env.cache->NotePathSource(key)) {
       absl::StatusOr<std::shared_ptr<const DistanceField>> solved =
           CachedField(env, **mesh, {*from}, *solver, &cached);
@@ -186,7 +255,7 @@ absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPath
     if (field != nullptr) {
       absl::StatusOr<GeodesicPath> path = TracePathFromVertex(*(*mesh)->mesh, *field, to->vertex);
       if (absl::IsNotFound(path.status())) {
-        return absl::NotFoundError("to: unreachable from `from`");
+        return UnreachableError("to: unreachable from `from`");
       }
       if (!path.ok()) return path.status();
       response->set_distance(field->distance[to->vertex]);
@@ -197,6 +266,7 @@ absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPath
       return CheckUnaryResponseSize(env, *response, "paths");
     }
   }
+  if (env.quick) return SolveLaneNeeded();
   PathQueryOptions options;
   options.solver = *solver;
   absl::StatusOr<PathQueryResult> result = ComputeShortestPath(*(*mesh)->mesh, *from, *to, options);
@@ -207,7 +277,7 @@ absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPath
   }
   if (!result.ok()) {
     if (result.status().code() == absl::StatusCode::kNotFound) {
-      return absl::NotFoundError(
+      return UnreachableError(
           absl::StrCat("to: unreachable from `from` (", result.status().message(), ")"));
     }
     return NameSolveError(result.status(), "from/to");
@@ -221,7 +291,7 @@ absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPath
 absl::Status RunEstimateDistances(const QueryEnv& env, const v1::EstimateDistancesRequest& request,
                                   v1::EstimateDistancesResponse* response) {
   absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh =
-      LookupMesh(*env.store, request.mesh(), "mesh");
+      LookupMesh(env, request.mesh(), "mesh");
   if (!mesh.ok()) return mesh.status();
   const TriangleMesh& tm = *(*mesh)->mesh;
   absl::StatusOr<std::vector<SurfacePoint>> sources =
@@ -236,6 +306,7 @@ absl::Status RunEstimateDistances(const QueryEnv& env, const v1::EstimateDistanc
   const bool estimate = request.mode() != v1::POINT_DISTANCE_MODE_EXACT;
   const bool exact = request.mode() == v1::POINT_DISTANCE_MODE_EXACT ||
                      request.mode() == v1::POINT_DISTANCE_MODE_BOTH;
+  if (exact && env.quick) return SolveLaneNeeded();
   absl::StatusOr<GeodesicOptions> solver = Options(env, request.options());
   if (!solver.ok()) return solver.status();
   if (estimate) {
@@ -272,7 +343,7 @@ absl::Status RunEstimateDistances(const QueryEnv& env, const v1::EstimateDistanc
 absl::Status RunLocatePoints(const QueryEnv& env, const v1::LocatePointsRequest& request,
                              v1::LocatePointsResponse* response) {
   absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh =
-      LookupMesh(*env.store, request.mesh(), "mesh");
+      LookupMesh(env, request.mesh(), "mesh");
   if (!mesh.ok()) return mesh.status();
   if (request.positions().empty()) {
     return absl::InvalidArgumentError("positions: at least one position is required");
@@ -361,12 +432,13 @@ absl::StatusOr<MessageProducer<v1::ComputeDistanceFieldResponse>> RunComputeDist
 
 absl::StatusOr<MessageProducer<v1::ComputeDistanceMatrixResponse>> RunComputeDistanceMatrix(
     const QueryEnv& env, const v1::ComputeDistanceMatrixRequest& request) {
+  if (env.quick) return SolveLaneNeeded();  // every row is a solve
   if (!v1::ValueType_IsValid(request.value_type())) {
     return absl::InvalidArgumentError(
         absl::StrCat("value_type: unknown value ", request.value_type()));
   }
   absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh =
-      LookupMesh(*env.store, request.mesh(), "mesh");
+      LookupMesh(env, request.mesh(), "mesh");
   if (!mesh.ok()) return mesh.status();
   absl::StatusOr<std::vector<SurfacePoint>> sources =
       ResolveSources(env, **mesh, request.sources());

@@ -11,6 +11,7 @@
 #include "absl/status/statusor.h"
 #include "geodex/cancel.h"
 #include "geodex/v1/geodex.pb.h"
+#include "call_descriptions.h"
 #include "compute_pool.h"
 #include "mesh_store.h"
 #include "stream_chunker.h"
@@ -36,7 +37,21 @@ struct QueryEnv {
   // Where a matrix's rows get helpers (queued behind other calls' work: a fair share); null: the
   // calling worker solves every row.
   ComputePool* pool = nullptr;
+  // On the quick lane (query_reactors.h): answer only what needs no solve and no disk load;
+  // anything else returns SolveLaneNeeded() and the call moves to the compute pool.
+  bool quick = false;
 };
+
+// The sentinel a quick-lane query returns when it must solve (never sent to a client).
+absl::Status SolveLaneNeeded();
+bool IsSolveLaneNeeded(const absl::Status& status);
+
+// Mesh resources (answered inline: map look-ups).
+absl::Status RunGetMesh(const QueryEnv& env, const v1::GetMeshRequest& request, v1::Mesh* response);
+absl::Status RunListMeshes(const QueryEnv& env, const v1::ListMeshesRequest& request,
+                           v1::ListMeshesResponse* response);
+absl::Status RunDeleteMesh(const QueryEnv& env, const v1::DeleteMeshRequest& request,
+                           v1::DeleteMeshResponse* response);
 
 // Unary queries.
 absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPathRequest& request,
@@ -60,7 +75,8 @@ absl::StatusOr<MessageProducer<v1::ComputeDelaunayResponse>> RunComputeDelaunay(
 
 // "meshes/{key}" looked up in the store: InvalidArgument for a malformed name, NotFound for an
 // unknown one. `field` names the request field.
-absl::StatusOr<std::shared_ptr<const StoredMesh>> LookupMesh(MeshStore& store,
+// On the quick lane a mesh that is not in memory is SolveLaneNeeded (loading it takes a while).
+absl::StatusOr<std::shared_ptr<const StoredMesh>> LookupMesh(const QueryEnv& env,
                                                              const std::string& name,
                                                              const std::string& field);
 

@@ -1,42 +1,92 @@
 #pragma once
 
-// Two reactor shapes serve every query method: a unary one and a server-streaming one. Both hand
-// the work to the ComputePool (never computing on gRPC's threads), answer RESOURCE_EXHAUSTED at
-// once when the pool's queue is full, cancel the engine's CancelToken on client cancellation or
-// deadline, and always Finish (a reactor that never finishes would hang the server's shutdown).
+// The reactors behind every geodex.v1 method. The service registers each method raw (request and
+// response as bytes, geodex_service.cc): a reactor first checks the bearer token, then parses the
+// request itself, so that
+//   - no byte of an unauthenticated request is ever parsed, and
+//   - a request that does not parse gets INVALID_ARGUMENT saying so (gRPC's typed callback API
+//     answers UNIMPLEMENTED with an empty message, telling the client the method does not exist).
+// Work never runs on gRPC's threads except plain map look-ups (Lane::kInline). Calls that may be
+// served without a solve (cached fields, traces from them, locate) run first on the quick pool, so
+// that they never wait behind full solves; one that turns out to need a solve moves to the compute
+// pool. A full queue answers RESOURCE_EXHAUSTED at once; client cancellation and deadlines cancel
+// the engine's CancelToken; every reactor finishes.
 
 #include <functional>
+#include <memory>
+#include <string>
 #include <utility>
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "absl/strings/str_cat.h"
+#include "auth.h"
 #include "compute_pool.h"
 #include "geodex/cancel.h"
+#include "grpcpp/support/byte_buffer.h"
+#include "grpcpp/support/proto_buffer_reader.h"
 #include "grpcpp/support/server_callback.h"
 #include "queries.h"
 #include "status_convert.h"
 
 namespace geodex::server {
 
-inline grpc::Status PoolFullStatus(const ComputePool& pool) {
+inline grpc::Status PoolFullStatus(const ComputePool& pool, const char* flags) {
   return ToGrpcStatus(absl::ResourceExhaustedError(
       absl::StrCat("compute queue full (", pool.threads(), " workers busy, ", pool.queue_capacity(),
-                   " queued; --pool_threads/--queue_capacity); retry later")));
+                   " queued; ", flags, "); retry later")));
 }
 
 inline grpc::Status CancelledStatus() {
   return grpc::Status(grpc::StatusCode::CANCELLED, "call cancelled or deadline exceeded");
 }
 
+// Parses one request message from its wire bytes; InvalidArgument naming the message type when
+// the bytes are not a valid encoding (bad wire format, invalid UTF-8 in a string, nesting deeper
+// than protobuf's recursion limit).
+template <typename Message>
+absl::Status ParseRequest(const grpc::ByteBuffer& bytes, Message* message, const char* what) {
+  grpc::ByteBuffer copy(bytes);  // shares the slices; the reader needs a mutable buffer
+  grpc::ProtoBufferReader reader(&copy);
+  if (!reader.status().ok() || !message->ParseFromZeroCopyStream(&reader)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        what, ": the request could not be parsed as ", Message::descriptor()->full_name(), " (",
+        bytes.Length(), " bytes: invalid wire format, invalid UTF-8 in a string field, or nesting "
+        "too deep)"));
+  }
+  return absl::OkStatus();
+}
+
+template <typename Message>
+void SerializeResponse(const Message& message, grpc::ByteBuffer* out) {
+  bool own = false;
+  grpc::SerializationTraits<Message>::Serialize(message, out, &own);
+}
+
 // What the reactors need from the service.
 struct ReactorEnv {
   MeshStore* store;
   const ServiceLimits* limits;
-  ComputePool* pool;
+  ComputePool* pool;        // solves
+  ComputePool* quick_pool;  // calls that need no solve (see Lane); null = none (all on `pool`)
   FieldCache* cache;
   ServiceCounters* counters;
+  const TokenAuthenticator* auth;
+  CallDescriptions* descriptions;  // may be null
 };
+
+// Where a method's work runs.
+enum class Lane {
+  kInline,  // on gRPC's thread: only map look-ups (GetMesh, ListMeshes, DeleteMesh)
+  kQuick,   // the quick pool first; moves to the compute pool if it needs a solve
+  kSolve,   // the compute pool
+};
+
+inline QueryEnv MakeQueryEnv(const ReactorEnv& env, const CancelToken* cancel, bool quick) {
+  QueryEnv q{env.store, env.limits, cancel, env.cache, env.counters, env.pool};
+  q.quick = quick;
+  return q;
+}
 
 template <typename Request, typename Response>
 class UnaryQueryReactor final : public grpc::ServerUnaryReactor {
@@ -44,11 +94,33 @@ class UnaryQueryReactor final : public grpc::ServerUnaryReactor {
   using Run = absl::Status (*)(const QueryEnv&, const Request&, Response*);
 
   // Starts the reactor: the caller returns it to gRPC.
-  static grpc::ServerUnaryReactor* Start(const ReactorEnv& env, Run run, const Request* request,
-                                         Response* response) {
-    auto* reactor = new UnaryQueryReactor(env, run, request, response);
-    if (!env.pool->TrySubmit([reactor] { reactor->Compute(); })) {
-      reactor->Finish(PoolFullStatus(*env.pool));
+  static grpc::ServerUnaryReactor* Start(const ReactorEnv& env, Run run, Lane lane,
+                                         grpc::CallbackServerContext* context,
+                                         const grpc::ByteBuffer* request, grpc::ByteBuffer* out) {
+    auto* reactor = new UnaryQueryReactor(env, run, out);
+    if (!env.auth->Allows(*context)) {
+      reactor->Finish(UnauthenticatedStatus());
+      return reactor;
+    }
+    if (absl::Status parsed = ParseRequest(*request, &reactor->request_, "request");
+        !parsed.ok()) {
+      reactor->Finish(ToGrpcStatus(parsed));
+      return reactor;
+    }
+    if (env.descriptions != nullptr) env.descriptions->Describe(context, reactor->request_);
+    switch (lane) {
+      case Lane::kInline:
+        reactor->Compute(/*quick=*/false);
+        break;
+      case Lane::kQuick:
+        if (env.quick_pool != nullptr) {
+          reactor->Submit(env.quick_pool, /*quick=*/true);
+          break;
+        }
+        [[fallthrough]];  // no quick lane (--quick_threads=0): everything on the compute pool
+      case Lane::kSolve:
+        reactor->Submit(env.pool, /*quick=*/false);
+        break;
     }
     return reactor;
   }
@@ -57,38 +129,69 @@ class UnaryQueryReactor final : public grpc::ServerUnaryReactor {
   void OnDone() override { delete this; }
 
  private:
-  UnaryQueryReactor(const ReactorEnv& env, Run run, const Request* request, Response* response)
-      : env_(env), run_(run), request_(request), response_(response) {}
+  UnaryQueryReactor(const ReactorEnv& env, Run run, grpc::ByteBuffer* out)
+      : env_(env), run_(run), out_(out) {}
 
-  void Compute() {
+  void Submit(ComputePool* pool, bool quick) {
+    if (!pool->TrySubmit([this, pool, quick] { Compute(quick, pool); })) {
+      Finish(PoolFullStatus(*pool, quick ? "--quick_threads/--queue_capacity"
+                                         : "--pool_threads/--queue_capacity"));
+    }
+  }
+
+  void Compute(bool quick, ComputePool* pool = nullptr) {
     if (cancel_.IsCancelled()) {
-      env_.pool->ReleaseWorker();
+      if (pool != nullptr) pool->ReleaseWorker();
       Finish(CancelledStatus());
       return;
     }
-    absl::Status status = run_(QueryEnv{env_.store, env_.limits, &cancel_, env_.cache, env_.counters, env_.pool}, *request_, response_);
-    if (!status.ok()) response_->Clear();
-    env_.pool->ReleaseWorker();  // before Finish: the client may send its next call at once
+    absl::Status status = run_(MakeQueryEnv(env_, &cancel_, quick), request_, &response_);
+    if (quick && IsSolveLaneNeeded(status)) {
+      response_.Clear();
+      pool->ReleaseWorker();
+      Submit(env_.pool, /*quick=*/false);
+      return;
+    }
+    if (status.ok()) {
+      SerializeResponse(response_, out_);
+    }
+    response_.Clear();
+    if (pool != nullptr) pool->ReleaseWorker();  // before Finish: the next call may come at once
     Finish(ToGrpcStatus(status));
   }
 
   ReactorEnv env_;
   Run run_;
-  const Request* request_;
-  Response* response_;
+  Request request_;
+  Response response_;
+  grpc::ByteBuffer* out_;
   CancelToken cancel_;
 };
 
 template <typename Request, typename Response>
-class StreamQueryReactor final : public grpc::ServerWriteReactor<Response> {
+class StreamQueryReactor final : public grpc::ServerWriteReactor<grpc::ByteBuffer> {
  public:
   using Run = absl::StatusOr<MessageProducer<Response>> (*)(const QueryEnv&, const Request&);
 
-  static grpc::ServerWriteReactor<Response>* Start(const ReactorEnv& env, Run run,
-                                                   const Request* request) {
-    auto* reactor = new StreamQueryReactor(env, run, request);
-    if (!env.pool->TrySubmit([reactor] { reactor->Compute(); })) {
-      reactor->Finish(PoolFullStatus(*env.pool));
+  static grpc::ServerWriteReactor<grpc::ByteBuffer>* Start(const ReactorEnv& env, Run run,
+                                                           Lane lane,
+                                                           grpc::CallbackServerContext* context,
+                                                           const grpc::ByteBuffer* request) {
+    auto* reactor = new StreamQueryReactor(env, run);
+    if (!env.auth->Allows(*context)) {
+      reactor->Finish(UnauthenticatedStatus());
+      return reactor;
+    }
+    if (absl::Status parsed = ParseRequest(*request, &reactor->request_, "request");
+        !parsed.ok()) {
+      reactor->Finish(ToGrpcStatus(parsed));
+      return reactor;
+    }
+    if (env.descriptions != nullptr) env.descriptions->Describe(context, reactor->request_);
+    if (lane == Lane::kQuick && env.quick_pool != nullptr) {
+      reactor->Submit(env.quick_pool, /*quick=*/true);
+    } else {
+      reactor->Submit(env.pool, /*quick=*/false);
     }
     return reactor;
   }
@@ -105,18 +208,29 @@ class StreamQueryReactor final : public grpc::ServerWriteReactor<Response> {
   void OnDone() override { delete this; }
 
  private:
-  StreamQueryReactor(const ReactorEnv& env, Run run, const Request* request)
-      : env_(env), run_(run), request_(request) {}
+  StreamQueryReactor(const ReactorEnv& env, Run run) : env_(env), run_(run) {}
 
-  void Compute() {
+  void Submit(ComputePool* pool, bool quick) {
+    if (!pool->TrySubmit([this, pool, quick] { Compute(pool, quick); })) {
+      this->Finish(PoolFullStatus(*pool, quick ? "--quick_threads/--queue_capacity"
+                                               : "--pool_threads/--queue_capacity"));
+    }
+  }
+
+  void Compute(ComputePool* pool, bool quick) {
     if (cancel_.IsCancelled()) {
-      env_.pool->ReleaseWorker();
+      pool->ReleaseWorker();
       this->Finish(CancelledStatus());
       return;
     }
     absl::StatusOr<MessageProducer<Response>> producer =
-        run_(QueryEnv{env_.store, env_.limits, &cancel_, env_.cache, env_.counters, env_.pool}, *request_);
-    env_.pool->ReleaseWorker();  // before any Finish or write: see ComputePool::ReleaseWorker
+        run_(MakeQueryEnv(env_, &cancel_, quick), request_);
+    if (quick && IsSolveLaneNeeded(producer.status())) {
+      pool->ReleaseWorker();
+      Submit(env_.pool, /*quick=*/false);
+      return;
+    }
+    pool->ReleaseWorker();  // before any Finish or write: see ComputePool::ReleaseWorker
     if (!producer.ok()) {
       this->Finish(ToGrpcStatus(producer.status()));
       return;
@@ -131,15 +245,18 @@ class StreamQueryReactor final : public grpc::ServerWriteReactor<Response> {
       this->Finish(cancel_.IsCancelled() ? CancelledStatus() : grpc::Status::OK);
       return;
     }
-    this->StartWrite(&response_);
+    buffer_.Clear();
+    SerializeResponse(response_, &buffer_);
+    this->StartWrite(&buffer_);
   }
 
   ReactorEnv env_;
   Run run_;
-  const Request* request_;
+  Request request_;
   CancelToken cancel_;
   MessageProducer<Response> producer_;
   Response response_;
+  grpc::ByteBuffer buffer_;
 };
 
 }  // namespace geodex::server

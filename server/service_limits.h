@@ -6,12 +6,15 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "geodex/limits.h"
+
 namespace geodex::server {
 
 struct ServiceLimits {
   uint64_t max_upload_bytes = uint64_t{1} << 30;  // --max_upload_bytes
   uint64_t max_vertices = 20'000'000;              // --max_vertices
   uint64_t max_faces = 40'000'000;                 // --max_faces
+  uint32_t max_names_per_mesh = 16;                // --max_names_per_mesh (display name + aliases)
   uint32_t max_sources = 100'000;                  // --max_sources
   uint32_t max_targets = 50'000;                   // --max_targets (matrix columns, points)
   uint32_t max_levels = 1'000;                     // --max_levels (isolines)
@@ -24,5 +27,20 @@ struct ServiceLimits {
   // --stream_chunk_bytes
   uint32_t stream_chunk_bytes = 1 << 20;
 };
+
+// The flag (without "--") that sets each limit core enforces for the server.
+inline const char* FlagOfLimit(Limit limit) {
+  switch (limit) {
+    case Limit::kVertices:
+      return "max_vertices";
+    case Limit::kFaces:
+      return "max_faces";
+    case Limit::kInputBytes:
+      return "max_upload_bytes";
+    case Limit::kWindows:
+      return "max_windows";
+  }
+  return "unknown";
+}
 
 }  // namespace geodex::server

@@ -1,13 +1,20 @@
 #include "status_convert.h"
 
+#include <optional>
 #include <string>
 
+#include "absl/strings/cord.h"
+#include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
+#include "geodex/limits.h"
 #include "google/rpc/error_details.pb.h"
 #include "google/rpc/status.pb.h"
+#include "service_limits.h"
 
 namespace geodex::server {
 namespace {
+
+constexpr absl::string_view kReasonPayload = "geodex/reason";
 
 // geodex's error messages start with the request field they concern: "sources[2].edge.t: ...".
 // Returns that field, or "" when the message does not start with one.
@@ -35,14 +42,37 @@ absl::string_view NamedFlag(absl::string_view message) {
   return end > start + 2 ? message.substr(start + 2, end - start - 2) : absl::string_view();
 }
 
+std::string CapMessage(absl::string_view message) {
+  if (message.size() <= kMaxStatusMessageBytes) return std::string(message);
+  return absl::StrCat(message.substr(0, kMaxStatusMessageBytes - 60), "... (message cut: ",
+                      message.size(), " bytes)");
+}
+
 }  // namespace
+
+std::string QuoteInput(absl::string_view input) {
+  if (input.size() <= kMaxEchoBytes) return absl::StrCat("\"", input, "\"");
+  size_t cut = kMaxEchoBytes;
+  while (cut > 0 && (static_cast<unsigned char>(input[cut]) & 0xC0) == 0x80) --cut;  // whole UTF-8
+  return absl::StrCat("\"", input.substr(0, cut), "...\" (cut: ", input.size(), " bytes)");
+}
+
+absl::Status UnreachableError(absl::string_view message) {
+  absl::Status status = absl::FailedPreconditionError(message);
+  status.SetPayload(kReasonPayload, absl::Cord("UNREACHABLE"));
+  return status;
+}
 
 grpc::Status ToGrpcStatus(const absl::Status& status) {
   if (status.ok()) return grpc::Status::OK;
   // absl::StatusCode and grpc::StatusCode share the canonical numbering (google.rpc.Code).
   int code = static_cast<int>(status.code());
   if (code < 0 || code > 16) code = grpc::StatusCode::UNKNOWN;
-  const std::string message(status.message());
+  std::string message(status.message());
+  if (std::optional<Limit> limit = ExceededLimit(status)) {
+    absl::StrAppend(&message, " (server flag --", FlagOfLimit(*limit), ")");
+  }
+  message = CapMessage(message);
 
   // Rich error details (google.rpc.Status in the grpc-status-details-bin trailer): BadRequest
   // naming the field for INVALID_ARGUMENT, ErrorInfo naming the flag for a limit.
@@ -63,6 +93,11 @@ grpc::Status ToGrpcStatus(const absl::Status& status) {
     const bool queue_full = message.rfind("compute queue full", 0) == 0;
     info.set_reason(queue_full ? "QUEUE_FULL" : flag.empty() ? "RESOURCE_EXHAUSTED" : "LIMIT");
     if (!flag.empty()) (*info.mutable_metadata())["flag"] = std::string(flag);
+    details.add_details()->PackFrom(info);
+  } else if (auto reason = status.GetPayload(kReasonPayload)) {
+    google::rpc::ErrorInfo info;
+    info.set_domain("geodex.v1");
+    info.set_reason(std::string(*reason));
     details.add_details()->PackFrom(info);
   }
   if (details.details_size() == 0) {

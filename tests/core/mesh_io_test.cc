@@ -1,6 +1,7 @@
 // Tests of the mesh readers and writers: every format and variant on good input (files under
 // tests/data/io, binary files built here), gzip, format detection, malformed and hostile input
 // (the error must name the file and the position), and write/read round trips.
+#include "geodex/limits.h"
 #include "geodex/mesh_io.h"
 
 #include <stdlib.h>
@@ -289,11 +290,15 @@ TEST(OffReaderTest, CountsBeyondLimitsAreResourceExhausted) {
   ReadLimits limits;
   limits.max_vertices = 3;
   ExpectError(Parse(kTetraOff, "lim.off", limits), Code::kResourceExhausted,
-              {"lim.off: line 2", "limits"});
+              {"lim.off: line 2", "4 vertices exceed the limit of 3"});
+  // Which limit was crossed travels as data, for a server to name its own flag.
+  EXPECT_EQ(ExceededLimit(Parse(kTetraOff, "lim.off", limits).status()), Limit::kVertices);
   limits = ReadLimits();
   limits.max_faces = 1;
+  EXPECT_EQ(ExceededLimit(Parse(kTetraOff, "lim.off", limits).status()), Limit::kFaces);
   ExpectError(Parse("OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n4 0 1 2 3\n", "poly.off", limits),
               Code::kResourceExhausted, {"poly.off: line 7", "triangles"});
+  EXPECT_FALSE(ExceededLimit(Parse("OFF\n", "bad.off").status()).has_value());
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -428,7 +433,7 @@ TEST(PlyReaderTest, MalformedHeaderAndAsciiNamesFileAndLine) {
   ExpectError(Parse(ascii + "5\n", "more.ply"), kInvalid, {"more.ply: line 29", "'5'"});
   ReadLimits limits;
   limits.max_faces = 3;
-  ExpectError(Parse(ascii, "lim.ply", limits), Code::kResourceExhausted, {"lim.ply", "limits"});
+  ExpectError(Parse(ascii, "lim.ply", limits), Code::kResourceExhausted, {"lim.ply", "faces exceed the limit of 3"});
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -162,7 +162,10 @@ TEST_F(PersistenceTest, CorruptTruncatedAndForeignFilesAreSkippedAndTemporariesR
   EXPECT_TRUE(ReadField(*stub_, FieldRequest("meshes/good", {0})).status.ok());
   grpc::Status s = ReadField(*stub_, FieldRequest("meshes/flipped", {0})).status;
   EXPECT_EQ(s.error_code(), grpc::StatusCode::DATA_LOSS) << s.error_message();
-  EXPECT_NE(s.error_message().find(MeshFile(bad.mesh)), std::string::npos) << s.error_message();
+  // The message names the mesh, never the server's data directory.
+  EXPECT_NE(s.error_message().find(bad.mesh.name()), std::string::npos) << s.error_message();
+  EXPECT_EQ(s.error_message().find(dir_.string()), std::string::npos) << s.error_message();
+  EXPECT_EQ(s.error_message().find(".gdxs"), std::string::npos) << s.error_message();
   v1::Mesh got;
   EXPECT_EQ(GetMesh("meshes/cut", &got).error_code(), grpc::StatusCode::NOT_FOUND);
   // The skipped files are left in place for an operator to inspect.

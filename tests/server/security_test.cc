@@ -51,6 +51,14 @@ class SecurityTest : public testing::ServerFixture {
       options.tls_key_file = (dir_ / "key.pem").string();
     }
     if (tokens) options.auth_token_file = (dir_ / "tokens").string();
+    if (tokens && !tls) {
+      // Tokens in plaintext are refused unless a TLS-terminating proxy is declared.
+      auto refused = GeodexServer::Start(options);
+      ASSERT_EQ(refused.status().code(), absl::StatusCode::kInvalidArgument);
+      EXPECT_NE(refused.status().message().find("--allow_plaintext_tokens"), std::string::npos)
+          << refused.status();
+      options.allow_plaintext_tokens = true;
+    }
     auto server = GeodexServer::Start(options);
     ASSERT_TRUE(server.ok()) << server.status();
     server_ = *std::move(server);
@@ -137,6 +145,7 @@ TEST_F(SecurityTest, BadSecuritySettingsFailToStartWithAClearError) {
   tokens.listen = "127.0.0.1:0";
   std::ofstream(dir_ / "empty") << "# nothing\n\n";
   tokens.auth_token_file = (dir_ / "empty").string();
+  tokens.allow_plaintext_tokens = true;
   server = GeodexServer::Start(tokens);
   EXPECT_NE(server.status().message().find("no token"), std::string::npos) << server.status();
 }

@@ -9,6 +9,7 @@
 #include <cmath>
 
 #include "absl/strings/str_format.h"
+#include "geodex/limits.h"
 #include "ich/numerics.h"
 
 namespace geodex::ich {
@@ -466,7 +467,7 @@ absl::Status IchSolver::Run(const std::vector<ResolvedSource>& sources,
       }
     }
     if (options_.max_windows != 0 && stats_.windows_created > options_.max_windows) {
-      status = absl::ResourceExhaustedError(absl::StrFormat(
+      status = LimitExceededError(Limit::kWindows, absl::StrFormat(
           "window budget exceeded: %d windows created (limit %d); use a larger budget, a "
           "max_distance, or lambda > 0",
           stats_.windows_created, options_.max_windows));

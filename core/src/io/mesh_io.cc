@@ -1,6 +1,7 @@
 // Entry points of the mesh readers: load the file, gunzip when it carries the gzip magic, pick the
 // format from the extension or by sniffing the content, and hand the bytes to the format's reader.
 #include "geodex/mesh_io.h"
+#include "geodex/limits.h"
 
 #include <zlib.h>
 
@@ -115,7 +116,8 @@ absl::StatusOr<std::string> Gunzip(absl::string_view in, const std::string& name
   while (true) {
     if (produced == out.size()) {
       if (produced > max_bytes) {
-        status = absl::ResourceExhaustedError(
+        status = LimitExceededError(
+            Limit::kInputBytes,
             absl::StrCat(name, ": decompressed data exceeds the limit of ", max_bytes, " bytes"));
         break;
       }
@@ -248,7 +250,7 @@ absl::StatusOr<MeshData> ReadMeshFile(const std::string& path, const ReadLimits&
   if (std::fseek(f, 0, SEEK_END) == 0) {
     const long size = std::ftell(f);
     if (size >= 0 && static_cast<uint64_t>(size) > limits.max_decompressed_bytes) {
-      status = absl::ResourceExhaustedError(absl::StrCat(path, ": file size ", size,
+      status = LimitExceededError(Limit::kInputBytes, absl::StrCat(path, ": file size ", size,
                                                          " exceeds the limit of ",
                                                          limits.max_decompressed_bytes, " bytes"));
     } else if (size > 0) {
@@ -262,7 +264,7 @@ absl::StatusOr<MeshData> ReadMeshFile(const std::string& path, const ReadLimits&
     const size_t n = std::fread(buffer, 1, sizeof(buffer), f);
     bytes.append(buffer, n);
     if (bytes.size() > limits.max_decompressed_bytes) {
-      status = absl::ResourceExhaustedError(absl::StrCat(path, ": file exceeds the limit of ",
+      status = LimitExceededError(Limit::kInputBytes, absl::StrCat(path, ": file exceeds the limit of ",
                                                          limits.max_decompressed_bytes, " bytes"));
     }
     if (n < sizeof(buffer)) {

@@ -10,6 +10,7 @@
 #include "absl/strings/string_view.h"
 #include "absl/strings/strip.h"
 #include "geodex/mesh_data.h"
+#include "geodex/limits.h"
 #include "geodex/mesh_io.h"
 #include "io/io_util.h"
 
@@ -100,9 +101,13 @@ absl::StatusOr<MeshData> ReadOff(absl::string_view bytes, const std::string& nam
                                   left, " bytes follow"));
   }
   if (nv > MaxVertices(limits) || nf > limits.max_faces) {
-    return absl::ResourceExhaustedError(absl::StrCat(
-        name, ": line ", header_line, ": ", nv, " vertices and ", nf,
-        " faces exceed the limits of ", MaxVertices(limits), " and ", limits.max_faces));
+    return LimitExceededError(
+        nv > MaxVertices(limits) ? Limit::kVertices : Limit::kFaces,
+        nv > MaxVertices(limits)
+            ? absl::StrCat(name, ": line ", header_line, ": ", nv,
+                           " vertices exceed the limit of ", MaxVertices(limits))
+            : absl::StrCat(name, ": line ", header_line, ": ", nf, " faces exceed the limit of ",
+                           limits.max_faces));
   }
 
   MeshData mesh;
@@ -181,7 +186,7 @@ absl::StatusOr<MeshData> ReadOff(absl::string_view bytes, const std::string& nam
     }
     triangles += static_cast<uint64_t>(n - 2);
     if (triangles > limits.max_faces) {
-      return absl::ResourceExhaustedError(absl::StrCat(name, ": line ", lines.line_number(),
+      return LimitExceededError(Limit::kFaces, absl::StrCat(name, ": line ", lines.line_number(),
                                                        ": more than ", limits.max_faces,
                                                        " triangles after splitting polygons"));
     }

@@ -15,6 +15,7 @@
 #include "absl/strings/str_split.h"
 #include "absl/strings/string_view.h"
 #include "geodex/mesh_data.h"
+#include "geodex/limits.h"
 #include "geodex/mesh_io.h"
 #include "io/io_util.h"
 
@@ -322,7 +323,8 @@ absl::Status BodyReader::AddFace(const Element& e, uint64_t i, const Property& p
     polygon_.push_back(static_cast<uint32_t>(index));
   }
   if (mesh_->faces.size() / 3 + static_cast<uint64_t>(n - 2) > limits_.max_faces) {
-    return absl::ResourceExhaustedError(
+    return LimitExceededError(
+        Limit::kFaces,
         absl::StrCat(name_, ": ", Where(e, i), ": more than ", limits_.max_faces, " triangles"));
   }
   for (size_t k = 2; k < polygon_.size(); ++k) {  // fan triangulation, in order
@@ -441,9 +443,11 @@ absl::StatusOr<MeshData> ReadPly(absl::string_view bytes, const std::string& nam
   const uint64_t nv = vertex->count;
   const uint64_t nf = face ? face->count : 0;
   if (nv > MaxVertices(limits) || nf > limits.max_faces) {
-    return absl::ResourceExhaustedError(
-        absl::StrCat(name, ": ", nv, " vertices and ", nf, " faces exceed the limits of ",
-                     MaxVertices(limits), " and ", limits.max_faces));
+    return LimitExceededError(
+        nv > MaxVertices(limits) ? Limit::kVertices : Limit::kFaces,
+        nv > MaxVertices(limits)
+            ? absl::StrCat(name, ": ", nv, " vertices exceed the limit of ", MaxVertices(limits))
+            : absl::StrCat(name, ": ", nf, " faces exceed the limit of ", limits.max_faces));
   }
   MeshData mesh;
   mesh.positions.resize(3 * nv);

@@ -12,6 +12,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
 #include "geodex/mesh_data.h"
+#include "geodex/limits.h"
 #include "geodex/mesh_io.h"
 #include "io/io_util.h"
 
@@ -66,8 +67,8 @@ class Welder {
 };
 
 absl::Status TooManyVertices(const std::string& name, uint64_t limit) {
-  return absl::ResourceExhaustedError(
-      absl::StrCat(name, ": more than ", limit, " distinct vertices"));
+  return LimitExceededError(Limit::kVertices,
+                            absl::StrCat(name, ": more than ", limit, " distinct vertices"));
 }
 
 uint32_t LoadLe32(const char* p) {
@@ -94,7 +95,8 @@ absl::StatusOr<MeshData> ReadBinaryStl(absl::string_view bytes, const std::strin
                                   " triangles the header declares"));
   }
   if (n > limits.max_faces) {
-    return absl::ResourceExhaustedError(
+    return LimitExceededError(
+        Limit::kFaces,
         absl::StrCat(name, ": ", n, " triangles exceed the limit of ", limits.max_faces));
   }
   MeshData mesh;
@@ -194,8 +196,9 @@ absl::StatusOr<MeshData> ReadAsciiStl(absl::string_view bytes, const std::string
     }
     if (absl::Status s = expect("endfacet"); !s.ok()) return s;
     if (mesh.face_count() + polygon.size() - 2 > limits.max_faces) {
-      return absl::ResourceExhaustedError(absl::StrCat(
-          name, ": line ", tokens.line(), ": more than ", limits.max_faces, " triangles"));
+      return LimitExceededError(Limit::kFaces,
+                                absl::StrCat(name, ": line ", tokens.line(), ": more than ",
+                                             limits.max_faces, " triangles"));
     }
     for (size_t k = 2; k < polygon.size(); ++k) {  // fan triangulation, in order
       mesh.faces.insert(mesh.faces.end(), {polygon[0], polygon[k - 1], polygon[k]});

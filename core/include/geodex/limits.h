@@ -1,0 +1,26 @@
+#pragma once
+
+// Errors for crossing a limit the caller set (ReadLimits, GeodesicOptions::max_windows). The
+// status is ResourceExhausted and carries which limit as a payload, so that a server can name its
+// own flag for it without reading the message.
+
+#include <optional>
+
+#include "absl/status/status.h"
+#include "absl/strings/string_view.h"
+
+namespace geodex {
+
+enum class Limit {
+  kVertices,     // ReadLimits::max_vertices
+  kFaces,        // ReadLimits::max_faces
+  kInputBytes,   // ReadLimits::max_decompressed_bytes (file size, gzip expansion)
+  kWindows,      // GeodesicOptions::max_windows
+};
+
+absl::Status LimitExceededError(Limit limit, absl::string_view message);
+
+// The limit a status reports, if it came from LimitExceededError.
+std::optional<Limit> ExceededLimit(const absl::Status& status);
+
+}  // namespace geodex
