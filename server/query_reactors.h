@@ -82,6 +82,19 @@ enum class Lane {
   kSolve,   // the compute pool
 };
 
+// The token, then the parse: OK, or the status to finish the call with. On OK the call is
+// described for its log line.
+template <typename Request>
+grpc::Status AdmitCall(const ReactorEnv& env, grpc::CallbackServerContext* context,
+                       const grpc::ByteBuffer& bytes, Request* request) {
+  if (!env.auth->Allows(*context)) return UnauthenticatedStatus();
+  if (absl::Status parsed = ParseRequest(bytes, request, "request"); !parsed.ok()) {
+    return ToGrpcStatus(parsed);
+  }
+  if (env.descriptions != nullptr) env.descriptions->Describe(context, *request);
+  return grpc::Status::OK;
+}
+
 inline QueryEnv MakeQueryEnv(const ReactorEnv& env, const CancelToken* cancel, bool quick) {
   QueryEnv q{env.store, env.limits, cancel, env.cache, env.counters, env.pool};
   q.quick = quick;
@@ -98,16 +111,11 @@ class UnaryQueryReactor final : public grpc::ServerUnaryReactor {
                                          grpc::CallbackServerContext* context,
                                          const grpc::ByteBuffer* request, grpc::ByteBuffer* out) {
     auto* reactor = new UnaryQueryReactor(env, run, out);
-    if (!env.auth->Allows(*context)) {
-      reactor->Finish(UnauthenticatedStatus());
+    if (grpc::Status admitted = AdmitCall(env, context, *request, &reactor->request_);
+        !admitted.ok()) {
+      reactor->Finish(admitted);
       return reactor;
     }
-    if (absl::Status parsed = ParseRequest(*request, &reactor->request_, "request");
-        !parsed.ok()) {
-      reactor->Finish(ToGrpcStatus(parsed));
-      return reactor;
-    }
-    if (env.descriptions != nullptr) env.descriptions->Describe(context, reactor->request_);
     switch (lane) {
       case Lane::kInline:
         reactor->Compute(/*quick=*/false);
@@ -178,16 +186,11 @@ class StreamQueryReactor final : public grpc::ServerWriteReactor<grpc::ByteBuffe
                                                            grpc::CallbackServerContext* context,
                                                            const grpc::ByteBuffer* request) {
     auto* reactor = new StreamQueryReactor(env, run);
-    if (!env.auth->Allows(*context)) {
-      reactor->Finish(UnauthenticatedStatus());
+    if (grpc::Status admitted = AdmitCall(env, context, *request, &reactor->request_);
+        !admitted.ok()) {
+      reactor->Finish(admitted);
       return reactor;
     }
-    if (absl::Status parsed = ParseRequest(*request, &reactor->request_, "request");
-        !parsed.ok()) {
-      reactor->Finish(ToGrpcStatus(parsed));
-      return reactor;
-    }
-    if (env.descriptions != nullptr) env.descriptions->Describe(context, reactor->request_);
     if (lane == Lane::kQuick && env.quick_pool != nullptr) {
       reactor->Submit(env.quick_pool, /*quick=*/true);
     } else {

@@ -2,6 +2,7 @@
 // tests/data/io, binary files built here), gzip, format detection, malformed and hostile input
 // (the error must name the file and the position), and write/read round trips.
 #include "geodex/limits.h"
+#include "util/gzip.h"
 #include "geodex/mesh_io.h"
 
 #include <stdlib.h>
@@ -161,20 +162,7 @@ std::string TetraStl(const std::string& header_text = "binary tetra") {
   return b.data;
 }
 
-std::string Gzip(const std::string& in) {
-  z_stream zs;
-  std::memset(&zs, 0, sizeof(zs));
-  EXPECT_EQ(deflateInit2(&zs, 6, Z_DEFLATED, 16 + MAX_WBITS, 8, Z_DEFAULT_STRATEGY), Z_OK);
-  std::string out(deflateBound(&zs, in.size()), '\0');
-  zs.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(in.data()));
-  zs.avail_in = static_cast<uInt>(in.size());
-  zs.next_out = reinterpret_cast<Bytef*>(out.data());
-  zs.avail_out = static_cast<uInt>(out.size());
-  EXPECT_EQ(deflate(&zs, Z_FINISH), Z_STREAM_END);
-  out.resize(zs.total_out);
-  deflateEnd(&zs);
-  return out;
-}
+using testing_support::Gzip;
 
 std::string ReadText(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

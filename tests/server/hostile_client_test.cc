@@ -2,8 +2,6 @@
 // stub could not send them (issue 17; docs/reliability.md lists the cases). Each test is one of
 // the failures reported against the proto by an independent client.
 
-#include <zlib.h>
-
 #include <filesystem>
 #include <fstream>
 #include <future>
@@ -18,6 +16,7 @@
 #include "grpcpp/support/byte_buffer.h"
 #include "listen_address.h"
 #include "server_test_util.h"
+#include "util/gzip.h"
 
 namespace geodex::server {
 namespace {
@@ -28,58 +27,8 @@ using testing::In;
 using testing::ReadField;
 using testing::Upload;
 
-struct RawResult {
-  grpc::Status status;
-  std::vector<std::string> replies;
-};
-
-// One call of `method` through the generic stub (every gRPC call is a stream on the wire): sends
-// each of `messages` as raw bytes, half-closes, reads every reply.
-RawResult RawCall(const std::shared_ptr<grpc::Channel>& channel, const std::string& method,
-                  const std::vector<std::string>& messages, const std::string& token = "") {
-  grpc::GenericStub stub(channel);
-  grpc::CompletionQueue cq;
-  grpc::ClientContext context;
-  context.set_deadline(In(60));
-  if (!token.empty()) context.AddMetadata("authorization", "Bearer " + token);
-  auto call = stub.PrepareCall(&context, method, &cq);
-  auto wait = [&](intptr_t tag) {
-    void* got = nullptr;
-    bool ok = false;
-    EXPECT_EQ(cq.AsyncNext(&got, &ok, In(60)), grpc::CompletionQueue::GOT_EVENT);
-    EXPECT_EQ(got, reinterpret_cast<void*>(tag));
-    return ok;
-  };
-  call->StartCall(reinterpret_cast<void*>(1));
-  wait(1);
-  for (const std::string& message : messages) {
-    grpc::Slice slice(message);
-    grpc::ByteBuffer buffer(&slice, 1);
-    call->Write(buffer, reinterpret_cast<void*>(2));
-    if (!wait(2)) break;  // the server already ended the call
-  }
-  call->WritesDone(reinterpret_cast<void*>(3));
-  wait(3);
-  RawResult result;
-  for (;;) {
-    grpc::ByteBuffer out;
-    call->Read(&out, reinterpret_cast<void*>(4));
-    if (!wait(4)) break;
-    std::vector<grpc::Slice> slices;
-    EXPECT_TRUE(out.Dump(&slices).ok());
-    std::string reply;
-    for (const auto& s : slices) reply.append(reinterpret_cast<const char*>(s.begin()), s.size());
-    result.replies.push_back(reply);
-  }
-  call->Finish(&result.status, reinterpret_cast<void*>(5));
-  wait(5);
-  cq.Shutdown();
-  void* tag;
-  bool ok;
-  while (cq.Next(&tag, &ok)) {
-  }
-  return result;
-}
+using testing::RawCall;
+using testing::RawResult;
 
 std::string Metadata(const std::string& name, uint64_t total_bytes = 0,
                      v1::MeshFormat format = v1::MESH_FORMAT_OFF) {
@@ -173,20 +122,7 @@ TEST_F(HostileClientTest, CorruptUploadStreamStoresNothing) {
   EXPECT_EQ(StoredMeshes(), 1u);
 }
 
-std::string Gzip(const std::string& bytes) {
-  uLongf size = compressBound(bytes.size()) + 64;
-  std::string out(size, '\0');
-  z_stream zs{};
-  EXPECT_EQ(deflateInit2(&zs, 9, Z_DEFLATED, 16 + MAX_WBITS, 9, Z_DEFAULT_STRATEGY), Z_OK);
-  zs.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(bytes.data()));
-  zs.avail_in = static_cast<uInt>(bytes.size());
-  zs.next_out = reinterpret_cast<Bytef*>(out.data());
-  zs.avail_out = static_cast<uInt>(out.size());
-  EXPECT_EQ(deflate(&zs, Z_FINISH), Z_STREAM_END);
-  out.resize(zs.total_out);
-  deflateEnd(&zs);
-  return out;
-}
+using testing_support::Gzip;
 
 // 2. A gzip upload inflates at most to --max_upload_bytes.
 TEST_F(HostileClientTest, GzipBombIsBoundedByTheUploadLimit) {

@@ -64,49 +64,14 @@ TEST_F(LifecycleTest, ErrorsCarryBadRequestAndErrorInfoDetails) {
   EXPECT_TRUE(s.error_details().empty());
 }
 
-// One exchange on grpc.reflection.v1alpha.ServerReflection/ServerReflectionInfo (a bidi stream)
-// through the generic stub; the request and response are raw protobuf bytes.
+// One exchange on grpc.reflection.v1alpha.ServerReflection/ServerReflectionInfo (a bidi stream);
+// the request and response are raw protobuf bytes.
 std::string ReflectionExchange(const std::shared_ptr<grpc::Channel>& channel,
                                const std::string& request) {
-  grpc::GenericStub stub(channel);
-  grpc::CompletionQueue cq;
-  grpc::ClientContext context;
-  context.set_deadline(In(30));
-  auto call =
-      stub.PrepareCall(&context, "/grpc.reflection.v1alpha.ServerReflection/ServerReflectionInfo",
-                       &cq);
-  auto wait = [&](intptr_t tag) {
-    void* got = nullptr;
-    bool ok = false;
-    EXPECT_EQ(cq.AsyncNext(&got, &ok, In(30)), grpc::CompletionQueue::GOT_EVENT);
-    EXPECT_EQ(got, reinterpret_cast<void*>(tag));
-    return ok;
-  };
-  call->StartCall(reinterpret_cast<void*>(1));
-  EXPECT_TRUE(wait(1));
-  grpc::Slice slice(request);
-  grpc::ByteBuffer in(&slice, 1), out;
-  call->Write(in, reinterpret_cast<void*>(2));
-  EXPECT_TRUE(wait(2));
-  call->WritesDone(reinterpret_cast<void*>(3));
-  EXPECT_TRUE(wait(3));
-  call->Read(&out, reinterpret_cast<void*>(4));
-  std::string reply;
-  if (wait(4)) {
-    std::vector<grpc::Slice> slices;
-    EXPECT_TRUE(out.Dump(&slices).ok());
-    for (const auto& s : slices) reply.append(reinterpret_cast<const char*>(s.begin()), s.size());
-  }
-  grpc::Status status;
-  call->Finish(&status, reinterpret_cast<void*>(5));
-  EXPECT_TRUE(wait(5));
-  EXPECT_TRUE(status.ok()) << status.error_message();
-  cq.Shutdown();
-  void* tag;
-  bool ok;
-  while (cq.Next(&tag, &ok)) {
-  }
-  return reply;
+  testing::RawResult r = testing::RawCall(
+      channel, "/grpc.reflection.v1alpha.ServerReflection/ServerReflectionInfo", {request});
+  EXPECT_TRUE(r.status.ok()) << r.status.error_message();
+  return r.replies.empty() ? std::string() : r.replies.front();
 }
 
 TEST_F(LifecycleTest, ReflectionListsTheServiceAndDescribesItsMethods) {

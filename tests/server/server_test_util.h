@@ -18,6 +18,8 @@
 #include "geodex/v1/geodex.grpc.pb.h"
 #include "geodex_server.h"
 #include "grpcpp/create_channel.h"
+#include "grpcpp/generic/generic_stub.h"
+#include "grpcpp/support/byte_buffer.h"
 #include "grpcpp/security/credentials.h"
 #include "gtest/gtest.h"
 
@@ -147,6 +149,59 @@ inline v1::ComputeDistanceFieldRequest FieldRequest(const std::string& mesh_name
   request.set_mesh(mesh_name);
   for (uint32_t v : vertices) request.add_sources()->set_vertex(v);
   return request;
+}
+
+struct RawResult {
+  grpc::Status status;
+  std::vector<std::string> replies;
+};
+
+// One call of `method` through the generic stub (every gRPC call is a stream on the wire): sends
+// each of `messages` as raw bytes, half-closes, reads every reply.
+inline RawResult RawCall(const std::shared_ptr<grpc::Channel>& channel, const std::string& method,
+                  const std::vector<std::string>& messages, const std::string& token = "") {
+  grpc::GenericStub stub(channel);
+  grpc::CompletionQueue cq;
+  grpc::ClientContext context;
+  context.set_deadline(In(60));
+  if (!token.empty()) context.AddMetadata("authorization", "Bearer " + token);
+  auto call = stub.PrepareCall(&context, method, &cq);
+  auto wait = [&](intptr_t tag) {
+    void* got = nullptr;
+    bool ok = false;
+    EXPECT_EQ(cq.AsyncNext(&got, &ok, In(60)), grpc::CompletionQueue::GOT_EVENT);
+    EXPECT_EQ(got, reinterpret_cast<void*>(tag));
+    return ok;
+  };
+  call->StartCall(reinterpret_cast<void*>(1));
+  wait(1);
+  for (const std::string& message : messages) {
+    grpc::Slice slice(message);
+    grpc::ByteBuffer buffer(&slice, 1);
+    call->Write(buffer, reinterpret_cast<void*>(2));
+    if (!wait(2)) break;  // the server already ended the call
+  }
+  call->WritesDone(reinterpret_cast<void*>(3));
+  wait(3);
+  RawResult result;
+  for (;;) {
+    grpc::ByteBuffer out;
+    call->Read(&out, reinterpret_cast<void*>(4));
+    if (!wait(4)) break;
+    std::vector<grpc::Slice> slices;
+    EXPECT_TRUE(out.Dump(&slices).ok());
+    std::string reply;
+    for (const auto& s : slices) reply.append(reinterpret_cast<const char*>(s.begin()), s.size());
+    result.replies.push_back(reply);
+  }
+  call->Finish(&result.status, reinterpret_cast<void*>(5));
+  wait(5);
+  cq.Shutdown();
+  void* tag;
+  bool ok;
+  while (cq.Next(&tag, &ok)) {
+  }
+  return result;
 }
 
 // An in-process server on 127.0.0.1:0 and a stub with default client limits.
