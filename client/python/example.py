@@ -21,6 +21,8 @@ def main():
           "windows:", stats.windows_created)
     length, points = client.shortest_path(mesh.name, vertex(0), vertex(n - 1))
     print("path: length", length, "with", len(points), "points")
+    rows = client.distance_matrix(mesh.name, [vertex(0), vertex(5)], [vertex(7), vertex(99)])
+    print("matrix:", rows)
     areas, boundaries = client.voronoi(mesh.name, [vertex(0), vertex(n // 3), vertex(2 * n // 3)])
     print("voronoi:", {site: round(area, 6) for site, area in areas.items()},
           len(boundaries), "boundaries")

@@ -7,6 +7,8 @@ build/python; put that directory on PYTHONPATH (see client/python/README.md).
     mesh = client.upload("tests/data/kitten.off", name="kitten")
     field = client.distance_field(mesh.name, [vertex(0)])
     path = client.shortest_path(mesh.name, vertex(0), vertex(1250))
+    rows = client.distance_matrix(mesh.name, [vertex(0), vertex(5)], [vertex(7), vertex(99)],
+                                  k_nearest=1, max_distance=40.0)
     cells, boundaries = client.voronoi(mesh.name, [vertex(0), vertex(1250)])
 """
 import os
@@ -97,6 +99,26 @@ class GeodexClient:
             timeout=self.timeout, metadata=self._metadata(mesh))
         points = [(p.position.x, p.position.y, p.position.z) for p in response.points]
         return response.distance, points
+
+    def distance_matrix(self, mesh, sources, targets, k_nearest=0, **options):
+        """Exact distances, one row per source: [[d(source, target), ...], ...]. `k_nearest`
+        keeps only each source's k nearest targets (the rest are inf); `options` are
+        SolverOptions fields (lambda_, max_distance, ...; lambda is spelled `lambda_` here or
+        passed as options={"lambda": x})."""
+        solver = dict(options.pop("options", {}))
+        if "lambda_" in options:
+            solver["lambda"] = options.pop("lambda_")
+        solver.update(options)
+        request = pb.ComputeDistanceMatrixRequest(
+            mesh=mesh, sources=sources, targets=targets, k_nearest=k_nearest,
+            options=pb.SolverOptions(**solver))
+        values, rows, cols = [], 0, 0
+        for chunk in self.stub.ComputeDistanceMatrix(request, timeout=self.timeout,
+                                                     metadata=self._metadata(mesh)):
+            assert chunk.offset == len(values)
+            rows, cols = chunk.rows, chunk.cols
+            values.extend(chunk.values_f64)
+        return [values[r * cols:(r + 1) * cols] for r in range(rows)]
 
     def voronoi(self, mesh, sites):
         """The approximate Voronoi diagram: ({site: area}, [(site_a, site_b, [(x, y, z), ...])]),

@@ -12,6 +12,8 @@ import tempfile
 import time
 import unittest
 
+import grpc
+
 from geodex_client import GeodexClient, face_point, vertex
 
 GEODEX, GEODEXD, DATA = os.environ["GEODEX"], os.environ["GEODEXD"], os.environ["DATA"]
@@ -78,6 +80,29 @@ class PythonClientTest(unittest.TestCase):
         self.assertEqual(length, float(lines[0]))
         self.assertEqual(len(points), len(lines) - 1)
         self.assertEqual(points[-1], tuple(float(x) for x in lines[-1].split()[:3]))
+
+    def test_matrix_equals_the_cli_with_k_nearest_and_max_distance(self):
+        sources, targets = [0, 5, 1250], [7, 100, 2000, 2400]
+        full = self.client.distance_matrix(self.mesh.name, [vertex(v) for v in sources],
+                                           [vertex(v) for v in targets])
+        lines = self.local("matrix", os.path.join(DATA, "kitten.off"), "--sources",
+                           ",".join(map(str, sources)), "--targets",
+                           ",".join(map(str, targets))).splitlines()
+        self.assertEqual(full, [[float(x) for x in line.split()] for line in lines])  # bit for bit
+        nearest = self.client.distance_matrix(self.mesh.name, [vertex(v) for v in sources],
+                                              [vertex(v) for v in targets], k_nearest=2)
+        for row, kept in zip(full, nearest):
+            finite = sorted(d for d in kept if d != float("inf"))
+            self.assertEqual(finite, sorted(row)[:2])  # the two nearest, exact
+        limit = sum(sorted(full[0])[1:3]) / 2  # between two entries: no ties at the limit
+        capped = self.client.distance_matrix(self.mesh.name, [vertex(v) for v in sources],
+                                             [vertex(v) for v in targets], max_distance=limit)
+        for row, cut in zip(full, capped):
+            self.assertEqual(cut, [d if d < limit else float("inf") for d in row])
+        with self.assertRaises(grpc.RpcError) as error:
+            self.client.distance_matrix(self.mesh.name, [vertex(0)], [vertex(7)], lambda_=2.0)
+        self.assertEqual(error.exception.code(), grpc.StatusCode.INVALID_ARGUMENT)
+        self.assertIn("options.lambda", error.exception.details())
 
     def test_voronoi(self):
         sites = [vertex(0), vertex(800), vertex(1600), vertex(2400)]
