@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <string>
 #include <utility>
@@ -430,9 +431,87 @@ absl::StatusOr<MessageProducer<v1::ComputeDistanceFieldResponse>> RunComputeDist
       });
 }
 
+namespace {
+
+// The rows of a matrix: from cached full fields where possible (see RunComputeDistanceMatrix),
+// the rest solved in one engine call. `*cached` is true when nothing was solved.
+absl::StatusOr<DistanceMatrix> SolveMatrixRows(const QueryEnv& env, const StoredMesh& mesh,
+                                               const std::vector<SurfacePoint>& sources,
+                                               const std::vector<SurfacePoint>& targets,
+                                               const GeodesicOptions& solver, uint32_t k_nearest,
+                                               bool symmetric, bool* cached) {
+  DistanceMatrix out;
+  out.rows = sources.size();
+  out.cols = targets.size();
+  out.values.assign(out.rows * out.cols, std::numeric_limits<double>::infinity());
+  std::vector<size_t> missing;
+  const bool vertex_targets =
+      std::all_of(targets.begin(), targets.end(),
+                  [](const SurfacePoint& p) { return p.kind == SurfacePoint::Kind::kVertex; });
+  for (size_t r = 0; r < sources.size(); ++r) {
+    std::shared_ptr<const DistanceField> field;
+    if (vertex_targets && !symmetric && env.cache->enabled()) {
+      field = env.cache->Find(FieldCacheKey(mesh.id, {sources[r]}, solver));
+    }
+    if (field == nullptr) {
+      missing.push_back(r);
+      continue;
+    }
+    double* row = &out.values[r * out.cols];
+    for (size_t c = 0; c < targets.size(); ++c) row[c] = field->distance[targets[c].vertex];
+    if (k_nearest > 0 && k_nearest < targets.size()) {
+      // The k nearest (ties: the lower target index) keep their values, as the engine's rows do.
+      std::vector<size_t> order(targets.size());
+      for (size_t c = 0; c < order.size(); ++c) order[c] = c;
+      std::nth_element(order.begin(), order.begin() + k_nearest, order.end(),
+                       [row](size_t a, size_t b) { return row[a] < row[b] || (row[a] == row[b] && a < b); });
+      std::vector<bool> keep(targets.size(), false);
+      for (size_t i = 0; i < k_nearest; ++i) keep[order[i]] = true;
+      for (size_t c = 0; c < targets.size(); ++c) {
+        if (!keep[c]) row[c] = std::numeric_limits<double>::infinity();
+      }
+    }
+  }
+  *cached = missing.empty();
+  if (missing.empty()) return out;
+
+  std::vector<SurfacePoint> rest;
+  rest.reserve(missing.size());
+  for (size_t r : missing) rest.push_back(sources[r]);
+  MatrixOptions matrix_options;
+  matrix_options.solver = solver;
+  matrix_options.k_nearest = k_nearest;
+  if (env.pool != nullptr) {
+    // Rows beyond the calling worker's go to the shared pool, behind work already queued; a
+    // refused helper (queue full) only means fewer rows at once.
+    ComputePool* pool = env.pool;
+    matrix_options.threads = static_cast<unsigned>(pool->threads());
+    matrix_options.spawn = [pool](std::function<void()> helper) {
+      pool->TrySubmit(std::move(helper));
+    };
+  } else {
+    matrix_options.threads = 1;
+  }
+  absl::StatusOr<DistanceMatrix> matrix =
+      ComputeDistanceMatrix(*mesh.mesh, missing.size() == sources.size() ? sources : rest,
+                            targets, matrix_options);
+  if (!matrix.ok()) return NameSolveError(matrix.status(), "sources/targets");
+  env.counters->solves.fetch_add(1, std::memory_order_relaxed);
+  env.counters->windows_processed.fetch_add(matrix->stats.windows_processed,
+                                            std::memory_order_relaxed);
+  if (missing.size() == sources.size()) return *std::move(matrix);
+  for (size_t i = 0; i < missing.size(); ++i) {
+    std::copy_n(matrix->values.begin() + i * out.cols, out.cols,
+                out.values.begin() + missing[i] * out.cols);
+  }
+  out.stats = matrix->stats;
+  return out;
+}
+
+}  // namespace
+
 absl::StatusOr<MessageProducer<v1::ComputeDistanceMatrixResponse>> RunComputeDistanceMatrix(
     const QueryEnv& env, const v1::ComputeDistanceMatrixRequest& request) {
-  if (env.quick) return SolveLaneNeeded();  // every row is a solve
   if (!v1::ValueType_IsValid(request.value_type())) {
     return absl::InvalidArgumentError(
         absl::StrCat("value_type: unknown value ", request.value_type()));
@@ -454,34 +533,42 @@ absl::StatusOr<MessageProducer<v1::ComputeDistanceMatrixResponse>> RunComputeDis
   }
   absl::StatusOr<GeodesicOptions> solver = Options(env, request.options());
   if (!solver.ok()) return solver.status();
-  MatrixOptions matrix_options;
-  matrix_options.solver = *solver;
-  matrix_options.k_nearest = request.k_nearest();
-  if (env.pool != nullptr) {
-    // Rows beyond the calling worker's go to the shared pool, behind work already queued; a
-    // refused helper (queue full) only means fewer rows at once.
-    ComputePool* pool = env.pool;
-    matrix_options.threads = static_cast<unsigned>(pool->threads());
-    matrix_options.spawn = [pool](std::function<void()> helper) {
-      pool->TrySubmit(std::move(helper));
-    };
-  } else {
-    matrix_options.threads = 1;
-  }
-  absl::StatusOr<DistanceMatrix> matrix =
-      ComputeDistanceMatrix(*(*mesh)->mesh, *sources, *targets, matrix_options);
-  if (!matrix.ok()) return NameSolveError(matrix.status(), "sources/targets");
-  env.counters->solves.fetch_add(1, std::memory_order_relaxed);
-  env.counters->windows_processed.fetch_add(matrix->stats.windows_processed,
-                                            std::memory_order_relaxed);
 
-  auto state = std::make_shared<DistanceMatrix>(*std::move(matrix));
+  // Reuse (issue 19): a repeated matrix is one cache entry (values as a DistanceField); otherwise
+  // rows whose source has a full field in the cache are read from it when every target is a
+  // vertex (not for symmetric requests, whose pairs the engine solves once and mirrors), and only
+  // the other rows are solved.
+  const std::string sources_key = FieldCacheKey((*mesh)->id, *sources, *solver);
+  const std::string targets_key = FieldCacheKey("", *targets, *solver);
+  const std::string matrix_key =
+      absl::StrCat(sources_key, "|matrix|", targets_key, "|k", request.k_nearest());
+  std::shared_ptr<const DistanceField> cached_matrix = env.cache->Find(matrix_key);
+  if (cached_matrix == nullptr && env.quick) return SolveLaneNeeded();
+  DistanceMatrix assembled;
+  bool cached = cached_matrix != nullptr;
+  if (cached) {
+    assembled.rows = sources->size();
+    assembled.cols = targets->size();
+    assembled.values = cached_matrix->distance;
+    assembled.stats = cached_matrix->stats;
+  } else {
+    const bool symmetric = sources_key == FieldCacheKey((*mesh)->id, *targets, *solver);
+    absl::StatusOr<DistanceMatrix> solved = SolveMatrixRows(
+        env, **mesh, *sources, *targets, *solver, request.k_nearest(), symmetric, &cached);
+    if (!solved.ok()) return solved.status();
+    assembled = *std::move(solved);
+    auto entry = std::make_shared<DistanceField>();
+    entry->distance = assembled.values;
+    entry->stats = assembled.stats;
+    env.cache->Insert(matrix_key, std::move(entry));
+  }
+  auto state = std::make_shared<DistanceMatrix>(std::move(assembled));
   auto next = std::make_shared<size_t>(0);
   const bool f32 = request.value_type() == v1::VALUE_TYPE_FLOAT32;
   const bool want_stats = request.want_stats();
   const size_t chunk = std::max<size_t>(1, env.limits->stream_chunk_bytes / (f32 ? 4 : 8));
   return MessageProducer<v1::ComputeDistanceMatrixResponse>(
-      [state, next, f32, want_stats, chunk](v1::ComputeDistanceMatrixResponse* out) {
+      [state, next, f32, want_stats, chunk, cached](v1::ComputeDistanceMatrixResponse* out) {
         const size_t n = state->values.size();
         // Always one message, even for an empty result, so rows/cols arrive.
         if (*next >= n && (n > 0 || *next > 0)) return false;
@@ -496,11 +583,16 @@ absl::StatusOr<MessageProducer<v1::ComputeDistanceMatrixResponse>> RunComputeDis
           out->mutable_values_f64()->Add(state->values.begin() + begin,
                                          state->values.begin() + end);
         }
-        if (end == n && want_stats) StatsToProto(state->stats, out->mutable_stats());
+        if (end == n && want_stats) {
+          StatsToProto(state->stats, out->mutable_stats());
+          out->mutable_stats()->set_cached(cached);
+        }
         *next = std::max(end, begin + 1);
         return true;
       });
 }
+
+
 
 absl::StatusOr<MessageProducer<v1::ComputeIsolinesResponse>> RunComputeIsolines(
     const QueryEnv& env, const v1::ComputeIsolinesRequest& request) {

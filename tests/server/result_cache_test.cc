@@ -1,6 +1,8 @@
 // The result cache: repeated fields, and paths from one source to many goals, reuse one solve.
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "geodex/shortest_path.h"
 #include "server_test_util.h"
@@ -107,6 +109,100 @@ TEST_F(ResultCacheTest, ZeroBudgetDisablesTheCache) {
   for (int i = 0; i < 3; ++i) EXPECT_FALSE(Path(*stub_, 5, 90).stats().cached());
   EXPECT_EQ(server_->cache().entries(), 0u);
   EXPECT_EQ(server_->service().counters().solves.load(), 5u);
+}
+
+// Reads a whole matrix (values and stats) from ComputeDistanceMatrix.
+struct MatrixResult {
+  grpc::Status status;
+  std::vector<double> values;
+  v1::SolveStats stats;
+};
+MatrixResult ReadMatrix(v1::Geodex::Stub& stub, const std::vector<uint32_t>& sources,
+                        const std::vector<uint32_t>& targets, uint32_t k_nearest = 0) {
+  v1::ComputeDistanceMatrixRequest request;
+  request.set_mesh("meshes/hills");
+  for (uint32_t v : sources) request.add_sources()->set_vertex(v);
+  for (uint32_t v : targets) request.add_targets()->set_vertex(v);
+  request.set_k_nearest(k_nearest);
+  request.set_want_stats(true);
+  grpc::ClientContext context;
+  context.set_deadline(In(60));
+  auto reader = stub.ComputeDistanceMatrix(&context, request);
+  MatrixResult out;
+  v1::ComputeDistanceMatrixResponse response;
+  while (reader->Read(&response)) {
+    out.values.insert(out.values.end(), response.values_f64().begin(), response.values_f64().end());
+    if (response.has_stats()) out.stats = response.stats();
+  }
+  out.status = reader->Finish();
+  return out;
+}
+
+TEST_F(ResultCacheTest, RepeatedMatrixAndRowsFromCachedFieldsAreNotSolvedAgain) {
+  StartServer();
+  ASSERT_TRUE(Upload(*stub_, GridOff(20, 20, true), "hills").status.ok());
+  const std::vector<uint32_t> sources = {3, 150, 400}, targets = {0, 77, 210, 440, 299};
+  MatrixResult first = ReadMatrix(*stub_, sources, targets);
+  ASSERT_TRUE(first.status.ok()) << first.status.error_message();
+  EXPECT_FALSE(first.stats.cached());
+  const uint64_t solves = server_->service().counters().solves.load();
+  MatrixResult again = ReadMatrix(*stub_, sources, targets);
+  ASSERT_TRUE(again.status.ok());
+  EXPECT_TRUE(again.stats.cached());
+  EXPECT_EQ(again.values, first.values);  // the same entry, bit for bit
+  EXPECT_EQ(server_->service().counters().solves.load(), solves);
+
+  // Fields of two of the sources are cached: a new matrix from them reads those rows and solves
+  // only the third; with all three cached it solves nothing. The k_nearest rows keep exactly the
+  // k smallest.
+  std::vector<std::vector<double>> fields;
+  for (uint32_t s : sources) {
+    testing::FieldResult f = ReadField(*stub_, FieldRequest("meshes/hills", {s}));
+    ASSERT_TRUE(f.status.ok());
+    fields.push_back(f.distances);
+  }
+  const std::vector<uint32_t> other_targets = {1, 78, 211, 439};
+  const uint64_t before = server_->service().counters().solves.load();
+  MatrixResult from_fields = ReadMatrix(*stub_, sources, other_targets);
+  ASSERT_TRUE(from_fields.status.ok()) << from_fields.status.error_message();
+  EXPECT_TRUE(from_fields.stats.cached());
+  EXPECT_EQ(server_->service().counters().solves.load(), before);
+  for (size_t r = 0; r < sources.size(); ++r) {
+    for (size_t c = 0; c < other_targets.size(); ++c) {
+      EXPECT_EQ(from_fields.values[r * other_targets.size() + c], fields[r][other_targets[c]]);
+    }
+  }
+  // The first matrix's rows were solved (targeted); read from the fields they agree to 1e-12.
+  MatrixResult reread = ReadMatrix(*stub_, sources, {0, 77, 210, 440});
+  ASSERT_TRUE(reread.status.ok());
+  for (size_t r = 0; r < sources.size(); ++r) {
+    for (size_t c = 0; c < 4; ++c) {
+      const double solved = first.values[r * targets.size() + c];
+      EXPECT_NEAR(reread.values[r * 4 + c], solved, 1e-12 * std::max(1.0, solved));
+    }
+  }
+  MatrixResult nearest = ReadMatrix(*stub_, sources, other_targets, 2);
+  ASSERT_TRUE(nearest.status.ok());
+  for (size_t r = 0; r < sources.size(); ++r) {
+    std::vector<double> row(from_fields.values.begin() + r * 4, from_fields.values.begin() + r * 4 + 4);
+    std::vector<double> kept;
+    for (size_t c = 0; c < 4; ++c) {
+      if (!std::isinf(nearest.values[r * 4 + c])) kept.push_back(nearest.values[r * 4 + c]);
+    }
+    std::sort(row.begin(), row.end());
+    std::sort(kept.begin(), kept.end());
+    EXPECT_EQ(kept, std::vector<double>(row.begin(), row.begin() + 2));
+  }
+  // A mixed request: one source without a cached field is solved, the others are read.
+  MatrixResult mixed = ReadMatrix(*stub_, {3, 5, 400}, other_targets);
+  ASSERT_TRUE(mixed.status.ok());
+  EXPECT_FALSE(mixed.stats.cached());
+  MatrixResult solved_row = ReadMatrix(*stub_, {5}, other_targets);
+  for (size_t c = 0; c < other_targets.size(); ++c) {
+    EXPECT_EQ(mixed.values[c], fields[0][other_targets[c]]);
+    EXPECT_EQ(mixed.values[4 + c], solved_row.values[c]);
+    EXPECT_EQ(mixed.values[8 + c], fields[2][other_targets[c]]);
+  }
 }
 
 }  // namespace
