@@ -319,6 +319,9 @@ const std::vector<MethodRow>& MethodTable() {
                &RunComputeDistanceField>},
       {{"FindShortestPath", Lane::kQuick},
        &Unary<v1::FindShortestPathRequest, v1::FindShortestPathResponse, &RunFindShortestPath>},
+      {{"FindShortestPaths", Lane::kSolve},
+       &Unary<v1::FindShortestPathsRequest, v1::FindShortestPathsResponse,
+              &RunFindShortestPaths>},
       {{"ComputeDistanceMatrix", Lane::kQuick},  // a repeated matrix is a cache hit
        &Stream<v1::ComputeDistanceMatrixRequest, v1::ComputeDistanceMatrixResponse,
                &RunComputeDistanceMatrix>},

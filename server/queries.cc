@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <limits>
 #include <memory>
 #include <string>
@@ -287,6 +288,64 @@ absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPath
   for (const PathPoint& p : result->path.points) PathPointToProto(p, response->add_points());
   if (request.want_stats()) StatsToProto(result->stats, response->mutable_stats());
   return CheckUnaryResponseSize(env, *response, "paths");
+}
+
+absl::Status RunFindShortestPaths(const QueryEnv& env, const v1::FindShortestPathsRequest& request,
+                                  v1::FindShortestPathsResponse* response) {
+  if (env.quick) return SolveLaneNeeded();
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh = LookupMesh(env, request.mesh(), "mesh");
+  if (!mesh.ok()) return mesh.status();
+  if (request.pairs().empty()) {
+    return absl::InvalidArgumentError("pairs: at least one pair is required");
+  }
+  if (static_cast<uint64_t>(request.pairs_size()) > env.limits->max_targets) {
+    return absl::ResourceExhaustedError(absl::StrCat(
+        "pairs: ", request.pairs_size(), " pairs, over --max_targets=", env.limits->max_targets));
+  }
+  absl::StatusOr<GeodesicOptions> solver = Options(env, request.options());
+  if (!solver.ok()) return solver.status();
+  // Group the pairs by their source point (bit for bit), in order of first appearance.
+  std::vector<SurfacePoint> froms, tos;
+  std::map<std::string, size_t> group_of;
+  std::vector<std::vector<size_t>> groups;
+  for (int i = 0; i < request.pairs_size(); ++i) {
+    const std::string field = absl::StrCat("pairs[", i, "]");
+    absl::StatusOr<SurfacePoint> from = ResolvePoint(**mesh, request.pairs(i).from(), field + ".from");
+    if (!from.ok()) return from.status();
+    absl::StatusOr<SurfacePoint> to = ResolvePoint(**mesh, request.pairs(i).to(), field + ".to");
+    if (!to.ok()) return to.status();
+    const std::string key = FieldCacheKey("", {*from}, *solver);
+    auto [it, fresh] = group_of.emplace(key, groups.size());
+    if (fresh) {
+      groups.emplace_back();
+      froms.push_back(*from);
+    }
+    groups[it->second].push_back(static_cast<size_t>(i));
+    tos.push_back(*to);
+    response->add_paths();
+  }
+  PathQueryOptions options;
+  options.solver = *solver;
+  SolveStats total;
+  for (size_t g = 0; g < groups.size(); ++g) {
+    std::vector<SurfacePoint> targets;
+    for (size_t i : groups[g]) targets.push_back(tos[i]);
+    absl::StatusOr<PathsQueryResult> result =
+        ComputeShortestPaths(*(*mesh)->mesh, froms[g], targets, options);
+    if (!result.ok()) return NameSolveError(result.status(), "pairs");
+    env.counters->solves.fetch_add(1, std::memory_order_relaxed);
+    env.counters->windows_processed.fetch_add(result->stats.windows_processed,
+                                              std::memory_order_relaxed);
+    AddSolveStats(result->stats, &total);
+    for (size_t k = 0; k < groups[g].size(); ++k) {
+      v1::FindShortestPathResponse* out = response->mutable_paths(static_cast<int>(groups[g][k]));
+      out->set_distance(result->distance[k]);
+      for (const PathPoint& p : result->paths[k].points) PathPointToProto(p, out->add_points());
+    }
+  }
+  response->set_solves(static_cast<uint32_t>(groups.size()));
+  if (request.want_stats()) StatsToProto(total, response->mutable_stats());
+  return CheckUnaryResponseSize(env, *response, "pairs");
 }
 
 absl::Status RunEstimateDistances(const QueryEnv& env, const v1::EstimateDistancesRequest& request,

@@ -56,6 +56,8 @@ absl::Status RunDeleteMesh(const QueryEnv& env, const v1::DeleteMeshRequest& req
 // Unary queries.
 absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPathRequest& request,
                                  v1::FindShortestPathResponse* response);
+absl::Status RunFindShortestPaths(const QueryEnv& env, const v1::FindShortestPathsRequest& request,
+                                  v1::FindShortestPathsResponse* response);
 absl::Status RunEstimateDistances(const QueryEnv& env, const v1::EstimateDistancesRequest& request,
                                   v1::EstimateDistancesResponse* response);
 absl::Status RunLocatePoints(const QueryEnv& env, const v1::LocatePointsRequest& request,

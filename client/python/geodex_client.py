@@ -100,6 +100,17 @@ class GeodexClient:
         points = [(p.position.x, p.position.y, p.position.z) for p in response.points]
         return response.distance, points
 
+    def shortest_paths(self, mesh, pairs, **options):
+        """Many exact shortest paths in one call, [(start, end), ...] -> [(length, points), ...];
+        pairs from the same start share one solve. An unreachable end gives (inf, [])."""
+        request = pb.FindShortestPathsRequest(
+            mesh=mesh, pairs=[pb.ShortestPathPair(to=end, **{"from": start}) for start, end in pairs],
+            options=pb.SolverOptions(**options))
+        response = self.stub.FindShortestPaths(request, timeout=self.timeout,
+                                               metadata=self._metadata(mesh))
+        return [(p.distance, [(q.position.x, q.position.y, q.position.z) for q in p.points])
+                for p in response.paths]
+
     def distance_matrix(self, mesh, sources, targets, k_nearest=0, **options):
         """Exact distances, one row per source: [[d(source, target), ...], ...]. `k_nearest`
         keeps only each source's k nearest targets (the rest are inf); `options` are

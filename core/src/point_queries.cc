@@ -83,7 +83,9 @@ absl::Status SolveUntilTargetsFinal(const TriangleMesh& mesh, const GeodesicOpti
   return solver.SolveForTargets(sources, targets, /*use_heuristic=*/true, true, results, stats);
 }
 
-void AddStats(const SolveStats& s, SolveStats* total) {
+}  // namespace
+
+void AddSolveStats(const SolveStats& s, SolveStats* total) {
   total->windows_created += s.windows_created;
   total->windows_filtered_at_creation += s.windows_filtered_at_creation;
   total->windows_filtered_at_pop += s.windows_filtered_at_pop;
@@ -95,44 +97,56 @@ void AddStats(const SolveStats& s, SolveStats* total) {
   total->solve_ms += s.solve_ms;
 }
 
-}  // namespace
+absl::StatusOr<PathsQueryResult> ComputeShortestPaths(const TriangleMesh& mesh,
+                                                      const SurfacePoint& from,
+                                                      const std::vector<SurfacePoint>& tos,
+                                                      const PathQueryOptions& options) {
+  if (absl::Status s = CheckOptions(options.solver); !s.ok()) return s;
+  if (tos.empty()) return absl::InvalidArgumentError("paths need at least one target");
+  absl::StatusOr<std::vector<ich::ResolvedSource>> sources = ResolveSources(mesh, {from});
+  if (!sources.ok()) return sources.status();
+  absl::StatusOr<std::vector<ich::ResolvedTarget>> targets = ResolveTargets(mesh, tos);
+  if (!targets.ok()) return targets.status();
+  ich::IchSolver solver(mesh, options.solver);
+  std::vector<ich::TargetResult> results;
+  PathsQueryResult out;
+  const bool early = !options.full_field;
+  if (absl::Status s = solver.SolveForTargets(*sources, *targets, options.use_heuristic && early,
+                                              early, &results, &out.stats);
+      !s.ok()) {
+    return s;
+  }
+  const VertexPaths paths{solver.distances().data(), solver.origins().data()};
+  out.distance.assign(tos.size(), kUnreachable);
+  out.paths.resize(tos.size());
+  for (size_t i = 0; i < tos.size(); ++i) {
+    absl::StatusOr<GeodesicPath> path = TraceFromTarget(mesh, paths, results[i], tos[i]);
+    if (absl::IsNotFound(path.status())) continue;  // unreachable: inf, no points
+    if (!path.ok()) return path.status();
+    // The trace runs from the target back to the source: report it from `from` to `to`.
+    std::reverse(path->points.begin(), path->points.end());
+    if (from.kind != SurfacePoint::Kind::kVertex) path->points.front().where = from;
+    out.distance[i] = results[i].distance;
+    out.paths[i] = *std::move(path);
+  }
+  return out;
+}
 
 absl::StatusOr<PathQueryResult> ComputeShortestPath(const TriangleMesh& mesh,
                                                     const SurfacePoint& from,
                                                     const SurfacePoint& to,
                                                     const PathQueryOptions& options) {
-  if (absl::Status s = CheckOptions(options.solver); !s.ok()) return s;
-  absl::StatusOr<std::vector<ich::ResolvedSource>> sources = ResolveSources(mesh, {from});
-  if (!sources.ok()) return sources.status();
-  absl::StatusOr<ich::ResolvedTarget> target = ResolveTarget(mesh, to);
-  if (!target.ok()) return target.status();
-  const std::vector<ich::ResolvedTarget> targets = {*std::move(target)};
-  ich::IchSolver solver(mesh, options.solver);
-  std::vector<ich::TargetResult> results;
-  SolveStats stats;
-  const bool early = !options.full_field;
-  if (absl::Status s = solver.SolveForTargets(*sources, targets, options.use_heuristic && early,
-                                              early, &results, &stats);
-      !s.ok()) {
-    return s;
+  absl::StatusOr<PathsQueryResult> paths = ComputeShortestPaths(mesh, from, {to}, options);
+  if (!paths.ok()) return paths.status();
+  if (paths->distance[0] == kUnreachable) {
+    return absl::NotFoundError(absl::StrFormat("%s is unreachable from %s",
+                                               SurfacePointToString(to),
+                                               SurfacePointToString(from)));
   }
-  absl::StatusOr<GeodesicPath> path = TraceFromTarget(
-      mesh, VertexPaths{solver.distances().data(), solver.origins().data()}, results[0], to);
-  if (!path.ok()) {
-    if (path.status().code() == absl::StatusCode::kNotFound) {
-      return absl::NotFoundError(absl::StrFormat("%s is unreachable from %s",
-                                                 SurfacePointToString(to),
-                                                 SurfacePointToString(from)));
-    }
-    return path.status();
-  }
-  // The trace runs from the target back to the source: report it from `from` to `to`.
-  std::reverse(path->points.begin(), path->points.end());
-  if (from.kind != SurfacePoint::Kind::kVertex) path->points.front().where = from;
   PathQueryResult result;
-  result.distance = results[0].distance;
-  result.path = *std::move(path);
-  result.stats = stats;
+  result.distance = paths->distance[0];
+  result.path = std::move(paths->paths[0]);
+  result.stats = paths->stats;
   return result;
 }
 
@@ -328,7 +342,7 @@ absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
       failed.store(true, std::memory_order_relaxed);
       return;
     }
-    AddStats(stats, &total_stats);
+    AddSolveStats(stats, &total_stats);
     ++rows_done;
     if (options.on_row) options.on_row(rows_done, rows);
   };

@@ -104,6 +104,15 @@ class PythonClientTest(unittest.TestCase):
         self.assertEqual(error.exception.code(), grpc.StatusCode.INVALID_ARGUMENT)
         self.assertIn("options.lambda", error.exception.details())
 
+    def test_shortest_paths_equal_single_paths(self):
+        pairs = [(vertex(0), vertex(1250)), (vertex(0), vertex(7)), (vertex(5), vertex(1250))]
+        batch = self.client.shortest_paths(self.mesh.name, pairs)
+        self.assertEqual(len(batch), 3)
+        for (start, end), (length, points) in zip(pairs, batch):
+            single_length, single_points = self.client.shortest_path(self.mesh.name, start, end)
+            self.assertAlmostEqual(length, single_length, delta=1e-12 * max(1.0, single_length))
+            self.assertEqual(len(points), len(single_points))
+
     def test_voronoi(self):
         sites = [vertex(0), vertex(800), vertex(1600), vertex(2400)]
         areas, boundaries = self.client.voronoi(self.mesh.name, sites)

@@ -138,6 +138,79 @@ TEST_F(QueriesTest, SymmetricAndKNearestMatricesEqualCore) {
   }
 }
 
+// Batched pairs: grouped by source (one solve each), every path equal to a single FindShortestPath
+// of that pair to 1e-12, unreachable pairs +inf without points.
+TEST_F(QueriesTest, FindShortestPathsGroupsPairsBySource) {
+  const std::vector<std::pair<SurfacePoint, SurfacePoint>> pairs = {
+      {SurfacePoint::AtVertex(3), SurfacePoint::AtVertex(400)},
+      {SurfacePoint::InFace(10, 0.6, 0.2, 0.2), SurfacePoint::AtVertex(17)},
+      {SurfacePoint::AtVertex(3), SurfacePoint::OnEdge(100, 101, 0.9)},
+      {SurfacePoint::AtVertex(3), SurfacePoint::InFace(200, 0.1, 0.3, 0.6)},
+      {SurfacePoint::InFace(10, 0.6, 0.2, 0.2), SurfacePoint::AtVertex(474)},
+  };
+  v1::FindShortestPathsRequest request;
+  request.set_mesh("meshes/hills");
+  for (const auto& [from, to] : pairs) {
+    v1::ShortestPathPair* pair = request.add_pairs();
+    SurfacePointToProto(from, pair->mutable_from());
+    SurfacePointToProto(to, pair->mutable_to());
+  }
+  request.set_want_stats(true);
+  grpc::ClientContext context;
+  context.set_deadline(In(120));
+  v1::FindShortestPathsResponse response;
+  grpc::Status status = stub_->FindShortestPaths(&context, request, &response);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(response.solves(), 2u);
+  EXPECT_GT(response.stats().windows_created(), 0u);
+  ASSERT_EQ(response.paths_size(), static_cast<int>(pairs.size()));
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    absl::StatusOr<PathQueryResult> single =
+        ComputeShortestPath(*local_, pairs[i].first, pairs[i].second);
+    ASSERT_TRUE(single.ok());
+    const v1::FindShortestPathResponse& got = response.paths(static_cast<int>(i));
+    EXPECT_NEAR(got.distance(), single->distance, 1e-12 * std::max(1.0, single->distance)) << i;
+    ASSERT_GE(got.points_size(), 2) << i;
+    const PathPoint& end = single->path.points.back();
+    EXPECT_NEAR(got.points(got.points_size() - 1).position().x(), end.position[0], 1e-9) << i;
+    EXPECT_NEAR(got.points(got.points_size() - 1).position().y(), end.position[1], 1e-9) << i;
+  }
+
+  // An empty batch and a bad point name the field.
+  v1::FindShortestPathsRequest bad;
+  bad.set_mesh("meshes/hills");
+  grpc::ClientContext c1;
+  EXPECT_EQ(stub_->FindShortestPaths(&c1, bad, &response).error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);
+  bad.add_pairs()->mutable_from()->set_vertex(0);
+  bad.mutable_pairs(0)->mutable_to()->set_vertex(99999);
+  grpc::ClientContext c2;
+  grpc::Status s = stub_->FindShortestPaths(&c2, bad, &response);
+  EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(s.error_message().find("pairs[0].to"), std::string::npos) << s.error_message();
+}
+
+TEST_F(QueriesTest, FindShortestPathsAnswersUnreachablePairsWithInf) {
+  const std::string off =
+      "OFF\n6 2 0\n0 0 0\n1 0 0\n0 1 0\n5 5 0\n6 5 0\n5 6 0\n3 0 1 2\n3 3 4 5\n";
+  testing::UploadResult up = Upload(*stub_, off);
+  ASSERT_TRUE(up.status.ok());
+  v1::FindShortestPathsRequest request;
+  request.set_mesh(up.mesh.name());
+  for (uint32_t to : {1u, 4u}) {
+    v1::ShortestPathPair* pair = request.add_pairs();
+    pair->mutable_from()->set_vertex(0);
+    pair->mutable_to()->set_vertex(to);
+  }
+  grpc::ClientContext context;
+  v1::FindShortestPathsResponse response;
+  ASSERT_TRUE(stub_->FindShortestPaths(&context, request, &response).ok());
+  ASSERT_EQ(response.paths_size(), 2);
+  EXPECT_EQ(response.paths(0).distance(), 1.0);
+  EXPECT_TRUE(std::isinf(response.paths(1).distance()));
+  EXPECT_EQ(response.paths(1).points_size(), 0);
+}
+
 TEST_F(QueriesTest, DistanceMatrixEqualsCoreBitForBit) {
   std::vector<SurfacePoint> sources = Sites();
   sources.push_back(SurfacePoint::AtVertex(3));  // repeated row

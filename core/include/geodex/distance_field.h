@@ -29,6 +29,9 @@ struct SolveStats {
   double solve_ms = 0;
 };
 
+// Adds the counters of `s` to `total` (peaks and the deepest level: the larger).
+void AddSolveStats(const SolveStats& s, SolveStats* total);
+
 // How a vertex got its distance: straight from the unfolded pseudo-source image (ix, iy) in the
 // frame of half-edge `half_edge` (the path crosses that edge into its face and ends at the vertex),
 // or along the edge from neighbour `pseudo_source` when half_edge == kNoIndex (edge relaxation or

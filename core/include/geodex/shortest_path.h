@@ -62,4 +62,16 @@ absl::StatusOr<PathQueryResult> ComputeShortestPath(const TriangleMesh& mesh,
                                                     const SurfacePoint& to,
                                                     const PathQueryOptions& options = {});
 
+// Paths from one point to several: one targeted solve (A* towards the targets when they are close
+// together, stopping once every target is final), then one trace per target.
+struct PathsQueryResult {
+  std::vector<double> distance;     // per target; kUnreachable when it cannot be reached
+  std::vector<GeodesicPath> paths;  // per target, from `from`; empty when unreachable
+  SolveStats stats;                 // of the one solve
+};
+absl::StatusOr<PathsQueryResult> ComputeShortestPaths(const TriangleMesh& mesh,
+                                                      const SurfacePoint& from,
+                                                      const std::vector<SurfacePoint>& tos,
+                                                      const PathQueryOptions& options = {});
+
 }  // namespace geodex
