@@ -1,6 +1,7 @@
 #include "geodex_service.h"
 
 #include <memory>
+#include <mutex>
 #include <string>
 #include <utility>
 #include <vector>
@@ -72,17 +73,25 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
       EndOfUpload();
       return;
     }
-    ++messages_;
-    v1::CreateMeshRequest request;
-    const std::string what = absl::StrCat("message ", messages_, " of the upload stream");
-    if (absl::Status parsed = ParseRequest(message_, &request, what.c_str()); !parsed.ok()) {
-      Fail(absl::InvalidArgumentError(
-          absl::StrCat(parsed.message(), "; nothing was stored, upload the mesh again")));
-      return;
+    absl::Status status;
+    {
+      // Successive reads may complete on different gRPC threads: the lock makes their order
+      // visible (to ThreadSanitizer too; gRPC's own hand-off is in an uninstrumented library).
+      std::lock_guard<std::mutex> lock(mu_);
+      ++messages_;
+      v1::CreateMeshRequest request;
+      const std::string what = absl::StrCat("message ", messages_, " of the upload stream");
+      status = ParseRequest(message_, &request, what.c_str());
+      if (!status.ok()) {
+        status = absl::InvalidArgumentError(
+            absl::StrCat(status.message(), "; nothing was stored, upload the mesh again"));
+      } else {
+        message_.Clear();
+        status = Accept(request);
+      }
     }
-    message_.Clear();
-    if (absl::Status s = Accept(request); !s.ok()) {
-      Fail(s);
+    if (!status.ok()) {
+      Fail(status);
       return;
     }
     StartRead(&message_);
@@ -92,9 +101,13 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
   void OnDone() override { delete this; }
 
  private:
+  // Never called with mu_ held: Finish may run OnDone (and delete this) at once.
   void Fail(const absl::Status& status) {
-    bytes_.clear();
-    bytes_.shrink_to_fit();
+    {
+      std::lock_guard<std::mutex> lock(mu_);
+      bytes_.clear();
+      bytes_.shrink_to_fit();
+    }
     Finish(ToGrpcStatus(status));
   }
 
@@ -158,20 +171,23 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
       Finish(CancelledStatus());
       return;
     }
-    if (!have_metadata_) {
-      Fail(absl::InvalidArgumentError("metadata: the upload stream was empty"));
-      return;
+    absl::Status complete;
+    {
+      std::lock_guard<std::mutex> lock(mu_);
+      if (!have_metadata_) {
+        complete = absl::InvalidArgumentError("metadata: the upload stream was empty");
+      } else if (metadata_.total_bytes() != 0 && bytes_.size() != metadata_.total_bytes()) {
+        complete = absl::InvalidArgumentError(
+            absl::StrCat("metadata.total_bytes: declared ", metadata_.total_bytes(),
+                         " bytes, but ", bytes_.size(), " arrived; nothing was stored"));
+      } else if (bytes_.empty()) {
+        complete = absl::InvalidArgumentError(
+            absl::StrCat("chunk: the upload stream ended after the metadata without any bytes (",
+                         messages_, " messages)"));
+      }
     }
-    if (metadata_.total_bytes() != 0 && bytes_.size() != metadata_.total_bytes()) {
-      Fail(absl::InvalidArgumentError(
-          absl::StrCat("metadata.total_bytes: declared ", metadata_.total_bytes(), " bytes, but ",
-                       bytes_.size(), " arrived; nothing was stored")));
-      return;
-    }
-    if (bytes_.empty()) {
-      Fail(absl::InvalidArgumentError(
-          absl::StrCat("chunk: the upload stream ended after the metadata without any bytes (",
-                       messages_, " messages)")));
+    if (!complete.ok()) {
+      Fail(complete);
       return;
     }
     if (!env_.pool->TrySubmit([this] { Build(); })) {
@@ -189,9 +205,13 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
       return;
     }
     v1::Mesh mesh;
-    const absl::Status status = BuildAndStore(&mesh);
-    bytes_.clear();
-    bytes_.shrink_to_fit();
+    absl::Status status;
+    {
+      std::lock_guard<std::mutex> lock(mu_);
+      status = BuildAndStore(&mesh);
+      bytes_.clear();
+      bytes_.shrink_to_fit();
+    }
     if (status.ok()) SerializeResponse(mesh, response_);
     env_.pool->ReleaseWorker();  // before Finish (see ComputePool::ReleaseWorker)
     Finish(ToGrpcStatus(status));
@@ -261,6 +281,7 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
   ReactorEnv env_;
   grpc::CallbackServerContext* context_;
   grpc::ByteBuffer* response_;
+  std::mutex mu_;  // guards the upload's state below (reads complete on several threads)
   grpc::ByteBuffer message_;
   uint64_t messages_ = 0;
   v1::CreateMeshMetadata metadata_;
