@@ -23,6 +23,7 @@
 #include "geodex_server.h"
 #include "grpcpp/create_channel.h"
 #include "grpcpp/security/credentials.h"
+#include "query_mix.h"
 
 namespace geodex::bench {
 namespace {
@@ -33,19 +34,8 @@ struct Percentiles {
   double p50 = 0, p99 = 0, max = 0;
 };
 
-Percentiles Summarise(std::vector<double> ms) {
-  std::sort(ms.begin(), ms.end());
-  Percentiles p;
-  if (ms.empty()) return p;
-  p.p50 = ms[ms.size() / 2];
-  p.p99 = ms[std::min(ms.size() - 1, ms.size() * 99 / 100)];
-  p.max = ms.back();
-  return p;
-}
-
-std::chrono::system_clock::time_point In(double seconds) {
-  return std::chrono::system_clock::now() +
-         std::chrono::milliseconds(static_cast<int64_t>(seconds * 1000));
+Percentiles Summarise(const std::vector<double>& ms) {
+  return {Percentile(ms, 0.5), Percentile(ms, 0.99), Percentile(ms, 1.0)};
 }
 
 grpc::Status Field(v1::Geodex::Stub& stub, const std::string& mesh, uint32_t source) {
@@ -111,24 +101,9 @@ int Main(int argc, char** argv) {
     const std::string address = absl::StrCat("127.0.0.1:", (*server)->port());
     auto stub = v1::Geodex::NewStub(grpc::CreateChannel(address, grpc::InsecureChannelCredentials()));
     v1::Mesh mesh;
-    {
-      grpc::ClientContext context;
-      context.set_deadline(In(600));
-      auto writer = stub->CreateMesh(&context, &mesh);
-      v1::CreateMeshRequest request;
-      request.mutable_metadata()->set_file_name(mesh_path);
-      writer->Write(request);
-      for (size_t at = 0; at < file.size(); at += 1 << 20) {
-        request.Clear();
-        request.set_chunk(file.substr(at, 1 << 20));
-        writer->Write(request);
-      }
-      writer->WritesDone();
-      grpc::Status s = writer->Finish();
-      if (!s.ok()) {
-        std::fprintf(stderr, "upload: %s\n", s.error_message().c_str());
-        return 1;
-      }
+    if (grpc::Status s = Upload(*stub, file, mesh_path, "", &mesh); !s.ok()) {
+      std::fprintf(stderr, "upload: %s\n", s.error_message().c_str());
+      return 1;
     }
     if (!Field(*stub, mesh.name(), 0).ok()) return 1;  // the cached field
 

@@ -126,9 +126,9 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
       if (absl::Status valid = ValidateDisplayName(metadata_.display_name()); !valid.ok()) {
         return valid;
       }
-      if (absl::StatusOr<MeshFormat> format = FormatFromProto(metadata_.format()); !format.ok()) {
-        return format.status();
-      }
+      absl::StatusOr<MeshFormat> format = FormatFromProto(metadata_.format());
+      if (!format.ok()) return format.status();
+      format_ = *format;
       if (!metadata_.expected_mesh_id().empty() && !IsMeshId(metadata_.expected_mesh_id())) {
         return absl::InvalidArgumentError(
             "metadata.expected_mesh_id: must be 64 lowercase hex digits");
@@ -191,9 +191,7 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
       return;
     }
     if (!env_.pool->TrySubmit([this] { Build(); })) {
-      Fail(absl::ResourceExhaustedError(absl::StrCat(
-          "compute queue full (", env_.pool->threads(), " workers busy, ",
-          env_.pool->queue_capacity(), " queued; --pool_threads/--queue_capacity); retry later")));
+      Fail(PoolFullError(*env_.pool, "--pool_threads/--queue_capacity"));
     }
   }
 
@@ -229,7 +227,7 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
             ? "upload"
             : std::string(metadata_.file_name().substr(0, kMaxEchoBytes));
     absl::StatusOr<MeshData> data = ReadMeshFromBuffer(
-        absl::string_view(bytes_), *FormatFromProto(metadata_.format()), file_name, read_limits);
+        absl::string_view(bytes_), format_, file_name, read_limits);
     if (!data.ok()) {
       if (data.status().code() == absl::StatusCode::kResourceExhausted) return data.status();
       return absl::InvalidArgumentError(absl::StrCat("chunk: ", data.status().message()));
@@ -285,6 +283,7 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
   grpc::ByteBuffer message_;
   uint64_t messages_ = 0;
   v1::CreateMeshMetadata metadata_;
+  MeshFormat format_ = MeshFormat::kAuto;  // metadata_.format(), checked
   bool have_metadata_ = false;
   std::string bytes_;
   CancelToken cancel_;

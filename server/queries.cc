@@ -518,18 +518,7 @@ absl::StatusOr<DistanceMatrix> SolveMatrixRows(const QueryEnv& env, const Stored
     }
     double* row = &out.values[r * out.cols];
     for (size_t c = 0; c < targets.size(); ++c) row[c] = field->distance[targets[c].vertex];
-    if (k_nearest > 0 && k_nearest < targets.size()) {
-      // The k nearest (ties: the lower target index) keep their values, as the engine's rows do.
-      std::vector<size_t> order(targets.size());
-      for (size_t c = 0; c < order.size(); ++c) order[c] = c;
-      std::nth_element(order.begin(), order.begin() + k_nearest, order.end(),
-                       [row](size_t a, size_t b) { return row[a] < row[b] || (row[a] == row[b] && a < b); });
-      std::vector<bool> keep(targets.size(), false);
-      for (size_t i = 0; i < k_nearest; ++i) keep[order[i]] = true;
-      for (size_t c = 0; c < targets.size(); ++c) {
-        if (!keep[c]) row[c] = std::numeric_limits<double>::infinity();
-      }
-    }
+    KeepKNearest(k_nearest, row, targets.size());  // as the engine's rows do
   }
   *cached = missing.empty();
   if (missing.empty()) return out;

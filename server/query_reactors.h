@@ -31,10 +31,14 @@
 
 namespace geodex::server {
 
-inline grpc::Status PoolFullStatus(const ComputePool& pool, const char* flags) {
-  return ToGrpcStatus(absl::ResourceExhaustedError(
+inline absl::Status PoolFullError(const ComputePool& pool, const char* flags) {
+  return absl::ResourceExhaustedError(
       absl::StrCat("compute queue full (", pool.threads(), " workers busy, ", pool.queue_capacity(),
-                   " queued; ", flags, "); retry later")));
+                   " queued; ", flags, "); retry later"));
+}
+
+inline grpc::Status PoolFullStatus(const ComputePool& pool, const char* flags) {
+  return ToGrpcStatus(PoolFullError(pool, flags));
 }
 
 inline grpc::Status CancelledStatus() {

@@ -150,6 +150,15 @@ absl::StatusOr<PathQueryResult> ComputeShortestPath(const TriangleMesh& mesh,
   return result;
 }
 
+void KeepKNearest(uint32_t k, double* row, size_t n) {
+  if (k == 0 || k >= n) return;
+  std::vector<size_t> order(n);
+  for (size_t j = 0; j < n; ++j) order[j] = j;
+  std::stable_sort(order.begin(), order.end(),
+                   [row](size_t a, size_t b) { return row[a] < row[b]; });
+  for (size_t j = k; j < n; ++j) row[order[j]] = kUnreachable;
+}
+
 unsigned UsableCores() {
   cpu_set_t set;
   CPU_ZERO(&set);
@@ -324,15 +333,8 @@ absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
       if (status.ok()) {
         double* row = &solved[r * cols];
         for (size_t j = 0; j < results.size(); ++j) row[columns[j]] = results[j].distance;
-        if (k > 0 && k < results.size()) {
-          // Only the k nearest are exact: keep them (ties: lower index), the rest are +inf.
-          std::vector<size_t> order(results.size());
-          for (size_t j = 0; j < order.size(); ++j) order[j] = j;
-          std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-            return results[a].distance < results[b].distance;
-          });
-          for (size_t n = k; n < order.size(); ++n) row[columns[order[n]]] = kUnreachable;
-        }
+        // Only the k nearest are exact (k > 0 is never symmetric: columns are every target).
+        KeepKNearest(k, row, cols);
       }
     }
     if (symmetric) solved[r * cols + r] = 0;

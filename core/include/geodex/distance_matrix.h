@@ -23,6 +23,10 @@ struct DistanceMatrix {
   SolveStats stats;  // summed over the solves (solve_ms: total)
 };
 
+// The k_nearest rule of a matrix row: the k smallest of `row[0..n)` keep their values (ties: the
+// lower index), every other entry becomes +inf. No-op when k is 0 or at least n.
+void KeepKNearest(uint32_t k, double* row, size_t n);
+
 struct MatrixOptions {
   // Per row: lambda, max_distance (entries beyond it are +inf and each row stops there), the
   // window budget (per row) and the cancel token (stops every row).
