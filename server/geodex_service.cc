@@ -306,7 +306,7 @@ grpc::internal::MethodHandler* Unary(const ReactorEnv* env, Lane lane) {
 }
 
 template <typename Request, typename Response,
-          absl::StatusOr<MessageProducer<Response>> (*kRun)(const QueryEnv&, const Request&)>
+          absl::StatusOr<MessageStream<Response>> (*kRun)(const QueryEnv&, const Request&)>
 grpc::internal::MethodHandler* Stream(const ReactorEnv* env, Lane lane) {
   return new grpc::internal::CallbackServerStreamingHandler<grpc::ByteBuffer, grpc::ByteBuffer>(
       [env, lane](grpc::CallbackServerContext* context, const grpc::ByteBuffer* request) {

@@ -5,6 +5,7 @@
 #include <map>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <utility>
 #include <vector>
@@ -432,7 +433,7 @@ absl::Status RunLocatePoints(const QueryEnv& env, const v1::LocatePointsRequest&
 // ------------------------------------------------------------------------------------------
 // Streamed queries
 
-absl::StatusOr<MessageProducer<v1::ComputeDistanceFieldResponse>> RunComputeDistanceField(
+absl::StatusOr<MessageStream<v1::ComputeDistanceFieldResponse>> RunComputeDistanceField(
     const QueryEnv& env, const v1::ComputeDistanceFieldRequest& request) {
   if (!v1::ValueType_IsValid(request.value_type())) {
     return absl::InvalidArgumentError(
@@ -492,18 +493,29 @@ absl::StatusOr<MessageProducer<v1::ComputeDistanceFieldResponse>> RunComputeDist
 
 namespace {
 
+using FinalRowFn = std::function<void(size_t row, const double* values)>;
+
 // The rows of a matrix: from cached full fields where possible (see RunComputeDistanceMatrix),
-// the rest solved in one engine call. `*cached` is true when nothing was solved.
+// the rest solved in one engine call. `*cached` is true when nothing was solved. Each row goes to
+// `on_final_row` as soon as it and every row before it are final, in order.
 absl::StatusOr<DistanceMatrix> SolveMatrixRows(const QueryEnv& env, const StoredMesh& mesh,
                                                const std::vector<SurfacePoint>& sources,
                                                const std::vector<SurfacePoint>& targets,
                                                const GeodesicOptions& solver, uint32_t k_nearest,
-                                               bool symmetric, bool* cached) {
+                                               bool symmetric, const FinalRowFn& on_final_row,
+                                               bool* cached) {
   DistanceMatrix out;
   out.rows = sources.size();
   out.cols = targets.size();
   out.values.assign(out.rows * out.cols, std::numeric_limits<double>::infinity());
   std::vector<size_t> missing;
+  std::vector<char> row_final(out.rows, 0);
+  size_t next_final = 0;
+  auto hand_out = [&] {  // the final prefix, in order
+    for (; next_final < out.rows && row_final[next_final]; ++next_final) {
+      on_final_row(next_final, &out.values[next_final * out.cols]);
+    }
+  };
   const bool vertex_targets =
       std::all_of(targets.begin(), targets.end(),
                   [](const SurfacePoint& p) { return p.kind == SurfacePoint::Kind::kVertex; });
@@ -519,7 +531,9 @@ absl::StatusOr<DistanceMatrix> SolveMatrixRows(const QueryEnv& env, const Stored
     double* row = &out.values[r * out.cols];
     for (size_t c = 0; c < targets.size(); ++c) row[c] = field->distance[targets[c].vertex];
     KeepKNearest(k_nearest, row, targets.size());  // as the engine's rows do
+    row_final[r] = 1;
   }
+  hand_out();
   *cached = missing.empty();
   if (missing.empty()) return out;
 
@@ -540,25 +554,66 @@ absl::StatusOr<DistanceMatrix> SolveMatrixRows(const QueryEnv& env, const Stored
   } else {
     matrix_options.threads = 1;
   }
-  absl::StatusOr<DistanceMatrix> matrix =
-      ComputeDistanceMatrix(*mesh.mesh, missing.size() == sources.size() ? sources : rest,
-                            targets, matrix_options);
+  // The engine hands out its rows one at a time, in order: place each, then pass on the prefix.
+  matrix_options.on_final_row = [&](size_t i, const double* values) {
+    std::copy_n(values, out.cols, out.values.begin() + missing[i] * out.cols);
+    row_final[missing[i]] = 1;
+    hand_out();
+  };
+  absl::StatusOr<DistanceMatrix> matrix = ComputeDistanceMatrix(*mesh.mesh, rest, targets,
+                                                                matrix_options);
   if (!matrix.ok()) return NameSolveError(matrix.status(), "sources/targets");
   env.counters->solves.fetch_add(1, std::memory_order_relaxed);
   env.counters->windows_processed.fetch_add(matrix->stats.windows_processed,
                                             std::memory_order_relaxed);
-  if (missing.size() == sources.size()) return *std::move(matrix);
-  for (size_t i = 0; i < missing.size(); ++i) {
-    std::copy_n(matrix->values.begin() + i * out.cols, out.cols,
-                out.values.begin() + missing[i] * out.cols);
-  }
   out.stats = matrix->stats;
   return out;
 }
 
+// A matrix on its way to the client: rows are added as they become final (the first
+// `final_values` values), `done` once the solve has returned and `stats` are set.
+struct MatrixStreamState {
+  std::mutex mu;
+  size_t rows = 0, cols = 0;
+  std::vector<double> values;
+  size_t final_values = 0;
+  bool done = false;
+  SolveStats stats;
+  bool cached = false;
+  size_t next = 0;    // the next value to send
+  bool sent = false;  // a message went out (an empty matrix still gets one)
+};
+
+// The next message of a matrix stream: the final values not sent yet (at most `chunk`), the last
+// value held back until the solve returned so that the stats ride with it.
+Produced NextMatrixMessage(MatrixStreamState& state, bool f32, bool want_stats, size_t chunk,
+                           v1::ComputeDistanceMatrixResponse* out) {
+  std::lock_guard<std::mutex> lock(state.mu);
+  const size_t n = state.values.size();
+  if (state.done && state.next >= n && (n > 0 || state.sent)) return Produced::kEnd;
+  const size_t ready = state.done ? n : std::min(state.final_values, n > 0 ? n - 1 : 0);
+  if (state.next >= ready && !(state.done && !state.sent)) return Produced::kLater;
+  out->set_rows(state.rows);
+  out->set_cols(state.cols);
+  out->set_offset(state.next);
+  const size_t begin = state.next, end = std::min(ready, begin + chunk);
+  if (f32) {
+    for (size_t i = begin; i < end; ++i) out->add_values_f32(static_cast<float>(state.values[i]));
+  } else {
+    out->mutable_values_f64()->Add(state.values.begin() + begin, state.values.begin() + end);
+  }
+  if (end == n && want_stats) {
+    StatsToProto(state.stats, out->mutable_stats());
+    out->mutable_stats()->set_cached(state.cached);
+  }
+  state.next = std::max(end, begin + 1);
+  state.sent = true;
+  return Produced::kMessage;
+}
+
 }  // namespace
 
-absl::StatusOr<MessageProducer<v1::ComputeDistanceMatrixResponse>> RunComputeDistanceMatrix(
+absl::StatusOr<MessageStream<v1::ComputeDistanceMatrixResponse>> RunComputeDistanceMatrix(
     const QueryEnv& env, const v1::ComputeDistanceMatrixRequest& request) {
   if (!v1::ValueType_IsValid(request.value_type())) {
     return absl::InvalidArgumentError(
@@ -588,61 +643,61 @@ absl::StatusOr<MessageProducer<v1::ComputeDistanceMatrixResponse>> RunComputeDis
   // the other rows are solved.
   const std::string sources_key = FieldCacheKey((*mesh)->id, *sources, *solver);
   const std::string targets_key = FieldCacheKey("", *targets, *solver);
-  const std::string matrix_key =
+  std::string matrix_key =
       absl::StrCat(sources_key, "|matrix|", targets_key, "|k", request.k_nearest());
   std::shared_ptr<const DistanceField> cached_matrix = env.cache->Find(matrix_key);
   if (cached_matrix == nullptr && env.quick) return SolveLaneNeeded();
-  DistanceMatrix assembled;
-  bool cached = cached_matrix != nullptr;
-  if (cached) {
-    assembled.rows = sources->size();
-    assembled.cols = targets->size();
-    assembled.values = cached_matrix->distance;
-    assembled.stats = cached_matrix->stats;
-  } else {
-    const bool symmetric = sources_key == FieldCacheKey((*mesh)->id, *targets, *solver);
-    absl::StatusOr<DistanceMatrix> solved = SolveMatrixRows(
-        env, **mesh, *sources, *targets, *solver, request.k_nearest(), symmetric, &cached);
-    if (!solved.ok()) return solved.status();
-    assembled = *std::move(solved);
-    auto entry = std::make_shared<DistanceField>();
-    entry->distance = assembled.values;
-    entry->stats = assembled.stats;
-    env.cache->Insert(matrix_key, std::move(entry));
-  }
-  auto state = std::make_shared<DistanceMatrix>(std::move(assembled));
-  auto next = std::make_shared<size_t>(0);
+
+  auto state = std::make_shared<MatrixStreamState>();
+  state->rows = sources->size();
+  state->cols = targets->size();
   const bool f32 = request.value_type() == v1::VALUE_TYPE_FLOAT32;
   const bool want_stats = request.want_stats();
   const size_t chunk = std::max<size_t>(1, env.limits->stream_chunk_bytes / (f32 ? 4 : 8));
-  return MessageProducer<v1::ComputeDistanceMatrixResponse>(
-      [state, next, f32, want_stats, chunk, cached](v1::ComputeDistanceMatrixResponse* out) {
-        const size_t n = state->values.size();
-        // Always one message, even for an empty result, so rows/cols arrive.
-        if (*next >= n && (n > 0 || *next > 0)) return false;
-        out->set_rows(state->rows);
-        out->set_cols(state->cols);
-        out->set_offset(*next);
-        const size_t begin = *next, end = std::min(n, begin + chunk);
-        if (f32) {
-          for (size_t i = begin; i < end; ++i)
-            out->add_values_f32(static_cast<float>(state->values[i]));
-        } else {
-          out->mutable_values_f64()->Add(state->values.begin() + begin,
-                                         state->values.begin() + end);
-        }
-        if (end == n && want_stats) {
-          StatsToProto(state->stats, out->mutable_stats());
-          out->mutable_stats()->set_cached(cached);
-        }
-        *next = std::max(end, begin + 1);
-        return true;
-      });
+  auto next = [state, f32, want_stats, chunk](v1::ComputeDistanceMatrixResponse* out) {
+    return NextMatrixMessage(*state, f32, want_stats, chunk, out);
+  };
+  if (cached_matrix != nullptr) {
+    state->values = cached_matrix->distance;
+    state->final_values = state->values.size();
+    state->stats = cached_matrix->stats;
+    state->cached = state->done = true;
+    return MessageStream<v1::ComputeDistanceMatrixResponse>(std::move(next), nullptr);
+  }
+  // Solved while streaming (issue 19): each row is sent as soon as it and the rows before it are
+  // final, so a client sees progress; the whole matrix then enters the cache.
+  state->values.assign(values, std::numeric_limits<double>::infinity());
+  const bool symmetric = sources_key == FieldCacheKey((*mesh)->id, *targets, *solver);
+  auto work = [env, mesh = *std::move(mesh), sources = *std::move(sources),
+               targets = *std::move(targets), solver = *solver, k = request.k_nearest(), symmetric,
+               matrix_key = std::move(matrix_key),
+               state](const std::function<void()>& ready) -> absl::Status {
+    auto on_final_row = [&](size_t row, const double* row_values) {
+      {
+        std::lock_guard<std::mutex> lock(state->mu);
+        std::copy_n(row_values, state->cols, state->values.begin() + row * state->cols);
+        state->final_values = (row + 1) * state->cols;
+      }
+      ready();
+    };
+    bool cached = false;
+    absl::StatusOr<DistanceMatrix> solved = SolveMatrixRows(env, *mesh, sources, targets, solver,
+                                                            k, symmetric, on_final_row, &cached);
+    if (!solved.ok()) return solved.status();
+    auto entry = std::make_shared<DistanceField>();
+    entry->distance = solved->values;
+    entry->stats = solved->stats;
+    env.cache->Insert(matrix_key, std::move(entry));
+    std::lock_guard<std::mutex> lock(state->mu);
+    state->stats = solved->stats;
+    state->cached = cached;
+    state->done = true;
+    return absl::OkStatus();
+  };
+  return MessageStream<v1::ComputeDistanceMatrixResponse>(std::move(next), std::move(work));
 }
 
-
-
-absl::StatusOr<MessageProducer<v1::ComputeIsolinesResponse>> RunComputeIsolines(
+absl::StatusOr<MessageStream<v1::ComputeIsolinesResponse>> RunComputeIsolines(
     const QueryEnv& env, const v1::ComputeIsolinesRequest& request) {
   const uint32_t max_levels = env.limits->max_levels;
   if (static_cast<uint64_t>(request.levels_size()) > max_levels) {
@@ -694,7 +749,7 @@ absl::StatusOr<MessageProducer<v1::ComputeIsolinesResponse>> RunComputeIsolines(
   return chunker.TakeProducer();
 }
 
-absl::StatusOr<MessageProducer<v1::ComputeVoronoiResponse>> RunComputeVoronoi(
+absl::StatusOr<MessageStream<v1::ComputeVoronoiResponse>> RunComputeVoronoi(
     const QueryEnv& env, const v1::ComputeVoronoiRequest& request) {
   absl::StatusOr<SolvedField> solved =
       SolveField(env, request.mesh(), request.sources(), request.options());
@@ -765,7 +820,7 @@ absl::StatusOr<MessageProducer<v1::ComputeVoronoiResponse>> RunComputeVoronoi(
   return chunker.TakeProducer();
 }
 
-absl::StatusOr<MessageProducer<v1::ComputeDelaunayResponse>> RunComputeDelaunay(
+absl::StatusOr<MessageStream<v1::ComputeDelaunayResponse>> RunComputeDelaunay(
     const QueryEnv& env, const v1::ComputeDelaunayRequest& request) {
   absl::StatusOr<SolvedField> solved =
       SolveField(env, request.mesh(), request.sources(), request.options());

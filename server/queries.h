@@ -64,15 +64,15 @@ absl::Status RunLocatePoints(const QueryEnv& env, const v1::LocatePointsRequest&
                              v1::LocatePointsResponse* response);
 
 // Streamed queries: compute everything, then produce the messages.
-absl::StatusOr<MessageProducer<v1::ComputeDistanceFieldResponse>> RunComputeDistanceField(
+absl::StatusOr<MessageStream<v1::ComputeDistanceFieldResponse>> RunComputeDistanceField(
     const QueryEnv& env, const v1::ComputeDistanceFieldRequest& request);
-absl::StatusOr<MessageProducer<v1::ComputeDistanceMatrixResponse>> RunComputeDistanceMatrix(
+absl::StatusOr<MessageStream<v1::ComputeDistanceMatrixResponse>> RunComputeDistanceMatrix(
     const QueryEnv& env, const v1::ComputeDistanceMatrixRequest& request);
-absl::StatusOr<MessageProducer<v1::ComputeIsolinesResponse>> RunComputeIsolines(
+absl::StatusOr<MessageStream<v1::ComputeIsolinesResponse>> RunComputeIsolines(
     const QueryEnv& env, const v1::ComputeIsolinesRequest& request);
-absl::StatusOr<MessageProducer<v1::ComputeVoronoiResponse>> RunComputeVoronoi(
+absl::StatusOr<MessageStream<v1::ComputeVoronoiResponse>> RunComputeVoronoi(
     const QueryEnv& env, const v1::ComputeVoronoiRequest& request);
-absl::StatusOr<MessageProducer<v1::ComputeDelaunayResponse>> RunComputeDelaunay(
+absl::StatusOr<MessageStream<v1::ComputeDelaunayResponse>> RunComputeDelaunay(
     const QueryEnv& env, const v1::ComputeDelaunayRequest& request);
 
 // "meshes/{key}" looked up in the store: InvalidArgument for a malformed name, NotFound for an

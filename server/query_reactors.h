@@ -14,6 +14,7 @@
 
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <utility>
 
@@ -183,7 +184,7 @@ class UnaryQueryReactor final : public grpc::ServerUnaryReactor {
 template <typename Request, typename Response>
 class StreamQueryReactor final : public grpc::ServerWriteReactor<grpc::ByteBuffer> {
  public:
-  using Run = absl::StatusOr<MessageProducer<Response>> (*)(const QueryEnv&, const Request&);
+  using Run = absl::StatusOr<MessageStream<Response>> (*)(const QueryEnv&, const Request&);
 
   static grpc::ServerWriteReactor<grpc::ByteBuffer>* Start(const ReactorEnv& env, Run run,
                                                            Lane lane,
@@ -205,16 +206,22 @@ class StreamQueryReactor final : public grpc::ServerWriteReactor<grpc::ByteBuffe
 
   // Each write starts only after the previous one completed (one outstanding write at a time).
   void OnWriteDone(bool ok) override {
-    if (!ok) {
-      this->Finish(CancelledStatus());
-      return;
+    std::unique_lock<std::mutex> lock(mu_);
+    writing_ = false;
+    if (!ok) {  // the client is gone: stop the work; finish once it has returned
+      cancel_.Cancel();
+      client_gone_ = true;
     }
-    WriteNext();
+    Act(Decide(), &lock);
   }
   void OnCancel() override { cancel_.Cancel(); }
   void OnDone() override { delete this; }
 
  private:
+  // What to do next once mu_ is released: Finish and StartWrite are called outside it, and after
+  // either this thread touches nothing more (gRPC may delete the reactor from another thread).
+  enum class Action { kNone, kWrite, kFinish };
+
   StreamQueryReactor(const ReactorEnv& env, Run run) : env_(env), run_(run) {}
 
   void Submit(ComputePool* pool, bool quick) {
@@ -230,38 +237,80 @@ class StreamQueryReactor final : public grpc::ServerWriteReactor<grpc::ByteBuffe
       this->Finish(CancelledStatus());
       return;
     }
-    absl::StatusOr<MessageProducer<Response>> producer =
+    absl::StatusOr<MessageStream<Response>> stream =
         run_(MakeQueryEnv(env_, &cancel_, quick), request_);
-    if (quick && IsSolveLaneNeeded(producer.status())) {
+    if (quick && IsSolveLaneNeeded(stream.status())) {
       pool->ReleaseWorker();
       Submit(env_.pool, /*quick=*/false);
       return;
     }
-    pool->ReleaseWorker();  // before any Finish or write: see ComputePool::ReleaseWorker
-    if (!producer.ok()) {
-      this->Finish(ToGrpcStatus(producer.status()));
+    if (!stream.ok()) {
+      pool->ReleaseWorker();  // before any Finish or write: see ComputePool::ReleaseWorker
+      this->Finish(ToGrpcStatus(stream.status()));
       return;
     }
-    producer_ = *std::move(producer);
-    WriteNext();
+    stream_ = *std::move(stream);
+    absl::Status work_status = absl::OkStatus();
+    if (stream_.work) {
+      // Messages go out while the work runs; the reactor cannot finish before it returns (work
+      // still uses cancel_), so it stays alive for every ready() call.
+      Pump();
+      work_status = stream_.work([this] { Pump(); });
+    }
+    pool->ReleaseWorker();
+    std::unique_lock<std::mutex> lock(mu_);
+    work_done_ = true;
+    work_status_ = work_status;
+    Act(Decide(), &lock);
   }
 
-  void WriteNext() {
-    response_.Clear();
-    if (cancel_.IsCancelled() || !producer_(&response_)) {
-      this->Finish(cancel_.IsCancelled() ? CancelledStatus() : grpc::Status::OK);
-      return;
+  void Pump() {
+    std::unique_lock<std::mutex> lock(mu_);
+    Act(Decide(), &lock);
+  }
+
+  // With mu_ held: the next step, given what is written, produced and finished.
+  Action Decide() {
+    if (writing_ || finishing_) return Action::kNone;
+    if (!cancel_.IsCancelled() && work_status_.ok()) {
+      response_.Clear();
+      const Produced produced = stream_.next ? stream_.next(&response_) : Produced::kLater;
+      if (produced == Produced::kMessage) {
+        buffer_.Clear();
+        SerializeResponse(response_, &buffer_);
+        writing_ = true;
+        return Action::kWrite;
+      }
+      if (produced == Produced::kLater && !work_done_) return Action::kNone;
     }
-    buffer_.Clear();
-    SerializeResponse(response_, &buffer_);
-    this->StartWrite(&buffer_);
+    if (!work_done_) return Action::kNone;  // cancelled: wait for the work to stop
+    finishing_ = true;
+    if (cancel_.IsCancelled() || client_gone_) {
+      final_status_ = CancelledStatus();
+    } else if (!work_status_.ok()) {
+      final_status_ = ToGrpcStatus(work_status_);
+    }
+    return Action::kFinish;
+  }
+
+  void Act(Action action, std::unique_lock<std::mutex>* lock) {
+    lock->unlock();
+    if (action == Action::kWrite) this->StartWrite(&buffer_);
+    if (action == Action::kFinish) this->Finish(final_status_);
   }
 
   ReactorEnv env_;
   Run run_;
   Request request_;
   CancelToken cancel_;
-  MessageProducer<Response> producer_;
+  MessageStream<Response> stream_;  // set by Compute before any write, then used under mu_
+  std::mutex mu_;  // orders the writer's state between the compute thread and gRPC's threads
+  bool writing_ = false;     // a StartWrite is outstanding
+  bool finishing_ = false;   // Finish was decided; nothing more happens
+  bool work_done_ = false;   // the query (and its work, if any) returned
+  bool client_gone_ = false;
+  absl::Status work_status_ = absl::OkStatus();
+  grpc::Status final_status_ = grpc::Status::OK;
   Response response_;
   grpc::ByteBuffer buffer_;
 };

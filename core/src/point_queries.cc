@@ -297,8 +297,31 @@ absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
   SolveStats total_stats;
   absl::Status first_error = absl::OkStatus();
   std::atomic<bool> failed{false};
-  std::mutex mu;  // guards total_stats, first_error, rows_done and on_row
+  std::mutex mu;  // guards total_stats, first_error, rows_done, on_row and the rows_final state
   size_t rows_done = 0;
+  // d(r, c) once rows r and (symmetric) c are solved: the sweep's earlier point solved the pair.
+  auto cell = [&](size_t r, size_t c) {
+    return symmetric && rank[c] < rank[r] ? solved[c * cols + r] : solved[r * cols + c];
+  };
+  // on_final_row's state: which rows are solved, how long the solved prefix of the sweep is, and
+  // the next output row to hand out.
+  std::vector<char> row_solved(options.on_final_row ? rows : 0, 0);
+  std::vector<char> rank_solved(options.on_final_row && symmetric ? rows : 0, 0);
+  size_t sweep_prefix = 0, next_final = 0;
+  std::vector<double> final_row(options.on_final_row ? targets.size() : 0);
+  auto hand_out_final_rows = [&](size_t r) {  // with mu held, after row r was solved
+    row_solved[r] = 1;
+    if (symmetric) {
+      rank_solved[rank[r]] = 1;
+      while (sweep_prefix < rows && rank_solved[sweep_prefix]) ++sweep_prefix;
+    }
+    for (; next_final < sources.size(); ++next_final) {
+      const size_t row = source_row[next_final];
+      if (!row_solved[row] || (symmetric && sweep_prefix < rank[row])) break;
+      for (size_t j = 0; j < targets.size(); ++j) final_row[j] = cell(row, column_of[j]);
+      options.on_final_row(next_final, final_row.data());
+    }
+  };
   const uint32_t k = options.k_nearest;
   auto solve_row = [&](size_t r) {
     if (failed.load(std::memory_order_relaxed)) return;
@@ -347,24 +370,17 @@ absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
     AddSolveStats(stats, &total_stats);
     ++rows_done;
     if (options.on_row) options.on_row(rows_done, rows);
+    if (options.on_final_row) hand_out_final_rows(r);
   };
   const unsigned threads = options.threads > 0 ? options.threads : UsableCores();
   RunRows(rows, threads, options.spawn, solve_row);
   if (!first_error.ok()) return first_error;
-  if (symmetric) {
-    for (size_t r = 0; r < rows; ++r) {
-      for (size_t c = 0; c < cols; ++c) {
-        if (rank[c] > rank[r]) solved[c * cols + r] = solved[r * cols + c];
-      }
-    }
-  }
   DistanceMatrix m;
   m.rows = sources.size();
   m.cols = targets.size();
   m.values.resize(m.rows * m.cols);
   for (size_t i = 0; i < m.rows; ++i) {
-    const double* row = &solved[source_row[i] * cols];
-    for (size_t j = 0; j < m.cols; ++j) m.values[i * m.cols + j] = row[column_of[j]];
+    for (size_t j = 0; j < m.cols; ++j) m.values[i * m.cols + j] = cell(source_row[i], column_of[j]);
   }
   m.stats = total_stats;
   return m;

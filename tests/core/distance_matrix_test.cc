@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <functional>
 #include <random>
 #include <string>
@@ -115,6 +116,38 @@ TEST_P(DistanceMatrixTest, OrderSizeAndThreadsDoNotChangeEntries) {
       EXPECT_NEAR(a.values[i * n + j], r.values[(n - 1 - i) * n + (n - 1 - j)], 1e-12 * scale);
       if (i < n / 2) {
         EXPECT_NEAR(a.values[i * n + j], h.values[i * n + j], 1e-12 * scale);
+      }
+    }
+  }
+}
+
+// on_final_row (streaming rows as they finish): every output row exactly once, in order, with the
+// values of the returned matrix bit for bit, whatever the threads; a symmetric row only once the
+// sweep's earlier rows (which solve its other pairs) are done.
+TEST_P(DistanceMatrixTest, FinalRowsArriveInOrderWithTheMatrixValues) {
+  absl::StatusOr<TriangleMesh> mesh = LoadTestMesh(GetParam());
+  ASSERT_TRUE(mesh.ok());
+  std::vector<SurfacePoint> points = LocalWaypoints(*mesh, 10, 0.1, 5);
+  points.push_back(points[2]);  // a repeated point
+  const std::vector<SurfacePoint> targets = SpreadPoints(*mesh, 7, 6);
+  for (unsigned threads : {1u, 3u}) {
+    for (bool symmetric : {true, false}) {
+      const std::vector<SurfacePoint>& cols = symmetric ? points : targets;
+      std::vector<std::vector<double>> rows;
+      MatrixOptions options;
+      options.threads = threads;
+      options.on_final_row = [&](size_t row, const double* values) {
+        EXPECT_EQ(row, rows.size()) << "out of order";
+        rows.emplace_back(values, values + cols.size());
+      };
+      absl::StatusOr<DistanceMatrix> m = ComputeDistanceMatrix(*mesh, points, cols, options);
+      ASSERT_TRUE(m.ok()) << m.status();
+      ASSERT_EQ(rows.size(), points.size()) << threads << " threads, symmetric " << symmetric;
+      for (size_t i = 0; i < rows.size(); ++i) {
+        for (size_t j = 0; j < cols.size(); ++j) {
+          const double want = m->values[i * cols.size() + j];
+          EXPECT_EQ(std::memcmp(&rows[i][j], &want, sizeof want), 0) << i << "," << j;
+        }
       }
     }
   }

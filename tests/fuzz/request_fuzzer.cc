@@ -69,13 +69,14 @@ void RunUnary(const uint8_t* data, size_t size, const QueryEnv& env,
 
 template <typename Request, typename Response>
 void RunStream(const uint8_t* data, size_t size, const QueryEnv& env,
-               absl::StatusOr<MessageProducer<Response>> (*run)(const QueryEnv&, const Request&)) {
+               absl::StatusOr<MessageStream<Response>> (*run)(const QueryEnv&, const Request&)) {
   Request request;
   if (!request.ParseFromArray(data, static_cast<int>(size))) return;
-  absl::StatusOr<MessageProducer<Response>> producer = run(env, request);
-  if (!producer.ok()) return;
+  absl::StatusOr<MessageStream<Response>> stream = run(env, request);
+  if (!stream.ok()) return;
+  if (stream->work && !stream->work([] {}).ok()) return;
   Response message;
-  for (int i = 0; i < 100000 && (*producer)(&message); ++i) message.Clear();
+  for (int i = 0; i < 100000 && stream->next(&message) == Produced::kMessage; ++i) message.Clear();
 }
 
 }  // namespace

@@ -609,6 +609,85 @@ TEST_F(QueriesTest, BadInputAndLimitsNameTheFieldOrFlag) {
   expect(delaunay(dr), grpc::StatusCode::INVALID_ARGUMENT, "mesh");
 }
 
+// Matrix rows stream as they finish (issue 19): with one compute worker the rows are solved one
+// after another, and the first message holds exactly the first row, sent before the second row is
+// solved; the reassembled matrix still equals core bit for bit, stats in the last message only.
+// A call cancelled after its first rows stops the rest.
+class MatrixStreamingTest : public testing::ServerFixture {
+ protected:
+  void SetUp() override {
+    ServerOptions options;
+    options.pool_threads = 1;
+    options.quick_threads = 0;
+    StartServer(options);
+  }
+};
+
+TEST_F(MatrixStreamingTest, RowsArriveAsTheyFinishInOrder) {
+  const std::string off = GridOff(24, 18, true);
+  ASSERT_TRUE(Upload(*stub_, off, "hills").status.ok());
+  const TriangleMesh local = BuildLocal(off);
+  std::vector<SurfacePoint> sources, targets;
+  for (uint32_t k = 0; k < 8; ++k) sources.push_back(SurfacePoint::AtVertex(5 + 53 * k));
+  for (uint32_t k = 0; k < 5; ++k) targets.push_back(SurfacePoint::AtVertex(11 + 71 * k));
+  v1::ComputeDistanceMatrixRequest request;
+  request.set_mesh("meshes/hills");
+  request.set_want_stats(true);
+  for (const SurfacePoint& p : sources) SurfacePointToProto(p, request.add_sources());
+  for (const SurfacePoint& p : targets) SurfacePointToProto(p, request.add_targets());
+  std::vector<v1::ComputeDistanceMatrixResponse> messages;
+  grpc::Status status = ReadAll<v1::ComputeDistanceMatrixResponse>(
+      [&](grpc::ClientContext* c, const auto& r) { return stub_->ComputeDistanceMatrix(c, r); },
+      request, &messages);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_GE(messages.size(), 2u);
+  EXPECT_EQ(messages[0].offset(), 0u);
+  EXPECT_EQ(messages[0].values_f64_size(), 5) << "the first message is the first row alone";
+  const DistanceMatrix expected = *ComputeDistanceMatrix(local, sources, targets);
+  std::vector<double> got;
+  for (size_t i = 0; i < messages.size(); ++i) {
+    EXPECT_EQ(messages[i].offset(), got.size());
+    EXPECT_EQ(messages[i].has_stats(), i + 1 == messages.size()) << "message " << i;
+    got.insert(got.end(), messages[i].values_f64().begin(), messages[i].values_f64().end());
+  }
+  ASSERT_EQ(got.size(), expected.values.size());
+  for (size_t i = 0; i < got.size(); ++i) EXPECT_TRUE(BitEqual(got[i], expected.values[i])) << i;
+  EXPECT_EQ(messages.back().stats().windows_processed(), expected.stats.windows_processed);
+}
+
+TEST_F(MatrixStreamingTest, CancellingAfterTheFirstRowsStopsTheRest) {
+  ASSERT_TRUE(Upload(*stub_, GridOff(120, 120, true), "big").status.ok());
+  v1::ComputeDistanceMatrixRequest request;
+  request.set_mesh("meshes/big");
+  for (uint32_t k = 0; k < 40; ++k) {  // spread rows: each about a full field
+    request.add_sources()->set_vertex((k * 7919) % 14641);
+    request.add_targets()->set_vertex((k * 104729 + 13) % 14641);
+  }
+  grpc::ClientContext context;
+  context.set_deadline(In(120));
+  auto reader = stub_->ComputeDistanceMatrix(&context, request);
+  v1::ComputeDistanceMatrixResponse first;
+  ASSERT_TRUE(reader->Read(&first));
+  EXPECT_LT(static_cast<size_t>(first.values_f64_size()), 40u * 40u);
+  context.TryCancel();
+  v1::ComputeDistanceMatrixResponse more;
+  while (reader->Read(&more)) {
+  }
+  EXPECT_EQ(reader->Finish().error_code(), grpc::StatusCode::CANCELLED);
+  // The only worker is free again: a small matrix on it answers.
+  v1::ComputeDistanceMatrixRequest small;
+  small.set_mesh("meshes/big");
+  small.add_sources()->set_vertex(0);
+  small.add_targets()->set_vertex(1);
+  std::vector<v1::ComputeDistanceMatrixResponse> messages;
+  grpc::Status status = ReadAll<v1::ComputeDistanceMatrixResponse>(
+      [&](grpc::ClientContext* c, const auto& r) { return stub_->ComputeDistanceMatrix(c, r); },
+      small, &messages);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  ASSERT_EQ(messages.size(), 1u);
+  EXPECT_GT(messages[0].values_f64(0), 0);
+}
+
 class QueryLimitsTest : public testing::ServerFixture {};
 
 TEST_F(QueryLimitsTest, TargetsOutputAndResponseLimits) {

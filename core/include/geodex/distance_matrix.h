@@ -44,6 +44,12 @@ struct MatrixOptions {
   // Called after each solved row with (rows done, rows to solve), one call at a time, from any of
   // the threads. For progress bars; keep it cheap.
   std::function<void(size_t, size_t)> on_row;
+  // Called with each output row (its index into `sources` and its targets.size() values) as soon
+  // as it and every row before it are final: in order 0, 1, ..., one call at a time, from any of
+  // the threads. For streaming rows as they finish; the returned matrix holds the same values.
+  // A symmetric row is final once every row before it in the sweep is solved too (they solve its
+  // other pairs).
+  std::function<void(size_t row, const double* values)> on_final_row;
 };
 
 // Rows (one targeted solve per distinct source) run in parallel. When sources and targets are the
