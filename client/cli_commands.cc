@@ -107,43 +107,6 @@ bool GetSolverFlags(const Args& args, GeodesicOptions* options, std::string* err
   return true;
 }
 
-// A progress bar on stderr for row-by-row work, shown only on a terminal and only once the call
-// has run for a second.
-class RowProgress {
- public:
-  RowProgress() : enabled_(isatty(fileno(stderr)) != 0), start_(Clock::now()) {}
-  ~RowProgress() { Finish(); }
-  // Clears the bar (before the answer is printed).
-  void Finish() {
-    if (shown_) std::fputs("\r\033[K", stderr);
-    shown_ = false;
-    enabled_ = false;
-  }
-  void Update(size_t done, size_t total) {
-    if (!enabled_) return;
-    const auto now = Clock::now();
-    const double elapsed = std::chrono::duration<double>(now - start_).count();
-    if (elapsed < 1 || (shown_ && now - last_ < std::chrono::milliseconds(100) && done < total)) {
-      return;
-    }
-    last_ = now;
-    shown_ = true;
-    constexpr int kWidth = 30;
-    const int filled = static_cast<int>(kWidth * done / std::max<size_t>(total, 1));
-    const double left = done > 0 ? elapsed * (total - done) / done : 0;
-    std::fprintf(stderr, "\r[%s%s] %zu/%zu rows, %.1f s, ~%.0f s left\033[K",
-                 std::string(filled, '#').c_str(), std::string(kWidth - filled, '.').c_str(), done,
-                 total, elapsed, left);
-    std::fflush(stderr);
-  }
-
- private:
-  using Clock = std::chrono::steady_clock;
-  bool enabled_;
-  bool shown_ = false;
-  Clock::time_point start_, last_;
-};
-
 int RunDistances(const Args& args) {
   std::string error;
   if (!CheckKnown(args, {"sources", "method", "lambda", "lambda-scale", "max-distance",

@@ -143,6 +143,33 @@ void Progress::Stop() {
   if (state_->shown) std::fputs("\r\033[K", stderr);  // clear the line
 }
 
+RowProgress::RowProgress() : enabled_(::isatty(2) != 0), start_(Clock::now()) {}
+
+void RowProgress::Finish() {
+  if (shown_) std::fputs("\r\033[K", stderr);
+  shown_ = false;
+  enabled_ = false;
+}
+
+void RowProgress::Update(size_t done, size_t total) {
+  if (!enabled_) return;
+  const auto now = Clock::now();
+  const double elapsed = std::chrono::duration<double>(now - start_).count();
+  if (elapsed < 1 || (shown_ && now - last_ < std::chrono::milliseconds(100) && done < total)) {
+    return;
+  }
+  if (!shown_ && g_active_progress != nullptr) g_active_progress->Stop();  // one line at a time
+  last_ = now;
+  shown_ = true;
+  constexpr int kWidth = 30;
+  const int filled = static_cast<int>(kWidth * done / std::max<size_t>(total, 1));
+  const double left = done > 0 ? elapsed * (total - done) / done : 0;
+  std::fprintf(stderr, "\r[%s%s] %zu/%zu rows, %.1f s, ~%.0f s left\033[K",
+               std::string(filled, '#').c_str(), std::string(kWidth - filled, '.').c_str(), done,
+               total, elapsed, left);
+  std::fflush(stderr);
+}
+
 std::array<double, 3> PositionOf(const MeshData& m, const SurfacePoint& p) {
   using Point3 = std::array<double, 3>;
   auto vertex = [&](uint32_t v) {

@@ -65,6 +65,24 @@ class Progress {
   std::unique_ptr<State> state_;
 };
 
+// A progress bar on stderr for row-by-row work (matrix rows, solved locally or streamed by a
+// server), shown only on a terminal and only once the call has run for a second; it replaces the
+// Progress line while shown.
+class RowProgress {
+ public:
+  RowProgress();
+  ~RowProgress() { Finish(); }
+  // Clears the bar (before the answer is printed).
+  void Finish();
+  void Update(size_t done, size_t total);
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  bool enabled_;
+  bool shown_ = false;
+  Clock::time_point start_, last_;
+};
+
 // The position (file coordinates) of a vertex, edge or face point of `mesh`.
 std::array<double, 3> PositionOf(const MeshData& mesh, const SurfacePoint& p);
 

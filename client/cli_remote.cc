@@ -324,8 +324,11 @@ int RemoteMatrix(GeodexClient& client, const Args& args) {
   }
   absl::StatusOr<MeshRef> mesh = client.ResolveMesh(args.positional[0]);
   if (!mesh.ok()) return FailStatus(mesh.status());
+  RowProgress progress;
   absl::StatusOr<DistanceMatrix> m =
-      client.Matrix(*mesh, sources, targets, options, static_cast<uint32_t>(k_nearest));
+      client.Matrix(*mesh, sources, targets, options, static_cast<uint32_t>(k_nearest),
+                    [&progress](size_t done, size_t total) { progress.Update(done, total); });
+  progress.Finish();
   if (!m.ok()) return FailStatus(m.status());
   const std::string text = FormatMatrix(*m);
   std::fwrite(text.data(), 1, text.size(), stdout);

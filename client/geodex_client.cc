@@ -328,7 +328,8 @@ absl::StatusOr<DistanceMatrix> GeodexClient::Matrix(MeshRef& mesh,
                                                     const std::vector<SurfacePoint>& sources,
                                                     const std::vector<SurfacePoint>& targets,
                                                     const v1::SolverOptions& options,
-                                                    uint32_t k_nearest) {
+                                                    uint32_t k_nearest,
+                                                    const std::function<void(size_t, size_t)>& on_rows) {
   v1::ComputeDistanceMatrixRequest request;
   request.set_mesh(mesh.name);
   request.set_k_nearest(k_nearest);
@@ -347,6 +348,10 @@ absl::StatusOr<DistanceMatrix> GeodexClient::Matrix(MeshRef& mesh,
       matrix.values.insert(matrix.values.end(), response.values_f64().begin(),
                            response.values_f64().end());
       if (response.has_stats()) matrix.stats = api::StatsFromProto(response.stats());
+      if (on_rows && matrix.cols > 0) {  // rows received, or rows' worth of solves done
+        const size_t solved = static_cast<size_t>(response.progress() * matrix.rows);
+        on_rows(std::max(matrix.values.size() / matrix.cols, solved), matrix.rows);
+      }
     }
     return reader->Finish();
   });

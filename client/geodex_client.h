@@ -83,10 +83,12 @@ class GeodexClient {
   absl::StatusOr<PathQueryResult> ShortestPath(MeshRef& mesh, const SurfacePoint& from,
                                                const SurfacePoint& to,
                                                const v1::SolverOptions& options);
-  // k_nearest > 0: per source only its k nearest targets (see the proto).
-  absl::StatusOr<DistanceMatrix> Matrix(MeshRef& mesh, const std::vector<SurfacePoint>& sources,
-                                        const std::vector<SurfacePoint>& targets,
-                                        const v1::SolverOptions& options, uint32_t k_nearest = 0);
+  // k_nearest > 0: per source only its k nearest targets (see the proto). The server streams
+  // rows as they finish; `on_rows(rows received, rows)`, when set, is called as they arrive.
+  absl::StatusOr<DistanceMatrix> Matrix(
+      MeshRef& mesh, const std::vector<SurfacePoint>& sources,
+      const std::vector<SurfacePoint>& targets, const v1::SolverOptions& options,
+      uint32_t k_nearest = 0, const std::function<void(size_t, size_t)>& on_rows = nullptr);
   absl::StatusOr<v1::EstimateDistancesResponse> PointDistances(
       MeshRef& mesh, const std::vector<SurfacePoint>& sources,
       const std::vector<SurfacePoint>& points, v1::PointDistanceMode mode,

@@ -503,6 +503,7 @@ absl::StatusOr<DistanceMatrix> SolveMatrixRows(const QueryEnv& env, const Stored
                                                const std::vector<SurfacePoint>& targets,
                                                const GeodesicOptions& solver, uint32_t k_nearest,
                                                bool symmetric, const FinalRowFn& on_final_row,
+                                               const std::function<void(double)>& on_progress,
                                                bool* cached) {
   DistanceMatrix out;
   out.rows = sources.size();
@@ -554,6 +555,10 @@ absl::StatusOr<DistanceMatrix> SolveMatrixRows(const QueryEnv& env, const Stored
   } else {
     matrix_options.threads = 1;
   }
+  const double cached_rows = static_cast<double>(out.rows - missing.size());
+  matrix_options.on_row = [&](size_t done, size_t total) {
+    on_progress((cached_rows + static_cast<double>(done) / total * missing.size()) / out.rows);
+  };
   // The engine hands out its rows one at a time, in order: place each, then pass on the prefix.
   matrix_options.on_final_row = [&](size_t i, const double* values) {
     std::copy_n(values, out.cols, out.values.begin() + missing[i] * out.cols);
@@ -582,6 +587,7 @@ struct MatrixStreamState {
   bool cached = false;
   size_t next = 0;    // the next value to send
   bool sent = false;  // a message went out (an empty matrix still gets one)
+  double progress = 0, progress_sent = 0;  // fraction of the solves done; the last one sent
 };
 
 // The next message of a matrix stream: the final values not sent yet (at most `chunk`), the last
@@ -592,10 +598,15 @@ Produced NextMatrixMessage(MatrixStreamState& state, bool f32, bool want_stats, 
   const size_t n = state.values.size();
   if (state.done && state.next >= n && (n > 0 || state.sent)) return Produced::kEnd;
   const size_t ready = state.done ? n : std::min(state.final_values, n > 0 ? n - 1 : 0);
-  if (state.next >= ready && !(state.done && !state.sent)) return Produced::kLater;
+  const double progress = state.done ? 1.0 : state.progress;
+  // Progress alone is worth a message in steps of 1% (rows that wait on others).
+  const bool progressed = progress >= state.progress_sent + 0.01;
+  if (state.next >= ready && !(state.done && !state.sent) && !progressed) return Produced::kLater;
   out->set_rows(state.rows);
   out->set_cols(state.cols);
   out->set_offset(state.next);
+  out->set_progress(progress);
+  state.progress_sent = progress;
   const size_t begin = state.next, end = std::min(ready, begin + chunk);
   if (f32) {
     for (size_t i = begin; i < end; ++i) out->add_values_f32(static_cast<float>(state.values[i]));
@@ -606,7 +617,7 @@ Produced NextMatrixMessage(MatrixStreamState& state, bool f32, bool want_stats, 
     StatsToProto(state.stats, out->mutable_stats());
     out->mutable_stats()->set_cached(state.cached);
   }
-  state.next = std::max(end, begin + 1);
+  state.next = end > begin ? end : (n == 0 ? 1 : begin);
   state.sent = true;
   return Produced::kMessage;
 }
@@ -680,9 +691,16 @@ absl::StatusOr<MessageStream<v1::ComputeDistanceMatrixResponse>> RunComputeDista
       }
       ready();
     };
+    auto on_progress = [&](double progress) {
+      {
+        std::lock_guard<std::mutex> lock(state->mu);
+        state->progress = progress;
+      }
+      ready();
+    };
     bool cached = false;
-    absl::StatusOr<DistanceMatrix> solved = SolveMatrixRows(env, *mesh, sources, targets, solver,
-                                                            k, symmetric, on_final_row, &cached);
+    absl::StatusOr<DistanceMatrix> solved = SolveMatrixRows(
+        env, *mesh, sources, targets, solver, k, symmetric, on_final_row, on_progress, &cached);
     if (!solved.ok()) return solved.status();
     auto entry = std::make_shared<DistanceField>();
     entry->distance = solved->values;

@@ -111,11 +111,12 @@ class GeodexClient:
         return [(p.distance, [(q.position.x, q.position.y, q.position.z) for q in p.points])
                 for p in response.paths]
 
-    def distance_matrix(self, mesh, sources, targets, k_nearest=0, **options):
+    def distance_matrix(self, mesh, sources, targets, k_nearest=0, on_progress=None, **options):
         """Exact distances, one row per source: [[d(source, target), ...], ...]. `k_nearest`
         keeps only each source's k nearest targets (the rest are inf); `options` are
         SolverOptions fields (lambda_, max_distance, ...; lambda is spelled `lambda_` here or
-        passed as options={"lambda": x})."""
+        passed as options={"lambda": x}). The server streams rows as they finish:
+        `on_progress(rows_received, rows, fraction_solved)`, when given, is called per message."""
         solver = dict(options.pop("options", {}))
         if "lambda_" in options:
             solver["lambda"] = options.pop("lambda_")
@@ -129,6 +130,8 @@ class GeodexClient:
             assert chunk.offset == len(values)
             rows, cols = chunk.rows, chunk.cols
             values.extend(chunk.values_f64)
+            if on_progress is not None and cols:
+                on_progress(len(values) // cols, rows, chunk.progress)
         return [values[r * cols:(r + 1) * cols] for r in range(rows)]
 
     def voronoi(self, mesh, sites):

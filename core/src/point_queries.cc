@@ -272,7 +272,8 @@ absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
   // Symmetric: pair (r, c) is solved by whichever of the two comes first in a sweep along the
   // points' longest extent, so later rows need only targets on one side of them, close together
   // (a small A* ball).
-  std::vector<size_t> rank(rows);
+  std::vector<size_t> rank(rows), order(rows);
+  for (size_t r = 0; r < rows; ++r) order[r] = r;
   if (symmetric) {
     double lo[3], hi[3];
     for (int k = 0; k < 3; ++k) lo[k] = hi[k] = (*resolved)[0].position[k];
@@ -286,8 +287,6 @@ absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
     for (int k = 1; k < 3; ++k) {
       if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
     }
-    std::vector<size_t> order(rows);
-    for (size_t r = 0; r < rows; ++r) order[r] = r;
     std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
       return (*resolved)[a].position[axis] < (*resolved)[b].position[axis];
     });
@@ -369,11 +368,13 @@ absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
     }
     AddSolveStats(stats, &total_stats);
     ++rows_done;
-    if (options.on_row) options.on_row(rows_done, rows);
     if (options.on_final_row) hand_out_final_rows(r);
+    if (options.on_row) options.on_row(rows_done, rows);
   };
   const unsigned threads = options.threads > 0 ? options.threads : UsableCores();
-  RunRows(rows, threads, options.spawn, solve_row);
+  // Symmetric rows go in sweep order: the largest rows first (they solve the most pairs), and
+  // rows become final (on_final_row) steadily rather than all at the end.
+  RunRows(rows, threads, options.spawn, [&](size_t n) { solve_row(order[n]); });
   if (!first_error.ok()) return first_error;
   DistanceMatrix m;
   m.rows = sources.size();

@@ -83,8 +83,12 @@ class PythonClientTest(unittest.TestCase):
 
     def test_matrix_equals_the_cli_with_k_nearest_and_max_distance(self):
         sources, targets = [0, 5, 1250], [7, 100, 2000, 2400]
+        seen = []  # rows stream as they finish: progress per message, rows never go back
         full = self.client.distance_matrix(self.mesh.name, [vertex(v) for v in sources],
-                                           [vertex(v) for v in targets])
+                                           [vertex(v) for v in targets],
+                                           on_progress=lambda *p: seen.append(p))
+        self.assertEqual(seen[-1], (3, 3, 1.0))
+        self.assertEqual(seen, sorted(seen))
         lines = self.local("matrix", os.path.join(DATA, "kitten.off"), "--sources",
                            ",".join(map(str, sources)), "--targets",
                            ",".join(map(str, targets))).splitlines()
