@@ -1,6 +1,6 @@
 // geodex_service_bench: geodexd under load, measured side by side with core in one run.
 //
-//   geodex_service_bench [--mesh FILE] [--seconds S] [--threads N] [--seed K]
+//   geodex_service_bench [--mesh FILE] [--seconds S] [--threads N] [--seed K] [--sections 1234]
 //
 // An in-process geodexd on 127.0.0.1:0 (N compute workers) is given the mesh (default: armadillo,
 // 86k faces, from ../shared/meshes), then:
@@ -9,13 +9,19 @@
 //   2. a query mix (A* paths 40%, distance fields 20%, point distances 20%, locate 10%,
 //      isolines 10%; random vertices and points) from 1, 2 and 4 concurrent clients for S seconds
 //      each: throughput, p50/p99 latency, status counts;
-//   3. health checks while every worker is busy with full fields: p50/p99/max.
+//   3. health checks while every worker is busy with full fields: p50/p99/max;
+//   4. planner matrices (issue 19), result cache off: 64 x 64 symmetric matrices between seeded
+//      random vertices spread over the mesh and between waypoints within a ball of 10% of the
+//      bounding-box diagonal, on 1 and on N workers, each against one full field through the same
+//      server (median of 3): matrix / field, the speed-up over one worker, and when the first
+//      streamed row arrived.
 // Load, overload and memory against a separate geodexd process: geodex_load_bench (load_bench.cc).
 // Results go to stdout as a table (docs/performance.md records them).
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <future>
 #include <map>
@@ -62,11 +68,102 @@ grpc::Status Field(v1::Geodex::Stub& stub, uint32_t source, size_t* values) {
   return reader->Finish();
 }
 
+// One 64 x 64 matrix through the service: wall ms, and ms until the first message with values.
+grpc::Status Matrix(v1::Geodex::Stub& stub, const std::vector<uint32_t>& points, double* total_ms,
+                    double* first_row_ms) {
+  v1::ComputeDistanceMatrixRequest request;
+  request.set_mesh("meshes/bench");
+  for (uint32_t v : points) {
+    request.add_sources()->set_vertex(v);
+    request.add_targets()->set_vertex(v);
+  }
+  grpc::ClientContext context;
+  context.set_deadline(In(600));
+  const auto t0 = Clock::now();
+  auto reader = stub.ComputeDistanceMatrix(&context, request);
+  v1::ComputeDistanceMatrixResponse response;
+  size_t values = 0;
+  *first_row_ms = -1;
+  while (reader->Read(&response)) {
+    if (response.values_f64_size() > 0 && *first_row_ms < 0) *first_row_ms = Ms(Clock::now() - t0);
+    values += response.values_f64_size();
+  }
+  *total_ms = Ms(Clock::now() - t0);
+  grpc::Status status = reader->Finish();
+  if (status.ok() && values != points.size() * points.size()) {
+    return grpc::Status(grpc::StatusCode::INTERNAL, "short matrix");
+  }
+  return status;
+}
+
+// Section 4: planner matrices on 1 and on `threads` workers, against one full field each time.
+int MatrixSection(const TriangleMesh& mesh, const std::string& bytes, const std::string& mesh_path,
+                  int threads, uint32_t seed) {
+  const uint32_t n = mesh.file_vertex_count();
+  std::mt19937 rng(seed * 2010);
+  std::vector<uint32_t> spread, local, near;
+  for (int i = 0; i < 64; ++i) spread.push_back(rng() % n);
+  const auto lo = mesh.BoundsMin(), hi = mesh.BoundsMax();
+  auto dist = [](const std::array<double, 3>& a, const std::array<double, 3>& b) {
+    return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                     (a[2] - b[2]) * (a[2] - b[2]));
+  };
+  const double radius = 0.05 * dist(lo, hi);  // a region of 10% of the diameter
+  const uint32_t centre = rng() % n;
+  for (uint32_t v = 0; v < n; ++v) {
+    if (dist(mesh.Position(v), mesh.Position(centre)) < radius) near.push_back(v);
+  }
+  std::shuffle(near.begin(), near.end(), rng);
+  local.assign(near.begin(), near.begin() + std::min<size_t>(64, near.size()));
+  std::printf("\n4. planner matrices, result cache off (median of 3; field: one full field "
+              "through the same server)\n");
+  std::printf("   matrix          workers   field ms   matrix ms   / field   speed-up   first row ms\n");
+  std::map<std::string, double> one_worker;
+  for (int workers : {1, threads}) {
+    ServerOptions options;
+    options.listen = "127.0.0.1:0";
+    options.pool_threads = workers;
+    options.result_cache_bytes = 0;
+    auto server = GeodexServer::Start(options);
+    if (!server.ok()) return 1;
+    auto channel = grpc::CreateChannel(absl::StrCat("127.0.0.1:", (*server)->port()),
+                                       grpc::InsecureChannelCredentials());
+    auto stub = v1::Geodex::NewStub(channel);
+    if (!bench::Upload(*stub, bytes, mesh_path, "bench").ok()) return 1;
+    for (const auto& [label, points] :
+         {std::pair<std::string, const std::vector<uint32_t>*>{"64 x 64 spread", &spread},
+          {"64 x 64 local", &local}}) {
+      std::vector<double> fields, matrices, firsts;
+      for (int run = 0; run < 3; ++run) {
+        auto t0 = Clock::now();
+        if (!Field(*stub, static_cast<uint32_t>((run * 7919u + 1) % n), nullptr).ok()) return 1;
+        fields.push_back(Ms(Clock::now() - t0));
+        double total = 0, first = 0;
+        grpc::Status status = Matrix(*stub, *points, &total, &first);
+        if (!status.ok()) {
+          std::fprintf(stderr, "matrix: %s\n", status.error_message().c_str());
+          return 1;
+        }
+        matrices.push_back(total);
+        firsts.push_back(first);
+      }
+      const double f = Percentile(fields, 0.5), m = Percentile(matrices, 0.5);
+      if (workers == 1) one_worker[label] = m;
+      std::printf("   %-15s %7d   %8.1f   %9.1f   %7.2f   %8.2f   %12.1f\n", label.c_str(), workers,
+                  f, m, m / f, one_worker[label] / m, Percentile(firsts, 0.5));
+    }
+    (*server)->Shutdown(absl::Now() + absl::Seconds(30));
+    if (threads == 1) break;
+  }
+  return 0;
+}
+
 int Main(int argc, char** argv) {
   std::string mesh_path = std::string(GEODEX_SOURCE_DIR) + "/../shared/meshes/armadillo.off";
   double seconds = 10;
   int threads = 2;
   uint32_t seed = 1;
+  std::string sections = "1234";
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string flag = argv[i], value = argv[i + 1];
     if (flag == "--mesh") {
@@ -77,6 +174,8 @@ int Main(int argc, char** argv) {
       threads = std::stoi(value);
     } else if (flag == "--seed") {
       seed = static_cast<uint32_t>(std::stoul(value));
+    } else if (flag == "--sections") {
+      sections = value;
     } else {
       std::fprintf(stderr, "unknown flag %s\n", flag.c_str());
       return 2;
@@ -103,8 +202,9 @@ int Main(int argc, char** argv) {
               mesh_path.c_str(), mesh.file_vertex_count(), mesh.face_count(), threads,
               std::thread::hardware_concurrency());
 
+  auto want = [&](char section) { return sections.find(section) != std::string::npos; };
   // 1. Overhead of the service for a full field, result cache off.
-  {
+  if (want('1')) {
     ServerOptions options;
     options.listen = "127.0.0.1:0";
     options.pool_threads = threads;
@@ -136,6 +236,9 @@ int Main(int argc, char** argv) {
     (*server)->Shutdown(absl::Now() + absl::Seconds(30));
   }
 
+  if (want('4') && MatrixSection(mesh, bytes, mesh_path, threads, seed) != 0) return 1;
+  if (!want('2') && !want('3')) return 0;
+
   // 2. Query mix from 1, 2 and 4 clients.
   ServerOptions options;
   options.listen = "127.0.0.1:0";
@@ -155,6 +258,7 @@ int Main(int argc, char** argv) {
               seconds);
   std::printf("   clients  queries  queries/s   p50 ms   p99 ms   statuses\n");
   for (int clients : {1, 2, 4}) {
+    if (!want('2')) break;
     std::atomic<bool> stop{false};
     std::vector<std::future<bench::MixResult>> futures;
     const auto start = Clock::now();
@@ -175,7 +279,7 @@ int Main(int argc, char** argv) {
   }
 
   // 3. Health while every worker is busy with full fields (distinct sources: no cache hits).
-  {
+  if (want('3')) {
     std::atomic<bool> stop{false};
     std::vector<std::thread> load;
     for (int c = 0; c < threads + 1; ++c) {
