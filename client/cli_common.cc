@@ -1,5 +1,7 @@
 #include "cli_common.h"
 
+#include "output_file.h"
+
 #include <unistd.h>
 
 #include <condition_variable>
@@ -291,10 +293,8 @@ int WriteOutput(const Args& args, const std::string& text) {
     std::fwrite(text.data(), 1, text.size(), stdout);
     return kExitOk;
   }
-  std::ofstream out(it->second, std::ios::binary);
-  out << text;
-  out.close();
-  if (!out) return Fail(kExitInput, absl::StrFormat("cannot write %s", it->second));
+  absl::Status written = WriteOutputFile(it->second, text);
+  if (!written.ok()) return Fail(kExitUsage, std::string(written.message()));
   return kExitOk;
 }
 

@@ -106,7 +106,7 @@ std::string FormatAtLine(const SurfacePoint& point, double estimate, double exac
 std::string FormatPath(const PathQueryResult& result);
 // One tab-separated row per source.
 std::string FormatMatrix(const DistanceMatrix& matrix);
-// Writes `text` to --output FILE, or stdout. kExitOk or kExitInput.
+// Writes `text` to --output FILE, or stdout. kExitOk, or kExitUsage naming the OS's reason.
 int WriteOutput(const Args& args, const std::string& text);
 
 }  // namespace geodex::cli

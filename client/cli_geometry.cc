@@ -113,18 +113,7 @@ bool OutputFormat(const Args& args, Format* format, std::string* error) {
   return false;
 }
 
-int Emit(const Args& args, const std::string& text) {
-  if (!args.options.count("output")) {
-    std::fwrite(text.data(), 1, text.size(), stdout);
-    return kExitOk;
-  }
-  const std::string& path = args.options.at("output");
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-  out.close();
-  if (!out) return Fail(kExitInput, absl::StrFormat("cannot write %s", path));
-  return kExitOk;
-}
+int Emit(const Args& args, const std::string& text) { return WriteOutput(args, text); }
 
 // --- JSON ------------------------------------------------------------------------------------
 

@@ -184,7 +184,10 @@ int RunRender(const Args& args, const std::string& server) {
   } else {
     written = render::WriteGltf(output, *data, scene.vertex_colors);
   }
-  if (!written.ok()) return Fail(kExitInput, std::string(written.message()));
+  if (!written.ok()) {  // a path we cannot write is a bad argument; a libpng failure is not
+    return Fail(absl::IsInternal(written) ? kExitInput : kExitUsage,
+                std::string(written.message()));
+  }
   return kExitOk;
 }
 

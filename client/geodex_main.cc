@@ -1,6 +1,7 @@
 // geodex: the command line. Thin: parses the command and hands over to cli_commands.cc (local)
 // or cli_remote.cc (--server).
 
+#include <cctype>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -77,12 +78,34 @@ commands:
       .ply and .gltf write the coloured mesh for 3D viewers instead.
 
 SPEC: comma-separated points: 17 (vertex), e:V1:V2:T (the point (1-T)*V1 + T*V2 on an edge),
-      f:FACE:B0:B1:B2 (barycentric in the face's vertex order as in the file).
+      f:FACE:B0:B1:B2 (barycentric in the face's vertex order as in the file),
+      p:X:Y:Z (a 3D position, snapped to the nearest point of the surface).
+
+geodex COMMAND --help prints that command's part of this text.
 
 exit codes: 0 ok; 1 the computation failed (cancelled, budget, target unreachable); 2 bad command
             line or argument;
             3 the mesh could not be read or is invalid.
 )";
+
+// `command`'s entry in kUsage (from its line to the next command's), then SPEC and the exit
+// codes; the whole text for a command it does not list.
+std::string CommandHelp(const std::string& command) {
+  const std::string usage = kUsage;
+  const size_t start = usage.find("\n  " + command + " ");
+  if (start == std::string::npos) return usage;
+  size_t end = start + 1;
+  for (;;) {  // the next line indented by exactly two spaces and a letter, or a blank line
+    end = usage.find('\n', end + 1);
+    if (end == std::string::npos || end + 1 >= usage.size() || usage[end + 1] == '\n' ||
+        (usage.compare(end + 1, 2, "  ") == 0 && std::isalpha(usage[end + 3]))) {
+      break;
+    }
+  }
+  const size_t spec = usage.find("\nSPEC:");
+  return "usage: geodex [--server HOST:PORT] COMMAND MESH [options]\n" +
+         usage.substr(start, end - start) + "\n" + usage.substr(spec);
+}
 
 }  // namespace
 
@@ -138,6 +161,12 @@ int main(int argc, char** argv) {
   SetRemoteOptions(remote);
   const std::string server = remote.target;
   const std::string command = argv[first];
+  for (int i = first + 1; i < argc; ++i) {  // help wins over anything else on the line
+    if (!std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-h")) {
+      std::fputs(CommandHelp(command).c_str(), stdout);
+      return kExitOk;
+    }
+  }
   Args args;
   std::string error;
   if (!ParseArgs(argc, argv, first + 1,

@@ -1,5 +1,7 @@
 #include "render.h"
 
+#include "output_file.h"
+
 #include <png.h>
 
 #include <algorithm>
@@ -235,8 +237,9 @@ Image Render(const Scene& scene, View view, int width, int height) {
 }
 
 absl::Status WritePng(const std::string& path, const Image& image) {
-  std::FILE* file = std::fopen(path.c_str(), "wb");
-  if (file == nullptr) return absl::InvalidArgumentError(absl::StrCat("cannot write ", path));
+  absl::Status opened;
+  std::FILE* file = cli::OpenOutputFile(path, &opened);
+  if (file == nullptr) return opened;
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
   png_infop info = png != nullptr ? png_create_info_struct(png) : nullptr;
   if (png == nullptr || info == nullptr || setjmp(png_jmpbuf(png))) {
@@ -254,8 +257,7 @@ absl::Status WritePng(const std::string& path, const Image& image) {
   }
   png_write_end(png, nullptr);
   png_destroy_write_struct(&png, &info);
-  if (std::fclose(file) != 0) return absl::InternalError(absl::StrCat("cannot write ", path));
-  return absl::OkStatus();
+  return cli::CloseOutputFile(path, file);
 }
 
 absl::Status WriteColoredPly(const std::string& path, const MeshData& mesh,
@@ -304,11 +306,7 @@ absl::Status WriteGltf(const std::string& path, const MeshData& mesh, const std:
       indices_offset - colors_offset, indices_offset, buffer.size() - indices_offset,
       mesh.vertex_count(), lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], mesh.vertex_count(),
       mesh.faces.size());
-  std::ofstream out(path, std::ios::binary);
-  out << json;
-  out.close();
-  if (!out) return absl::InvalidArgumentError(absl::StrCat("cannot write ", path));
-  return absl::OkStatus();
+  return cli::WriteOutputFile(path, json);
 }
 
 }  // namespace geodex::render

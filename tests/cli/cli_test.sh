@@ -120,6 +120,25 @@ expect_usage "path with two points" "one point" path "$DATA/knight.off" --from 0
 expect_usage "bad path method" "--method" path "$DATA/knight.off" --from 0 --to 2 --method foo
 expect_usage "matrix bad target" "--targets" matrix "$DATA/knight.off" --sources 0 --targets f:0:2:0:0
 expect_usage "bad position" "p:1:2" distances "$DATA/knight.off" --sources p:1:2
+expect_usage "unwritable output" "cannot write $tmp/none/x.txt: No such file or directory" \
+  distances "$DATA/knight.off" --sources 0 --output "$tmp/none/x.txt"
+expect_usage "unwritable geometry output" "cannot write $tmp/none/x.json: No such file" \
+  isolines "$DATA/knight.off" --sources 0 --count 3 --output "$tmp/none/x.json"
+
+# --help anywhere after the command prints that command's help (with the point grammar), exit 0.
+for cmd in matrix distances path; do
+  "$GEODEX" "$cmd" --sources 0 --help >"$tmp/help.txt" 2>&1
+  check "$cmd --help exits 0" test $? -eq 0
+  check "$cmd --help shows its usage" grep -q "^  $cmd MESH" "$tmp/help.txt"
+  check "$cmd --help lists p:X:Y:Z" grep -q "p:X:Y:Z" "$tmp/help.txt"
+done
+"$GEODEX" --help | grep -q "p:X:Y:Z"
+check "geodex --help lists p:X:Y:Z" test $? -eq 0
+
+# A directory as MESH says so.
+"$GEODEX" info "$tmp" >/dev/null 2>"$tmp/err.txt"
+check "directory exits 3" test $? -eq 3
+check "directory: says it is a directory" grep -q "is a directory" "$tmp/err.txt"
 
 echo "cli: $pass passed, $fail failed"
 test "$fail" -eq 0

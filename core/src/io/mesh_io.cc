@@ -3,6 +3,7 @@
 #include "geodex/mesh_io.h"
 #include "geodex/limits.h"
 
+#include <sys/stat.h>
 #include <zlib.h>
 
 #include <algorithm>
@@ -244,6 +245,10 @@ absl::StatusOr<MeshData> ReadMeshFile(const std::string& path, const ReadLimits&
     const int err = errno;
     const std::string message = absl::StrCat(path, ": cannot open: ", std::strerror(err));
     return err == ENOENT ? absl::NotFoundError(message) : absl::PermissionDeniedError(message);
+  }
+  if (struct stat st; fstat(fileno(f), &st) == 0 && S_ISDIR(st.st_mode)) {
+    std::fclose(f);  // fopen opens a directory; reading it would fail with a vaguer reason
+    return absl::InvalidArgumentError(absl::StrCat(path, ": is a directory, not a mesh file"));
   }
   std::string bytes;
   absl::Status status;
