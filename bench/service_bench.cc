@@ -68,6 +68,34 @@ grpc::Status Field(v1::Geodex::Stub& stub, uint32_t source, size_t* values) {
   return reader->Finish();
 }
 
+// An in-process geodexd on 127.0.0.1:0 with `workers` compute workers and the mesh uploaded as
+// "meshes/bench". Null server on failure.
+struct BenchServer {
+  std::unique_ptr<GeodexServer> server;
+  std::shared_ptr<grpc::Channel> channel;
+  std::unique_ptr<v1::Geodex::Stub> stub;
+};
+
+BenchServer StartBenchServer(int workers, bool result_cache, const std::string& bytes,
+                             const std::string& mesh_path) {
+  BenchServer out;
+  ServerOptions options;
+  options.listen = "127.0.0.1:0";
+  options.pool_threads = workers;
+  if (!result_cache) options.result_cache_bytes = 0;
+  auto server = GeodexServer::Start(options);
+  if (!server.ok()) return out;
+  out.channel = grpc::CreateChannel(absl::StrCat("127.0.0.1:", (*server)->port()),
+                                    grpc::InsecureChannelCredentials());
+  out.stub = v1::Geodex::NewStub(out.channel);
+  if (!bench::Upload(*out.stub, bytes, mesh_path, "bench").ok()) {
+    (*server)->Shutdown(absl::Now() + absl::Seconds(30));
+    return out;
+  }
+  out.server = *std::move(server);
+  return out;
+}
+
 // One 64 x 64 matrix through the service: wall ms, and ms until the first message with values.
 grpc::Status Matrix(v1::Geodex::Stub& stub, const std::vector<uint32_t>& points, double* total_ms,
                     double* first_row_ms) {
@@ -120,16 +148,9 @@ int MatrixSection(const TriangleMesh& mesh, const std::string& bytes, const std:
   std::printf("   matrix          workers   field ms   matrix ms   / field   speed-up   first row ms\n");
   std::map<std::string, double> one_worker;
   for (int workers : {1, threads}) {
-    ServerOptions options;
-    options.listen = "127.0.0.1:0";
-    options.pool_threads = workers;
-    options.result_cache_bytes = 0;
-    auto server = GeodexServer::Start(options);
-    if (!server.ok()) return 1;
-    auto channel = grpc::CreateChannel(absl::StrCat("127.0.0.1:", (*server)->port()),
-                                       grpc::InsecureChannelCredentials());
-    auto stub = v1::Geodex::NewStub(channel);
-    if (!bench::Upload(*stub, bytes, mesh_path, "bench").ok()) return 1;
+    BenchServer bench_server = StartBenchServer(workers, /*result_cache=*/false, bytes, mesh_path);
+    if (bench_server.server == nullptr) return 1;
+    auto& stub = bench_server.stub;
     for (const auto& [label, points] :
          {std::pair<std::string, const std::vector<uint32_t>*>{"64 x 64 spread", &spread},
           {"64 x 64 local", &local}}) {
@@ -152,7 +173,7 @@ int MatrixSection(const TriangleMesh& mesh, const std::string& bytes, const std:
       std::printf("   %-15s %7d   %8.1f   %9.1f   %7.2f   %8.2f   %12.1f\n", label.c_str(), workers,
                   f, m, m / f, one_worker[label] / m, Percentile(firsts, 0.5));
     }
-    (*server)->Shutdown(absl::Now() + absl::Seconds(30));
+    bench_server.server->Shutdown(absl::Now() + absl::Seconds(30));
     if (threads == 1) break;
   }
   return 0;
@@ -205,16 +226,9 @@ int Main(int argc, char** argv) {
   auto want = [&](char section) { return sections.find(section) != std::string::npos; };
   // 1. Overhead of the service for a full field, result cache off.
   if (want('1')) {
-    ServerOptions options;
-    options.listen = "127.0.0.1:0";
-    options.pool_threads = threads;
-    options.result_cache_bytes = 0;
-    auto server = GeodexServer::Start(options);
-    if (!server.ok()) return 1;
-    auto channel = grpc::CreateChannel(absl::StrCat("127.0.0.1:", (*server)->port()),
-                                       grpc::InsecureChannelCredentials());
-    auto stub = v1::Geodex::NewStub(channel);
-    if (!bench::Upload(*stub, bytes, mesh_path, "bench").ok()) return 1;
+    BenchServer bench_server = StartBenchServer(threads, /*result_cache=*/false, bytes, mesh_path);
+    if (bench_server.server == nullptr) return 1;
+    auto& stub = bench_server.stub;
     std::vector<double> direct, service;
     for (int run = 0; run < 7; ++run) {
       const uint32_t source = static_cast<uint32_t>((run * 7919u) % mesh.file_vertex_count());
@@ -233,24 +247,17 @@ int Main(int argc, char** argv) {
     std::printf("   core ComputeDistanceField  %8.1f ms\n", d);
     std::printf("   geodexd ComputeDistanceField %8.1f ms   overhead %+.1f%%\n", s,
                 100.0 * (s - d) / d);
-    (*server)->Shutdown(absl::Now() + absl::Seconds(30));
+    bench_server.server->Shutdown(absl::Now() + absl::Seconds(30));
   }
 
   if (want('4') && MatrixSection(mesh, bytes, mesh_path, threads, seed) != 0) return 1;
   if (!want('2') && !want('3')) return 0;
 
   // 2. Query mix from 1, 2 and 4 clients.
-  ServerOptions options;
-  options.listen = "127.0.0.1:0";
-  options.pool_threads = threads;
-  auto server = GeodexServer::Start(options);
-  if (!server.ok()) return 1;
-  auto channel = grpc::CreateChannel(absl::StrCat("127.0.0.1:", (*server)->port()),
-                                     grpc::InsecureChannelCredentials());
-  {
-    auto stub = v1::Geodex::NewStub(channel);
-    if (!bench::Upload(*stub, bytes, mesh_path, "bench").ok()) return 1;
-  }
+  BenchServer bench_server = StartBenchServer(threads, /*result_cache=*/true, bytes, mesh_path);
+  if (bench_server.server == nullptr) return 1;
+  GeodexServer* server = bench_server.server.get();
+  std::shared_ptr<grpc::Channel> channel = bench_server.channel;
   const std::vector<bench::MixMesh> mix_meshes = {
       {"meshes/bench", mesh.file_vertex_count(), mesh.face_count(), data->positions}};
   std::printf("\n2. query mix for %.0f s per row (40%% A* paths, 20%% fields, 20%% point "
@@ -291,14 +298,14 @@ int Main(int argc, char** argv) {
         }
       });
     }
-    while ((*server)->pool().busy() < static_cast<size_t>(threads)) {
+    while (server->pool().busy() < static_cast<size_t>(threads)) {
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
     grpc::GenericStub generic(channel);
     std::vector<double> health;
     int busy_samples = 0, failures = 0;
     for (int i = 0; i < 300; ++i) {
-      busy_samples += (*server)->pool().busy() == static_cast<size_t>(threads);
+      busy_samples += server->pool().busy() == static_cast<size_t>(threads);
       const auto t0 = Clock::now();
       failures += !bench::HealthCheck(generic).ok();
       health.push_back(Ms(Clock::now() - t0));
@@ -313,7 +320,7 @@ int Main(int argc, char** argv) {
                 Percentile(health, 0.5), Percentile(health, 0.99),
                 *std::max_element(health.begin(), health.end()), failures);
   }
-  (*server)->Shutdown(absl::Now() + absl::Seconds(60));
+  server->Shutdown(absl::Now() + absl::Seconds(60));
 
   return 0;
 }
