@@ -113,7 +113,6 @@ bool OutputFormat(const Args& args, Format* format, std::string* error) {
   return false;
 }
 
-int Emit(const Args& args, const std::string& text) { return WriteOutput(args, text); }
 
 // --- JSON ------------------------------------------------------------------------------------
 
@@ -332,9 +331,9 @@ int RunIsolines(const Args& args, const std::string& server) {
                      LevelColor(p.level / top)});
   }
   json += "]}\n";
-  if (format == Format::kObj) return Emit(args, Obj("isolines", lines));
-  if (format == Format::kSvg) return Emit(args, Svg("isolines", s.data, lines, SitePositions(s)));
-  return Emit(args, json);
+  if (format == Format::kObj) return WriteOutput(args, Obj("isolines", lines));
+  if (format == Format::kSvg) return WriteOutput(args, Svg("isolines", s.data, lines, SitePositions(s)));
+  return WriteOutput(args, json);
 }
 
 int RunVoronoi(const Args& args, const std::string& server) {
@@ -393,9 +392,9 @@ int RunVoronoi(const Args& args, const std::string& server) {
     json += "]}";
   }
   json += "]}\n";
-  if (format == Format::kObj) return Emit(args, Obj("voronoi", lines));
-  if (format == Format::kSvg) return Emit(args, Svg("voronoi", s.data, lines, SitePositions(s)));
-  return Emit(args, json);
+  if (format == Format::kObj) return WriteOutput(args, Obj("voronoi", lines));
+  if (format == Format::kSvg) return WriteOutput(args, Svg("voronoi", s.data, lines, SitePositions(s)));
+  return WriteOutput(args, json);
 }
 
 namespace {
@@ -467,9 +466,9 @@ int RunDelaunay(const Args& args, const std::string& server) {
         {{a, b}, false, absl::StrFormat("xl_%d_%d", x.vertex_a, x.vertex_b), "#ff8c00", 4});
   }
   json += "]}\n";
-  if (format == Format::kObj) return Emit(args, Obj("delaunay", lines));
-  if (format == Format::kSvg) return Emit(args, Svg("delaunay", s.data, lines, SitePositions(s)));
-  return Emit(args, json);
+  if (format == Format::kObj) return WriteOutput(args, Obj("delaunay", lines));
+  if (format == Format::kSvg) return WriteOutput(args, Svg("delaunay", s.data, lines, SitePositions(s)));
+  return WriteOutput(args, json);
 }
 
 }  // namespace geodex::cli

@@ -703,7 +703,7 @@ absl::StatusOr<MessageStream<v1::ComputeDistanceMatrixResponse>> RunComputeDista
         env, *mesh, sources, targets, solver, k, symmetric, on_final_row, on_progress, &cached);
     if (!solved.ok()) return solved.status();
     auto entry = std::make_shared<DistanceField>();
-    entry->distance = solved->values;
+    entry->distance = std::move(solved->values);  // the stream already holds every row
     entry->stats = solved->stats;
     env.cache->Insert(matrix_key, std::move(entry));
     std::lock_guard<std::mutex> lock(state->mu);

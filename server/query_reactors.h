@@ -274,7 +274,7 @@ class StreamQueryReactor final : public grpc::ServerWriteReactor<grpc::ByteBuffe
     if (writing_ || finishing_) return Action::kNone;
     if (!cancel_.IsCancelled() && work_status_.ok()) {
       response_.Clear();
-      const Produced produced = stream_.next ? stream_.next(&response_) : Produced::kLater;
+      const Produced produced = stream_.next(&response_);
       if (produced == Produced::kMessage) {
         buffer_.Clear();
         SerializeResponse(response_, &buffer_);

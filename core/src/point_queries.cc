@@ -302,21 +302,18 @@ absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
   auto cell = [&](size_t r, size_t c) {
     return symmetric && rank[c] < rank[r] ? solved[c * cols + r] : solved[r * cols + c];
   };
-  // on_final_row's state: which rows are solved, how long the solved prefix of the sweep is, and
-  // the next output row to hand out.
+  // on_final_row's state: which rows are solved, how many rows at the start of the solve order
+  // are (a symmetric row is final once it and every row before it in the sweep are), and the
+  // next output row to hand out.
   std::vector<char> row_solved(options.on_final_row ? rows : 0, 0);
-  std::vector<char> rank_solved(options.on_final_row && symmetric ? rows : 0, 0);
-  size_t sweep_prefix = 0, next_final = 0;
+  size_t solved_prefix = 0, next_final = 0;
   std::vector<double> final_row(options.on_final_row ? targets.size() : 0);
   auto hand_out_final_rows = [&](size_t r) {  // with mu held, after row r was solved
     row_solved[r] = 1;
-    if (symmetric) {
-      rank_solved[rank[r]] = 1;
-      while (sweep_prefix < rows && rank_solved[sweep_prefix]) ++sweep_prefix;
-    }
+    while (solved_prefix < rows && row_solved[order[solved_prefix]]) ++solved_prefix;
     for (; next_final < sources.size(); ++next_final) {
       const size_t row = source_row[next_final];
-      if (!row_solved[row] || (symmetric && sweep_prefix < rank[row])) break;
+      if (symmetric ? solved_prefix <= rank[row] : !row_solved[row]) break;
       for (size_t j = 0; j < targets.size(); ++j) final_row[j] = cell(row, column_of[j]);
       options.on_final_row(next_final, final_row.data());
     }
