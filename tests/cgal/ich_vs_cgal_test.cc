@@ -16,6 +16,7 @@
 
 #include "absl/status/statusor.h"
 #include "geodex/distance_field.h"
+#include "geodex/distance_matrix.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/surface_point.h"
 #include "geodex/triangle_mesh.h"
@@ -125,6 +126,55 @@ TEST_P(IchVsCgalTest, DistancesMatchCgalAtEveryVertex) {
   }
   std::printf("[ vs CGAL ] %-16s worst over all source sets: abs %.3e rel %.3e\n",
               GetParam().c_str(), mesh_worst_abs, mesh_worst_rel);
+}
+
+// A robot's local plan: waypoints at vertices close together, so each row's targeted solve steers
+// towards a small ball around its targets and fits it again as the near ones become final. Every
+// entry against CGAL's distance from the row's source.
+TEST_P(IchVsCgalTest, LocalMatrixEntriesMatchCgal) {
+  absl::StatusOr<MeshData> data = LoadTestMeshData(GetParam());
+  ASSERT_TRUE(data.ok()) << data.status();
+  absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(*data);
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  // 9 waypoints among the vertices nearest (in 3D) to vertex V/3: every 1/9 of the nearest V/10.
+  const uint32_t centre = static_cast<uint32_t>(data->vertex_count() / 3);
+  auto at = [&](uint32_t v) {
+    return std::array<double, 3>{data->positions[3 * v], data->positions[3 * v + 1],
+                                 data->positions[3 * v + 2]};
+  };
+  std::vector<std::pair<double, uint32_t>> by_distance;
+  for (uint32_t v = 0; v < data->vertex_count(); ++v) {
+    double d2 = 0;
+    for (int k = 0; k < 3; ++k) d2 += (at(v)[k] - at(centre)[k]) * (at(v)[k] - at(centre)[k]);
+    by_distance.push_back({d2, v});
+  }
+  std::sort(by_distance.begin(), by_distance.end());
+  const size_t step = std::max<size_t>(1, data->vertex_count() / 90);
+  std::vector<SurfacePoint> points;
+  for (size_t i = 0; i < 9; ++i) points.push_back(SurfacePoint::AtVertex(by_distance[i * step].second));
+  // Symmetric (each pair solved by one row) and not (every row solves every target).
+  const std::vector<SurfacePoint> sources(points.begin(), points.begin() + 4);
+  std::map<uint32_t, std::vector<double>> cgal_from;  // by source vertex
+  for (const SurfacePoint& p : points) cgal_from[p.vertex] = CgalDistances(*data, {p});
+  using Points = const std::vector<SurfacePoint>*;
+  for (const auto& [rows, cols] :
+       {std::pair<Points, Points>{&points, &points}, std::pair<Points, Points>{&sources, &points}}) {
+    absl::StatusOr<DistanceMatrix> m = ComputeDistanceMatrix(*mesh, *rows, *cols);
+    ASSERT_TRUE(m.ok()) << m.status();
+    for (size_t i = 0; i < rows->size(); ++i) {
+      const std::vector<double>& cgal = cgal_from[(*rows)[i].vertex];
+      ASSERT_EQ(cgal.size(), data->vertex_count()) << "CGAL reference failed";
+      double max_d = 0;
+      for (double d : cgal) {
+        if (std::isfinite(d)) max_d = std::max(max_d, d);
+      }
+      for (size_t j = 0; j < cols->size(); ++j) {
+        const double expected = cgal[(*cols)[j].vertex];
+        EXPECT_NEAR(m->values[i * m->cols + j], expected, kRelTol * max_d)
+            << "row " << i << " column " << j;
+      }
+    }
+  }
 }
 
 std::string MeshTestName(const ::testing::TestParamInfo<std::string>& info) {

@@ -3,6 +3,8 @@
 // row, distances at points) the target is a ball (centre c, radius r) holding them all: for any
 // target t, |p t| >= |p c| - r, so the single-target key towards c, less r, still bounds every
 // path through the window to any of them, and never decreases along a path (as the paper's).
+// As the row's near targets become final the ball is fitted again around the rest, so the search
+// narrows towards the far ones instead of growing a disk out to them.
 
 #include "ich/ich_solver.h"
 
@@ -51,32 +53,50 @@ double IchSolver::VertexKey(uint32_t v, double d) const {
                                goal_radius_);
 }
 
-bool IchSolver::SetGoal(const std::vector<ResolvedTarget>& targets) {
-  if (targets.empty()) return false;
+bool IchSolver::FitGoal() {
+  if (unfinished_.empty()) return false;
+  const std::vector<ResolvedTarget>& targets = *targets_;
   double lo[3], hi[3];
-  for (int k = 0; k < 3; ++k) lo[k] = hi[k] = targets[0].position[k];
-  for (const ResolvedTarget& t : targets) {
+  for (int k = 0; k < 3; ++k) lo[k] = hi[k] = targets[unfinished_[0]].position[k];
+  for (uint32_t t : unfinished_) {
     for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], t.position[k]);
-      hi[k] = std::max(hi[k], t.position[k]);
+      lo[k] = std::min(lo[k], targets[t].position[k]);
+      hi[k] = std::max(hi[k], targets[t].position[k]);
     }
   }
   for (int k = 0; k < 3; ++k) goal_[k] = 0.5 * (lo[k] + hi[k]);
   double r2 = 0;
-  for (const ResolvedTarget& t : targets) {
+  for (uint32_t t : unfinished_) {
     double d2 = 0;
-    for (int k = 0; k < 3; ++k) d2 += (t.position[k] - goal_[k]) * (t.position[k] - goal_[k]);
+    for (int k = 0; k < 3; ++k) {
+      d2 += (targets[t].position[k] - goal_[k]) * (targets[t].position[k] - goal_[k]);
+    }
     r2 = std::max(r2, d2);
   }
   // Round the radius up: the bound must hold for every target despite round-off.
-  goal_radius_ = targets.size() == 1 ? 0 : std::sqrt(r2) * (1 + 1e-12);
+  goal_radius_ = unfinished_.size() == 1 ? 0 : std::sqrt(r2) * (1 + 1e-12);
   // A ball reaching over much of the mesh steers nothing and costs a key per window.
   double diagonal2 = 0;
   for (int k = 0; k < 3; ++k) {
     const double e = mesh_.BoundsMax()[k] - mesh_.BoundsMin()[k];
     diagonal2 += e * e;
   }
-  return targets.size() == 1 || goal_radius_ <= kGoalBallMaxRel * std::sqrt(diagonal2);
+  return unfinished_.size() == 1 || goal_radius_ <= kGoalBallMaxRel * std::sqrt(diagonal2);
+}
+
+void IchSolver::RefitGoal(double floor) {
+  // Keys already queued were made with a ball holding every target still unfinished, so they
+  // stay lower bounds for those. A key made with the smaller ball may fall below its parent's:
+  // the queue lifts it to its floor, still a bound (every path through a child runs through its
+  // parent, whose key bounds them all).
+  size_t kept = 0;
+  for (uint32_t t : unfinished_) {
+    if (CurrentTargetDistance(t) > floor) unfinished_[kept++] = t;
+  }
+  unfinished_.resize(kept);
+  // Once on, the A* key stays on: a ball too large to pay for itself is still a valid bound.
+  if (FitGoal()) heuristic_ = true;
+  targets_dirty_ = true;  // next_final_ among the rest
 }
 
 }  // namespace geodex::ich

@@ -409,12 +409,18 @@ absl::Status IchSolver::Run(const std::vector<ResolvedSource>& sources,
   const auto start = std::chrono::steady_clock::now();
   stats_ = SolveStats{};
   has_targets_ = targets != nullptr;
+  refit_goal_ = false;
   if (has_targets_) {
     targets_ = targets;
     target_results_ = results;
     results->assign(targets->size(), TargetResult{});
     stop_early_ = stop_early;
-    heuristic_ = use_heuristic && SetGoal(*targets);
+    unfinished_.clear();
+    for (uint32_t t = 0; t < targets->size(); ++t) unfinished_.push_back(t);
+    heuristic_ = use_heuristic && FitGoal();
+    // Refitting needs the stop test's bookkeeping (TargetsBound), hence stop_early.
+    refit_goal_ = use_heuristic && stop_early && targets->size() > 1;
+    next_final_ = kUnreachable;
     for (uint32_t t = 0; t < targets->size(); ++t) {
       for (uint32_t v : (*targets)[t].vertices) {
         vertex_is_target_[v] = 1;
@@ -459,6 +465,7 @@ absl::Status IchSolver::Run(const std::vector<ResolvedSource>& sources,
     // Every path not yet accounted for is at least as long as this key (keys are lower bounds,
     // and never decrease along a path): targets whose distance is at most the key are final.
     if (target_results_ != nullptr && stop_early_ && floor >= TargetsBound()) break;
+    if (refit_goal_ && floor >= next_final_) RefitGoal(floor);
     if (++polls == kCancelPollInterval) {
       polls = 0;
       if (options_.cancel != nullptr && options_.cancel->IsCancelled()) {

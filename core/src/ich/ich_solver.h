@@ -144,8 +144,13 @@ class IchSolver {
   double WindowKey(uint32_t half_edge, double b0, double b1, double ix, double iy, double sigma,
                    double plain_key) const;
   double VertexKey(uint32_t v, double d) const;
-  // The A* goal: the target, or a ball around several. False when the ball is too large to help.
-  bool SetGoal(const std::vector<ResolvedTarget>& targets);
+  // The A* goal: the target, or a ball around the targets not yet final (unfinished_). False when
+  // the ball is too large to help.
+  bool FitGoal();
+  // Drops the targets final at queue floor `floor` from the goal and fits the ball again around
+  // the rest (a matrix row's far targets steer the search once its near ones are done).
+  void RefitGoal(double floor);
+  double CurrentTargetDistance(uint32_t t) const;  // the best distance found for target t so far
   // Offers target candidates from a window entering face(h), and from a point (a pseudo-source
   // vertex, or a source point) seen straight inside face f.
   void OfferWindowToTargets(uint32_t h, const Window& w);
@@ -153,7 +158,8 @@ class IchSolver {
                            uint32_t via_vertex, uint32_t frame_edge, double fx, double fy);
   void Offer(uint32_t t, uint32_t placement, double d, uint32_t label, const VertexOrigin& origin,
              double tx, double ty);
-  double TargetsBound();  // the largest current target distance (+inf while any is unknown)
+  // The largest current target distance (+inf while any is unknown); also updates next_final_.
+  double TargetsBound();
 
   // First: the references below point into it. From the mesh's cache (or owned, for a mesh that
   // has none).
@@ -172,6 +178,11 @@ class IchSolver {
   bool has_targets_ = false;
   double goal_[3] = {0, 0, 0};  // A*: the target, or the centre of a ball holding the targets
   double goal_radius_ = 0;
+  // Several targets with A*: the ones not yet final, and the smallest current distance among them
+  // (once the queue's floor passes it, that target is final and the goal is refitted).
+  bool refit_goal_ = false;
+  std::vector<uint32_t> unfinished_;
+  double next_final_ = kUnreachable;
   uint32_t final_needed_ = 0;          // 0: every target
   std::vector<double> bound_scratch_;  // TargetsBound's k-th smallest, k < targets
 

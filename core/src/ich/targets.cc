@@ -66,26 +66,31 @@ void IchSolver::OfferPointToTargets(uint32_t f, double px, double py, double d, 
   }
 }
 
+double IchSolver::CurrentTargetDistance(uint32_t t) const {
+  double d = (*target_results_)[t].distance;
+  for (uint32_t v : (*targets_)[t].vertices) d = std::min(d, dist_[v]);
+  return d;
+}
+
 double IchSolver::TargetsBound() {
   if (!targets_dirty_) return targets_bound_;
   targets_dirty_ = false;
   const size_t n = targets_->size();
-  auto current = [&](uint32_t t) {
-    double d = (*target_results_)[t].distance;
-    for (uint32_t v : (*targets_)[t].vertices) d = std::min(d, dist_[v]);
-    return d;
-  };
   double bound = 0;
   if (final_needed_ == 0 || final_needed_ >= n) {
-    for (uint32_t t = 0; t < n; ++t) bound = std::max(bound, current(t));
+    for (uint32_t t = 0; t < n; ++t) bound = std::max(bound, CurrentTargetDistance(t));
   } else {
     // Once the queue's floor passes the k-th smallest upper bound, at least k targets are final,
     // and every target not among them is at least the floor away: those k are the k nearest.
     bound_scratch_.clear();
-    for (uint32_t t = 0; t < n; ++t) bound_scratch_.push_back(current(t));
+    for (uint32_t t = 0; t < n; ++t) bound_scratch_.push_back(CurrentTargetDistance(t));
     std::nth_element(bound_scratch_.begin(), bound_scratch_.begin() + (final_needed_ - 1),
                      bound_scratch_.end());
     bound = bound_scratch_[final_needed_ - 1];
+  }
+  if (refit_goal_) {
+    next_final_ = kUnreachable;
+    for (uint32_t t : unfinished_) next_final_ = std::min(next_final_, CurrentTargetDistance(t));
   }
   targets_bound_ = bound;
   return bound;
