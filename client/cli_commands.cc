@@ -1,4 +1,6 @@
 #include "cli_commands.h"
+
+#include "cli_backend.h"
 #include "cli_common.h"
 
 #include <chrono>
@@ -50,9 +52,59 @@ bool ParseArgs(int argc, char** argv, int first, const std::vector<std::string>&
   return true;
 }
 
-int RunInfo(const Args& args) {
+namespace {
+
+// Parses --`key` (which must be present), then snaps and checks its points on the backend's mesh.
+absl::Status Points(Backend& backend, const Args& args, const std::string& key,
+                    std::vector<SurfacePoint>* out) {
+  absl::StatusOr<std::vector<SurfacePoint>> p = ParseSurfacePoints(args.options.at(key));
+  if (!p.ok()) {
+    return absl::InvalidArgumentError(absl::StrFormat("--%s: %s", key, p.status().message()));
+  }
+  if (absl::Status s = backend.Resolve(key, &*p); !s.ok()) return s;
+  *out = *std::move(p);
+  return absl::OkStatus();
+}
+
+// A SPEC that must name exactly one point.
+absl::Status OnePoint(Backend& backend, const Args& args, const std::string& key,
+                      SurfacePoint* out) {
+  std::vector<SurfacePoint> p;
+  if (absl::Status s = Points(backend, args, key, &p); !s.ok()) return s;
+  if (p.size() != 1) {
+    return absl::InvalidArgumentError(
+        absl::StrFormat("--%s: expected one point, got %d", key, p.size()));
+  }
+  *out = p.front();
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+int OpenMesh(Backend& backend, const std::string& mesh, const MeshBuildOptions& build) {
+  absl::Status s = backend.Open(mesh, build);
+  if (s.ok()) return kExitOk;
+  switch (s.code()) {  // the service failed, not the mesh
+    case absl::StatusCode::kUnauthenticated:
+    case absl::StatusCode::kUnavailable:
+    case absl::StatusCode::kDeadlineExceeded:
+    case absl::StatusCode::kResourceExhausted:
+    case absl::StatusCode::kCancelled:
+      return Fail(kExitSolveFailed, std::string(s.message()));
+    default:
+      return Fail(kExitInput, std::string(s.message()));
+  }
+}
+
+namespace {
+
+}  // namespace
+
+int RunInfo(Backend& backend, const Args& args) {
   std::string error;
-  if (!CheckKnown(args, {"format", "strict"}, &error)) return Fail(kExitUsage, error);
+  if (!CheckKnown(args, {"format", "strict"}, &error) || !backend.Supports(args, &error)) {
+    return Fail(kExitUsage, error);
+  }
   if (args.positional.size() != 1) return Fail(kExitUsage, "usage: geodex info MESH [--format json]");
   const std::string format = args.options.count("format") ? args.options.at("format") : "text";
   if (format != "text" && format != "json") {
@@ -60,21 +112,10 @@ int RunInfo(const Args& args) {
   }
   MeshBuildOptions options;
   options.strict = args.options.count("strict") > 0;
-  absl::StatusOr<LoadedMesh> loaded = LoadMesh(args.positional[0], options);
-  if (!loaded.ok()) return Fail(kExitInput, std::string(loaded.status().message()));
-  const TriangleMesh& mesh = loaded->mesh;
-  const MeshReport& r = mesh.report();
-  InfoValues v;
-  v.report = r;
-  v.internal_vertices = mesh.vertex_count();
-  v.mean_edge_length = mesh.MeanEdgeLength();
-  v.max_edge_length = mesh.MaxEdgeLength();
-  v.bbox_min = mesh.BoundsMin();
-  v.bbox_max = mesh.BoundsMax();
-  v.bytes = mesh.MemoryBytes();
-  v.load_ms = loaded->load_ms;
-  v.build_ms = loaded->build_ms;
-  std::fputs(FormatInfo(v, format == "json").c_str(), stdout);
+  if (int code = OpenMesh(backend, args.positional[0], options)) return code;
+  absl::StatusOr<InfoValues> info = backend.Info();
+  if (!info.ok()) return FailQuery(info.status());
+  std::fputs(FormatInfo(*info, format == "json").c_str(), stdout);
   return kExitOk;
 }
 
@@ -107,121 +148,99 @@ bool GetSolverFlags(const Args& args, GeodesicOptions* options, std::string* err
   return true;
 }
 
-int RunDistances(const Args& args) {
+namespace {
+
+// The counters every --stats line carries, after the backend's context.
+std::string StatsJson(const Backend& backend, const std::string& leading, const SolveStats& s,
+                      const std::string& trailing) {
+  return absl::StrFormat(
+      "{%s%s\"windows_created\": %llu, \"windows_filtered_at_creation\": %llu, "
+      "\"windows_filtered_at_pop\": %llu, \"windows_filtered_overfilter\": %llu, "
+      "\"children_skipped_one_split\": %llu, \"windows_deleted_one_split\": %llu, "
+      "\"windows_processed\": %llu, \"pseudo_sources\": %llu, \"pseudo_sources_full_fan\": %llu, "
+      "\"pseudo_sources_shadow_only\": %llu, \"edge_relaxations\": %llu, \"max_level\": %u, "
+      "\"peak_live_windows\": %llu, \"peak_bytes\": %llu, %s\"solve_ms\": %.3f}\n",
+      leading, backend.StatsContext(), (unsigned long long)s.windows_created,
+      (unsigned long long)s.windows_filtered_at_creation,
+      (unsigned long long)s.windows_filtered_at_pop,
+      (unsigned long long)s.windows_filtered_overfilter,
+      (unsigned long long)s.children_skipped_one_split,
+      (unsigned long long)s.windows_deleted_one_split, (unsigned long long)s.windows_processed,
+      (unsigned long long)s.pseudo_sources, (unsigned long long)s.pseudo_sources_full_fan,
+      (unsigned long long)s.pseudo_sources_shadow_only, (unsigned long long)s.edge_relaxations,
+      s.max_level, (unsigned long long)s.peak_live_windows, (unsigned long long)s.peak_bytes,
+      trailing, s.solve_ms);
+}
+
+}  // namespace
+
+int RunDistances(Backend& backend, const Args& args) {
   std::string error;
   if (!CheckKnown(args, {"sources", "method", "lambda", "lambda-scale", "max-distance",
                          "max-windows", "stats", "output", "no-filter", "no-one-split", "at"},
-                  &error)) {
+                  &error) ||
+      !backend.Supports(args, &error)) {
     return Fail(kExitUsage, error);
   }
   if (args.positional.size() != 1 || !args.options.count("sources")) {
     return Fail(kExitUsage, "usage: geodex distances MESH --sources SPEC [options]");
   }
-  GeodesicOptions options;
-  const std::string method = args.options.count("method") ? args.options.at("method") : "exact";
-  if (method == "exact") {
-    options.method = Method::kExact;
-  } else if (method == "ich") {
-    options.method = Method::kIch;
-  } else if (method == "dijkstra") {
-    options.method = Method::kDijkstra;
+  FieldOptions options;
+  options.method = args.options.count("method") ? args.options.at("method") : "exact";
+  if (options.method == "exact") {
+    options.solver.method = Method::kExact;
+  } else if (options.method == "ich") {
+    options.solver.method = Method::kIch;
+  } else if (options.method == "dijkstra") {
+    options.solver.method = Method::kDijkstra;
   } else {
     return Fail(kExitUsage, "--method must be exact, ich or dijkstra");
   }
-  if (!GetSolverFlags(args, &options, &error)) return Fail(kExitUsage, error);
-  options.use_filter = !args.options.count("no-filter");
-  options.use_one_angle_one_split = !args.options.count("no-one-split");
-
-  absl::StatusOr<std::vector<SurfacePoint>> sources = ParseSurfacePoints(args.options.at("sources"));
-  if (!sources.ok()) return Fail(kExitUsage, "--sources: " + std::string(sources.status().message()));
-  absl::StatusOr<LoadedMesh> loaded = LoadMesh(args.positional[0], MeshBuildOptions{});
-  if (!loaded.ok()) return Fail(kExitInput, std::string(loaded.status().message()));
-  std::unique_ptr<SurfaceLocator> locator;
-  if (!ResolvePoints(loaded->mesh, "sources", &*sources, &locator, &error)) {
-    return Fail(kExitUsage, error);
+  if (!GetSolverFlags(args, &options.solver, &error)) return Fail(kExitUsage, error);
+  options.solver.use_filter = !args.options.count("no-filter");
+  options.solver.use_one_angle_one_split = !args.options.count("no-one-split");
+  absl::StatusOr<std::vector<SurfacePoint>> parsed = ParseSurfacePoints(args.options.at("sources"));
+  if (!parsed.ok()) return Fail(kExitUsage, "--sources: " + std::string(parsed.status().message()));
+  if (int code = OpenMesh(backend, args.positional[0], MeshBuildOptions{})) return code;
+  std::vector<SurfacePoint> sources, at;
+  if (absl::Status s = Points(backend, args, "sources", &sources); !s.ok()) return FailQuery(s);
+  if (args.options.count("at")) {
+    if (absl::Status s = Points(backend, args, "at", &at); !s.ok()) return FailQuery(s);
   }
-  absl::StatusOr<DistanceField> field = ComputeDistanceField(loaded->mesh, *sources, options);
-  if (!field.ok()) {
-    const int code = field.status().code() == absl::StatusCode::kInvalidArgument ? kExitUsage
-                                                                                  : kExitSolveFailed;
-    return Fail(code, std::string(field.status().message()));
-  }
-  const auto t_out = std::chrono::steady_clock::now();
   std::string text;
+  SolveStats stats;
+  const auto t_solve = std::chrono::steady_clock::now();
   if (args.options.count("at")) {
     // Surface points: the unfolding estimate and the exact value, one line each.
-    absl::StatusOr<std::vector<SurfacePoint>> at = ParseSurfacePoints(args.options.at("at"));
-    if (!at.ok()) return Fail(kExitUsage, "--at: " + std::string(at.status().message()));
-    if (!ResolvePoints(loaded->mesh, "at", &*at, &locator, &error)) return Fail(kExitUsage, error);
-    absl::StatusOr<std::vector<std::pair<double, uint32_t>>> exact =
-        ComputeExactDistancesAt(loaded->mesh, *sources, *at, options);
-    if (!exact.ok()) return Fail(kExitSolveFailed, std::string(exact.status().message()));
-    for (size_t i = 0; i < at->size(); ++i) {
-      absl::StatusOr<PointEstimate> est = EstimateDistanceAt(loaded->mesh, *field, (*at)[i]);
-      if (!est.ok()) return Fail(kExitUsage, "--at: " + std::string(est.status().message()));
-      text += FormatAtLine((*at)[i], est->distance, (*exact)[i].first, (*exact)[i].second);
+    absl::StatusOr<std::vector<AtValue>> values = backend.DistancesAt(sources, at, options.solver);
+    if (!values.ok()) return FailQuery(values.status());
+    for (size_t i = 0; i < at.size(); ++i) {
+      text += FormatAtLine(at[i], (*values)[i].estimate, (*values)[i].exact, (*values)[i].source);
     }
   } else {
+    absl::StatusOr<DistanceField> field = backend.Field(sources, options);
+    if (!field.ok()) return FailQuery(field.status());
     text = FormatDistances(field->distance);
+    stats = field->stats;
   }
+  if (stats.solve_ms == 0) stats.solve_ms = MsSince(t_solve);
+  const auto t_out = std::chrono::steady_clock::now();
   if (int code = WriteOutput(args, text); code != kExitOk) return code;
   if (args.options.count("stats")) {
-    const SolveStats& s = field->stats;
-    std::fprintf(
-        stderr,
-        "{\"method\": \"%s\", \"vertices\": %u, \"faces\": %u, \"sources\": %zu, "
-        "\"windows_created\": %llu, \"windows_filtered_at_creation\": %llu, "
-        "\"windows_filtered_at_pop\": %llu, \"windows_filtered_overfilter\": %llu, "
-        "\"children_skipped_one_split\": %llu, \"windows_deleted_one_split\": %llu, "
-        "\"windows_processed\": %llu, \"pseudo_sources\": %llu, \"pseudo_sources_full_fan\": %llu, "
-        "\"pseudo_sources_shadow_only\": %llu, \"edge_relaxations\": %llu, "
-        "\"max_level\": %u, \"peak_live_windows\": %llu, \"peak_bytes\": %llu, "
-        "\"mesh_bytes\": %llu, \"load_ms\": %.3f, \"build_ms\": %.3f, \"solve_ms\": %.3f, "
-        "\"output_ms\": %.3f}\n",
-        method.c_str(), loaded->mesh.file_vertex_count(), loaded->mesh.face_count(),
-        sources->size(), (unsigned long long)s.windows_created,
-        (unsigned long long)s.windows_filtered_at_creation,
-        (unsigned long long)s.windows_filtered_at_pop,
-        (unsigned long long)s.windows_filtered_overfilter,
-        (unsigned long long)s.children_skipped_one_split,
-        (unsigned long long)s.windows_deleted_one_split, (unsigned long long)s.windows_processed,
-        (unsigned long long)s.pseudo_sources, (unsigned long long)s.pseudo_sources_full_fan,
-        (unsigned long long)s.pseudo_sources_shadow_only, (unsigned long long)s.edge_relaxations, s.max_level,
-        (unsigned long long)s.peak_live_windows, (unsigned long long)s.peak_bytes,
-        (unsigned long long)loaded->mesh.MemoryBytes(), loaded->load_ms, loaded->build_ms,
-        s.solve_ms, MsSince(t_out));
+    const std::string leading =
+        absl::StrFormat("\"method\": \"%s\", \"sources\": %d, ", options.method, sources.size());
+    const std::string trailing = absl::StrFormat("\"output_ms\": %.3f, ", MsSince(t_out));
+    std::fputs(StatsJson(backend, leading, stats, trailing).c_str(), stderr);
   }
   return kExitOk;
 }
 
-namespace {
-
-
-// Parses a SPEC that must name exactly one point, and checks it against the mesh.
-bool OnePoint(const Args& args, const std::string& key, const TriangleMesh& mesh, SurfacePoint* out,
-              std::string* error) {
-  absl::StatusOr<std::vector<SurfacePoint>> p = ParseSurfacePoints(args.options.at(key));
-  if (!p.ok()) {
-    *error = absl::StrFormat("--%s: %s", key, p.status().message());
-    return false;
-  }
-  if (p->size() != 1) {
-    *error = absl::StrFormat("--%s: expected one point, got %d", key, p->size());
-    return false;
-  }
-  std::unique_ptr<SurfaceLocator> locator;
-  if (!ResolvePoints(mesh, key, &*p, &locator, error)) return false;
-  *out = p->front();
-  return true;
-}
-
-}  // namespace
-
-int RunPath(const Args& args) {
+int RunPath(Backend& backend, const Args& args) {
   std::string error;
   if (!CheckKnown(args, {"from", "to", "method", "stats", "lambda", "lambda-scale", "max-distance",
                          "max-windows"},
-                  &error)) {
+                  &error) ||
+      !backend.Supports(args, &error)) {
     return Fail(kExitUsage, error);
   }
   if (args.positional.size() != 1 || !args.options.count("from") || !args.options.count("to")) {
@@ -237,40 +256,28 @@ int RunPath(const Args& args) {
     return Fail(kExitUsage, "--method must be astar or full");
   }
   if (!GetSolverFlags(args, &options.solver, &error)) return Fail(kExitUsage, error);
-  absl::StatusOr<LoadedMesh> loaded = LoadMesh(args.positional[0], MeshBuildOptions{});
-  if (!loaded.ok()) return Fail(kExitInput, std::string(loaded.status().message()));
+  if (int code = OpenMesh(backend, args.positional[0], MeshBuildOptions{})) return code;
   SurfacePoint from, to;
-  if (!OnePoint(args, "from", loaded->mesh, &from, &error) ||
-      !OnePoint(args, "to", loaded->mesh, &to, &error)) {
-    return Fail(kExitUsage, error);
-  }
-  absl::StatusOr<PathQueryResult> result = ComputeShortestPath(loaded->mesh, from, to, options);
-  if (!result.ok()) {
-    const int code = result.status().code() == absl::StatusCode::kInvalidArgument ? kExitUsage
-                                                                                   : kExitSolveFailed;
-    return Fail(code, std::string(result.status().message()));
-  }
+  if (absl::Status s = OnePoint(backend, args, "from", &from); !s.ok()) return FailQuery(s);
+  if (absl::Status s = OnePoint(backend, args, "to", &to); !s.ok()) return FailQuery(s);
+  absl::StatusOr<PathQueryResult> result = backend.Path(from, to, options);
+  if (!result.ok()) return FailQuery(result.status());
   const std::string text = FormatPath(*result);
   std::fwrite(text.data(), 1, text.size(), stdout);
   if (args.options.count("stats")) {
-    const SolveStats& s = result->stats;
-    std::fprintf(stderr,
-                 "{\"method\": \"%s\", \"windows_created\": %llu, \"windows_processed\": %llu, "
-                 "\"peak_live_windows\": %llu, \"peak_bytes\": %llu, \"path_points\": %zu, "
-                 "\"load_ms\": %.3f, \"build_ms\": %.3f, \"solve_ms\": %.3f}\n",
-                 method.c_str(), (unsigned long long)s.windows_created,
-                 (unsigned long long)s.windows_processed, (unsigned long long)s.peak_live_windows,
-                 (unsigned long long)s.peak_bytes, result->path.points.size(), loaded->load_ms,
-                 loaded->build_ms, s.solve_ms);
+    const std::string leading = absl::StrFormat("\"method\": \"%s\", \"path_points\": %d, ",
+                                                method, result->path.points.size());
+    std::fputs(StatsJson(backend, leading, result->stats, "").c_str(), stderr);
   }
   return kExitOk;
 }
 
-int RunMatrix(const Args& args) {
+int RunMatrix(Backend& backend, const Args& args) {
   std::string error;
   if (!CheckKnown(args, {"sources", "targets", "stats", "lambda", "lambda-scale", "max-distance",
                          "max-windows", "k-nearest", "threads"},
-                  &error)) {
+                  &error) ||
+      !backend.Supports(args, &error)) {
     return Fail(kExitUsage, error);
   }
   if (args.positional.size() != 1 || !args.options.count("sources") ||
@@ -290,34 +297,20 @@ int RunMatrix(const Args& args) {
   options.threads = static_cast<unsigned>(threads);
   RowProgress progress;
   options.on_row = [&progress](size_t done, size_t total) { progress.Update(done, total); };
-  absl::StatusOr<LoadedMesh> loaded = LoadMesh(args.positional[0], MeshBuildOptions{});
-  if (!loaded.ok()) return Fail(kExitInput, std::string(loaded.status().message()));
-  std::vector<SurfacePoint> lists[2];
-  const char* keys[2] = {"sources", "targets"};
-  for (int i = 0; i < 2; ++i) {
-    absl::StatusOr<std::vector<SurfacePoint>> p = ParseSurfacePoints(args.options.at(keys[i]));
-    if (!p.ok()) return Fail(kExitUsage, absl::StrFormat("--%s: %s", keys[i], p.status().message()));
-    std::unique_ptr<SurfaceLocator> locator;
-    if (!ResolvePoints(loaded->mesh, keys[i], &*p, &locator, &error)) {
-      return Fail(kExitUsage, error);
-    }
-    lists[i] = *std::move(p);
-  }
-  absl::StatusOr<DistanceMatrix> m = ComputeDistanceMatrix(loaded->mesh, lists[0], lists[1], options);
+  if (int code = OpenMesh(backend, args.positional[0], MeshBuildOptions{})) return code;
+  std::vector<SurfacePoint> sources, targets;
+  if (absl::Status s = Points(backend, args, "sources", &sources); !s.ok()) return FailQuery(s);
+  if (absl::Status s = Points(backend, args, "targets", &targets); !s.ok()) return FailQuery(s);
+  absl::StatusOr<DistanceMatrix> m = backend.Matrix(sources, targets, options);
   progress.Finish();
-  if (!m.ok()) {
-    const int code = m.status().code() == absl::StatusCode::kInvalidArgument ? kExitUsage
-                                                                              : kExitSolveFailed;
-    return Fail(code, std::string(m.status().message()));
-  }
+  if (!m.ok()) return FailQuery(m.status());
   const std::string text = FormatMatrix(*m);
   std::fwrite(text.data(), 1, text.size(), stdout);
   if (args.options.count("stats")) {
-    std::fprintf(stderr,
-                 "{\"rows\": %zu, \"cols\": %zu, \"windows_created\": %llu, \"solve_ms\": %.3f, "
-                 "\"threads\": %u}\n",
-                 m->rows, m->cols, (unsigned long long)m->stats.windows_created, m->stats.solve_ms,
-                 options.threads > 0 ? options.threads : UsableCores());
+    const std::string leading = absl::StrFormat("\"rows\": %d, \"cols\": %d, \"threads\": %u, ",
+                                                m->rows, m->cols,
+                                                options.threads > 0 ? options.threads : UsableCores());
+    std::fputs(StatsJson(backend, leading, m->stats, "").c_str(), stderr);
   }
   return kExitOk;
 }

@@ -1,6 +1,7 @@
 #pragma once
 
-// The geodex command line: argument parsing and the local (in-process core) commands.
+// The geodex command line: argument parsing and the query commands (info, distances, path,
+// matrix), each written once against a Backend (local or remote).
 
 #include <map>
 #include <string>
@@ -26,9 +27,11 @@ struct Args {
 bool ParseArgs(int argc, char** argv, int first, const std::vector<std::string>& boolean_flags,
                Args* out, std::string* error);
 
-int RunInfo(const Args& args);
-int RunDistances(const Args& args);
-int RunPath(const Args& args);
-int RunMatrix(const Args& args);
+class Backend;  // cli_backend.h: where the command runs (this process or a geodexd)
+
+int RunInfo(Backend& backend, const Args& args);
+int RunDistances(Backend& backend, const Args& args);
+int RunPath(Backend& backend, const Args& args);
+int RunMatrix(Backend& backend, const Args& args);
 
 }  // namespace geodex::cli

@@ -5,7 +5,7 @@
 #include "cli_geometry.h"
 
 #include "cli_common.h"
-#include "cli_remote.h"
+#include "cli_backend.h"
 
 #include <algorithm>
 #include <cmath>
@@ -34,59 +34,26 @@ namespace {
 
 using Point3 = std::array<double, 3>;
 
-// Everything a command needs: the mesh as read (file coordinates, for drawing) and built, the
-// points, the solved field.
+// Everything a command needs: the mesh as read (file coordinates, for drawing and placing sites)
+// and its points.
 struct Solved {
-  MeshData data;
-  std::unique_ptr<TriangleMesh> mesh;
+  const MeshData* data = nullptr;
   std::vector<SurfacePoint> points;
-  DistanceField field;
 };
 
-// Reads the mesh (or sample:NAME), parses and resolves --`key`, solves. Returns 0 or an exit code
-// (after printing the one-line message).
-int Prepare(const Args& args, const std::string& key, Solved* out) {
-  absl::StatusOr<LoadedMesh> loaded = LoadMesh(args.positional[0], MeshBuildOptions{});
-  if (!loaded.ok()) return Fail(kExitInput, std::string(loaded.status().message()));
-  out->data = std::move(loaded->data);
-  out->mesh = std::make_unique<TriangleMesh>(std::move(loaded->mesh));
+// Opens the mesh on the backend, parses and resolves --`key`. Returns 0 or an exit code (after
+// printing the one-line message).
+int Prepare(Backend& backend, const Args& args, const std::string& key, Solved* out) {
   absl::StatusOr<std::vector<SurfacePoint>> points = ParseSurfacePoints(args.options.at(key));
   if (!points.ok()) {
     return Fail(kExitUsage, "--" + key + ": " + std::string(points.status().message()));
   }
-  std::unique_ptr<SurfaceLocator> locator;
-  std::string error;
-  if (!ResolvePoints(*out->mesh, key, &*points, &locator, &error)) return Fail(kExitUsage, error);
+  if (int code = OpenMesh(backend, args.positional[0], MeshBuildOptions{})) return code;
+  if (absl::Status s = backend.Resolve(key, &*points); !s.ok()) return FailQuery(s);
   out->points = *std::move(points);
-  absl::StatusOr<DistanceField> field = ComputeDistanceField(*out->mesh, out->points);
-  if (!field.ok()) {
-    const bool bad = field.status().code() == absl::StatusCode::kInvalidArgument;
-    return Fail(bad ? kExitUsage : kExitSolveFailed, std::string(field.status().message()));
-  }
-  out->field = *std::move(field);
-  return 0;
-}
-
-// Remote mode: the mesh is read locally too (its coordinates place the sites and draw the SVG), so
-// MESH must be a file or sample:NAME; the points are resolved and the geometry computed by the
-// server. Fills s.data and s.points; returns 0 or an exit code.
-int PrepareRemote(const Args& args, const std::string& key, RemoteGeometry& remote, Solved* s) {
-  absl::StatusOr<MeshData> data = LoadMeshData(args.positional[0]);
-  if (!data.ok()) {
-    return Fail(kExitInput, absl::StrFormat("%s (in remote mode isolines, voronoi and delaunay "
-                                            "need the mesh file or sample:NAME: its coordinates "
-                                            "place the sites)",
-                                            data.status().message()));
-  }
-  s->data = *std::move(data);
-  absl::StatusOr<std::vector<SurfacePoint>> points = ParseSurfacePoints(args.options.at(key));
-  if (!points.ok()) {
-    return Fail(kExitUsage, "--" + key + ": " + std::string(points.status().message()));
-  }
-  s->points = *std::move(points);
-  if (absl::Status st = remote.Prepare(args.positional[0], &s->points); !st.ok()) {
-    return FailRemote(st);
-  }
+  absl::StatusOr<const MeshData*> data = backend.Geometry();
+  if (!data.ok()) return FailQuery(data.status());
+  out->data = *data;
   return 0;
 }
 
@@ -151,7 +118,7 @@ std::string SitesJson(const Solved& s) {
   for (size_t i = 0; i < s.points.size(); ++i) {
     json +=
         absl::StrFormat("%s{\"site\": %d, \"spec\": \"%s\", \"p\": %s}", i ? ", " : "", i,
-                        SurfacePointToString(s.points[i]), Xyz(PositionOf(s.data, s.points[i])));
+                        SurfacePointToString(s.points[i]), Xyz(PositionOf(*s.data, s.points[i])));
   }
   return json + "]";
 }
@@ -269,7 +236,7 @@ std::string LevelColor(double x) {
 
 std::vector<Point3> SitePositions(const Solved& s) {
   std::vector<Point3> out;
-  for (const SurfacePoint& p : s.points) out.push_back(PositionOf(s.data, p));
+  for (const SurfacePoint& p : s.points) out.push_back(PositionOf(*s.data, p));
   return out;
 }
 
@@ -280,7 +247,7 @@ int Usage(const std::string& command, const std::string& key, const std::string&
 
 }  // namespace
 
-int RunIsolines(const Args& args, const std::string& server) {
+int RunIsolines(Backend& backend, const Args& args) {
   std::string error;
   if (!CheckKnown(args, {"sources", "levels", "count", "output"}, &error)) {
     return Fail(kExitUsage, error);
@@ -306,17 +273,9 @@ int RunIsolines(const Args& args, const std::string& server) {
   if (!OutputFormat(args, &format, &error)) return Fail(kExitUsage, error);
   Solved s;
   absl::StatusOr<Isolines> iso;
-  if (!server.empty()) {
-    std::unique_ptr<RemoteGeometry> remote = ConnectRemoteGeometry(server);
-    if (remote == nullptr) return RunRemote(server, "isolines", args);
-    if (int code = PrepareRemote(args, "sources", *remote, &s)) return code;
-    iso = remote->ComputeIsolines(s.points, options);
-    if (!iso.ok()) return FailRemote(iso.status());
-  } else {
-    if (int code = Prepare(args, "sources", &s)) return code;
-    iso = ExtractIsolines(*s.mesh, s.field, options);
-    if (!iso.ok()) return Fail(kExitUsage, std::string(iso.status().message()));
-  }
+  if (int code = Prepare(backend, args, "sources", &s)) return code;
+  iso = backend.ComputeIsolines(s.points, options);
+  if (!iso.ok()) return FailQuery(iso.status());
 
   const double top = iso->levels.empty() ? 1 : std::max(iso->levels.back(), 1e-300);
   std::vector<Line> lines;
@@ -332,11 +291,11 @@ int RunIsolines(const Args& args, const std::string& server) {
   }
   json += "]}\n";
   if (format == Format::kObj) return WriteOutput(args, Obj("isolines", lines));
-  if (format == Format::kSvg) return WriteOutput(args, Svg("isolines", s.data, lines, SitePositions(s)));
+  if (format == Format::kSvg) return WriteOutput(args, Svg("isolines", *s.data, lines, SitePositions(s)));
   return WriteOutput(args, json);
 }
 
-int RunVoronoi(const Args& args, const std::string& server) {
+int RunVoronoi(Backend& backend, const Args& args) {
   std::string error;
   if (!CheckKnown(args, {"sites", "output"}, &error)) return Fail(kExitUsage, error);
   if (args.positional.size() != 1 || !args.options.count("sites")) {
@@ -346,17 +305,9 @@ int RunVoronoi(const Args& args, const std::string& server) {
   if (!OutputFormat(args, &format, &error)) return Fail(kExitUsage, error);
   Solved s;
   absl::StatusOr<VoronoiDiagram> vd;
-  if (!server.empty()) {
-    std::unique_ptr<RemoteGeometry> remote = ConnectRemoteGeometry(server);
-    if (remote == nullptr) return RunRemote(server, "voronoi", args);
-    if (int code = PrepareRemote(args, "sites", *remote, &s)) return code;
-    vd = remote->ComputeVoronoi(s.points);
-    if (!vd.ok()) return FailRemote(vd.status());
-  } else {
-    if (int code = Prepare(args, "sites", &s)) return code;
-    vd = BuildVoronoi(*s.mesh, s.field);
-    if (!vd.ok()) return Fail(kExitSolveFailed, std::string(vd.status().message()));
-  }
+  if (int code = Prepare(backend, args, "sites", &s)) return code;
+  vd = backend.ComputeVoronoi(s.points);
+  if (!vd.ok()) return FailQuery(vd.status());
 
   std::vector<Line> lines;
   std::string json = absl::StrFormat(
@@ -393,7 +344,7 @@ int RunVoronoi(const Args& args, const std::string& server) {
   }
   json += "]}\n";
   if (format == Format::kObj) return WriteOutput(args, Obj("voronoi", lines));
-  if (format == Format::kSvg) return WriteOutput(args, Svg("voronoi", s.data, lines, SitePositions(s)));
+  if (format == Format::kSvg) return WriteOutput(args, Svg("voronoi", *s.data, lines, SitePositions(s)));
   return WriteOutput(args, json);
 }
 
@@ -408,7 +359,7 @@ std::string EdgeJson(const DelaunayEdge& e) {
 
 }  // namespace
 
-int RunDelaunay(const Args& args, const std::string& server) {
+int RunDelaunay(Backend& backend, const Args& args) {
   std::string error;
   if (!CheckKnown(args, {"sites", "output"}, &error)) return Fail(kExitUsage, error);
   if (args.positional.size() != 1 || !args.options.count("sites")) {
@@ -418,17 +369,9 @@ int RunDelaunay(const Args& args, const std::string& server) {
   if (!OutputFormat(args, &format, &error)) return Fail(kExitUsage, error);
   Solved s;
   absl::StatusOr<DelaunayTriangulation> dt;
-  if (!server.empty()) {
-    std::unique_ptr<RemoteGeometry> remote = ConnectRemoteGeometry(server);
-    if (remote == nullptr) return RunRemote(server, "delaunay", args);
-    if (int code = PrepareRemote(args, "sites", *remote, &s)) return code;
-    dt = remote->ComputeDelaunay(s.points);
-    if (!dt.ok()) return FailRemote(dt.status());
-  } else {
-    if (int code = Prepare(args, "sites", &s)) return code;
-    dt = BuildDelaunay(*s.mesh, s.field);
-    if (!dt.ok()) return Fail(kExitSolveFailed, std::string(dt.status().message()));
-  }
+  if (int code = Prepare(backend, args, "sites", &s)) return code;
+  dt = backend.ComputeDelaunay(s.points);
+  if (!dt.ok()) return FailQuery(dt.status());
 
   std::vector<Line> lines;
   std::string json = "{\"approximate\": true, \"kind\": \"delaunay\", \"sites\": " + SitesJson(s) +
@@ -460,14 +403,14 @@ int RunDelaunay(const Args& args, const std::string& server) {
         "%s\n{\"edge\": [%d, %d], \"sites\": [%d, %d], \"witness\": %d, "
         "\"point\": %s}",
         i ? "," : "", x.vertex_a, x.vertex_b, x.site_a, x.site_b, x.witness, PointJson(x.point));
-    const Point3 a = PositionOf(s.data, SurfacePoint::AtVertex(x.vertex_a));
-    const Point3 b = PositionOf(s.data, SurfacePoint::AtVertex(x.vertex_b));
+    const Point3 a = PositionOf(*s.data, SurfacePoint::AtVertex(x.vertex_a));
+    const Point3 b = PositionOf(*s.data, SurfacePoint::AtVertex(x.vertex_b));
     lines.push_back(
         {{a, b}, false, absl::StrFormat("xl_%d_%d", x.vertex_a, x.vertex_b), "#ff8c00", 4});
   }
   json += "]}\n";
   if (format == Format::kObj) return WriteOutput(args, Obj("delaunay", lines));
-  if (format == Format::kSvg) return WriteOutput(args, Svg("delaunay", s.data, lines, SitePositions(s)));
+  if (format == Format::kSvg) return WriteOutput(args, Svg("delaunay", *s.data, lines, SitePositions(s)));
   return WriteOutput(args, json);
 }
 

@@ -10,10 +10,12 @@
 namespace geodex::cli {
 
 // geodex isolines MESH --sources SPEC (--levels L1,L2,... | --count K) [--output FILE]
-int RunIsolines(const Args& args, const std::string& server = "");
+class Backend;
+
+int RunIsolines(Backend& backend, const Args& args);
 // geodex voronoi MESH --sites SPEC [--output FILE]
-int RunVoronoi(const Args& args, const std::string& server = "");
+int RunVoronoi(Backend& backend, const Args& args);
 // geodex delaunay MESH --sites SPEC [--output FILE]
-int RunDelaunay(const Args& args, const std::string& server = "");
+int RunDelaunay(Backend& backend, const Args& args);
 
 }  // namespace geodex::cli

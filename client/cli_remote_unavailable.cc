@@ -1,5 +1,6 @@
 // Remote mode when the binary is built without the gRPC API (GEODEX_BUILD_SERVER=OFF).
 
+#include "cli_backend.h"
 #include "cli_common.h"
 #include "cli_remote.h"
 
@@ -9,14 +10,10 @@ bool RemoteAvailable() { return false; }
 
 void SetRemoteOptions(const RemoteOptions&) {}
 
-int RunRemote(const std::string&, const std::string&, const Args&) {
+int RunServerCommand(const std::string&, const std::string&, const Args&) {
   return Fail(kExitUsage, "this geodex was built without gRPC: --server is not available");
 }
 
-std::unique_ptr<RemoteGeometry> ConnectRemoteGeometry(const std::string&) { return nullptr; }
-
-int FailRemote(const absl::Status& status) {
-  return Fail(kExitSolveFailed, std::string(status.message()));
-}
+std::unique_ptr<Backend> MakeRemoteBackend(const std::string&) { return nullptr; }
 
 }  // namespace geodex::cli

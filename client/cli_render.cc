@@ -1,6 +1,6 @@
 // geodex render: a picture of a distance field (and optionally its isolines, Voronoi boundaries,
-// Delaunay edges and a shortest path) as PNG, or the coloured mesh as PLY or glTF. Local or, with
-// --server, computed by a geodexd (the mesh file is read here too: it is what gets drawn).
+// Delaunay edges and a shortest path) as PNG, or the coloured mesh as PLY or glTF, on either
+// backend (with --server the mesh file is read here too: it is what gets drawn).
 
 #include <cstdio>
 #include <memory>
@@ -9,7 +9,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
 #include "cli_common.h"
-#include "cli_remote.h"
+#include "cli_backend.h"
 #include "cli_render.h"
 #include "geodex/delaunay.h"
 #include "geodex/geodesic_solver.h"
@@ -44,7 +44,7 @@ struct Layers {
 
 }  // namespace
 
-int RunRender(const Args& args, const std::string& server) {
+int RunRender(Backend& backend, const Args& args) {
   std::string error;
   if (!CheckKnown(args, {"sources", "isolines", "voronoi", "delaunay", "path", "output", "view",
                          "size"},
@@ -86,8 +86,6 @@ int RunRender(const Args& args, const std::string& server) {
   }
   const bool voronoi = args.options.count("voronoi") > 0, delaunay = args.options.count("delaunay") > 0;
 
-  absl::StatusOr<MeshData> data = LoadMeshData(positional[0]);
-  if (!data.ok()) return Fail(kExitInput, std::string(data.status().message()));
   absl::StatusOr<std::vector<SurfacePoint>> sources = ParseSurfacePoints(args.options.at("sources"));
   if (!sources.ok()) return Fail(kExitUsage, "--sources: " + std::string(sources.status().message()));
   std::vector<SurfacePoint> ends;
@@ -98,68 +96,44 @@ int RunRender(const Args& args, const std::string& server) {
     }
     ends = *std::move(p);
   }
+  if (int code = OpenMesh(backend, positional[0], MeshBuildOptions{})) return code;
+  absl::StatusOr<const MeshData*> data = backend.Geometry();
+  if (!data.ok()) return FailQuery(data.status());
+  if (absl::Status s = backend.Resolve("sources", &*sources); !s.ok()) return FailQuery(s);
+  if (!ends.empty()) {
+    if (absl::Status s = backend.Resolve("path", &ends); !s.ok()) return FailQuery(s);
+  }
 
+  // A local backend solves the field once and derives the layers from it.
   Layers layers;
   IsolineOptions levels;
   levels.count = isoline_count;
-  if (server.empty()) {
-    absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(*data);
-    if (!mesh.ok()) return Fail(kExitInput, std::string(mesh.status().message()));
-    std::unique_ptr<SurfaceLocator> locator;
-    if (!ResolvePoints(*mesh, "sources", &*sources, &locator, &error) ||
-        (!ends.empty() && !ResolvePoints(*mesh, "path", &ends, &locator, &error))) {
-      return Fail(kExitUsage, error);
-    }
-    absl::StatusOr<DistanceField> field = ComputeDistanceField(*mesh, *sources);
-    if (!field.ok()) return Fail(kExitSolveFailed, std::string(field.status().message()));
-    layers.field = *std::move(field);
-    if (isoline_count) layers.isolines = *ExtractIsolines(*mesh, layers.field, levels);
-    if (voronoi) layers.voronoi = *BuildVoronoi(*mesh, layers.field);
-    if (delaunay) {
-      absl::StatusOr<DelaunayTriangulation> d = BuildDelaunay(*mesh, layers.field);
-      if (!d.ok()) return Fail(kExitSolveFailed, std::string(d.status().message()));
-      layers.delaunay = *std::move(d);
-    }
-    if (!ends.empty()) {
-      absl::StatusOr<PathQueryResult> p = ComputeShortestPath(*mesh, ends[0], ends[1]);
-      if (!p.ok()) return Fail(kExitSolveFailed, std::string(p.status().message()));
-      layers.path = *std::move(p);
-    }
-  } else {
-    std::unique_ptr<RemoteGeometry> remote = ConnectRemoteGeometry(server);
-    if (remote == nullptr) return RunRemote(server, "render", args);
-    if (absl::Status s = remote->Prepare(positional[0], &*sources); !s.ok()) return FailRemote(s);
-    if (absl::Status s = ends.empty() ? absl::OkStatus() : remote->Prepare(positional[0], &ends);
-        !s.ok()) {
-      return FailRemote(s);
-    }
-    absl::StatusOr<DistanceField> field = remote->ComputeField(*sources);
-    if (!field.ok()) return FailRemote(field.status());
-    layers.field = *std::move(field);
-    if (isoline_count) {
-      absl::StatusOr<Isolines> iso = remote->ComputeIsolines(*sources, levels);
-      if (!iso.ok()) return FailRemote(iso.status());
-      layers.isolines = *std::move(iso);
-    }
-    if (voronoi) {
-      absl::StatusOr<VoronoiDiagram> v = remote->ComputeVoronoi(*sources);
-      if (!v.ok()) return FailRemote(v.status());
-      layers.voronoi = *std::move(v);
-    }
-    if (delaunay) {
-      absl::StatusOr<DelaunayTriangulation> d = remote->ComputeDelaunay(*sources);
-      if (!d.ok()) return FailRemote(d.status());
-      layers.delaunay = *std::move(d);
-    }
-    if (!ends.empty()) {
-      absl::StatusOr<PathQueryResult> p = remote->ComputePath(ends[0], ends[1]);
-      if (!p.ok()) return FailRemote(p.status());
-      layers.path = *std::move(p);
-    }
+  absl::StatusOr<DistanceField> field = backend.Field(*sources, FieldOptions{});
+  if (!field.ok()) return FailQuery(field.status());
+  layers.field = *std::move(field);
+  if (isoline_count) {
+    absl::StatusOr<Isolines> iso = backend.ComputeIsolines(*sources, levels);
+    if (!iso.ok()) return FailQuery(iso.status());
+    layers.isolines = *std::move(iso);
+  }
+  if (voronoi) {
+    absl::StatusOr<VoronoiDiagram> v = backend.ComputeVoronoi(*sources);
+    if (!v.ok()) return FailQuery(v.status());
+    layers.voronoi = *std::move(v);
+  }
+  if (delaunay) {
+    absl::StatusOr<DelaunayTriangulation> d = backend.ComputeDelaunay(*sources);
+    if (!d.ok()) return FailQuery(d.status());
+    layers.delaunay = *std::move(d);
+  }
+  if (!ends.empty()) {
+    absl::StatusOr<PathQueryResult> p = backend.Path(ends[0], ends[1], PathQueryOptions{});
+    if (!p.ok()) return FailQuery(p.status());
+    layers.path = *std::move(p);
   }
 
   render::Scene scene;
-  scene.mesh = &*data;
+  scene.mesh = *data;
   scene.vertex_colors = render::FieldColors(layers.field.distance);
   for (const IsolinePolyline& line : layers.isolines.polylines) {
     scene.lines.push_back({Positions(line.points), line.closed, Rgb{25, 25, 25}, 1.5});
@@ -172,17 +146,17 @@ int RunRender(const Args& args, const std::string& server) {
   }
   if (!layers.path.path.points.empty()) {
     scene.lines.push_back({Positions(layers.path.path.points), false, Rgb{220, 20, 60}, 3});
-    for (const SurfacePoint& p : ends) scene.markers.push_back(PositionOf(*data, p));
+    for (const SurfacePoint& p : ends) scene.markers.push_back(PositionOf(**data, p));
   }
-  for (const SurfacePoint& p : *sources) scene.markers.push_back(PositionOf(*data, p));
+  for (const SurfacePoint& p : *sources) scene.markers.push_back(PositionOf(**data, p));
 
   absl::Status written;
   if (EndsWith(output, ".png")) {
     written = render::WritePng(output, render::Render(scene, *view, width, height));
   } else if (EndsWith(output, ".ply")) {
-    written = render::WriteColoredPly(output, *data, scene.vertex_colors, layers.field.distance);
+    written = render::WriteColoredPly(output, **data, scene.vertex_colors, layers.field.distance);
   } else {
-    written = render::WriteGltf(output, *data, scene.vertex_colors);
+    written = render::WriteGltf(output, **data, scene.vertex_colors);
   }
   if (!written.ok()) {  // a path we cannot write is a bad argument; a libpng failure is not
     return Fail(absl::IsInternal(written) ? kExitInput : kExitUsage,

@@ -10,6 +10,8 @@
 
 namespace geodex::cli {
 
-int RunRender(const Args& args, const std::string& server = "");
+class Backend;
+
+int RunRender(Backend& backend, const Args& args);
 
 }  // namespace geodex::cli

@@ -1,12 +1,15 @@
-// geodex: the command line. Thin: parses the command and hands over to cli_commands.cc (local)
-// or cli_remote.cc (--server).
+// geodex: the command line. Thin: parses the command and runs it on a backend (cli_backend.h):
+// this process, or a geodexd with --server.
 
 #include <cctype>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <memory>
 #include <string>
+#include <utility>
 
+#include "cli_backend.h"
 #include "cli_commands.h"
 #include "cli_common.h"
 #include "cli_geometry.h"
@@ -177,24 +180,25 @@ int main(int argc, char** argv) {
   }
   // A terminal sees elapsed time for anything that takes more than a second.
   Progress progress(server.empty() ? command : command + " on " + server);
-  // The section-6 geometry is formatted by cli_geometry.cc in both modes.
-  if (command == "isolines") return RunIsolines(args, server);
-  if (command == "render") return RunRender(args, server);
-  if (command == "voronoi") return RunVoronoi(args, server);
-  if (command == "delaunay") return RunDelaunay(args, server);
-  if (!server.empty()) return RunRemote(server, command, args);
   if (command == "mesh" || command == "health") {
+    if (!server.empty()) return RunServerCommand(server, command, args);
     std::fprintf(stderr, "geodex: '%s' talks to a server: use --server HOST:PORT\n",
                  command.c_str());
     return kExitUsage;
   }
-  if (command == "info") return RunInfo(args);
-  if (command == "distances") return RunDistances(args);
-  if (command == "path") return RunPath(args);
-  if (command == "matrix") return RunMatrix(args);
-  if (command == "isolines") return RunIsolines(args);
-  if (command == "voronoi") return RunVoronoi(args);
-  if (command == "delaunay") return RunDelaunay(args);
+  // Every query command is written once against a backend: this process, or the server.
+  using Command = int (*)(Backend&, const Args&);
+  static const std::pair<const char*, Command> kCommands[] = {
+      {"info", RunInfo},         {"distances", RunDistances}, {"path", RunPath},
+      {"matrix", RunMatrix},     {"isolines", RunIsolines},   {"voronoi", RunVoronoi},
+      {"delaunay", RunDelaunay}, {"render", RunRender},
+  };
+  for (const auto& [name, run] : kCommands) {
+    if (command != name) continue;
+    std::unique_ptr<Backend> backend = server.empty() ? MakeLocalBackend() : MakeRemoteBackend(server);
+    if (backend == nullptr) return RunServerCommand(server, command, args);  // built without gRPC
+    return run(*backend, args);
+  }
   std::fprintf(stderr, "geodex: unknown command '%s' (see geodex --help)\n", command.c_str());
   return kExitUsage;
 }

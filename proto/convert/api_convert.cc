@@ -1,5 +1,7 @@
 #include "api_convert.h"
 
+#include <cmath>
+
 namespace geodex::api {
 
 void SurfacePointToProto(const SurfacePoint& point, v1::SurfacePoint* out) {
@@ -94,6 +96,14 @@ SolveStats StatsFromProto(const v1::SolveStats& stats) {
   s.peak_bytes = stats.peak_bytes();
   s.solve_ms = stats.solve_ms();
   return s;
+}
+
+void SolverOptionsToProto(const GeodesicOptions& options, v1::SolverOptions* out) {
+  out->set_lambda(options.lambda);
+  out->set_lambda_scale(options.lambda_scale == LambdaScale::kMeanEdge
+                            ? v1::LAMBDA_SCALE_MEAN_EDGE
+                            : v1::LAMBDA_SCALE_MAX_EDGE);
+  if (std::isfinite(options.max_distance)) out->set_max_distance(options.max_distance);
 }
 
 }  // namespace geodex::api

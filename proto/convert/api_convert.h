@@ -7,6 +7,7 @@
 #include <array>
 
 #include "geodex/distance_field.h"
+#include "geodex/geodesic_solver.h"
 #include "geodex/shortest_path.h"
 #include "geodex/surface_point.h"
 #include "geodex/v1/geodex.pb.h"
@@ -25,5 +26,9 @@ PathPoint PathPointFromProto(const v1::PathPoint& point);
 void StatsToProto(const SolveStats& stats, v1::SolveStats* out);
 // The counters the API carries (windows_filtered goes to windows_filtered_at_pop).
 SolveStats StatsFromProto(const v1::SolveStats& stats);
+
+// The request's solver options: lambda, its scale and max_distance (the server's conversion back,
+// with validation and its window limit, is server/proto_convert.h's SolverOptionsFromProto).
+void SolverOptionsToProto(const GeodesicOptions& options, v1::SolverOptions* out);
 
 }  // namespace geodex::api

@@ -70,6 +70,34 @@ for ext in obj svg; do
   check "voronoi --output .$ext non-empty" test -s "$tmp/remote.$ext"
 done
 same "lambda" distances "$DATA/kitten.off" --sources 0 --lambda 0.1 --lambda-scale mean
+# One command, two backends: the options that used to differ between the modes.
+same "path lambda" path "$DATA/kitten.off" --from 3 --to 400 --lambda 0.2 --max-distance 500
+same "matrix lambda" matrix "$DATA/kitten.off" --sources 0,9 --targets 2,44 --lambda 0.1 --lambda-scale mean
+same "matrix k-nearest" matrix "$DATA/kitten.off" --sources 0,9,30 --targets 2,44,100,7 --k-nearest 2
+same "matrix max-distance" matrix "$DATA/kitten.off" --sources 0,9 --targets 2,44,1000 --max-distance 0.3
+"$GEODEX" render "$DATA/knight.off" --sources 0 --isolines 4 --path 3 400 --output "$tmp/local.ply"
+"${R[@]}" render "$DATA/knight.off" --sources 0 --isolines 4 --path 3 400 --output "$tmp/remote.ply"
+check "render: identical .ply" cmp -s "$tmp/local.ply" "$tmp/remote.ply"
+same_error() {  # same_error NAME ARGS...: the same exit code and a one-line message in both modes
+  local name="$1"
+  shift
+  "$GEODEX" "$@" >/dev/null 2>"$tmp/local.err"
+  local lrc=$?
+  "${R[@]}" "$@" >/dev/null 2>"$tmp/remote.err"
+  local rrc=$?
+  check "$name: exit codes ($lrc local, $rrc remote)" test "$lrc" -eq "$rrc" -a "$lrc" -ne 0
+  check "$name: one line each" test "$(cat "$tmp/local.err" "$tmp/remote.err" | wc -l)" -eq 2
+}
+same_error "bad option" matrix "$DATA/kitten.off" --sources 0 --targets 1 --bogus 1
+same_error "unreachable target" path "$DATA/kitten.off" --from 3 --to 400 --max-distance 1
+same_error "bad lambda" path "$DATA/kitten.off" --from 3 --to 400 --lambda 2
+same_error "two --from points" path "$DATA/kitten.off" --from 3,4 --to 400
+for flag in "--max-windows 10" "--no-filter" "--method dijkstra"; do
+  "${R[@]}" distances "$DATA/kitten.off" --sources 0 $flag 2>"$tmp/err.txt" >/dev/null
+  check "remote $flag: exit 2" test $? -eq 2
+  check "remote $flag: names the flag" grep -q -- "^geodex: ${flag%% *}" "$tmp/err.txt"
+  check "remote $flag: says why" grep -q "geodexd\|local only" "$tmp/err.txt"
+done
 same "position source" path "$DATA/kitten.off" --from p:0:0:0 --to 100
 "$GEODEX" distances "$DATA/knight.off" --sources 0 --output "$tmp/local-out.txt"
 "${R[@]}" distances "$DATA/knight.off" --sources 0 --output "$tmp/remote-out.txt"

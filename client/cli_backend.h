@@ -1,0 +1,95 @@
+#pragma once
+
+// Where a geodex command runs: in this process (core) or on a geodexd (--server HOST:PORT). Each
+// command is written once against this interface (cli_commands.cc, cli_geometry.cc,
+// cli_render.cc), so it takes the same options and prints the same output in both modes.
+// LocalBackend is in cli_local_backend.cc, RemoteBackend in cli_remote.cc.
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "cli_common.h"
+#include "geodex/delaunay.h"
+#include "geodex/distance_field.h"
+#include "geodex/distance_matrix.h"
+#include "geodex/geodesic_solver.h"
+#include "geodex/isolines.h"
+#include "geodex/mesh_data.h"
+#include "geodex/shortest_path.h"
+#include "geodex/surface_point.h"
+#include "geodex/voronoi.h"
+
+namespace geodex::cli {
+
+// What a field-only option asks of the solver beyond GeodesicOptions' exact ICH defaults.
+struct FieldOptions {
+  GeodesicOptions solver;
+  std::string method = "exact";  // exact | ich | dijkstra (the name, for --stats)
+};
+
+// One point of `distances --at`: the unfolding estimate, the exact distance and its source.
+struct AtValue {
+  double estimate = 0, exact = 0;
+  uint32_t source = 0;
+};
+
+class Backend {
+ public:
+  virtual ~Backend() = default;
+
+  // Opens MESH: a file or sample:NAME; remotely also a mesh id or a name the server knows (a file
+  // is uploaded only if the server lacks it). Its errors are the mesh's (exit 3).
+  virtual absl::Status Open(const std::string& mesh, const MeshBuildOptions& build) = 0;
+  // False, with *error naming the flag, for an option this backend cannot honour (a remote call
+  // leaves engine ablations, threads and the window budget to geodexd).
+  virtual bool Supports(const Args& args, std::string* error) const = 0;
+  // Snaps p:X:Y:Z points to the surface and checks every point against the mesh; errors name
+  // `option` (exit 2).
+  virtual absl::Status Resolve(const std::string& option, std::vector<SurfacePoint>* points) = 0;
+  // The mesh as read, file coordinates: what draws a picture or places a site.
+  virtual absl::StatusOr<const MeshData*> Geometry() = 0;
+
+  virtual absl::StatusOr<InfoValues> Info() = 0;
+  virtual absl::StatusOr<DistanceField> Field(const std::vector<SurfacePoint>& sources,
+                                              const FieldOptions& options) = 0;
+  virtual absl::StatusOr<std::vector<AtValue>> DistancesAt(const std::vector<SurfacePoint>& sources,
+                                                           const std::vector<SurfacePoint>& at,
+                                                           const GeodesicOptions& options) = 0;
+  virtual absl::StatusOr<PathQueryResult> Path(const SurfacePoint& from, const SurfacePoint& to,
+                                               const PathQueryOptions& options) = 0;
+  // options.on_row sees rows as they are solved (locally) or arrive (remotely).
+  virtual absl::StatusOr<DistanceMatrix> Matrix(const std::vector<SurfacePoint>& sources,
+                                                const std::vector<SurfacePoint>& targets,
+                                                const MatrixOptions& options) = 0;
+  // Section 6 geometry of the exact field of `sources` (a local backend solves it once for all).
+  virtual absl::StatusOr<Isolines> ComputeIsolines(const std::vector<SurfacePoint>& sources,
+                                                   const IsolineOptions& levels) = 0;
+  virtual absl::StatusOr<VoronoiDiagram> ComputeVoronoi(const std::vector<SurfacePoint>& sites) = 0;
+  virtual absl::StatusOr<DelaunayTriangulation> ComputeDelaunay(
+      const std::vector<SurfacePoint>& sites) = 0;
+
+  // --stats members that say where the work ran, as `"key": value, ` pairs: the load and build
+  // times locally; the server, replica, mesh and cache remotely.
+  virtual std::string StatsContext() const = 0;
+};
+
+std::unique_ptr<Backend> MakeLocalBackend();
+// nullptr when this geodex was built without gRPC.
+std::unique_ptr<Backend> MakeRemoteBackend(const std::string& target);
+
+// The exit code of a failed query, the same in both modes: a bad argument 2 (INVALID_ARGUMENT,
+// OUT_OF_RANGE), an unknown or unreadable mesh 3 (NOT_FOUND, DATA_LOSS), anything else 1
+// (cancelled, budget, unreachable target).
+int QueryExitCode(const absl::Status& status);
+// Prints the status as one line and returns QueryExitCode.
+int FailQuery(const absl::Status& status);
+// Backend::Open, or the one-line failure's exit code: 3 for the mesh (unreadable, invalid,
+// unknown), 1 when the service failed (unauthenticated, unavailable, over its limits).
+int OpenMesh(Backend& backend, const std::string& mesh, const MeshBuildOptions& build);
+
+}  // namespace geodex::cli

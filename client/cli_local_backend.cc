@@ -1,0 +1,183 @@
+// The local backend: every query runs in this process on core. The mesh is read and built once
+// per command; the field of the last sources is kept so that a command needing the field and the
+// geometry derived from it (render, isolines) solves once.
+
+#include <chrono>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "cli_backend.h"
+#include "geodex/locate.h"
+#include "geodex/point_distance.h"
+#include "geodex/triangle_mesh.h"
+
+namespace geodex::cli {
+namespace {
+
+std::string Key(const std::vector<SurfacePoint>& sources, const FieldOptions& o) {
+  std::string key = absl::StrFormat("%s|%.17g|%d|%.17g|%d|%d|%d|", o.method, o.solver.lambda,
+                                    static_cast<int>(o.solver.lambda_scale), o.solver.max_distance,
+                                    o.solver.max_windows, o.solver.use_filter,
+                                    o.solver.use_one_angle_one_split);
+  for (const SurfacePoint& p : sources) absl::StrAppend(&key, SurfacePointToString(p), ",");
+  return key;
+}
+
+// Core says NOT_FOUND for a target no source reaches; as geodexd does, the CLI treats that as a
+// failed computation (FAILED_PRECONDITION, exit 1), keeping NOT_FOUND for an unknown mesh.
+template <typename T>
+absl::StatusOr<T> Reachable(absl::StatusOr<T> result) {
+  if (result.status().code() == absl::StatusCode::kNotFound) {
+    return absl::FailedPreconditionError(result.status().message());
+  }
+  return result;
+}
+
+class LocalBackend final : public Backend {
+ public:
+  absl::Status Open(const std::string& mesh, const MeshBuildOptions& build) override {
+    absl::StatusOr<LoadedMesh> loaded = LoadMesh(mesh, build);
+    if (!loaded.ok()) return loaded.status();
+    loaded_ = std::make_unique<LoadedMesh>(*std::move(loaded));
+    return absl::OkStatus();
+  }
+
+  bool Supports(const Args&, std::string*) const override { return true; }
+
+  absl::Status Resolve(const std::string& option, std::vector<SurfacePoint>* points) override {
+    std::string error;
+    if (!ResolvePoints(loaded_->mesh, option, points, &locator_, &error)) {
+      return absl::InvalidArgumentError(error);
+    }
+    return absl::OkStatus();
+  }
+
+  absl::StatusOr<const MeshData*> Geometry() override { return &loaded_->data; }
+
+  absl::StatusOr<InfoValues> Info() override {
+    const TriangleMesh& mesh = loaded_->mesh;
+    InfoValues v;
+    v.report = mesh.report();
+    v.internal_vertices = mesh.vertex_count();
+    v.mean_edge_length = mesh.MeanEdgeLength();
+    v.max_edge_length = mesh.MaxEdgeLength();
+    v.bbox_min = mesh.BoundsMin();
+    v.bbox_max = mesh.BoundsMax();
+    v.bytes = mesh.MemoryBytes();
+    v.load_ms = loaded_->load_ms;
+    v.build_ms = loaded_->build_ms;
+    return v;
+  }
+
+  absl::StatusOr<DistanceField> Field(const std::vector<SurfacePoint>& sources,
+                                      const FieldOptions& options) override {
+    absl::StatusOr<const DistanceField*> f = CachedField(sources, options);
+    if (!f.ok()) return f.status();
+    return **f;
+  }
+
+  absl::StatusOr<std::vector<AtValue>> DistancesAt(const std::vector<SurfacePoint>& sources,
+                                                   const std::vector<SurfacePoint>& at,
+                                                   const GeodesicOptions& options) override {
+    FieldOptions field_options;
+    field_options.solver = options;
+    absl::StatusOr<const DistanceField*> field = CachedField(sources, field_options);
+    if (!field.ok()) return field.status();
+    absl::StatusOr<std::vector<std::pair<double, uint32_t>>> exact =
+        Reachable(ComputeExactDistancesAt(loaded_->mesh, sources, at, options));
+    if (!exact.ok()) return exact.status();
+    std::vector<AtValue> out;
+    for (size_t i = 0; i < at.size(); ++i) {
+      absl::StatusOr<PointEstimate> est = EstimateDistanceAt(loaded_->mesh, **field, at[i]);
+      if (!est.ok()) {
+        return absl::InvalidArgumentError(absl::StrCat("--at: ", est.status().message()));
+      }
+      out.push_back({est->distance, (*exact)[i].first, (*exact)[i].second});
+    }
+    return out;
+  }
+
+  absl::StatusOr<PathQueryResult> Path(const SurfacePoint& from, const SurfacePoint& to,
+                                       const PathQueryOptions& options) override {
+    return Reachable(ComputeShortestPath(loaded_->mesh, from, to, options));
+  }
+
+  absl::StatusOr<DistanceMatrix> Matrix(const std::vector<SurfacePoint>& sources,
+                                        const std::vector<SurfacePoint>& targets,
+                                        const MatrixOptions& options) override {
+    return Reachable(ComputeDistanceMatrix(loaded_->mesh, sources, targets, options));
+  }
+
+  absl::StatusOr<Isolines> ComputeIsolines(const std::vector<SurfacePoint>& sources,
+                                           const IsolineOptions& levels) override {
+    absl::StatusOr<const DistanceField*> field = CachedField(sources, FieldOptions{});
+    if (!field.ok()) return field.status();
+    return ExtractIsolines(loaded_->mesh, **field, levels);
+  }
+
+  absl::StatusOr<VoronoiDiagram> ComputeVoronoi(const std::vector<SurfacePoint>& sites) override {
+    absl::StatusOr<const DistanceField*> field = CachedField(sites, FieldOptions{});
+    if (!field.ok()) return field.status();
+    return BuildVoronoi(loaded_->mesh, **field);
+  }
+
+  absl::StatusOr<DelaunayTriangulation> ComputeDelaunay(
+      const std::vector<SurfacePoint>& sites) override {
+    absl::StatusOr<const DistanceField*> field = CachedField(sites, FieldOptions{});
+    if (!field.ok()) return field.status();
+    return BuildDelaunay(loaded_->mesh, **field);
+  }
+
+  std::string StatsContext() const override {
+    return absl::StrFormat(
+        "\"vertices\": %u, \"faces\": %u, \"mesh_bytes\": %llu, \"load_ms\": %.3f, "
+        "\"build_ms\": %.3f, ",
+        loaded_->mesh.file_vertex_count(), loaded_->mesh.face_count(),
+        static_cast<unsigned long long>(loaded_->mesh.MemoryBytes()), loaded_->load_ms,
+        loaded_->build_ms);
+  }
+
+ private:
+  absl::StatusOr<const DistanceField*> CachedField(const std::vector<SurfacePoint>& sources,
+                                                   const FieldOptions& options) {
+    const std::string key = Key(sources, options);
+    if (field_ != nullptr && key == field_key_) return field_.get();
+    absl::StatusOr<DistanceField> field =
+        ComputeDistanceField(loaded_->mesh, sources, options.solver);
+    if (!field.ok()) return field.status();
+    field_ = std::make_unique<DistanceField>(*std::move(field));
+    field_key_ = key;
+    return field_.get();
+  }
+
+  std::unique_ptr<LoadedMesh> loaded_;
+  std::unique_ptr<SurfaceLocator> locator_;  // built on the first p:X:Y:Z point
+  std::unique_ptr<DistanceField> field_;     // the last sources' field
+  std::string field_key_;
+};
+
+}  // namespace
+
+std::unique_ptr<Backend> MakeLocalBackend() { return std::make_unique<LocalBackend>(); }
+
+int QueryExitCode(const absl::Status& status) {
+  switch (status.code()) {
+    case absl::StatusCode::kInvalidArgument:
+    case absl::StatusCode::kOutOfRange:
+      return kExitUsage;
+    case absl::StatusCode::kNotFound:
+    case absl::StatusCode::kDataLoss:
+      return kExitInput;
+    default:
+      return kExitSolveFailed;
+  }
+}
+
+int FailQuery(const absl::Status& status) {
+  return Fail(QueryExitCode(status), std::string(status.message()));
+}
+
+}  // namespace geodex::cli
