@@ -19,6 +19,7 @@
 #include "geodex/distance_matrix.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/isolines.h"
+#include "geodex/locate.h"
 #include "geodex/mesh_data.h"
 #include "geodex/shortest_path.h"
 #include "geodex/surface_point.h"
@@ -48,9 +49,13 @@ class Backend {
   // False, with *error naming the flag, for an option this backend cannot honour (a remote call
   // leaves engine ablations, threads and the window budget to geodexd).
   virtual bool Supports(const Args& args, std::string* error) const = 0;
-  // Snaps p:X:Y:Z points to the surface and checks every point against the mesh; errors name
-  // `option` (exit 2).
-  virtual absl::Status Resolve(const std::string& option, std::vector<SurfacePoint>* points) = 0;
+  // The nearest surface points to 3D positions (file coordinates), with how far each moved.
+  virtual absl::StatusOr<std::vector<LocatedPoint>> Locate(
+      const std::vector<std::array<double, 3>>& xyz) = 0;
+  // Checks vertex, edge and face points against the mesh (remotely the server checks them with
+  // the query); errors name `option` (exit 2).
+  virtual absl::Status Check(const std::string& option,
+                             const std::vector<SurfacePoint>& points) = 0;
   // The mesh as read, file coordinates: what draws a picture or places a site.
   virtual absl::StatusOr<const MeshData*> Geometry() = 0;
 
@@ -77,6 +82,21 @@ class Backend {
   // times locally; the server, replica, mesh and cache remotely.
   virtual std::string StatsContext() const = 0;
 };
+
+// Snapping is never silent: the farthest a command's p:X:Y:Z points moved onto the surface.
+struct SnapReport {
+  double max_distance = 0;
+  std::string point;  // that point's SPEC, "" when no position was given
+};
+// A snap farther than this fraction of the mesh's bounding-box diagonal is warned about on stderr.
+inline constexpr double kSnapWarnRel = 0.01;
+// Snaps `points`' p:X:Y:Z entries on the backend, refusing any farther than --max-snap (when
+// given) and warning above kSnapWarnRel, then checks every point. Errors name --`option`.
+absl::Status ResolvePoints(Backend& backend, const Args& args, const std::string& option,
+                           std::vector<SurfacePoint>* points, SnapReport* report);
+// Parses --`option` (which must be present), then ResolvePoints.
+absl::Status ResolveOption(Backend& backend, const Args& args, const std::string& option,
+                           std::vector<SurfacePoint>* points, SnapReport* report);
 
 std::unique_ptr<Backend> MakeLocalBackend();
 // nullptr when this geodex was built without gRPC.

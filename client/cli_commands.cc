@@ -3,7 +3,9 @@
 #include "cli_backend.h"
 #include "cli_common.h"
 
+#include <array>
 #include <chrono>
+#include <limits>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -52,25 +54,74 @@ bool ParseArgs(int argc, char** argv, int first, const std::vector<std::string>&
   return true;
 }
 
-namespace {
-
-// Parses --`key` (which must be present), then snaps and checks its points on the backend's mesh.
-absl::Status Points(Backend& backend, const Args& args, const std::string& key,
-                    std::vector<SurfacePoint>* out) {
-  absl::StatusOr<std::vector<SurfacePoint>> p = ParseSurfacePoints(args.options.at(key));
-  if (!p.ok()) {
-    return absl::InvalidArgumentError(absl::StrFormat("--%s: %s", key, p.status().message()));
+absl::Status ResolvePoints(Backend& backend, const Args& args, const std::string& option,
+                           std::vector<SurfacePoint>* points, SnapReport* report) {
+  double max_snap = std::numeric_limits<double>::infinity();
+  std::string error;
+  if (!GetDouble(args, "max-snap", &max_snap, &error)) return absl::InvalidArgumentError(error);
+  if (!(max_snap > 0)) return absl::InvalidArgumentError("--max-snap must be positive");
+  std::vector<std::array<double, 3>> xyz;
+  for (const SurfacePoint& p : *points) {
+    if (p.kind == SurfacePoint::Kind::kPosition) xyz.push_back(p.position);
   }
-  if (absl::Status s = backend.Resolve(key, &*p); !s.ok()) return s;
-  *out = *std::move(p);
+  if (!xyz.empty()) {
+    absl::StatusOr<std::vector<LocatedPoint>> located = backend.Locate(xyz);
+    if (!located.ok()) {
+      return absl::Status(located.status().code(),
+                          absl::StrFormat("--%s: %s", option, located.status().message()));
+    }
+    double warn_above = std::numeric_limits<double>::infinity();
+    size_t k = 0;
+    for (SurfacePoint& p : *points) {
+      if (p.kind != SurfacePoint::Kind::kPosition) continue;
+      const LocatedPoint& at = (*located)[k++];
+      if (absl::Status s = CheckSnapDistance(p.position, at, max_snap); !s.ok()) {
+        return absl::InvalidArgumentError(absl::StrFormat("--%s: %s", option, s.message()));
+      }
+      if (at.distance > 0 && !std::isfinite(warn_above)) {  // the mesh's size, on first need
+        absl::StatusOr<InfoValues> info = backend.Info();
+        if (!info.ok()) return info.status();
+        double d2 = 0;
+        for (int c = 0; c < 3; ++c) {
+          d2 += (info->bbox_max[c] - info->bbox_min[c]) * (info->bbox_max[c] - info->bbox_min[c]);
+        }
+        warn_above = kSnapWarnRel * std::sqrt(d2);
+      }
+      if (at.distance > warn_above) {
+        std::fprintf(stderr,
+                     "geodex: warning: --%s: %s is %.6g from the surface; snapped to %s (--max-snap "
+                     "D refuses such points)\n",
+                     option.c_str(), SurfacePointToString(p).c_str(), at.distance,
+                     SurfacePointToString(at.point).c_str());
+      }
+      if (report != nullptr && at.distance >= report->max_distance) {
+        report->max_distance = at.distance;
+        report->point = SurfacePointToString(p);
+      }
+      p = at.point;
+    }
+  }
+  return backend.Check(option, *points);
+}
+
+absl::Status ResolveOption(Backend& backend, const Args& args, const std::string& option,
+                           std::vector<SurfacePoint>* points, SnapReport* report) {
+  absl::StatusOr<std::vector<SurfacePoint>> p = ParseSurfacePoints(args.options.at(option));
+  if (!p.ok()) {
+    return absl::InvalidArgumentError(absl::StrFormat("--%s: %s", option, p.status().message()));
+  }
+  if (absl::Status s = ResolvePoints(backend, args, option, &*p, report); !s.ok()) return s;
+  *points = *std::move(p);
   return absl::OkStatus();
 }
 
+namespace {
+
 // A SPEC that must name exactly one point.
 absl::Status OnePoint(Backend& backend, const Args& args, const std::string& key,
-                      SurfacePoint* out) {
+                      SurfacePoint* out, SnapReport* report) {
   std::vector<SurfacePoint> p;
-  if (absl::Status s = Points(backend, args, key, &p); !s.ok()) return s;
+  if (absl::Status s = ResolveOption(backend, args, key, &p, report); !s.ok()) return s;
   if (p.size() != 1) {
     return absl::InvalidArgumentError(
         absl::StrFormat("--%s: expected one point, got %d", key, p.size()));
@@ -150,6 +201,13 @@ bool GetSolverFlags(const Args& args, GeodesicOptions* options, std::string* err
 
 namespace {
 
+// --stats members for the farthest snap of a p:X:Y:Z point (none without positions).
+std::string SnapJson(const SnapReport& snap) {
+  if (snap.point.empty()) return "";
+  return absl::StrFormat("\"snap_max\": %.17g, \"snap_point\": \"%s\", ", snap.max_distance,
+                         snap.point);
+}
+
 // The counters every --stats line carries, after the backend's context.
 std::string StatsJson(const Backend& backend, const std::string& leading, const SolveStats& s,
                       const std::string& trailing) {
@@ -176,9 +234,12 @@ std::string StatsJson(const Backend& backend, const std::string& leading, const 
 
 int RunDistances(Backend& backend, const Args& args) {
   std::string error;
+  bool json = false;
   if (!CheckKnown(args, {"sources", "method", "lambda", "lambda-scale", "max-distance",
-                         "max-windows", "stats", "output", "no-filter", "no-one-split", "at"},
+                         "max-windows", "stats", "output", "no-filter", "no-one-split", "at",
+                         "max-snap", "format"},
                   &error) ||
+      !GetFormat(args, &json, &error) ||
       !backend.Supports(args, &error)) {
     return Fail(kExitUsage, error);
   }
@@ -203,9 +264,14 @@ int RunDistances(Backend& backend, const Args& args) {
   if (!parsed.ok()) return Fail(kExitUsage, "--sources: " + std::string(parsed.status().message()));
   if (int code = OpenMesh(backend, args.positional[0], MeshBuildOptions{})) return code;
   std::vector<SurfacePoint> sources, at;
-  if (absl::Status s = Points(backend, args, "sources", &sources); !s.ok()) return FailQuery(s);
+  SnapReport snap;
+  if (absl::Status s = ResolveOption(backend, args, "sources", &sources, &snap); !s.ok()) {
+    return FailQuery(s);
+  }
   if (args.options.count("at")) {
-    if (absl::Status s = Points(backend, args, "at", &at); !s.ok()) return FailQuery(s);
+    if (absl::Status s = ResolveOption(backend, args, "at", &at, &snap); !s.ok()) {
+      return FailQuery(s);
+    }
   }
   std::string text;
   SolveStats stats;
@@ -214,13 +280,20 @@ int RunDistances(Backend& backend, const Args& args) {
     // Surface points: the unfolding estimate and the exact value, one line each.
     absl::StatusOr<std::vector<AtValue>> values = backend.DistancesAt(sources, at, options.solver);
     if (!values.ok()) return FailQuery(values.status());
+    std::vector<double> estimate, exact;
+    std::vector<int64_t> source;
     for (size_t i = 0; i < at.size(); ++i) {
-      text += FormatAtLine(at[i], (*values)[i].estimate, (*values)[i].exact, (*values)[i].source);
+      const AtValue& v = (*values)[i];
+      if (!json) text += FormatAtLine(at[i], v.estimate, v.exact, v.source);
+      estimate.push_back(v.estimate);
+      exact.push_back(v.exact);
+      source.push_back(v.source == kNoIndex ? -1 : int64_t{v.source});
     }
+    if (json) text = FormatAtJson(at, estimate, exact, source);
   } else {
     absl::StatusOr<DistanceField> field = backend.Field(sources, options);
     if (!field.ok()) return FailQuery(field.status());
-    text = FormatDistances(field->distance);
+    text = json ? FormatDistancesJson(field->distance) : FormatDistances(field->distance);
     stats = field->stats;
   }
   if (stats.solve_ms == 0) stats.solve_ms = MsSince(t_solve);
@@ -228,7 +301,8 @@ int RunDistances(Backend& backend, const Args& args) {
   if (int code = WriteOutput(args, text); code != kExitOk) return code;
   if (args.options.count("stats")) {
     const std::string leading =
-        absl::StrFormat("\"method\": \"%s\", \"sources\": %d, ", options.method, sources.size());
+        absl::StrFormat("\"method\": \"%s\", \"sources\": %d, %s", options.method,
+                        sources.size(), SnapJson(snap));
     const std::string trailing = absl::StrFormat("\"output_ms\": %.3f, ", MsSince(t_out));
     std::fputs(StatsJson(backend, leading, stats, trailing).c_str(), stderr);
   }
@@ -237,9 +311,11 @@ int RunDistances(Backend& backend, const Args& args) {
 
 int RunPath(Backend& backend, const Args& args) {
   std::string error;
+  bool json = false;
   if (!CheckKnown(args, {"from", "to", "method", "stats", "lambda", "lambda-scale", "max-distance",
-                         "max-windows"},
+                         "max-windows", "max-snap", "format"},
                   &error) ||
+      !GetFormat(args, &json, &error) ||
       !backend.Supports(args, &error)) {
     return Fail(kExitUsage, error);
   }
@@ -258,15 +334,16 @@ int RunPath(Backend& backend, const Args& args) {
   if (!GetSolverFlags(args, &options.solver, &error)) return Fail(kExitUsage, error);
   if (int code = OpenMesh(backend, args.positional[0], MeshBuildOptions{})) return code;
   SurfacePoint from, to;
-  if (absl::Status s = OnePoint(backend, args, "from", &from); !s.ok()) return FailQuery(s);
-  if (absl::Status s = OnePoint(backend, args, "to", &to); !s.ok()) return FailQuery(s);
+  SnapReport snap;
+  if (absl::Status s = OnePoint(backend, args, "from", &from, &snap); !s.ok()) return FailQuery(s);
+  if (absl::Status s = OnePoint(backend, args, "to", &to, &snap); !s.ok()) return FailQuery(s);
   absl::StatusOr<PathQueryResult> result = backend.Path(from, to, options);
   if (!result.ok()) return FailQuery(result.status());
-  const std::string text = FormatPath(*result);
+  const std::string text = json ? FormatPathJson(*result) : FormatPath(*result);
   std::fwrite(text.data(), 1, text.size(), stdout);
   if (args.options.count("stats")) {
-    const std::string leading = absl::StrFormat("\"method\": \"%s\", \"path_points\": %d, ",
-                                                method, result->path.points.size());
+    const std::string leading = absl::StrFormat("\"method\": \"%s\", \"path_points\": %d, %s",
+                                                method, result->path.points.size(), SnapJson(snap));
     std::fputs(StatsJson(backend, leading, result->stats, "").c_str(), stderr);
   }
   return kExitOk;
@@ -274,9 +351,11 @@ int RunPath(Backend& backend, const Args& args) {
 
 int RunMatrix(Backend& backend, const Args& args) {
   std::string error;
+  bool json = false;
   if (!CheckKnown(args, {"sources", "targets", "stats", "lambda", "lambda-scale", "max-distance",
-                         "max-windows", "k-nearest", "threads"},
+                         "max-windows", "k-nearest", "threads", "max-snap", "format"},
                   &error) ||
+      !GetFormat(args, &json, &error) ||
       !backend.Supports(args, &error)) {
     return Fail(kExitUsage, error);
   }
@@ -299,19 +378,72 @@ int RunMatrix(Backend& backend, const Args& args) {
   options.on_row = [&progress](size_t done, size_t total) { progress.Update(done, total); };
   if (int code = OpenMesh(backend, args.positional[0], MeshBuildOptions{})) return code;
   std::vector<SurfacePoint> sources, targets;
-  if (absl::Status s = Points(backend, args, "sources", &sources); !s.ok()) return FailQuery(s);
-  if (absl::Status s = Points(backend, args, "targets", &targets); !s.ok()) return FailQuery(s);
+  SnapReport snap;
+  if (absl::Status s = ResolveOption(backend, args, "sources", &sources, &snap); !s.ok()) {
+    return FailQuery(s);
+  }
+  if (absl::Status s = ResolveOption(backend, args, "targets", &targets, &snap); !s.ok()) {
+    return FailQuery(s);
+  }
   absl::StatusOr<DistanceMatrix> m = backend.Matrix(sources, targets, options);
   progress.Finish();
   if (!m.ok()) return FailQuery(m.status());
-  const std::string text = FormatMatrix(*m);
+  const std::string text = json ? FormatMatrixJson(*m) : FormatMatrix(*m);
   std::fwrite(text.data(), 1, text.size(), stdout);
   if (args.options.count("stats")) {
-    const std::string leading = absl::StrFormat("\"rows\": %d, \"cols\": %d, \"threads\": %u, ",
-                                                m->rows, m->cols,
-                                                options.threads > 0 ? options.threads : UsableCores());
+    const std::string leading = absl::StrFormat(
+        "\"rows\": %d, \"cols\": %d, \"threads\": %u, %s", m->rows, m->cols,
+        options.threads > 0 ? options.threads : UsableCores(), SnapJson(snap));
     std::fputs(StatsJson(backend, leading, m->stats, "").c_str(), stderr);
   }
+  return kExitOk;
+}
+
+int RunLocate(Backend& backend, const Args& args) {
+  std::string error;
+  bool json = false;
+  if (!CheckKnown(args, {"points", "max-snap", "format"}, &error) ||
+      !GetFormat(args, &json, &error) || !backend.Supports(args, &error)) {
+    return Fail(kExitUsage, error);
+  }
+  if (args.positional.size() != 1 || !args.options.count("points")) {
+    return Fail(kExitUsage, "usage: geodex locate MESH --points p:X:Y:Z,... [--max-snap D]");
+  }
+  double max_snap = std::numeric_limits<double>::infinity();
+  if (!GetDouble(args, "max-snap", &max_snap, &error)) return Fail(kExitUsage, error);
+  if (!(max_snap > 0)) return Fail(kExitUsage, "--max-snap must be positive");
+  absl::StatusOr<std::vector<SurfacePoint>> points = ParseSurfacePoints(args.options.at("points"));
+  if (!points.ok()) return Fail(kExitUsage, "--points: " + std::string(points.status().message()));
+  std::vector<std::array<double, 3>> xyz;
+  for (const SurfacePoint& p : *points) {
+    if (p.kind != SurfacePoint::Kind::kPosition) {
+      return Fail(kExitUsage, absl::StrFormat("--points: %s is not a position (locate takes p:X:Y:Z)",
+                                              SurfacePointToString(p)));
+    }
+    xyz.push_back(p.position);
+  }
+  if (int code = OpenMesh(backend, args.positional[0], MeshBuildOptions{})) return code;
+  absl::StatusOr<std::vector<LocatedPoint>> located = backend.Locate(xyz);
+  if (!located.ok()) return FailQuery(located.status());
+  std::string text = json ? "{\"points\": [" : "";
+  for (size_t i = 0; i < xyz.size(); ++i) {
+    const LocatedPoint& at = (*located)[i];
+    if (absl::Status s = CheckSnapDistance(xyz[i], at, max_snap); !s.ok()) {
+      return Fail(kExitUsage, absl::StrFormat("--points: %s", s.message()));
+    }
+    const std::string query = SurfacePointToString((*points)[i]);
+    if (json) {
+      text += absl::StrFormat(
+          "%s{\"query\": \"%s\", \"point\": \"%s\", \"p\": %s, \"snap_distance\": %.17g}",
+          i ? ", " : "", query, SurfacePointToString(at.point), JsonXyz(at.position), at.distance);
+    } else {
+      text += absl::StrFormat("%s\t%s\t%.17g %.17g %.17g\tsnap %.17g\n", query,
+                              SurfacePointToString(at.point), at.position[0], at.position[1],
+                              at.position[2], at.distance);
+    }
+  }
+  if (json) text += "]}\n";
+  std::fwrite(text.data(), 1, text.size(), stdout);
   return kExitOk;
 }
 

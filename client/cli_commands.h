@@ -33,5 +33,6 @@ int RunInfo(Backend& backend, const Args& args);
 int RunDistances(Backend& backend, const Args& args);
 int RunPath(Backend& backend, const Args& args);
 int RunMatrix(Backend& backend, const Args& args);
+int RunLocate(Backend& backend, const Args& args);
 
 }  // namespace geodex::cli

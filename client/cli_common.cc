@@ -4,6 +4,7 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <condition_variable>
 #include <cstdio>
 #include <mutex>
@@ -13,6 +14,8 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_split.h"
+#include "absl/strings/str_join.h"
 #include "geodex/mesh_io.h"
 #include "geodex/samples.h"
 
@@ -81,29 +84,6 @@ bool CheckKnown(const Args& args, const std::set<std::string>& known, std::strin
   }
   return true;
 }
-
-bool ResolvePoints(const TriangleMesh& mesh, const std::string& option,
-                   std::vector<SurfacePoint>* points, std::unique_ptr<SurfaceLocator>* locator,
-                   std::string* error) {
-  for (SurfacePoint& p : *points) {
-    if (p.kind == SurfacePoint::Kind::kPosition) {
-      if (*locator == nullptr) *locator = std::make_unique<SurfaceLocator>(mesh);
-      absl::StatusOr<LocatedPoint> located = (*locator)->Locate(p.position);
-      if (!located.ok()) {
-        *error = absl::StrFormat("--%s: %s: %s", option, SurfacePointToString(p),
-                                 located.status().message());
-        return false;
-      }
-      p = located->point;
-    }
-    if (absl::Status s = ValidateSurfacePoint(mesh, p); !s.ok()) {
-      *error = absl::StrFormat("--%s: %s", option, s.message());
-      return false;
-    }
-  }
-  return true;
-}
-
 
 struct Progress::State {
   std::mutex mu;
@@ -224,9 +204,12 @@ std::string FormatInfo(const InfoValues& v, bool json) {
   }
   out = "{";
   for (size_t i = 0; i < rows.size(); ++i) {
-    const bool quoted = rows[i].first.rfind("bbox_", 0) == 0;
-    out += absl::StrFormat("%s\"%s\": %s%s%s", i ? ", " : "", rows[i].first, quoted ? "\"" : "",
-                           rows[i].second, quoted ? "\"" : "");
+    // A bounding-box corner is an array of three numbers in JSON.
+    const bool triple = rows[i].first.rfind("bbox_", 0) == 0;
+    out += absl::StrFormat("%s\"%s\": %s%s%s", i ? ", " : "", rows[i].first, triple ? "[" : "",
+                           triple ? absl::StrJoin(absl::StrSplit(rows[i].second, ' '), ", ")
+                                  : rows[i].second,
+                           triple ? "]" : "");
   }
   return out + "}\n";
 }
@@ -285,6 +268,83 @@ std::string FormatMatrix(const DistanceMatrix& m) {
     text += "\n";
   }
   return text;
+}
+
+std::string JsonNumber(double x) {
+  return std::isfinite(x) ? absl::StrFormat("%.17g", x) : "null";
+}
+
+std::string JsonXyz(const std::array<double, 3>& p) {
+  return absl::StrFormat("[%.17g, %.17g, %.17g]", p[0], p[1], p[2]);
+}
+
+std::string PathPointJson(const PathPoint& p) {
+  const SurfacePoint& w = p.where;
+  std::string s = "{\"p\": " + JsonXyz(p.position) + ", ";
+  switch (w.kind) {
+    case SurfacePoint::Kind::kVertex:
+      return s + absl::StrFormat("\"v\": %d}", w.vertex);
+    case SurfacePoint::Kind::kEdge:
+      return s + absl::StrFormat("\"e\": [%d, %d, %.17g]}", w.edge_from, w.edge_to, w.t);
+    case SurfacePoint::Kind::kFace:
+      return s + absl::StrFormat("\"f\": [%d, %.17g, %.17g, %.17g]}", w.face, w.bary[0], w.bary[1],
+                                 w.bary[2]);
+    case SurfacePoint::Kind::kPosition:
+      break;
+  }
+  return s + "\"position\": true}";
+}
+
+std::string FormatDistancesJson(const std::vector<double>& distances) {
+  std::string text = "{\"distances\": [";
+  text.reserve(distances.size() * 24);
+  for (size_t i = 0; i < distances.size(); ++i) {
+    if (i) text += ", ";
+    text += JsonNumber(distances[i]);
+  }
+  return text + "]}\n";
+}
+
+std::string FormatAtJson(const std::vector<SurfacePoint>& points, const std::vector<double>& estimate,
+                         const std::vector<double>& exact, const std::vector<int64_t>& source) {
+  std::string text = "{\"points\": [";
+  for (size_t i = 0; i < points.size(); ++i) {
+    text += absl::StrFormat(
+        "%s{\"point\": \"%s\", \"estimate\": %s, \"exact\": %s, \"source\": %s}",
+        i ? ", " : "", SurfacePointToString(points[i]), JsonNumber(estimate[i]),
+        JsonNumber(exact[i]), source[i] < 0 ? "null" : absl::StrCat(source[i]));
+  }
+  return text + "]}\n";
+}
+
+std::string FormatPathJson(const PathQueryResult& result) {
+  std::string text = "{\"length\": " + JsonNumber(result.distance) + ", \"points\": [";
+  for (size_t i = 0; i < result.path.points.size(); ++i) {
+    text += (i ? ", " : "") + PathPointJson(result.path.points[i]);
+  }
+  return text + "]}\n";
+}
+
+std::string FormatMatrixJson(const DistanceMatrix& m) {
+  std::string text = absl::StrFormat("{\"rows\": %d, \"cols\": %d, \"values\": [", m.rows, m.cols);
+  for (size_t i = 0; i < m.rows; ++i) {
+    text += i ? ", [" : "[";
+    for (size_t j = 0; j < m.cols; ++j) {
+      text += (j ? ", " : "") + JsonNumber(m.values[i * m.cols + j]);
+    }
+    text += "]";
+  }
+  return text + "]}\n";
+}
+
+bool GetFormat(const Args& args, bool* json, std::string* error) {
+  const std::string format = args.options.count("format") ? args.options.at("format") : "text";
+  if (format != "text" && format != "json") {
+    *error = "--format must be text or json";
+    return false;
+  }
+  *json = format == "json";
+  return true;
 }
 
 int WriteOutput(const Args& args, const std::string& text) {

@@ -43,12 +43,6 @@ bool GetUint(const Args& args, const std::string& key, uint64_t* out, std::strin
 // False with *error naming the first option not in `known`.
 bool CheckKnown(const Args& args, const std::set<std::string>& known, std::string* error);
 
-// Snaps `p:X:Y:Z` points onto the surface (the locator is built once, on first need), then checks
-// every point against the mesh. Errors name the option and the point.
-bool ResolvePoints(const TriangleMesh& mesh, const std::string& option,
-                   std::vector<SurfacePoint>* points, std::unique_ptr<SurfaceLocator>* locator,
-                   std::string* error);
-
 // While alive, shows "geodex: WHAT... 3.4 s" on stderr, refreshed, once the work has taken more than
 // a second, and only when stderr is a terminal (scripts and pipes see nothing). Cleared at the end.
 class Progress {
@@ -106,6 +100,23 @@ std::string FormatAtLine(const SurfacePoint& point, double estimate, double exac
 std::string FormatPath(const PathQueryResult& result);
 // One tab-separated row per source.
 std::string FormatMatrix(const DistanceMatrix& matrix);
+// --- JSON (--format json): %.17g numbers, null for an unreachable (infinite) distance ---
+std::string JsonNumber(double x);
+std::string JsonXyz(const std::array<double, 3>& p);
+// {"p": [x, y, z], "v": id} / "e": [from, to, t] / "f": [face, b0, b1, b2]
+std::string PathPointJson(const PathPoint& p);
+// {"distances": [...]}
+std::string FormatDistancesJson(const std::vector<double>& distances);
+// {"points": [{"point": SPEC, "estimate": e, "exact": d, "source": i}, ...]}
+std::string FormatAtJson(const std::vector<SurfacePoint>& points, const std::vector<double>& estimate,
+                         const std::vector<double>& exact, const std::vector<int64_t>& source);
+// {"length": L, "points": [PathPointJson, ...]}
+std::string FormatPathJson(const PathQueryResult& result);
+// {"rows": R, "cols": C, "values": [[...], ...]}
+std::string FormatMatrixJson(const DistanceMatrix& matrix);
+// --format text|json (absent: text). False with *error naming the flag.
+bool GetFormat(const Args& args, bool* json, std::string* error);
+
 // Writes `text` to --output FILE, or stdout. kExitOk, or kExitUsage naming the OS's reason.
 int WriteOutput(const Args& args, const std::string& text);
 

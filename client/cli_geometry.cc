@@ -49,7 +49,9 @@ int Prepare(Backend& backend, const Args& args, const std::string& key, Solved* 
     return Fail(kExitUsage, "--" + key + ": " + std::string(points.status().message()));
   }
   if (int code = OpenMesh(backend, args.positional[0], MeshBuildOptions{})) return code;
-  if (absl::Status s = backend.Resolve(key, &*points); !s.ok()) return FailQuery(s);
+  if (absl::Status s = ResolvePoints(backend, args, key, &*points, nullptr); !s.ok()) {
+    return FailQuery(s);
+  }
   out->points = *std::move(points);
   absl::StatusOr<const MeshData*> data = backend.Geometry();
   if (!data.ok()) return FailQuery(data.status());
@@ -84,31 +86,10 @@ bool OutputFormat(const Args& args, Format* format, std::string* error) {
 // --- JSON ------------------------------------------------------------------------------------
 
 std::string Num(double x) { return absl::StrFormat("%.17g", x); }
-std::string Xyz(const Point3& p) {
-  return absl::StrFormat("[%.17g, %.17g, %.17g]", p[0], p[1], p[2]);
-}
-
-// {"p": [x, y, z], "e": [from, to, t]} / "v": id / "f": [face, b0, b1, b2]
-std::string PointJson(const PathPoint& p) {
-  const SurfacePoint& w = p.where;
-  std::string s = "{\"p\": " + Xyz(p.position) + ", ";
-  switch (w.kind) {
-    case SurfacePoint::Kind::kVertex:
-      return s + absl::StrFormat("\"v\": %d}", w.vertex);
-    case SurfacePoint::Kind::kEdge:
-      return s + absl::StrFormat("\"e\": [%d, %d, %.17g]}", w.edge_from, w.edge_to, w.t);
-    case SurfacePoint::Kind::kFace:
-      return s + absl::StrFormat("\"f\": [%d, %.17g, %.17g, %.17g]}", w.face, w.bary[0], w.bary[1],
-                                 w.bary[2]);
-    case SurfacePoint::Kind::kPosition:
-      break;
-  }
-  return s + "\"position\": true}";
-}
 
 std::string PointsJson(const std::vector<PathPoint>& points) {
   std::string s = "[";
-  for (size_t i = 0; i < points.size(); ++i) s += (i ? ", " : "") + PointJson(points[i]);
+  for (size_t i = 0; i < points.size(); ++i) s += (i ? ", " : "") + PathPointJson(points[i]);
   return s + "]";
 }
 
@@ -118,7 +99,7 @@ std::string SitesJson(const Solved& s) {
   for (size_t i = 0; i < s.points.size(); ++i) {
     json +=
         absl::StrFormat("%s{\"site\": %d, \"spec\": \"%s\", \"p\": %s}", i ? ", " : "", i,
-                        SurfacePointToString(s.points[i]), Xyz(PositionOf(*s.data, s.points[i])));
+                        SurfacePointToString(s.points[i]), JsonXyz(PositionOf(*s.data, s.points[i])));
   }
   return json + "]";
 }
@@ -249,7 +230,7 @@ int Usage(const std::string& command, const std::string& key, const std::string&
 
 int RunIsolines(Backend& backend, const Args& args) {
   std::string error;
-  if (!CheckKnown(args, {"sources", "levels", "count", "output"}, &error)) {
+  if (!CheckKnown(args, {"sources", "levels", "count", "output", "max-snap"}, &error)) {
     return Fail(kExitUsage, error);
   }
   if (args.positional.size() != 1 || !args.options.count("sources") ||
@@ -297,7 +278,7 @@ int RunIsolines(Backend& backend, const Args& args) {
 
 int RunVoronoi(Backend& backend, const Args& args) {
   std::string error;
-  if (!CheckKnown(args, {"sites", "output"}, &error)) return Fail(kExitUsage, error);
+  if (!CheckKnown(args, {"sites", "output", "max-snap"}, &error)) return Fail(kExitUsage, error);
   if (args.positional.size() != 1 || !args.options.count("sites")) {
     return Usage("voronoi", "sites", "");
   }
@@ -361,7 +342,7 @@ std::string EdgeJson(const DelaunayEdge& e) {
 
 int RunDelaunay(Backend& backend, const Args& args) {
   std::string error;
-  if (!CheckKnown(args, {"sites", "output"}, &error)) return Fail(kExitUsage, error);
+  if (!CheckKnown(args, {"sites", "output", "max-snap"}, &error)) return Fail(kExitUsage, error);
   if (args.positional.size() != 1 || !args.options.count("sites")) {
     return Usage("delaunay", "sites", "");
   }
@@ -402,7 +383,7 @@ int RunDelaunay(Backend& backend, const Args& args) {
     json += absl::StrFormat(
         "%s\n{\"edge\": [%d, %d], \"sites\": [%d, %d], \"witness\": %d, "
         "\"point\": %s}",
-        i ? "," : "", x.vertex_a, x.vertex_b, x.site_a, x.site_b, x.witness, PointJson(x.point));
+        i ? "," : "", x.vertex_a, x.vertex_b, x.site_a, x.site_b, x.witness, PathPointJson(x.point));
     const Point3 a = PositionOf(*s.data, SurfacePoint::AtVertex(x.vertex_a));
     const Point3 b = PositionOf(*s.data, SurfacePoint::AtVertex(x.vertex_b));
     lines.push_back(

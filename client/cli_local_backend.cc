@@ -47,10 +47,23 @@ class LocalBackend final : public Backend {
 
   bool Supports(const Args&, std::string*) const override { return true; }
 
-  absl::Status Resolve(const std::string& option, std::vector<SurfacePoint>* points) override {
-    std::string error;
-    if (!ResolvePoints(loaded_->mesh, option, points, &locator_, &error)) {
-      return absl::InvalidArgumentError(error);
+  absl::StatusOr<std::vector<LocatedPoint>> Locate(
+      const std::vector<std::array<double, 3>>& xyz) override {
+    if (locator_ == nullptr) locator_ = std::make_unique<SurfaceLocator>(loaded_->mesh);
+    std::vector<LocatedPoint> out;
+    for (const auto& q : xyz) {
+      absl::StatusOr<LocatedPoint> located = locator_->Locate(q);
+      if (!located.ok()) return located.status();
+      out.push_back(*located);
+    }
+    return out;
+  }
+
+  absl::Status Check(const std::string& option, const std::vector<SurfacePoint>& points) override {
+    for (const SurfacePoint& p : points) {
+      if (absl::Status s = ValidateSurfacePoint(loaded_->mesh, p); !s.ok()) {
+        return absl::InvalidArgumentError(absl::StrFormat("--%s: %s", option, s.message()));
+      }
     }
     return absl::OkStatus();
   }

@@ -55,22 +55,6 @@ std::unique_ptr<GeodexClient> Connect(const std::string& target) {
   return std::make_unique<GeodexClient>(options);
 }
 
-// Positions (p:X:Y:Z) located on the server, so that printed points match local mode.
-absl::Status LocatePositions(GeodexClient& client, MeshRef& mesh, std::vector<SurfacePoint>* points) {
-  std::vector<std::array<double, 3>> xyz;
-  for (const SurfacePoint& p : *points) {
-    if (p.kind == SurfacePoint::Kind::kPosition) xyz.push_back(p.position);
-  }
-  if (xyz.empty()) return absl::OkStatus();
-  absl::StatusOr<std::vector<SurfacePoint>> located = client.Locate(mesh, xyz);
-  if (!located.ok()) return located.status();
-  size_t k = 0;
-  for (SurfacePoint& p : *points) {
-    if (p.kind == SurfacePoint::Kind::kPosition) p = (*located)[k++];
-  }
-  return absl::OkStatus();
-}
-
 v1::SolverOptions ToProto(const GeodesicOptions& options) {
   v1::SolverOptions out;
   api::SolverOptionsToProto(options, &out);
@@ -119,8 +103,13 @@ class RemoteBackend final : public Backend {
     return true;
   }
 
-  absl::Status Resolve(const std::string&, std::vector<SurfacePoint>* points) override {
-    return LocatePositions(*client_, mesh_, points);
+  absl::StatusOr<std::vector<LocatedPoint>> Locate(
+      const std::vector<std::array<double, 3>>& xyz) override {
+    return client_->Locate(mesh_, xyz);
+  }
+
+  absl::Status Check(const std::string&, const std::vector<SurfacePoint>&) override {
+    return absl::OkStatus();  // the server checks them with the query, naming the field
   }
 
   absl::StatusOr<const MeshData*> Geometry() override {

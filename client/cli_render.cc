@@ -47,7 +47,7 @@ struct Layers {
 int RunRender(Backend& backend, const Args& args) {
   std::string error;
   if (!CheckKnown(args, {"sources", "isolines", "voronoi", "delaunay", "path", "output", "view",
-                         "size"},
+                         "size", "max-snap"},
                   &error)) {
     return Fail(kExitUsage, error);
   }
@@ -99,9 +99,13 @@ int RunRender(Backend& backend, const Args& args) {
   if (int code = OpenMesh(backend, positional[0], MeshBuildOptions{})) return code;
   absl::StatusOr<const MeshData*> data = backend.Geometry();
   if (!data.ok()) return FailQuery(data.status());
-  if (absl::Status s = backend.Resolve("sources", &*sources); !s.ok()) return FailQuery(s);
+  if (absl::Status s = ResolvePoints(backend, args, "sources", &*sources, nullptr); !s.ok()) {
+    return FailQuery(s);
+  }
   if (!ends.empty()) {
-    if (absl::Status s = backend.Resolve("path", &ends); !s.ok()) return FailQuery(s);
+    if (absl::Status s = ResolvePoints(backend, args, "path", &ends, nullptr); !s.ok()) {
+      return FailQuery(s);
+    }
   }
 
   // A local backend solves the field once and derives the layers from it.

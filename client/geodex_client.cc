@@ -1,6 +1,7 @@
 #include "geodex_client.h"
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <future>
@@ -376,18 +377,22 @@ absl::StatusOr<v1::EstimateDistancesResponse> GeodexClient::PointDistances(
   return response;
 }
 
-absl::StatusOr<std::vector<SurfacePoint>> GeodexClient::Locate(
-    MeshRef& mesh, const std::vector<std::array<double, 3>>& xyz) {
+absl::StatusOr<std::vector<LocatedPoint>> GeodexClient::Locate(
+    MeshRef& mesh, const std::vector<std::array<double, 3>>& xyz, double max_snap) {
   v1::LocatePointsRequest request;
   request.set_mesh(mesh.name);
   for (const auto& q : xyz) api::PositionToProto(q, request.add_positions());
+  if (std::isfinite(max_snap)) request.set_max_snap(max_snap);
   v1::LocatePointsResponse response;
   grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
     return stub_->LocatePoints(context, request, &response);
   });
   if (!status.ok()) return ToAbsl(status);
-  std::vector<SurfacePoint> out;
-  for (const auto& p : response.points()) out.push_back(api::SurfacePointFromProto(p.point()));
+  std::vector<LocatedPoint> out;
+  for (const auto& p : response.points()) {
+    out.push_back({api::SurfacePointFromProto(p.point()), api::PositionFromProto(p.position()),
+                   p.distance()});
+  }
   return out;
 }
 

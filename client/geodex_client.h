@@ -16,16 +16,18 @@
 
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "geodex/distance_field.h"
 #include "geodex/delaunay.h"
+#include "geodex/distance_field.h"
 #include "geodex/distance_matrix.h"
 #include "geodex/isolines.h"
+#include "geodex/locate.h"
 #include "geodex/mesh_data.h"
 #include "geodex/shortest_path.h"
 #include "geodex/surface_point.h"
@@ -104,9 +106,12 @@ class GeodexClient {
   absl::StatusOr<DelaunayTriangulation> ComputeDelaunay(MeshRef& mesh,
                                                         const std::vector<SurfacePoint>& sites,
                                                         const v1::SolverOptions& options);
-  // Positions -> surface points (vertex, edge or face point) on the server's copy of the mesh.
-  absl::StatusOr<std::vector<SurfacePoint>> Locate(MeshRef& mesh,
-                                                   const std::vector<std::array<double, 3>>& xyz);
+  // Positions -> surface points (vertex, edge or face point) on the server's copy of the mesh,
+  // with where they landed and how far they moved. A finite `max_snap` makes the server refuse a
+  // position farther than that from the surface (INVALID_ARGUMENT naming it).
+  absl::StatusOr<std::vector<LocatedPoint>> Locate(
+      MeshRef& mesh, const std::vector<std::array<double, 3>>& xyz,
+      double max_snap = std::numeric_limits<double>::infinity());
 
   // Calls made, retries (UNAVAILABLE, full queue) and transparent re-uploads (for tests and
   // --stats).

@@ -41,26 +41,29 @@ commands:
       isolated_vertices, non_manifold_edges, non_manifold_vertices, degenerate_faces,
       saddle_vertices, bytes, ...). Reports on any readable mesh, valid or messy.
   distances MESH --sources SPEC [--method exact|ich|dijkstra] [--lambda L] [--lambda-scale max|mean]
-                 [--max-distance D] [--max-windows N] [--stats] [--output FILE]
+                 [--max-distance D] [--max-windows N] [--stats] [--output FILE] [--format json]
       One distance per vertex in the file's vertex order (%.17g; 'inf' if unreachable).
       --stats prints one JSON object with counters and times (*_ms) on stderr.
       --no-filter / --no-one-split switch off Lemma 2 / Lemma 1 (slower; same answer).
       --at SPEC: instead, one line per surface point: its unfolding estimate (paper section 4)
       and its exact distance ('POINT<TAB>estimate D<TAB>exact D<TAB>source I').
   path MESH --from SPEC --to SPEC [--method astar|full] [--stats] [--lambda L]
-       [--max-distance D]
+       [--max-distance D] [--format json]
       The exact shortest path: line 1 its length; then one line per polyline point,
       'x y z' and the simplex it lies on ('v ID', 'e V1 V2 T' or 'f FACE B0 B1 B2').
       astar (default) uses the paper's section 5 heuristic and stops at the target.
       --lambda L (as for distances) trades exactness for speed; --max-distance D: a target
       farther than D is unreachable.
   matrix MESH --sources SPEC --targets SPEC [--stats] [--lambda L] [--max-distance D]
-         [--k-nearest K] [--threads N]
+         [--k-nearest K] [--threads N] [--format json]
       Exact distances, one row per source, tab-separated. Rows run in parallel on every usable
       core (--threads N to limit). The same points as sources and targets give a symmetric
       matrix, each pair solved once. --max-distance D: entries beyond D are inf. --k-nearest K:
       per source only its K nearest targets are filled in, the rest inf. A progress bar shows
       on a terminal for calls longer than a second.
+  locate MESH --points p:X:Y:Z,... [--max-snap D] [--format text|json]
+      The nearest surface point to each 3D position: 'QUERY<TAB>SPEC<TAB>x y z<TAB>snap D', D
+      the distance it moved. --max-snap D refuses a position farther than D from the surface.
   isolines MESH --sources SPEC (--levels L1,L2,... | --count K) [--output FILE.json|.obj|.svg]
       Approximate geodesic offsets (paper section 6.1; linear along edges): polylines of edge
       points per level. --count K: the levels D*j/K, j = 1..K-1, D the largest distance.
@@ -82,7 +85,14 @@ commands:
 
 SPEC: comma-separated points: 17 (vertex), e:V1:V2:T (the point (1-T)*V1 + T*V2 on an edge),
       f:FACE:B0:B1:B2 (barycentric in the face's vertex order as in the file),
-      p:X:Y:Z (a 3D position, snapped to the nearest point of the surface).
+      p:X:Y:Z (a 3D position, snapped to the nearest point of the surface). Snapping is never
+      silent: --stats reports the farthest snap (snap_max), a snap beyond 1% of the mesh's
+      diagonal is warned about on stderr, and --max-snap D (every command taking a SPEC)
+      refuses a point farther than D from the surface.
+
+--format json (distances, path, matrix, locate, info) prints one JSON object instead of text:
+      distances {"distances": [...]} (or {"points": [...]} with --at), path {"length", "points"
+      with each point's simplex}, matrix {"rows", "cols", "values"}; null for unreachable.
 
 geodex COMMAND --help prints that command's part of this text.
 
@@ -190,8 +200,8 @@ int main(int argc, char** argv) {
   using Command = int (*)(Backend&, const Args&);
   static const std::pair<const char*, Command> kCommands[] = {
       {"info", RunInfo},         {"distances", RunDistances}, {"path", RunPath},
-      {"matrix", RunMatrix},     {"isolines", RunIsolines},   {"voronoi", RunVoronoi},
-      {"delaunay", RunDelaunay}, {"render", RunRender},
+      {"matrix", RunMatrix},     {"locate", RunLocate},       {"isolines", RunIsolines},
+      {"voronoi", RunVoronoi},   {"delaunay", RunDelaunay},   {"render", RunRender},
   };
   for (const auto& [name, run] : kCommands) {
     if (command != name) continue;

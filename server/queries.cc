@@ -414,10 +414,20 @@ absl::Status RunLocatePoints(const QueryEnv& env, const v1::LocatePointsRequest&
         absl::StrCat("positions: ", request.positions_size(),
                      " points, over --max_targets=", env.limits->max_targets));
   }
+  const double max_snap =
+      request.has_max_snap() ? request.max_snap() : std::numeric_limits<double>::infinity();
+  if (!(max_snap > 0)) {  // also NaN
+    return absl::InvalidArgumentError(
+        absl::StrCat("max_snap: must be > 0 when set, got ", request.max_snap()));
+  }
   for (int i = 0; i < request.positions_size(); ++i) {
     if ((i & 1023) == 0 && env.cancel->IsCancelled()) return absl::CancelledError("cancelled");
     const v1::Position& q = request.positions(i);
     absl::StatusOr<LocatedPoint> located = (*mesh)->locator->Locate({q.x(), q.y(), q.z()});
+    if (located.ok()) {
+      absl::Status snap = CheckSnapDistance({q.x(), q.y(), q.z()}, *located, max_snap);
+      if (!snap.ok()) located = snap;
+    }
     if (!located.ok()) {
       return absl::Status(located.status().code(),
                           absl::StrCat("positions[", i, "]: ", located.status().message()));

@@ -140,5 +140,77 @@ check "geodex --help lists p:X:Y:Z" test $? -eq 0
 check "directory exits 3" test $? -eq 3
 check "directory: says it is a directory" grep -q "is a directory" "$tmp/err.txt"
 
+# --format json: the same numbers as the text formats, parsed by a real JSON parser.
+K="$DATA/kitten.off"
+"$GEODEX" distances "$K" --sources 0 --max-distance 20 >"$tmp/d.txt"
+"$GEODEX" distances "$K" --sources 0 --max-distance 20 --format json >"$tmp/d.json"
+check "distances json = text (inf -> null)" /usr/bin/python3 - "$tmp/d.txt" "$tmp/d.json" <<'PY'
+import json, math, sys
+text = [float(x) for x in open(sys.argv[1])]
+js = json.load(open(sys.argv[2]))["distances"]
+assert len(js) == len(text) == 2500 and any(math.isinf(t) for t in text)
+assert all((j is None) if math.isinf(t) else j == t for t, j in zip(text, js))
+PY
+"$GEODEX" distances "$K" --sources 0 --at 7,f:30:0.2:0.2:0.6 >"$tmp/at.txt"
+"$GEODEX" distances "$K" --sources 0 --at 7,f:30:0.2:0.2:0.6 --format json >"$tmp/at.json"
+check "distances --at json = text" /usr/bin/python3 - "$tmp/at.txt" "$tmp/at.json" <<'PY'
+import json, sys
+rows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1])]
+js = json.load(open(sys.argv[2]))["points"]
+assert [r[0] for r in rows] == [p["point"] for p in js]
+assert all(float(r[2].split()[1]) == p["exact"] and int(r[3].split()[1]) == p["source"] for r, p in zip(rows, js))
+PY
+"$GEODEX" path "$K" --from 3 --to f:300:0.1:0.2:0.7 >"$tmp/p.txt"
+"$GEODEX" path "$K" --from 3 --to f:300:0.1:0.2:0.7 --format json >"$tmp/p.json"
+check "path json = text, with simplices" /usr/bin/python3 - "$tmp/p.txt" "$tmp/p.json" <<'PY'
+import json, sys
+lines = open(sys.argv[1]).read().split("\n")[:-1]
+js = json.load(open(sys.argv[2]))
+assert float(lines[0]) == js["length"] and len(lines) - 1 == len(js["points"])
+for line, p in zip(lines[1:], js["points"]):
+    f = line.split()
+    assert [float(x) for x in f[:3]] == p["p"]
+    assert f[3] in p and (f[3] != "v" or int(f[4]) == p["v"])
+assert js["points"][0]["v"] == 3 and js["points"][-1]["f"][0] == 300
+PY
+"$GEODEX" matrix "$K" --sources 0,9 --targets 2,44,1000 --max-distance 30 >"$tmp/m.txt"
+"$GEODEX" matrix "$K" --sources 0,9 --targets 2,44,1000 --max-distance 30 --format json >"$tmp/m.json"
+check "matrix json = text" /usr/bin/python3 - "$tmp/m.txt" "$tmp/m.json" <<'PY'
+import json, math, sys
+text = [[float(x) for x in l.split("\t")] for l in open(sys.argv[1])]
+js = json.load(open(sys.argv[2]))
+assert js["rows"] == 2 and js["cols"] == 3
+assert all((j is None) if math.isinf(t) else j == t for tr, jr in zip(text, js["values"]) for t, j in zip(tr, jr))
+PY
+"$GEODEX" info "$K" --format json >"$tmp/i.json"
+check "info json bbox is numeric" /usr/bin/python3 -c "import json; d=json.load(open('$tmp/i.json')); assert all(isinstance(x, float) for x in d['bbox_min'] + d['bbox_max']) and d['bbox_min'][1] < d['bbox_max'][1]"
+expect_usage "bad format" "--format" matrix "$K" --sources 0 --targets 1 --format xml
+
+# Snapping is never silent: locate reports it, --stats carries it, a far point is warned about,
+# --max-snap refuses it naming the point.
+"$GEODEX" locate "$K" --points p:0:0:0,p:0:100:0 >"$tmp/loc.txt"
+check "locate exits 0" test $? -eq 0
+check "locate: one line per point, snap distance last" /usr/bin/python3 - "$tmp/loc.txt" "$K" <<'PY'
+import math, sys
+rows = [l.rstrip("\n").split("\t") for l in open(sys.argv[1])]
+assert [r[0] for r in rows] == ["p:0:0:0", "p:0:100:0"]
+for (q, spec, xyz, snap) in rows:
+    query = [float(x) for x in q[2:].split(":")]
+    at = [float(x) for x in xyz.split()]
+    assert abs(math.dist(query, at) - float(snap.split()[1])) <= 1e-12 * (1 + math.dist(query, at))
+assert rows[0][1] == "2461"  # the nearest vertex of the origin on the kitten
+PY
+"$GEODEX" locate "$K" --points p:0:0:0 --format json >"$tmp/loc.json"
+check "locate json" /usr/bin/python3 -c "import json; d=json.load(open('$tmp/loc.json'))['points'][0]; assert d['point']=='2461' and d['snap_distance'] > 2"
+expect_usage "locate --max-snap refuses a far point" "p:0:100:0 is 19.4561 from the surface" \
+  locate "$K" --points p:0:0:0,p:0:100:0 --max-snap 5
+expect_usage "locate takes positions" "not a position" locate "$K" --points 7
+expect_usage "path --max-snap" "--to: p:0:100:0 is" path "$K" --from 1 --to p:0:100:0 --max-snap 1
+"$GEODEX" path "$K" --from 1 --to p:0:100:0 --stats >/dev/null 2>"$tmp/snap.err"
+check "a far snap is warned about" grep -q "^geodex: warning: --to: p:0:100:0 is 19.4561 from the surface" "$tmp/snap.err"
+check "--stats carries snap_max" /usr/bin/python3 -c "import json; d=json.loads(open('$tmp/snap.err').read().splitlines()[-1]); assert abs(d['snap_max'] - 19.456143372030692) < 1e-9 and d['snap_point'] == 'p:0:100:0'"
+"$GEODEX" path "$K" --from 1 --to p:-1.203724:-1.917213:1.356663 2>"$tmp/near.err" >/dev/null
+check "a snap on the surface is not warned about" test ! -s "$tmp/near.err"
+
 echo "cli: $pass passed, $fail failed"
 test "$fail" -eq 0

@@ -88,6 +88,15 @@ same_error() {  # same_error NAME ARGS...: the same exit code and a one-line mes
   check "$name: exit codes ($lrc local, $rrc remote)" test "$lrc" -eq "$rrc" -a "$lrc" -ne 0
   check "$name: one line each" test "$(cat "$tmp/local.err" "$tmp/remote.err" | wc -l)" -eq 2
 }
+same "locate" locate "$DATA/kitten.off" --points p:0:0:0,p:0:100:0,p:3:40:2
+same "locate json" locate "$DATA/kitten.off" --points p:0:0:0 --format json
+same "distances json" distances "$DATA/kitten.off" --sources 0,p:1:50:2 --format json --max-distance 20
+same "at json" distances "$DATA/kitten.off" --sources 1 --at 7,f:30:0.2:0.2:0.6 --format json
+same "path json" path "$DATA/kitten.off" --from p:0:100:0 --to f:300:0.1:0.2:0.7 --format json
+same "matrix json" matrix "$DATA/kitten.off" --sources 0,9 --targets 2,44 --format json
+same "info json" info "$DATA/kitten.off" --format json
+same_error "max-snap" path "$DATA/kitten.off" --from 1 --to p:0:100:0 --max-snap 1
+check "max-snap: the same message" diff "$tmp/local.err" "$tmp/remote.err"
 same_error "bad option" matrix "$DATA/kitten.off" --sources 0 --targets 1 --bogus 1
 same_error "unreachable target" path "$DATA/kitten.off" --from 3 --to 400 --max-distance 1
 same_error "bad lambda" path "$DATA/kitten.off" --from 3 --to 400 --lambda 2

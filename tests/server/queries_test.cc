@@ -332,6 +332,39 @@ TEST_F(QueriesTest, LocatePointsEqualsCore) {
     EXPECT_TRUE(BitEqual(got.distance(), want.distance));
   }
   EXPECT_EQ(response.points(0).point().point_case(), v1::SurfacePoint::kVertex);
+
+  // max_snap: a limit between the nearest and the farthest query refuses exactly the position
+  // that is farther, naming it; a limit above all of them changes nothing; 0 is refused.
+  double nearest = response.points(0).distance(), farthest = nearest;
+  for (int i = 0; i < response.points_size(); ++i) {
+    nearest = std::min(nearest, response.points(i).distance());
+    farthest = std::max(farthest, response.points(i).distance());
+  }
+  ASSERT_LT(nearest, farthest);
+  for (const double limit : {0.5 * (nearest + farthest), 2 * farthest, 0.0}) {
+    v1::LocatePointsRequest limited = request;
+    limited.set_max_snap(limit);
+    grpc::ClientContext c;
+    c.set_deadline(In(60));
+    v1::LocatePointsResponse r;
+    grpc::Status s = stub_->LocatePoints(&c, limited, &r);
+    if (limit > farthest) {
+      ASSERT_TRUE(s.ok()) << s.error_message();
+      EXPECT_EQ(r.SerializeAsString(), response.SerializeAsString());
+    } else {
+      EXPECT_EQ(s.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+      const std::string field = limit == 0 ? "max_snap" : "positions[";
+      EXPECT_NE(s.error_message().find(field), std::string::npos) << s.error_message();
+      if (limit > 0) {  // the first position farther than the limit is named
+        int first = 0;
+        while (response.points(first).distance() <= limit) ++first;
+        EXPECT_NE(s.error_message().find("positions[" + std::to_string(first) + "]: "),
+                  std::string::npos)
+            << s.error_message();
+        EXPECT_NE(s.error_message().find("maximum snap distance"), std::string::npos);
+      }
+    }
+  }
 }
 
 TEST_F(QueriesTest, IsolinesEqualCoreAcrossManyMessages) {

@@ -94,4 +94,10 @@ class SurfaceLocator {
   double extent_ = 0;
 };
 
+// Snapping is never silent: OK when `located` is at most `max_snap` from its query position
+// (+inf: any distance), else InvalidArgument "QUERY is D from the surface, farther than the
+// maximum snap distance M" (the caller prefixes the option or request field).
+absl::Status CheckSnapDistance(const std::array<double, 3>& query, const LocatedPoint& located,
+                               double max_snap);
+
 }  // namespace geodex
