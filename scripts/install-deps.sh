@@ -20,8 +20,9 @@ packages=(
   zlib1g-dev libpng-dev
   # tests and benchmarks (CGAL is a test-only reference)
   libgtest-dev libgmock-dev libbenchmark-dev libcgal-dev libgmp-dev libmpfr-dev
-  # the Python client example and its test (Debian's gRPC for Python)
-  python3-grpcio python3-protobuf
+  # the Python client package, its example and tests (Debian's gRPC for Python; pip and venv for
+  # `pip install ./client/python`)
+  python3-grpcio python3-protobuf python3-pip python3-venv python3-setuptools python3-wheel
   # the Kubernetes manifest checks (tests/deploy)
   python3-yaml
   # the mesh-affine gateway (deploy/gateway) and its end-to-end test

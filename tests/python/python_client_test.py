@@ -1,8 +1,9 @@
 #!/usr/bin/python3
-"""The Python client against a real geodexd (127.0.0.1, a port it picks): upload, distance field,
-shortest path and Voronoi, each checked against the geodex CLI's local answer. Bounded: the server
+"""The geodex Python package against a real geodexd (127.0.0.1, a port it picks): every method,
+each checked against the geodex CLI's local answer, and the typed exceptions. Bounded: the server
 is started and stopped here, every wait gives up.
-Env: GEODEX, GEODEXD (binaries), DATA (tests/data); PYTHONPATH has build/python and client/python.
+Env: GEODEX, GEODEXD (binaries), DATA (tests/data); `import geodex` works (PYTHONPATH with
+build/python and client/python, or the package installed: tests/python/package_test.sh).
 """
 import os
 import re
@@ -12,9 +13,10 @@ import tempfile
 import time
 import unittest
 
-import grpc
+import json
 
-from geodex_client import GeodexClient, face_point, vertex
+import geodex
+from geodex import GeodexClient, face_point, position, vertex
 
 GEODEX, GEODEXD, DATA = os.environ["GEODEX"], os.environ["GEODEXD"], os.environ["DATA"]
 
@@ -26,7 +28,8 @@ class PythonClientTest(unittest.TestCase):
         cls.log = open(os.path.join(cls.tmp.name, "server.log"), "w+")
         cls.server = subprocess.Popen(
             [GEODEXD, "--listen", "127.0.0.1:0", "--metrics_listen", "", "--pool-threads", "2",
-             "--data-dir", os.path.join(cls.tmp.name, "data"), "--shutdown_grace_seconds", "5"],
+             "--data-dir", os.path.join(cls.tmp.name, "data"), "--shutdown_grace_seconds", "5",
+             "--max_targets", "1000"],
             stdout=cls.log, stderr=subprocess.STDOUT)
         port = None
         for _ in range(300):
@@ -79,7 +82,12 @@ class PythonClientTest(unittest.TestCase):
                            "1250").splitlines()
         self.assertEqual(length, float(lines[0]))
         self.assertEqual(len(points), len(lines) - 1)
-        self.assertEqual(points[-1], tuple(float(x) for x in lines[-1].split()[:3]))
+        for point, line in zip(points, lines[1:]):  # positions bit for bit, and the simplices
+            fields = line.split()
+            self.assertEqual(point.position, tuple(float(x) for x in fields[:3]))
+            self.assertEqual(point.simplex[0], fields[3])
+        self.assertEqual(points[0].simplex, ("v", 0))
+        self.assertEqual(points[-1].simplex, ("v", 1250))
 
     def test_matrix_equals_the_cli_with_k_nearest_and_max_distance(self):
         sources, targets = [0, 5, 1250], [7, 100, 2000, 2400]
@@ -103,10 +111,9 @@ class PythonClientTest(unittest.TestCase):
                                              [vertex(v) for v in targets], max_distance=limit)
         for row, cut in zip(full, capped):
             self.assertEqual(cut, [d if d < limit else float("inf") for d in row])
-        with self.assertRaises(grpc.RpcError) as error:
+        with self.assertRaises(geodex.InvalidArgumentError) as error:
             self.client.distance_matrix(self.mesh.name, [vertex(0)], [vertex(7)], lambda_=2.0)
-        self.assertEqual(error.exception.code(), grpc.StatusCode.INVALID_ARGUMENT)
-        self.assertIn("options.lambda", error.exception.details())
+        self.assertEqual(error.exception.field, "options.lambda")
 
     def test_shortest_paths_equal_single_paths(self):
         pairs = [(vertex(0), vertex(1250)), (vertex(0), vertex(7)), (vertex(5), vertex(1250))]
@@ -119,20 +126,81 @@ class PythonClientTest(unittest.TestCase):
 
     def test_voronoi(self):
         sites = [vertex(0), vertex(800), vertex(1600), vertex(2400)]
-        areas, boundaries = self.client.voronoi(self.mesh.name, sites)
+        areas, boundaries, adjacency = self.client.voronoi(self.mesh.name, sites)
         self.assertEqual(sorted(areas), [0, 1, 2, 3])
         self.assertTrue(all(a > 0 for a in areas.values()))
         self.assertTrue(boundaries)
         for a, b, points in boundaries:
             self.assertLess(a, b)
+            self.assertIn((a, b), adjacency)
             self.assertGreaterEqual(len(points), 2)
+        cli = json.loads(self.local("voronoi", os.path.join(DATA, "kitten.off"), "--sites",
+                                    "0,800,1600,2400"))
+        self.assertEqual(len(boundaries), len(cli["boundaries"]))
 
-    def test_errors_carry_the_status_code(self):
-        import grpc
-        with self.assertRaises(grpc.RpcError) as error:
+    def test_isolines_and_delaunay_equal_the_cli(self):
+        kitten = os.path.join(DATA, "kitten.off")
+        iso = self.client.isolines(self.mesh.name, [vertex(0)], count=5)
+        cli = json.loads(self.local("isolines", kitten, "--sources", "0", "--count", "5"))
+        self.assertEqual(iso.levels, cli["levels"])
+        self.assertEqual(len(iso.lines), len(cli["polylines"]))
+        for (level, closed, points), line in zip(iso.lines, cli["polylines"]):
+            self.assertEqual((level, closed, len(points)), (line["level"], line["closed"],
+                                                            len(line["points"])))
+            self.assertEqual(list(points[0].position), line["points"][0]["p"])
+        sites = [vertex(0), vertex(800), vertex(1600), vertex(2400), vertex(1200)]
+        dt = self.client.delaunay(self.mesh.name, sites)
+        cli = json.loads(self.local("delaunay", kitten, "--sites", "0,800,1600,2400,1200"))
+        self.assertEqual(sorted((a, b) for a, b, _, _ in dt.edges),
+                         sorted(tuple(e["sites"]) for e in cli["edges"]))
+        self.assertEqual(sorted(dt.triangles), sorted(tuple(t) for t in cli["triangles"]))
+
+    def test_point_distances_and_locate_equal_the_cli(self):
+        kitten = os.path.join(DATA, "kitten.off")
+        at = self.client.point_distances(self.mesh.name, [vertex(1)],
+                                         [vertex(7), face_point(30, 0.2, 0.2, 0.6)])
+        cli = json.loads(self.local("distances", kitten, "--sources", "1", "--at",
+                                    "7,f:30:0.2:0.2:0.6", "--format", "json"))["points"]
+        self.assertEqual(at.exact, [p["exact"] for p in cli])
+        self.assertEqual(at.estimates, [p["estimate"] for p in cli])
+        self.assertEqual(at.exact_labels, [0, 0])
+        located = self.client.locate(self.mesh.name, [(0, 0, 0), (0, 100, 0)])
+        cli = json.loads(self.local("locate", kitten, "--points", "p:0:0:0,p:0:100:0",
+                                    "--format", "json"))["points"]
+        self.assertEqual([l.distance for l in located], [p["snap_distance"] for p in cli])
+        self.assertEqual([list(l.position) for l in located], [p["p"] for p in cli])
+        self.assertEqual(located[0].point.vertex, int(cli[0]["point"]))
+        with self.assertRaises(geodex.InvalidArgumentError) as error:
+            self.client.locate(self.mesh.name, [(0, 0, 0), (0, 100, 0)], max_snap=5.0)
+        self.assertEqual(error.exception.field, "positions[1]")
+        # A position snapped by the server in a query: the same path as from the located vertex.
+        self.assertEqual(self.client.shortest_path(self.mesh.name, position(0, 0, 0), vertex(9)),
+                         self.client.shortest_path(self.mesh.name, vertex(2461), vertex(9)))
+
+    def test_list_and_delete(self):
+        extra = self.client.upload(os.path.join(DATA, "knight.off"), name="knight")
+        self.assertIn(extra.name, [m.name for m in self.client.list_meshes()])
+        self.client.delete_mesh("meshes/knight")
+        self.assertNotIn(extra.name, [m.name for m in self.client.list_meshes()])
+        with self.assertRaises(geodex.NotFoundError):
+            self.client.get_mesh("meshes/knight")
+
+    def test_errors_are_typed_and_carry_the_details(self):
+        with self.assertRaises(geodex.InvalidArgumentError) as error:
             self.client.distance_field(self.mesh.name, [vertex(99999)])
-        self.assertEqual(error.exception.code(), grpc.StatusCode.INVALID_ARGUMENT)
-        self.assertIn("sources[0].vertex", error.exception.details())
+        self.assertEqual(error.exception.code.name, "INVALID_ARGUMENT")
+        self.assertEqual(error.exception.field, "sources[0].vertex")
+        self.assertIsInstance(error.exception, geodex.GeodexError)
+        with self.assertRaises(geodex.NotFoundError):
+            self.client.distance_field("meshes/no-such-mesh", [vertex(0)])
+        with self.assertRaises(geodex.UnreachableError) as error:
+            self.client.shortest_path(self.mesh.name, vertex(0), vertex(1250), max_distance=1.0)
+        self.assertEqual(error.exception.reason, "UNREACHABLE")
+        with self.assertRaises(geodex.ResourceExhaustedError) as error:  # --max_targets 1000
+            self.client.locate(self.mesh.name, [(0, 0, 0)] * 1001)
+        self.assertEqual((error.exception.reason, error.exception.flag), ("LIMIT", "max_targets"))
+        with self.assertRaises(geodex.UnavailableError):
+            geodex.GeodexClient("127.0.0.1:1", timeout=5).health()
 
 
 if __name__ == "__main__":

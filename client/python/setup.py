@@ -1,0 +1,35 @@
+"""Builds the geodex package: the geodex.v1 modules are generated from the repository's
+proto/geodex/v1/geodex.proto with protoc and grpc_python_plugin (Debian: protobuf-compiler,
+protobuf-compiler-grpc), and google.rpc's error details are kept as a descriptor set for
+geodex.errors. GEODEX_PROTO_DIR overrides where the protos are (default ../../proto)."""
+import os
+import shutil
+import subprocess
+
+from setuptools import setup
+from setuptools.command.build_py import build_py
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+class BuildWithStubs(build_py):
+    def run(self):
+        super().run()
+        proto_dir = os.environ.get("GEODEX_PROTO_DIR", os.path.join(HERE, "..", "..", "proto"))
+        plugin = shutil.which("grpc_python_plugin")
+        protoc = shutil.which("protoc")
+        if not (plugin and protoc and os.path.isdir(proto_dir)):
+            raise SystemExit("geodex: building needs protoc, grpc_python_plugin and the protos in "
+                             + proto_dir + " (set GEODEX_PROTO_DIR)")
+        subprocess.check_call([
+            protoc, "--proto_path=" + proto_dir, "--python_out=" + self.build_lib,
+            "--grpc_python_out=" + self.build_lib, "--plugin=protoc-gen-grpc_python=" + plugin,
+            "geodex/v1/geodex.proto"])
+        open(os.path.join(self.build_lib, "geodex", "v1", "__init__.py"), "a").close()
+        subprocess.check_call([
+            protoc, "--proto_path=" + proto_dir, "--include_imports",
+            "--descriptor_set_out=" + os.path.join(self.build_lib, "geodex", "_rpc_details.desc"),
+            "google/rpc/status.proto", "google/rpc/error_details.proto"])
+
+
+setup(cmdclass={"build_py": BuildWithStubs})
