@@ -65,15 +65,21 @@ GeodexClient::GeodexClient(ClientOptions options) : options_(std::move(options))
 namespace {
 // RESOURCE_EXHAUSTED because every worker was busy and the queue full (ErrorInfo reason QUEUE_FULL,
 // see server/status_convert.h), as opposed to a request over a limit.
-bool IsQueueFull(const grpc::Status& status) {
-  if (status.error_code() != grpc::StatusCode::RESOURCE_EXHAUSTED) return false;
+// The ErrorInfo reason geodexd attached to a failed call ("QUEUE_FULL", "MESH_NOT_FOUND", ...;
+// see server/status_convert.h), or "".
+std::string ErrorReason(const grpc::Status& status) {
   google::rpc::Status details;
-  if (!details.ParseFromString(status.error_details())) return false;
+  if (!details.ParseFromString(status.error_details())) return "";
   for (const google::protobuf::Any& any : details.details()) {
     google::rpc::ErrorInfo info;
-    if (any.UnpackTo(&info) && info.reason() == "QUEUE_FULL") return true;
+    if (any.UnpackTo(&info)) return info.reason();
   }
-  return false;
+  return "";
+}
+
+bool IsQueueFull(const grpc::Status& status) {
+  return status.error_code() == grpc::StatusCode::RESOURCE_EXHAUSTED &&
+         ErrorReason(status) == "QUEUE_FULL";
 }
 }  // namespace
 
@@ -112,7 +118,7 @@ grpc::Status GeodexClient::MeshCall(MeshRef& mesh,
                                     const std::function<grpc::Status(grpc::ClientContext*)>& call) {
   grpc::Status status = Call(mesh.id, call);
   if (status.error_code() == grpc::StatusCode::NOT_FOUND && !mesh.file_bytes.empty() &&
-      status.error_message().rfind("mesh:", 0) == 0) {
+      ErrorReason(status) == "MESH_NOT_FOUND") {
     // The server lost (or never had) the mesh: upload it again and retry once.
     absl::StatusOr<v1::Mesh> uploaded = Upload(mesh.file_name, mesh.file_bytes, "", mesh.id);
     if (!uploaded.ok()) {

@@ -28,9 +28,7 @@ absl::Status ValidateDisplayName(const std::string& name) {
                 c == '.' || c == '_' || c == '-');
   }
   if (!ok) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("metadata.display_name: ", QuoteInput(name),
-                     " must be 1-63 characters of [A-Za-z0-9._-] and not a 64-digit hex id"));
+    return FieldError("metadata.display_name", absl::StrCat(QuoteInput(name), " must be 1-63 characters of [A-Za-z0-9._-] and not a 64-digit hex id"));
   }
   return absl::OkStatus();
 }
@@ -48,7 +46,7 @@ absl::StatusOr<MeshFormat> FormatFromProto(int format) {
     case v1::MESH_FORMAT_STL:
       return MeshFormat::kStl;
     default:
-      return absl::InvalidArgumentError(absl::StrCat("metadata.format: unknown value ", format));
+      return FieldError("metadata.format", absl::StrCat("unknown value ", format));
   }
 }
 
@@ -115,8 +113,7 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
     const ServiceLimits& limits = *env_.limits;
     if (!have_metadata_) {
       if (!request.has_metadata()) {
-        return absl::InvalidArgumentError(
-            "metadata: the first CreateMeshRequest must carry metadata");
+        return FieldError("metadata", "the first CreateMeshRequest must carry metadata");
       }
       metadata_ = request.metadata();
       have_metadata_ = true;
@@ -130,8 +127,7 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
       if (!format.ok()) return format.status();
       format_ = *format;
       if (!metadata_.expected_mesh_id().empty() && !IsMeshId(metadata_.expected_mesh_id())) {
-        return absl::InvalidArgumentError(
-            "metadata.expected_mesh_id: must be 64 lowercase hex digits");
+        return FieldError("metadata.expected_mesh_id", "must be 64 lowercase hex digits");
       }
       if (metadata_.total_bytes() > limits.max_upload_bytes) {
         return TooLarge(metadata_.total_bytes());
@@ -140,28 +136,23 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
       return absl::OkStatus();
     }
     if (request.has_metadata()) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("metadata: message ", messages_,
-                       " carries metadata again; only the first CreateMeshRequest may"));
+      return FieldError("metadata", absl::StrCat("message ", messages_, " carries metadata again; only the first CreateMeshRequest may"));
     }
     if (request.payload_case() != v1::CreateMeshRequest::kChunk) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "chunk: message ", messages_, " of the upload stream carries neither metadata nor a chunk"));
+      return FieldError("chunk", absl::StrCat("message ", messages_, " of the upload stream carries neither metadata nor a chunk"));
     }
     const std::string& chunk = request.chunk();
     const uint64_t total = bytes_.size() + chunk.size();
     if (total > limits.max_upload_bytes) return TooLarge(total);
     if (metadata_.total_bytes() != 0 && total > metadata_.total_bytes()) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("metadata.total_bytes: declared ", metadata_.total_bytes(),
-                       " bytes, but message ", messages_, " brings the upload to ", total));
+      return FieldError("metadata.total_bytes", absl::StrCat("declared ", metadata_.total_bytes(), " bytes, but message ", messages_, " brings the upload to ", total));
     }
     bytes_.append(chunk);
     return absl::OkStatus();
   }
 
   absl::Status TooLarge(uint64_t bytes) const {
-    return absl::ResourceExhaustedError(absl::StrCat("upload of ", bytes,
+    return ServerLimitError("max_upload_bytes", absl::StrCat("upload of ", bytes,
                                                      " bytes exceeds --max_upload_bytes=",
                                                      env_.limits->max_upload_bytes));
   }
@@ -175,15 +166,11 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
     {
       std::lock_guard<std::mutex> lock(mu_);
       if (!have_metadata_) {
-        complete = absl::InvalidArgumentError("metadata: the upload stream was empty");
+        complete = FieldError("metadata", "the upload stream was empty");
       } else if (metadata_.total_bytes() != 0 && bytes_.size() != metadata_.total_bytes()) {
-        complete = absl::InvalidArgumentError(
-            absl::StrCat("metadata.total_bytes: declared ", metadata_.total_bytes(),
-                         " bytes, but ", bytes_.size(), " arrived; nothing was stored"));
+        complete = FieldError("metadata.total_bytes", absl::StrCat("declared ", metadata_.total_bytes(), " bytes, but ", bytes_.size(), " arrived; nothing was stored"));
       } else if (bytes_.empty()) {
-        complete = absl::InvalidArgumentError(
-            absl::StrCat("chunk: the upload stream ended after the metadata without any bytes (",
-                         messages_, " messages)"));
+        complete = FieldError("chunk", absl::StrCat("the upload stream ended after the metadata without any bytes (", messages_, " messages)"));
       }
     }
     if (!complete.ok()) {
@@ -230,22 +217,19 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
         absl::string_view(bytes_), format_, file_name, read_limits);
     if (!data.ok()) {
       if (data.status().code() == absl::StatusCode::kResourceExhausted) return data.status();
-      return absl::InvalidArgumentError(absl::StrCat("chunk: ", data.status().message()));
+      return FieldError("chunk", data.status().message());
     }
     if (data->vertex_count() > limits.max_vertices) {
-      return absl::ResourceExhaustedError(
-          absl::StrCat("mesh has ", data->vertex_count(),
+      return ServerLimitError("max_vertices", absl::StrCat("mesh has ", data->vertex_count(),
                        " vertices, over --max_vertices=", limits.max_vertices));
     }
     if (data->face_count() > limits.max_faces) {
-      return absl::ResourceExhaustedError(absl::StrCat(
+      return ServerLimitError("max_faces", absl::StrCat(
           "mesh has ", data->face_count(), " faces, over --max_faces=", limits.max_faces));
     }
     std::string id = ComputeMeshId(*data);
     if (!metadata_.expected_mesh_id().empty() && metadata_.expected_mesh_id() != id) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("metadata.expected_mesh_id: ", metadata_.expected_mesh_id(),
-                       " differs from the uploaded mesh's id ", id));
+      return FieldError("metadata.expected_mesh_id", absl::StrCat(metadata_.expected_mesh_id(), " differs from the uploaded mesh's id ", id));
     }
     std::shared_ptr<StoredMesh> candidate;
     if (env_.store->Contains(id)) {
@@ -257,7 +241,7 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
       build_options.strict = metadata_.strict();
       absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(*data, build_options);
       if (!mesh.ok()) {
-        return absl::InvalidArgumentError(absl::StrCat("chunk: ", mesh.status().message()));
+        return FieldError("chunk", mesh.status().message());
       }
       if (cancel_.IsCancelled()) return absl::CancelledError("upload cancelled");
       candidate = MakeStoredMesh(id, *std::move(mesh));

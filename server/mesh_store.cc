@@ -1,5 +1,7 @@
 #include "mesh_store.h"
 
+#include "status_convert.h"
+
 #include <algorithm>
 #include <utility>
 
@@ -103,8 +105,7 @@ void MeshStore::AttachDisk(MeshDisk disk, const MeshDisk::Index& index) {
 
 absl::StatusOr<std::vector<std::string>> MeshStore::VictimsLocked(uint64_t bytes) const {
   if (bytes > budget_bytes_) {
-    return absl::ResourceExhaustedError(
-        absl::StrCat("mesh needs ", bytes, " bytes of memory, more than the whole ",
+    return ServerLimitError("mesh_budget_bytes", absl::StrCat("mesh needs ", bytes, " bytes of memory, more than the whole ",
                      "mesh budget (--mesh_budget_bytes=", budget_bytes_, ")"));
   }
   std::vector<std::string> victims;
@@ -117,7 +118,7 @@ absl::StatusOr<std::vector<std::string>> MeshStore::VictimsLocked(uint64_t bytes
     freed += slot.mesh->memory_bytes;
   }
   if (used_bytes_ - freed + bytes > budget_bytes_) {
-    return absl::ResourceExhaustedError(absl::StrCat(
+    return ServerLimitError("mesh_budget_bytes", absl::StrCat(
         "mesh needs ", bytes, " bytes of memory but pinned meshes hold ", used_bytes_ - freed,
         " of the ", budget_bytes_, " byte budget (--mesh_budget_bytes)"));
   }
@@ -143,9 +144,7 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::Insert(
     if (!mesh->display_name.empty()) {
       auto alias = aliases_.find(mesh->display_name);
       if (alias != aliases_.end() && alias->second != mesh->id) {
-        return absl::InvalidArgumentError(absl::StrCat("metadata.display_name: \"",
-                                                       mesh->display_name,
-                                                       "\" already names mesh ", alias->second));
+        return FieldError("metadata.display_name", absl::StrCat("\"", mesh->display_name, "\" already names mesh ", alias->second));
       }
     }
     auto existing = meshes_.find(mesh->id);
@@ -159,7 +158,7 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::Insert(
       if (!known) {
         const size_t names = (old.display_name.empty() ? 0 : 1) + old.aliases.size();
         if (names >= max_names) {
-          return absl::ResourceExhaustedError(absl::StrCat(
+          return ServerLimitError("max_names_per_mesh", absl::StrCat(
               "metadata.display_name: mesh ", mesh->id, " already has ", names,
               " names, the most a mesh may have (--max_names_per_mesh=", max_names, ")"));
         }

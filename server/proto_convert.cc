@@ -32,9 +32,7 @@ absl::StatusOr<std::string> ParseMeshName(const std::string& name, const std::st
   constexpr absl::string_view kPrefix = "meshes/";
   if (!absl::StartsWith(name, kPrefix) || name.size() == kPrefix.size() ||
       name.find('/', kPrefix.size()) != std::string::npos) {
-    return absl::InvalidArgumentError(
-        absl::StrCat(field, ": expected \"meshes/{mesh_id}\" or \"meshes/{display_name}\", got ",
-                     QuoteInput(name)));
+    return FieldError(field, absl::StrCat("expected \"meshes/{mesh_id}\" or \"meshes/{display_name}\", got ", QuoteInput(name)));
   }
   return name.substr(kPrefix.size());
 }
@@ -63,15 +61,13 @@ absl::StatusOr<SurfacePoint> ResolvePoint(const StoredMesh& mesh, const v1::Surf
   switch (point.point_case()) {
     case v1::SurfacePoint::kVertex:
       if (point.vertex() >= mesh.vertex_count) {
-        return absl::InvalidArgumentError(absl::StrCat(field, ".vertex: ", point.vertex(),
-                                                       " is out of range (the mesh has ",
-                                                       mesh.vertex_count, " vertices)"));
+        return FieldError(absl::StrCat(field, ".vertex"), absl::StrCat(point.vertex(), " is out of range (the mesh has ", mesh.vertex_count, " vertices)"));
       }
       return SurfacePoint::AtVertex(point.vertex());
     case v1::SurfacePoint::kEdge: {
       const v1::EdgePoint& e = point.edge();
       if (!std::isfinite(e.t())) {
-        return absl::InvalidArgumentError(absl::StrCat(field, ".edge.t: must be finite"));
+        return FieldError(absl::StrCat(field, ".edge.t"), "must be finite");
       }
       p = SurfacePoint::OnEdge(e.from(), e.to(), e.t());
       break;
@@ -79,8 +75,7 @@ absl::StatusOr<SurfacePoint> ResolvePoint(const StoredMesh& mesh, const v1::Surf
     case v1::SurfacePoint::kFace: {
       const v1::FacePoint& f = point.face();
       if (!std::isfinite(f.b0()) || !std::isfinite(f.b1()) || !std::isfinite(f.b2())) {
-        return absl::InvalidArgumentError(
-            absl::StrCat(field, ".face: barycentrics must be finite"));
+        return FieldError(absl::StrCat(field, ".face"), "barycentrics must be finite");
       }
       p = SurfacePoint::InFace(f.face(), f.b0(), f.b1(), f.b2());
       break;
@@ -89,23 +84,20 @@ absl::StatusOr<SurfacePoint> ResolvePoint(const StoredMesh& mesh, const v1::Surf
       const v1::Position& q = point.position();
       absl::StatusOr<LocatedPoint> located = mesh.locator->Locate({q.x(), q.y(), q.z()});
       if (!located.ok()) {
-        return absl::InvalidArgumentError(
-            absl::StrCat(field, ".position: ", located.status().message()));
+        return FieldError(absl::StrCat(field, ".position"), located.status().message());
       }
       return located->point;
     }
     case v1::SurfacePoint::POINT_NOT_SET:
-      return absl::InvalidArgumentError(
-          absl::StrCat(field, ": no point set (vertex, edge, face or position)"));
+      return FieldError(field, "no point set (vertex, edge, face or position)");
   }
   absl::Status valid = ValidateSurfacePoint(*mesh.mesh, p);
   if (!valid.ok()) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        field, p.kind == SurfacePoint::Kind::kEdge ? ".edge: " : ".face: ", valid.message()));
+    return FieldError(absl::StrCat(field, p.kind == SurfacePoint::Kind::kEdge ? ".edge" : ".face"),
+                      valid.message());
   }
   if (p.kind == SurfacePoint::Kind::kEdge && !HasFileEdge(*mesh.mesh, p.edge_from, p.edge_to)) {
-    return absl::InvalidArgumentError(absl::StrCat(field, ".edge: the mesh has no edge between ",
-                                                   "vertices ", p.edge_from, " and ", p.edge_to));
+    return FieldError(absl::StrCat(field, ".edge"), absl::StrCat("the mesh has no edge between ", "vertices ", p.edge_from, " and ", p.edge_to));
   }
   return p;
 }
@@ -118,8 +110,7 @@ absl::StatusOr<GeodesicOptions> SolverOptionsFromProto(const v1::SolverOptions& 
                                                        const std::string& field) {
   GeodesicOptions out;
   if (!(options.lambda() >= 0 && options.lambda() <= 1)) {  // also NaN
-    return absl::InvalidArgumentError(
-        absl::StrCat(field, ".lambda: must be in [0, 1], got ", options.lambda()));
+    return FieldError(absl::StrCat(field, ".lambda"), absl::StrCat("must be in [0, 1], got ", options.lambda()));
   }
   out.lambda = options.lambda();
   switch (options.lambda_scale()) {
@@ -131,13 +122,11 @@ absl::StatusOr<GeodesicOptions> SolverOptionsFromProto(const v1::SolverOptions& 
       out.lambda_scale = LambdaScale::kMeanEdge;
       break;
     default:
-      return absl::InvalidArgumentError(
-          absl::StrCat(field, ".lambda_scale: unknown value ", options.lambda_scale()));
+      return FieldError(absl::StrCat(field, ".lambda_scale"), absl::StrCat("unknown value ", options.lambda_scale()));
   }
   if (options.has_max_distance()) {
     if (std::isnan(options.max_distance()) || options.max_distance() <= 0) {
-      return absl::InvalidArgumentError(
-          absl::StrCat(field, ".max_distance: must be > 0, got ", options.max_distance()));
+      return FieldError(absl::StrCat(field, ".max_distance"), absl::StrCat("must be > 0, got ", options.max_distance()));
     }
     out.max_distance = options.max_distance();
   }

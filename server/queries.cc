@@ -36,11 +36,11 @@ absl::StatusOr<std::vector<SurfacePoint>> ResolvePoints(const StoredMesh& mesh,
                                                         const std::string& field, uint64_t limit,
                                                         const char* flag) {
   if (points.empty()) {
-    return absl::InvalidArgumentError(absl::StrCat(field, ": at least one point is required"));
+    return FieldError(field, "at least one point is required");
   }
   if (static_cast<uint64_t>(points.size()) > limit) {
-    return absl::ResourceExhaustedError(
-        absl::StrCat(field, ": ", points.size(), " points, over --", flag, "=", limit));
+    return ServerLimitError(
+        flag, absl::StrCat(field, ": ", points.size(), " points, over --", flag, "=", limit));
   }
   std::vector<SurfacePoint> out;
   out.reserve(points.size());
@@ -70,15 +70,14 @@ absl::StatusOr<GeodesicOptions> Options(const QueryEnv& env, const v1::SolverOpt
 // different components is fine, but a point on a degenerate face is not): name the field.
 absl::Status NameSolveError(const absl::Status& status, const char* field) {
   if (status.code() == absl::StatusCode::kInvalidArgument) {
-    return absl::InvalidArgumentError(absl::StrCat(field, ": ", status.message()));
+    return FieldError(field, status.message());
   }
   return status;
 }
 
 absl::Status CheckFieldSize(const QueryEnv& env, const StoredMesh& mesh) {
   if (mesh.vertex_count > env.limits->max_output_values) {
-    return absl::ResourceExhaustedError(
-        absl::StrCat("the field has ", mesh.vertex_count,
+    return ServerLimitError("max_output_values", absl::StrCat("the field has ", mesh.vertex_count,
                      " values, over --max_output_values=", env.limits->max_output_values));
   }
   return absl::OkStatus();
@@ -88,8 +87,7 @@ absl::Status CheckUnaryResponseSize(const QueryEnv& env, const google::protobuf:
                                     const char* what) {
   const size_t bytes = response.ByteSizeLong();
   if (bytes > env.limits->max_unary_response_bytes) {
-    return absl::ResourceExhaustedError(
-        absl::StrCat("the response would be ", bytes, " bytes, over --max_unary_response_bytes=",
+    return ServerLimitError("max_unary_response_bytes", absl::StrCat("the response would be ", bytes, " bytes, over --max_unary_response_bytes=",
                      env.limits->max_unary_response_bytes, "; send fewer ", what, " per call"));
   }
   return absl::OkStatus();
@@ -173,7 +171,7 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> LookupMesh(const QueryEnv& env
   }
   absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh = env.store->Get(*key);
   if (absl::IsNotFound(mesh.status())) {
-    return absl::NotFoundError(absl::StrCat(field, ": mesh ", QuoteInput(name), " not found"));
+    return MeshNotFoundError(field, absl::StrCat("mesh ", QuoteInput(name), " not found"));
   }
   return mesh;  // or DataLoss (a corrupt file), ResourceExhausted (cannot be loaded back)
 }
@@ -188,8 +186,7 @@ absl::Status RunGetMesh(const QueryEnv& env, const v1::GetMeshRequest& request,
   // The record: a mesh that is only on disk is described without loading it.
   absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh = env.store->GetRecord(*key);
   if (!mesh.ok()) {
-    return absl::NotFoundError(
-        absl::StrCat("name: mesh ", QuoteInput(request.name()), " not found"));
+    return MeshNotFoundError("name", absl::StrCat("mesh ", QuoteInput(request.name()), " not found"));
   }
   MeshToProto(**mesh, response);
   return absl::OkStatus();
@@ -200,11 +197,10 @@ absl::Status RunListMeshes(const QueryEnv& env, const v1::ListMeshesRequest& req
   constexpr int kDefaultPageSize = 50;
   constexpr int kMaxPageSize = 1000;
   if (request.page_size() < 0) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("page_size: must be >= 0, got ", request.page_size()));
+    return FieldError("page_size", absl::StrCat("must be >= 0, got ", request.page_size()));
   }
   if (!request.page_token().empty() && !IsMeshId(request.page_token())) {
-    return absl::InvalidArgumentError("page_token: not a token returned by ListMeshes");
+    return FieldError("page_token", "not a token returned by ListMeshes");
   }
   const int page_size =
       request.page_size() == 0 ? kDefaultPageSize : std::min(request.page_size(), kMaxPageSize);
@@ -222,8 +218,7 @@ absl::Status RunDeleteMesh(const QueryEnv& env, const v1::DeleteMeshRequest& req
   if (!key.ok()) return key.status();
   absl::Status status = env.store->Delete(*key);
   if (absl::IsNotFound(status)) {
-    return absl::NotFoundError(
-        absl::StrCat("name: mesh ", QuoteInput(request.name()), " not found"));
+    return MeshNotFoundError("name", absl::StrCat("mesh ", QuoteInput(request.name()), " not found"));
   }
   return status;
 }
@@ -297,10 +292,10 @@ absl::Status RunFindShortestPaths(const QueryEnv& env, const v1::FindShortestPat
   absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh = LookupMesh(env, request.mesh(), "mesh");
   if (!mesh.ok()) return mesh.status();
   if (request.pairs().empty()) {
-    return absl::InvalidArgumentError("pairs: at least one pair is required");
+    return FieldError("pairs", "at least one pair is required");
   }
   if (static_cast<uint64_t>(request.pairs_size()) > env.limits->max_targets) {
-    return absl::ResourceExhaustedError(absl::StrCat(
+    return ServerLimitError("max_targets", absl::StrCat(
         "pairs: ", request.pairs_size(), " pairs, over --max_targets=", env.limits->max_targets));
   }
   absl::StatusOr<GeodesicOptions> solver = Options(env, request.options());
@@ -362,7 +357,7 @@ absl::Status RunEstimateDistances(const QueryEnv& env, const v1::EstimateDistanc
       ResolvePoints(**mesh, request.points(), "points", env.limits->max_targets, "max_targets");
   if (!points.ok()) return points.status();
   if (!v1::PointDistanceMode_IsValid(request.mode())) {
-    return absl::InvalidArgumentError(absl::StrCat("mode: unknown value ", request.mode()));
+    return FieldError("mode", absl::StrCat("unknown value ", request.mode()));
   }
   const bool estimate = request.mode() != v1::POINT_DISTANCE_MODE_EXACT;
   const bool exact = request.mode() == v1::POINT_DISTANCE_MODE_EXACT ||
@@ -407,18 +402,16 @@ absl::Status RunLocatePoints(const QueryEnv& env, const v1::LocatePointsRequest&
       LookupMesh(env, request.mesh(), "mesh");
   if (!mesh.ok()) return mesh.status();
   if (request.positions().empty()) {
-    return absl::InvalidArgumentError("positions: at least one position is required");
+    return FieldError("positions", "at least one position is required");
   }
   if (static_cast<uint64_t>(request.positions_size()) > env.limits->max_targets) {
-    return absl::ResourceExhaustedError(
-        absl::StrCat("positions: ", request.positions_size(),
+    return ServerLimitError("max_targets", absl::StrCat("positions: ", request.positions_size(),
                      " points, over --max_targets=", env.limits->max_targets));
   }
   const double max_snap =
       request.has_max_snap() ? request.max_snap() : std::numeric_limits<double>::infinity();
   if (!(max_snap > 0)) {  // also NaN
-    return absl::InvalidArgumentError(
-        absl::StrCat("max_snap: must be > 0 when set, got ", request.max_snap()));
+    return FieldError("max_snap", absl::StrCat("must be > 0 when set, got ", request.max_snap()));
   }
   for (int i = 0; i < request.positions_size(); ++i) {
     if ((i & 1023) == 0 && env.cancel->IsCancelled()) return absl::CancelledError("cancelled");
@@ -429,8 +422,12 @@ absl::Status RunLocatePoints(const QueryEnv& env, const v1::LocatePointsRequest&
       if (!snap.ok()) located = snap;
     }
     if (!located.ok()) {
+      const std::string field = absl::StrCat("positions[", i, "]");
+      if (absl::IsInvalidArgument(located.status())) {
+        return FieldError(field, located.status().message());
+      }
       return absl::Status(located.status().code(),
-                          absl::StrCat("positions[", i, "]: ", located.status().message()));
+                          absl::StrCat(field, ": ", located.status().message()));
     }
     v1::LocatedPoint* out = response->add_points();
     SurfacePointToProto(located->point, out->mutable_point());
@@ -446,8 +443,7 @@ absl::Status RunLocatePoints(const QueryEnv& env, const v1::LocatePointsRequest&
 absl::StatusOr<MessageStream<v1::ComputeDistanceFieldResponse>> RunComputeDistanceField(
     const QueryEnv& env, const v1::ComputeDistanceFieldRequest& request) {
   if (!v1::ValueType_IsValid(request.value_type())) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("value_type: unknown value ", request.value_type()));
+    return FieldError("value_type", absl::StrCat("unknown value ", request.value_type()));
   }
   absl::StatusOr<SolvedField> solved =
       SolveField(env, request.mesh(), request.sources(), request.options());
@@ -637,8 +633,7 @@ Produced NextMatrixMessage(MatrixStreamState& state, bool f32, bool want_stats, 
 absl::StatusOr<MessageStream<v1::ComputeDistanceMatrixResponse>> RunComputeDistanceMatrix(
     const QueryEnv& env, const v1::ComputeDistanceMatrixRequest& request) {
   if (!v1::ValueType_IsValid(request.value_type())) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("value_type: unknown value ", request.value_type()));
+    return FieldError("value_type", absl::StrCat("unknown value ", request.value_type()));
   }
   absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh =
       LookupMesh(env, request.mesh(), "mesh");
@@ -651,8 +646,7 @@ absl::StatusOr<MessageStream<v1::ComputeDistanceMatrixResponse>> RunComputeDista
   if (!targets.ok()) return targets.status();
   const uint64_t values = uint64_t{sources->size()} * targets->size();
   if (values > env.limits->max_output_values) {
-    return absl::ResourceExhaustedError(
-        absl::StrCat("the matrix has ", sources->size(), " x ", targets->size(), " = ", values,
+    return ServerLimitError("max_output_values", absl::StrCat("the matrix has ", sources->size(), " x ", targets->size(), " = ", values,
                      " values, over --max_output_values=", env.limits->max_output_values));
   }
   absl::StatusOr<GeodesicOptions> solver = Options(env, request.options());
@@ -729,24 +723,22 @@ absl::StatusOr<MessageStream<v1::ComputeIsolinesResponse>> RunComputeIsolines(
     const QueryEnv& env, const v1::ComputeIsolinesRequest& request) {
   const uint32_t max_levels = env.limits->max_levels;
   if (static_cast<uint64_t>(request.levels_size()) > max_levels) {
-    return absl::ResourceExhaustedError(
-        absl::StrCat("levels: ", request.levels_size(), " levels, over --max_levels=", max_levels));
+    return ServerLimitError("max_levels", absl::StrCat("levels: ", request.levels_size(), " levels, over --max_levels=", max_levels));
   }
   IsolineOptions options;
   for (int i = 0; i < request.levels_size(); ++i) {
     if (!std::isfinite(request.levels(i))) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("levels[", i, "]: must be finite, got ", request.levels(i)));
+      return FieldError(absl::StrCat("levels[", i, "]"),
+                        absl::StrCat("must be finite, got ", request.levels(i)));
     }
     options.levels.push_back(request.levels(i));
   }
   if (options.levels.empty()) {
     if (request.count() < 2) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("count: give levels, or a count >= 2 (got ", request.count(), ")"));
+      return FieldError("count", absl::StrCat("give levels, or a count >= 2 (got ", request.count(), ")"));
     }
     if (static_cast<uint64_t>(request.count()) > uint64_t{max_levels} + 1) {
-      return absl::ResourceExhaustedError(absl::StrCat("count: ", request.count(), " gives ",
+      return ServerLimitError("max_levels", absl::StrCat("count: ", request.count(), " gives ",
                                                        request.count() - 1,
                                                        " levels, over --max_levels=", max_levels));
     }

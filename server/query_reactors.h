@@ -33,7 +33,7 @@
 namespace geodex::server {
 
 inline absl::Status PoolFullError(const ComputePool& pool, const char* flags) {
-  return absl::ResourceExhaustedError(
+  return QueueFullError(
       absl::StrCat("compute queue full (", pool.threads(), " workers busy, ", pool.queue_capacity(),
                    " queued; ", flags, "); retry later"));
 }

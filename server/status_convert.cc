@@ -4,6 +4,7 @@
 #include <string>
 
 #include "absl/strings/cord.h"
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
 #include "geodex/limits.h"
@@ -14,32 +15,14 @@
 namespace geodex::server {
 namespace {
 
+// The payloads of the typed errors (type URLs private to this file).
 constexpr absl::string_view kReasonPayload = "geodex/reason";
+constexpr absl::string_view kFieldPayload = "geodex/field";
+constexpr absl::string_view kFlagPayload = "geodex/flag";
 
-// geodex's error messages start with the request field they concern: "sources[2].edge.t: ...".
-// Returns that field, or "" when the message does not start with one.
-absl::string_view LeadingField(absl::string_view message) {
-  const size_t colon = message.find(": ");
-  if (colon == absl::string_view::npos || colon == 0) return {};
-  absl::string_view field = message.substr(0, colon);
-  for (char c : field) {
-    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
-                    c == '_' || c == '.' || c == '[' || c == ']' || c == '/';
-    if (!ok) return {};
-  }
-  return field;
-}
-
-// The first "--flag_name" a limit's message names, or "".
-absl::string_view NamedFlag(absl::string_view message) {
-  const size_t start = message.find("--");
-  if (start == absl::string_view::npos) return {};
-  size_t end = start + 2;
-  while (end < message.size() &&
-         ((message[end] >= 'a' && message[end] <= 'z') || message[end] == '_')) {
-    ++end;
-  }
-  return end > start + 2 ? message.substr(start + 2, end - start - 2) : absl::string_view();
+std::string PayloadOf(const absl::Status& status, absl::string_view url) {
+  auto payload = status.GetPayload(url);  // absl::optional<absl::Cord>
+  return payload ? std::string(*payload) : std::string();
 }
 
 std::string CapMessage(absl::string_view message) {
@@ -55,6 +38,32 @@ std::string QuoteInput(absl::string_view input) {
   size_t cut = kMaxEchoBytes;
   while (cut > 0 && (static_cast<unsigned char>(input[cut]) & 0xC0) == 0x80) --cut;  // whole UTF-8
   return absl::StrCat("\"", input.substr(0, cut), "...\" (cut: ", input.size(), " bytes)");
+}
+
+absl::Status FieldError(absl::string_view field, absl::string_view description) {
+  absl::Status status = absl::InvalidArgumentError(absl::StrCat(field, ": ", description));
+  status.SetPayload(kFieldPayload, absl::Cord(field));
+  return status;
+}
+
+absl::Status ServerLimitError(absl::string_view flag, absl::string_view message) {
+  absl::Status status = absl::ResourceExhaustedError(message);
+  status.SetPayload(kReasonPayload, absl::Cord("LIMIT"));
+  status.SetPayload(kFlagPayload, absl::Cord(flag));
+  return status;
+}
+
+absl::Status QueueFullError(absl::string_view message) {
+  absl::Status status = absl::ResourceExhaustedError(message);
+  status.SetPayload(kReasonPayload, absl::Cord("QUEUE_FULL"));
+  return status;
+}
+
+absl::Status MeshNotFoundError(absl::string_view field, absl::string_view message) {
+  absl::Status status = absl::NotFoundError(absl::StrCat(field, ": ", message));
+  status.SetPayload(kReasonPayload, absl::Cord("MESH_NOT_FOUND"));
+  status.SetPayload(kFieldPayload, absl::Cord(field));
+  return status;
 }
 
 absl::Status UnreachableError(absl::string_view message) {
@@ -74,30 +83,32 @@ grpc::Status ToGrpcStatus(const absl::Status& status) {
   }
   message = CapMessage(message);
 
-  // Rich error details (google.rpc.Status in the grpc-status-details-bin trailer): BadRequest
-  // naming the field for INVALID_ARGUMENT, ErrorInfo naming the flag for a limit.
+  // Rich error details (google.rpc.Status in the grpc-status-details-bin trailer), from the
+  // payloads only: a BadRequest naming the field, an ErrorInfo with the reason (and the flag).
   google::rpc::Status details;
-  if (status.code() == absl::StatusCode::kInvalidArgument) {
-    absl::string_view field = LeadingField(message);
-    if (!field.empty()) {
-      google::rpc::BadRequest bad_request;
-      google::rpc::BadRequest::FieldViolation* violation = bad_request.add_field_violations();
-      violation->set_field(std::string(field));
-      violation->set_description(message.substr(field.size() + 2));
-      details.add_details()->PackFrom(bad_request);
-    }
-  } else if (status.code() == absl::StatusCode::kResourceExhausted) {
+  const std::string field = PayloadOf(status, kFieldPayload);
+  if (!field.empty()) {
+    google::rpc::BadRequest bad_request;
+    google::rpc::BadRequest::FieldViolation* violation = bad_request.add_field_violations();
+    violation->set_field(field);
+    violation->set_description(
+        absl::StartsWith(message, field + ": ") ? message.substr(field.size() + 2) : message);
+    details.add_details()->PackFrom(bad_request);
+  }
+  std::string reason = PayloadOf(status, kReasonPayload);
+  std::string flag = PayloadOf(status, kFlagPayload);
+  if (std::optional<Limit> limit = ExceededLimit(status)) {  // a core limit: the flag that set it
+    reason = "LIMIT";
+    flag = FlagOfLimit(*limit);
+  }
+  if (reason.empty() && status.code() == absl::StatusCode::kResourceExhausted) {
+    reason = "RESOURCE_EXHAUSTED";  // the mesh budget, a full data directory
+  }
+  if (!reason.empty()) {
     google::rpc::ErrorInfo info;
     info.set_domain("geodex.v1");
-    absl::string_view flag = NamedFlag(message);
-    const bool queue_full = message.rfind("compute queue full", 0) == 0;
-    info.set_reason(queue_full ? "QUEUE_FULL" : flag.empty() ? "RESOURCE_EXHAUSTED" : "LIMIT");
-    if (!flag.empty()) (*info.mutable_metadata())["flag"] = std::string(flag);
-    details.add_details()->PackFrom(info);
-  } else if (auto reason = status.GetPayload(kReasonPayload)) {
-    google::rpc::ErrorInfo info;
-    info.set_domain("geodex.v1");
-    info.set_reason(std::string(*reason));
+    info.set_reason(reason);
+    if (!flag.empty()) (*info.mutable_metadata())["flag"] = flag;
     details.add_details()->PackFrom(info);
   }
   if (details.details_size() == 0) {

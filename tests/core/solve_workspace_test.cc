@@ -178,9 +178,11 @@ TEST_P(SolveWorkspaceTest, IdleMemoryFollowsTheMeshNotTheWork) {
   EXPECT_GT(mesh->workspaces()->IdleBytes(), 0u);
   EXPECT_LE(mesh->workspaces()->IdleBytes(), per_mesh);
   RunQueries(*mesh);
-  // One workspace per solve that ran at once: the matrix's 5 rows ran on up to every core.
+  // One workspace per solve that ran at once: the matrix's 5 rows ran on up to every core. Each
+  // keeps its mesh arrays and at most as many bytes again of window pool and queue (Release
+  // frees larger ones), whatever the work was.
   const uint64_t at_once = std::max(1u, std::min(UsableCores(), 5u));
-  EXPECT_LE(mesh->workspaces()->IdleBytes(), at_once * per_mesh);
+  EXPECT_LE(mesh->workspaces()->IdleBytes(), at_once * 2 * per_mesh);
 }
 
 INSTANTIATE_TEST_SUITE_P(CommittedMeshes, SolveWorkspaceTest,

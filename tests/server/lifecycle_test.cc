@@ -58,10 +58,16 @@ TEST_F(LifecycleTest, ErrorsCarryBadRequestAndErrorInfoDetails) {
   EXPECT_EQ(info.domain(), "geodex.v1");
   EXPECT_EQ(info.metadata().at("flag"), "max_sources");
 
-  // NOT_FOUND carries no details (the message names the mesh).
+  // An unknown mesh: NOT_FOUND with ErrorInfo MESH_NOT_FOUND (what a client re-uploads on) and a
+  // BadRequest naming the request field.
   s = ReadField(*stub_, FieldRequest("meshes/unknown", {0}), 30).status;
   EXPECT_EQ(s.error_code(), grpc::StatusCode::NOT_FOUND);
-  EXPECT_TRUE(s.error_details().empty());
+  details = Details(s);
+  ASSERT_EQ(details.details_size(), 2);
+  ASSERT_TRUE(details.details(0).UnpackTo(&bad_request));
+  EXPECT_EQ(bad_request.field_violations(0).field(), "mesh");
+  ASSERT_TRUE(details.details(1).UnpackTo(&info));
+  EXPECT_EQ(info.reason(), "MESH_NOT_FOUND");
 }
 
 // One exchange on grpc.reflection.v1alpha.ServerReflection/ServerReflectionInfo (a bidi stream);
