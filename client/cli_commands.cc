@@ -3,6 +3,7 @@
 #include "cli_backend.h"
 #include "cli_common.h"
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <limits>
@@ -177,12 +178,10 @@ bool GetSolverFlags(const Args& args, GeodesicOptions* options, std::string* err
       !GetUint(args, "max-windows", &options->max_windows, error)) {
     return false;
   }
-  if (!(options->lambda >= 0 && options->lambda <= 1)) {
-    *error = absl::StrFormat("--lambda must be in [0, 1], got %g", options->lambda);
-    return false;
-  }
-  if (!(options->max_distance > 0)) {
-    *error = "--max-distance must be positive";
+  if (absl::Status s = ValidateGeodesicOptions(*options); !s.ok()) {  // core's one check
+    std::string flag = InvalidOptionOf(s);
+    std::replace(flag.begin(), flag.end(), '_', '-');
+    *error = absl::StrFormat("--%s: %s", flag, s.message());
     return false;
   }
   if (args.options.count("lambda-scale")) {

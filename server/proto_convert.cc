@@ -109,9 +109,6 @@ absl::StatusOr<GeodesicOptions> SolverOptionsFromProto(const v1::SolverOptions& 
                                                        uint64_t max_windows,
                                                        const std::string& field) {
   GeodesicOptions out;
-  if (!(options.lambda() >= 0 && options.lambda() <= 1)) {  // also NaN
-    return FieldError(absl::StrCat(field, ".lambda"), absl::StrCat("must be in [0, 1], got ", options.lambda()));
-  }
   out.lambda = options.lambda();
   switch (options.lambda_scale()) {
     case v1::LAMBDA_SCALE_UNSPECIFIED:
@@ -122,13 +119,12 @@ absl::StatusOr<GeodesicOptions> SolverOptionsFromProto(const v1::SolverOptions& 
       out.lambda_scale = LambdaScale::kMeanEdge;
       break;
     default:
-      return FieldError(absl::StrCat(field, ".lambda_scale"), absl::StrCat("unknown value ", options.lambda_scale()));
+      return FieldError(absl::StrCat(field, ".lambda_scale"),
+                        absl::StrCat("unknown value ", options.lambda_scale()));
   }
-  if (options.has_max_distance()) {
-    if (std::isnan(options.max_distance()) || options.max_distance() <= 0) {
-      return FieldError(absl::StrCat(field, ".max_distance"), absl::StrCat("must be > 0, got ", options.max_distance()));
-    }
-    out.max_distance = options.max_distance();
+  if (options.has_max_distance()) out.max_distance = options.max_distance();
+  if (absl::Status s = ValidateGeodesicOptions(out); !s.ok()) {  // core's one check
+    return FieldError(absl::StrCat(field, ".", InvalidOptionOf(s)), s.message());
   }
   out.max_windows = max_windows;
   return out;

@@ -5,19 +5,49 @@
 #include <limits>
 #include <new>
 
+#include "absl/strings/cord.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/string_view.h"
 #include "dijkstra.h"
 #include "ich/ich_solver.h"
 #include "mesh_lookup.h"
 #include "source_resolver.h"
 
 namespace geodex {
+namespace {
+
+// The option an InvalidArgument from ValidateGeodesicOptions is about (a type URL private to core).
+constexpr absl::string_view kOptionPayload = "geodex/option";
+
+absl::Status OptionError(absl::string_view option, const std::string& description) {
+  absl::Status status = absl::InvalidArgumentError(description);
+  status.SetPayload(kOptionPayload, absl::Cord(option));
+  return status;
+}
+
+}  // namespace
+
+absl::Status ValidateGeodesicOptions(const GeodesicOptions& options) {
+  if (!(options.lambda >= 0 && options.lambda <= 1)) {  // also NaN
+    return OptionError("lambda", absl::StrFormat("must be in [0, 1], got %g", options.lambda));
+  }
+  if (!(options.max_distance > 0)) {
+    return OptionError("max_distance",
+                       absl::StrFormat("must be > 0, got %g", options.max_distance));
+  }
+  return absl::OkStatus();
+}
+
+std::string InvalidOptionOf(const absl::Status& status) {
+  auto option = status.GetPayload(kOptionPayload);
+  return option ? std::string(*option) : std::string();
+}
 
 absl::StatusOr<DistanceField> ComputeDistanceField(const TriangleMesh& mesh,
                                                    const std::vector<SurfacePoint>& sources,
                                                    const GeodesicOptions& options) {
   if (sources.empty()) return absl::InvalidArgumentError("no sources given");
-  if (absl::Status s = ValidateSolveOptions(options); !s.ok()) return s;
+  if (absl::Status s = ValidateGeodesicOptions(options); !s.ok()) return s;
   SourceResolver resolver(mesh);
   for (uint32_t i = 0; i < sources.size(); ++i) {
     if (absl::Status s = resolver.Add(sources[i], i); !s.ok()) return s;

@@ -28,7 +28,7 @@ absl::Status CheckOptions(const GeodesicOptions& options) {
   if (!IsExactMethod(options.method)) {
     return absl::InvalidArgumentError("point queries and paths need an exact method (exact or ich)");
   }
-  return ValidateSolveOptions(options);
+  return ValidateGeodesicOptions(options);
 }
 
 absl::StatusOr<std::vector<ich::ResolvedSource>> ResolveSources(

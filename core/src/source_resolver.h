@@ -17,19 +17,6 @@
 
 namespace geodex {
 
-// Checks the options every solve shares; errors name the option.
-inline absl::Status ValidateSolveOptions(const GeodesicOptions& options) {
-  if (!(options.lambda >= 0 && options.lambda <= 1)) {
-    return absl::InvalidArgumentError(
-        absl::StrFormat("lambda = %g is outside [0, 1]", options.lambda));
-  }
-  if (!(options.max_distance > 0)) {
-    return absl::InvalidArgumentError(
-        absl::StrFormat("max_distance = %g must be positive", options.max_distance));
-  }
-  return absl::OkStatus();
-}
-
 // Barycentrics (and edge parameters) this close to 0 or 1 snap to the face's edge or vertex, so a
 // point "on" an edge behaves exactly like the edge point.
 constexpr double kSnap = 1e-12;

@@ -143,6 +143,20 @@ TEST(MaxDistanceTest, RejectsNonPositiveBounds) {
   o.max_distance = 0;
   absl::StatusOr<DistanceField> f = ComputeDistanceField(*mesh, {SurfacePoint::AtVertex(0)}, o);
   EXPECT_EQ(f.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(InvalidOptionOf(f.status()), "max_distance");  // the option as data, for front ends
+}
+
+TEST(OptionsTest, OneCheckNamesTheOption) {
+  GeodesicOptions o;
+  EXPECT_TRUE(ValidateGeodesicOptions(o).ok());
+  o.lambda = std::nan("");
+  absl::Status s = ValidateGeodesicOptions(o);
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(InvalidOptionOf(s), "lambda");
+  o.lambda = 1;
+  o.max_distance = -2;
+  EXPECT_EQ(InvalidOptionOf(ValidateGeodesicOptions(o)), "max_distance");
+  EXPECT_EQ(InvalidOptionOf(absl::InvalidArgumentError("lambda: no payload")), "");
 }
 
 TEST(CancellationTest, CancelledTokenStopsTheSolveAndTheThreadServesTheNextOne) {

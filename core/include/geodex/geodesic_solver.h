@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -45,6 +46,13 @@ struct GeodesicOptions {
   bool use_filter = true;            // Lemma 2, the filter theorem
   bool use_one_angle_one_split = true;  // Lemma 1, Chen & Han
 };
+
+// The one check of the options every solve shares (lambda in [0, 1], max_distance > 0), made by
+// every query; the CLI and geodexd call it too, before any work. An error is InvalidArgument
+// "must be ..., got X" naming the option as data: InvalidOptionOf gives its name ("lambda",
+// "max_distance"), which each front end spells its own way (--lambda, options.lambda).
+absl::Status ValidateGeodesicOptions(const GeodesicOptions& options);
+std::string InvalidOptionOf(const absl::Status& status);  // "" when the error is not an option's
 
 // Distances from every vertex to the nearest of `sources`, with the nearest source's index.
 // Errors: InvalidArgument for an empty source list or a bad source (named), Cancelled,
