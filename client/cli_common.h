@@ -83,12 +83,7 @@ std::array<double, 3> PositionOf(const MeshData& mesh, const SurfacePoint& p);
 // --- Output, shared by local and remote mode (so both print the same bytes) ---
 
 // What `geodex info` prints.
-struct InfoValues {
-  MeshReport report;
-  uint64_t internal_vertices = 0;
-  double mean_edge_length = 0, max_edge_length = 0;
-  std::array<double, 3> bbox_min{}, bbox_max{};
-  uint64_t bytes = 0;
+struct InfoValues : MeshSummary {
   double load_ms = 0, build_ms = 0;
 };
 std::string FormatInfo(const InfoValues& v, bool json);

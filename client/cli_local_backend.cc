@@ -71,15 +71,8 @@ class LocalBackend final : public Backend {
   absl::StatusOr<const MeshData*> Geometry() override { return &loaded_->data; }
 
   absl::StatusOr<InfoValues> Info() override {
-    const TriangleMesh& mesh = loaded_->mesh;
     InfoValues v;
-    v.report = mesh.report();
-    v.internal_vertices = mesh.vertex_count();
-    v.mean_edge_length = mesh.MeanEdgeLength();
-    v.max_edge_length = mesh.MaxEdgeLength();
-    v.bbox_min = mesh.BoundsMin();
-    v.bbox_max = mesh.BoundsMax();
-    v.bytes = mesh.MemoryBytes();
+    static_cast<MeshSummary&>(v) = Summarize(loaded_->mesh);
     v.load_ms = loaded_->load_ms;
     v.build_ms = loaded_->build_ms;
     return v;

@@ -130,28 +130,8 @@ class RemoteBackend final : public Backend {
     const auto t0 = std::chrono::steady_clock::now();
     absl::StatusOr<v1::Mesh> m = client_->GetMesh(mesh_.name);
     if (!m.ok()) return m.status();
-    const v1::MeshInfo& i = m->info();
     InfoValues v;
-    v.report.file_vertices = m->vertex_count();
-    v.report.file_faces = m->face_count();
-    v.report.boundary_edges = m->boundary_edges();
-    v.report.boundary_loops = i.boundary_loops();
-    v.report.components = m->components();
-    v.report.vertex_connected_components = i.vertex_connected_components();
-    v.report.isolated_vertices = i.isolated_vertices();
-    v.report.non_manifold_edges = m->non_manifold_edges();
-    v.report.non_manifold_vertices = i.non_manifold_vertices();
-    v.report.degenerate_faces = m->degenerate_faces();
-    v.report.flipped_faces = i.flipped_faces();
-    v.report.orientation_cuts = i.orientation_cuts();
-    v.report.saddle_vertices = i.saddle_vertices();
-    v.report.boundary_vertices = i.boundary_vertices();
-    v.internal_vertices = i.internal_vertices();
-    v.mean_edge_length = i.mean_edge_length();
-    v.max_edge_length = i.max_edge_length();
-    v.bbox_min = {i.bbox_min().x(), i.bbox_min().y(), i.bbox_min().z()};
-    v.bbox_max = {i.bbox_max().x(), i.bbox_max().y(), i.bbox_max().z()};
-    v.bytes = i.mesh_bytes();
+    static_cast<MeshSummary&>(v) = api::MeshSummaryFromProto(*m);
     v.load_ms = MsSince(t0);  // remote: the time to describe the mesh
     return v;
   }

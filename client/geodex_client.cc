@@ -11,6 +11,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "api_convert.h"
+#include "geometry_convert.h"
 #include "geodex/mesh_io.h"
 #include "geodex/samples.h"
 #include "google/rpc/error_details.pb.h"
@@ -402,18 +403,6 @@ absl::StatusOr<std::vector<LocatedPoint>> GeodexClient::Locate(
   return out;
 }
 
-namespace {
-
-// Appends a streamed piece's points to the item being assembled: a piece continues the previous
-// one when that one said `continued`.
-template <typename Piece, typename Item, typename Convert>
-void AddPiece(const Piece& piece, bool* open, std::vector<Item>* items, Convert start) {
-  if (!*open) items->push_back(start(piece));
-  for (const auto& p : piece.points()) items->back().points.push_back(api::PathPointFromProto(p));
-  *open = piece.continued();
-}
-
-}  // namespace
 
 absl::StatusOr<Isolines> GeodexClient::ComputeIsolines(MeshRef& mesh,
                                                        const std::vector<SurfacePoint>& sources,
@@ -425,27 +414,16 @@ absl::StatusOr<Isolines> GeodexClient::ComputeIsolines(MeshRef& mesh,
   for (double level : levels.levels) request.add_levels(level);
   request.set_count(levels.count);
   *request.mutable_options() = options;
-  Isolines out;
+  api::IsolinesAssembler out;
   grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
-    out = Isolines();
-    bool open = false;
+    out = api::IsolinesAssembler();
     auto reader = stub_->ComputeIsolines(context, request);
     v1::ComputeIsolinesResponse response;
-    while (reader->Read(&response)) {
-      out.levels.insert(out.levels.end(), response.levels().begin(), response.levels().end());
-      for (const v1::Isoline& piece : response.isolines()) {
-        AddPiece(piece, &open, &out.polylines, [](const v1::Isoline& first) {
-          IsolinePolyline line;
-          line.level = first.level();
-          line.closed = first.closed();
-          return line;
-        });
-      }
-    }
+    while (reader->Read(&response)) out.Add(response);
     return reader->Finish();
   });
   if (!status.ok()) return ToAbsl(status);
-  return out;
+  return std::move(out.result());
 }
 
 absl::StatusOr<VoronoiDiagram> GeodexClient::ComputeVoronoi(MeshRef& mesh,
@@ -455,52 +433,16 @@ absl::StatusOr<VoronoiDiagram> GeodexClient::ComputeVoronoi(MeshRef& mesh,
   request.set_mesh(mesh.name);
   for (const SurfacePoint& p : sites) api::SurfacePointToProto(p, request.add_sources());
   *request.mutable_options() = options;
-  VoronoiDiagram out;
+  api::VoronoiAssembler out;
   grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
-    out = VoronoiDiagram();
-    bool first_message = true, cell_open = false, boundary_open = false;
+    out = api::VoronoiAssembler();
     auto reader = stub_->ComputeVoronoi(context, request);
     v1::ComputeVoronoiResponse response;
-    while (reader->Read(&response)) {
-      if (first_message) {
-        out.total_area = response.total_area();
-        out.junction_faces = response.junction_faces();
-        for (const auto& pair : response.adjacency()) out.adjacency.push_back({pair.a(), pair.b()});
-        first_message = false;
-      }
-      for (const v1::VoronoiCell& piece : response.cells()) {
-        if (!cell_open) {
-          VoronoiCell cell;
-          cell.site = piece.site();
-          cell.area = piece.area();
-          out.cells.push_back(std::move(cell));
-        }
-        VoronoiCell& cell = out.cells.back();
-        cell.whole_faces.insert(cell.whole_faces.end(), piece.whole_faces().begin(),
-                                piece.whole_faces().end());
-        for (const v1::VoronoiFragment& f : piece.fragments()) {
-          VoronoiFragment fragment;
-          fragment.face = f.face();
-          fragment.area = f.area();
-          for (const auto& p : f.polygon()) fragment.polygon.push_back(api::PathPointFromProto(p));
-          cell.fragments.push_back(std::move(fragment));
-        }
-        cell_open = piece.continued();
-      }
-      for (const v1::VoronoiBoundary& piece : response.boundaries()) {
-        AddPiece(piece, &boundary_open, &out.boundaries, [](const v1::VoronoiBoundary& first) {
-          VoronoiBoundary b;
-          b.site_a = first.site_a();
-          b.site_b = first.site_b();
-          b.closed = first.closed();
-          return b;
-        });
-      }
-    }
+    while (reader->Read(&response)) out.Add(response);
     return reader->Finish();
   });
   if (!status.ok()) return ToAbsl(status);
-  return out;
+  return std::move(out.result());
 }
 
 absl::StatusOr<DelaunayTriangulation> GeodexClient::ComputeDelaunay(
@@ -509,43 +451,16 @@ absl::StatusOr<DelaunayTriangulation> GeodexClient::ComputeDelaunay(
   request.set_mesh(mesh.name);
   for (const SurfacePoint& p : sites) api::SurfacePointToProto(p, request.add_sources());
   *request.mutable_options() = options;
-  DelaunayTriangulation out;
+  api::DelaunayAssembler out;
   grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
-    out = DelaunayTriangulation();
-    bool kept_open = false, removed_open = false;
-    auto start = [](const v1::DelaunayEdge& first) {
-      DelaunayEdge e;
-      e.site_a = first.site_a();
-      e.site_b = first.site_b();
-      e.vertex_a = first.vertex_a();
-      e.vertex_b = first.vertex_b();
-      e.length = first.length();
-      e.edge_start = first.edge_start();
-      return e;
-    };
+    out = api::DelaunayAssembler();
     auto reader = stub_->ComputeDelaunay(context, request);
     v1::ComputeDelaunayResponse response;
-    while (reader->Read(&response)) {
-      for (const auto& piece : response.edges()) AddPiece(piece, &kept_open, &out.edges, start);
-      for (const auto& piece : response.removed_edges()) {
-        AddPiece(piece, &removed_open, &out.removed_edges, start);
-      }
-      for (const auto& t : response.triangles()) out.triangles.push_back({t.a(), t.b(), t.c()});
-      for (const auto& x : response.xl_edges()) {
-        XlEdge xl;
-        xl.vertex_a = x.vertex_a();
-        xl.vertex_b = x.vertex_b();
-        xl.site_a = x.site_a();
-        xl.site_b = x.site_b();
-        xl.witness = x.witness();
-        xl.point = api::PathPointFromProto(x.point());
-        out.xl_edges.push_back(xl);
-      }
-    }
+    while (reader->Read(&response)) out.Add(response);
     return reader->Finish();
   });
   if (!status.ok()) return ToAbsl(status);
-  return out;
+  return std::move(out.result());
 }
 
 }  // namespace geodex::client

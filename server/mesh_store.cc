@@ -22,27 +22,7 @@ std::shared_ptr<StoredMesh> MakeStoredMesh(std::string id, TriangleMesh mesh) {
   stored->face_count = stored->mesh->face_count();
   stored->memory_bytes = stored->mesh->MemoryBytes() + stored->locator->MemoryBytes();
   stored->create_time = absl::Now();
-  const MeshReport& report = stored->mesh->report();
-  stored->boundary_edges = report.boundary_edges;
-  stored->components = report.components;
-  stored->non_manifold_edges = report.non_manifold_edges;
-  stored->degenerate_faces = report.degenerate_faces;
-  const TriangleMesh& m = *stored->mesh;
-  v1::MeshInfo& info = stored->info;
-  info.set_boundary_loops(report.boundary_loops);
-  info.set_vertex_connected_components(report.vertex_connected_components);
-  info.set_isolated_vertices(report.isolated_vertices);
-  info.set_non_manifold_vertices(report.non_manifold_vertices);
-  info.set_flipped_faces(report.flipped_faces);
-  info.set_orientation_cuts(report.orientation_cuts);
-  info.set_saddle_vertices(report.saddle_vertices);
-  info.set_boundary_vertices(report.boundary_vertices);
-  info.set_internal_vertices(m.vertex_count());
-  info.set_mean_edge_length(m.MeanEdgeLength());
-  info.set_max_edge_length(m.MaxEdgeLength());
-  api::PositionToProto(m.BoundsMin(), info.mutable_bbox_min());
-  api::PositionToProto(m.BoundsMax(), info.mutable_bbox_max());
-  info.set_mesh_bytes(m.MemoryBytes());
+  stored->summary = Summarize(*stored->mesh);
   return stored;
 }
 
@@ -58,11 +38,7 @@ std::shared_ptr<StoredMesh> RecordFromProto(const std::string& id, const v1::Mes
   record->pinned = proto.pinned();
   record->create_time = absl::FromUnixNanos(
       google::protobuf::util::TimeUtil::TimestampToNanoseconds(proto.create_time()));
-  record->boundary_edges = proto.boundary_edges();
-  record->components = proto.components();
-  record->non_manifold_edges = proto.non_manifold_edges();
-  record->degenerate_faces = proto.degenerate_faces();
-  record->info = proto.info();
+  record->summary = api::MeshSummaryFromProto(proto);
   return record;
 }
 

@@ -42,12 +42,8 @@ struct StoredMesh {
   uint64_t memory_bytes = 0;  // mesh + locator, counted against the budget
   bool pinned = false;
   absl::Time create_time;
-  // From the mesh's build report (kept so that records answer GetMesh without loading).
-  uint64_t boundary_edges = 0;
-  uint64_t components = 0;
-  uint64_t non_manifold_edges = 0;
-  uint64_t degenerate_faces = 0;
-  v1::MeshInfo info;  // the rest of the report and the geometry summary
+  // The build report and geometry (kept so that records answer GetMesh without loading).
+  MeshSummary summary;
 };
 
 // Builds a StoredMesh (mesh + locator) from a built mesh; fills memory_bytes and counts.

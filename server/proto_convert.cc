@@ -38,6 +38,7 @@ absl::StatusOr<std::string> ParseMeshName(const std::string& name, const std::st
 }
 
 void MeshToProto(const StoredMesh& mesh, v1::Mesh* out) {
+  api::MeshSummaryToProto(mesh.summary, out);
   out->set_name(absl::StrCat("meshes/", mesh.id));
   out->set_display_name(mesh.display_name);
   for (const std::string& alias : mesh.aliases) out->add_aliases(alias);
@@ -48,11 +49,6 @@ void MeshToProto(const StoredMesh& mesh, v1::Mesh* out) {
   *out->mutable_create_time() =
       google::protobuf::util::TimeUtil::NanosecondsToTimestamp(absl::ToUnixNanos(mesh.create_time));
   out->set_pinned(mesh.pinned);
-  out->set_boundary_edges(mesh.boundary_edges);
-  out->set_components(mesh.components);
-  out->set_non_manifold_edges(mesh.non_manifold_edges);
-  out->set_degenerate_faces(mesh.degenerate_faces);
-  *out->mutable_info() = mesh.info;
 }
 
 absl::StatusOr<SurfacePoint> ResolvePoint(const StoredMesh& mesh, const v1::SurfacePoint& point,

@@ -1,5 +1,7 @@
 #include "queries.h"
 
+#include "geometry_convert.h"
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -750,23 +752,12 @@ absl::StatusOr<MessageStream<v1::ComputeIsolinesResponse>> RunComputeIsolines(
   absl::StatusOr<Isolines> isolines = ExtractIsolines(*solved->mesh->mesh, *solved->field, options);
   if (!isolines.ok()) return isolines.status();
 
-  StreamChunker<v1::ComputeIsolinesResponse> chunker(env.limits->stream_chunk_bytes);
-  for (double level : isolines->levels) chunker.first().add_levels(level);
-  chunker.Account(isolines->levels.size() * 8);
-  for (size_t i = 0; i < isolines->polylines.size(); ++i) {
-    const IsolinePolyline& line = isolines->polylines[i];
-    chunker.AppendPolyline(line.points, [&](v1::ComputeIsolinesResponse& message) {
-      v1::Isoline* item = message.add_isolines();
-      item->set_index(static_cast<uint32_t>(i));
-      item->set_level(line.level);
-      item->set_closed(line.closed);
-      return item;
-    });
-  }
+  std::vector<v1::ComputeIsolinesResponse> messages =
+      api::IsolinesToProto(*isolines, env.limits->stream_chunk_bytes);
   if (request.want_stats()) {
-    FieldStatsToProto(*solved->field, solved->cached, chunker.last().mutable_stats());
+    FieldStatsToProto(*solved->field, solved->cached, messages.back().mutable_stats());
   }
-  return chunker.TakeProducer();
+  return ProducerOf(std::move(messages));
 }
 
 absl::StatusOr<MessageStream<v1::ComputeVoronoiResponse>> RunComputeVoronoi(
@@ -777,67 +768,12 @@ absl::StatusOr<MessageStream<v1::ComputeVoronoiResponse>> RunComputeVoronoi(
   absl::StatusOr<VoronoiDiagram> diagram = BuildVoronoi(*solved->mesh->mesh, *solved->field);
   if (!diagram.ok()) return diagram.status();
 
-  StreamChunker<v1::ComputeVoronoiResponse> chunker(env.limits->stream_chunk_bytes);
-  v1::ComputeVoronoiResponse& first = chunker.first();
-  for (const auto& [a, b] : diagram->adjacency) {
-    v1::SitePair* pair = first.add_adjacency();
-    pair->set_a(a);
-    pair->set_b(b);
-  }
-  first.set_junction_faces(diagram->junction_faces);
-  first.set_total_area(diagram->total_area);
-  for (const SurfacePoint& p : solved->sources)
-    SurfacePointToProto(p, first.add_resolved_sources());
-  chunker.Account(first.ByteSizeLong());
-
-  for (const VoronoiCell& cell : diagram->cells) {
-    chunker.MakeRoom();
-    auto new_piece = [&]() {
-      v1::VoronoiCell* piece = chunker.current().add_cells();
-      piece->set_site(cell.site);
-      piece->set_area(cell.area);
-      chunker.Account(16);
-      return piece;
-    };
-    v1::VoronoiCell* piece = new_piece();
-    if (request.omit_cell_faces()) continue;
-    for (uint32_t face : cell.whole_faces) {
-      if (chunker.Full()) {
-        piece->set_continued(true);
-        chunker.MakeRoom();
-        piece = new_piece();
-      }
-      piece->add_whole_faces(face);
-      chunker.Account(5);
-    }
-    for (const VoronoiFragment& fragment : cell.fragments) {
-      if (chunker.Full()) {
-        piece->set_continued(true);
-        chunker.MakeRoom();
-        piece = new_piece();
-      }
-      v1::VoronoiFragment* out = piece->add_fragments();
-      out->set_face(fragment.face);
-      out->set_area(fragment.area);
-      for (const PathPoint& p : fragment.polygon) PathPointToProto(p, out->add_polygon());
-      chunker.Account(out->ByteSizeLong() + 4);
-    }
-  }
-  for (size_t i = 0; i < diagram->boundaries.size(); ++i) {
-    const VoronoiBoundary& boundary = diagram->boundaries[i];
-    chunker.AppendPolyline(boundary.points, [&](v1::ComputeVoronoiResponse& message) {
-      v1::VoronoiBoundary* item = message.add_boundaries();
-      item->set_index(static_cast<uint32_t>(i));
-      item->set_site_a(boundary.site_a);
-      item->set_site_b(boundary.site_b);
-      item->set_closed(boundary.closed);
-      return item;
-    });
-  }
+  std::vector<v1::ComputeVoronoiResponse> messages = api::VoronoiToProto(
+      *diagram, solved->sources, request.omit_cell_faces(), env.limits->stream_chunk_bytes);
   if (request.want_stats()) {
-    FieldStatsToProto(*solved->field, solved->cached, chunker.last().mutable_stats());
+    FieldStatsToProto(*solved->field, solved->cached, messages.back().mutable_stats());
   }
-  return chunker.TakeProducer();
+  return ProducerOf(std::move(messages));
 }
 
 absl::StatusOr<MessageStream<v1::ComputeDelaunayResponse>> RunComputeDelaunay(
@@ -849,52 +785,12 @@ absl::StatusOr<MessageStream<v1::ComputeDelaunayResponse>> RunComputeDelaunay(
       BuildDelaunay(*solved->mesh->mesh, *solved->field);
   if (!delaunay.ok()) return delaunay.status();
 
-  StreamChunker<v1::ComputeDelaunayResponse> chunker(env.limits->stream_chunk_bytes);
-  for (const SurfacePoint& p : solved->sources) {
-    SurfacePointToProto(p, chunker.first().add_resolved_sources());
-  }
-  chunker.Account(chunker.first().ByteSizeLong());
-  auto append_edges = [&](const std::vector<DelaunayEdge>& edges, bool removed) {
-    for (size_t i = 0; i < edges.size(); ++i) {
-      const DelaunayEdge& edge = edges[i];
-      chunker.AppendPolyline(edge.points, [&](v1::ComputeDelaunayResponse& message) {
-        v1::DelaunayEdge* item = removed ? message.add_removed_edges() : message.add_edges();
-        item->set_index(static_cast<uint32_t>(i));
-        item->set_site_a(edge.site_a);
-        item->set_site_b(edge.site_b);
-        item->set_vertex_a(edge.vertex_a);
-        item->set_vertex_b(edge.vertex_b);
-        item->set_length(edge.length);
-        item->set_edge_start(edge.edge_start);
-        return item;
-      });
-    }
-  };
-  append_edges(delaunay->edges, false);
-  append_edges(delaunay->removed_edges, true);
-  for (const auto& [a, b, c] : delaunay->triangles) {
-    chunker.MakeRoom();
-    v1::SiteTriple* t = chunker.current().add_triangles();
-    t->set_a(a);
-    t->set_b(b);
-    t->set_c(c);
-    chunker.Account(t->ByteSizeLong() + 2);
-  }
-  for (const XlEdge& xl : delaunay->xl_edges) {
-    chunker.MakeRoom();
-    v1::XlEdge* out = chunker.current().add_xl_edges();
-    out->set_vertex_a(xl.vertex_a);
-    out->set_vertex_b(xl.vertex_b);
-    out->set_site_a(xl.site_a);
-    out->set_site_b(xl.site_b);
-    out->set_witness(xl.witness);
-    PathPointToProto(xl.point, out->mutable_point());
-    chunker.Account(out->ByteSizeLong() + 2);
-  }
+  std::vector<v1::ComputeDelaunayResponse> messages =
+      api::DelaunayToProto(*delaunay, solved->sources, env.limits->stream_chunk_bytes);
   if (request.want_stats()) {
-    FieldStatsToProto(*solved->field, solved->cached, chunker.last().mutable_stats());
+    FieldStatsToProto(*solved->field, solved->cached, messages.back().mutable_stats());
   }
-  return chunker.TakeProducer();
+  return ProducerOf(std::move(messages));
 }
 
 }  // namespace geodex::server

@@ -1,9 +1,8 @@
 #pragma once
 
-// Cuts a long result into stream messages of about `budget_bytes` each, far below gRPC's default
-// 4 MiB receive limit. Lists of points (polylines) or faces too long for one message are split into
-// pieces that repeat the item's header and set `continued` on all but the last (geodex.proto,
-// "Streaming of long results").
+// What a streamed query returns to its reactor (MessageStream), and ProducerOf for results whose
+// messages are all ready. The cutting of long results into messages is proto/convert's
+// (geometry_convert.h), far below gRPC's default 4 MiB receive limit.
 
 #include <cstddef>
 #include <functional>
@@ -46,62 +45,17 @@ struct MessageStream {
   Work work;  // empty: nothing to wait for
 };
 
+// A stream whose messages are all ready (the section-6 geometry, cut by proto/convert's
+// geometry_convert.h), as a producer for a streaming reactor.
 template <typename Response>
-class StreamChunker {
- public:
-  explicit StreamChunker(size_t budget_bytes) : budget_(budget_bytes) { messages_.emplace_back(); }
-
-  Response& current() { return messages_.back(); }
-  Response& first() { return messages_.front(); }
-  Response& last() { return messages_.back(); }
-
-  // Counts bytes added to the current message.
-  void Account(size_t bytes) { bytes_ += bytes; }
-  bool Full() const { return bytes_ >= budget_; }
-  // Starts the next message when the current one is full.
-  void MakeRoom() {
-    if (Full()) {
-      messages_.emplace_back();
-      bytes_ = 0;
-    }
-  }
-
-  // Appends one item holding a point list. `new_item(message)` adds a new item with its header
-  // fields set to the message and returns it; `points_of(item)` is its repeated PathPoint field.
-  template <typename NewItem>
-  void AppendPolyline(const std::vector<PathPoint>& points, NewItem new_item) {
-    MakeRoom();
-    auto* item = new_item(current());
-    const size_t header = item->ByteSizeLong() + 4;
-    Account(header);
-    for (const PathPoint& p : points) {
-      if (Full()) {
-        item->set_continued(true);
-        MakeRoom();
-        item = new_item(current());
-        Account(header);
-      }
-      v1::PathPoint* out = item->add_points();
-      PathPointToProto(p, out);
-      Account(out->ByteSizeLong() + 3);
-    }
-  }
-
-  // The messages, as a producer for a streaming reactor (at least one message).
-  MessageProducer<Response> TakeProducer() {
-    auto messages = std::make_shared<std::vector<Response>>(std::move(messages_));
-    auto next = std::make_shared<size_t>(0);
-    return [messages, next](Response* out) {
-      if (*next >= messages->size()) return false;
-      out->Swap(&(*messages)[(*next)++]);
-      return true;
-    };
-  }
-
- private:
-  const size_t budget_;
-  size_t bytes_ = 0;
-  std::vector<Response> messages_;
-};
+MessageProducer<Response> ProducerOf(std::vector<Response> messages) {
+  auto all = std::make_shared<std::vector<Response>>(std::move(messages));
+  auto next = std::make_shared<size_t>(0);
+  return [all, next](Response* out) {
+    if (*next >= all->size()) return false;
+    out->Swap(&(*all)[(*next)++]);
+    return true;
+  };
+}
 
 }  // namespace geodex::server

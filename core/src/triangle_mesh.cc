@@ -535,4 +535,16 @@ uint64_t TriangleMesh::MemoryBytes() const {
          bytes(neighbor_length_);
 }
 
+MeshSummary Summarize(const TriangleMesh& mesh) {
+  MeshSummary s;
+  s.report = mesh.report();
+  s.internal_vertices = mesh.vertex_count();
+  s.mean_edge_length = mesh.MeanEdgeLength();
+  s.max_edge_length = mesh.MaxEdgeLength();
+  s.bbox_min = mesh.BoundsMin();
+  s.bbox_max = mesh.BoundsMax();
+  s.bytes = mesh.MemoryBytes();
+  return s;
+}
+
 }  // namespace geodex

@@ -98,6 +98,58 @@ SolveStats StatsFromProto(const v1::SolveStats& stats) {
   return s;
 }
 
+void MeshSummaryToProto(const MeshSummary& s, v1::Mesh* out) {
+  const MeshReport& r = s.report;
+  out->set_vertex_count(r.file_vertices);
+  out->set_face_count(r.file_faces);
+  out->set_boundary_edges(r.boundary_edges);
+  out->set_components(r.components);
+  out->set_non_manifold_edges(r.non_manifold_edges);
+  out->set_degenerate_faces(r.degenerate_faces);
+  v1::MeshInfo* info = out->mutable_info();
+  info->set_boundary_loops(r.boundary_loops);
+  info->set_vertex_connected_components(r.vertex_connected_components);
+  info->set_isolated_vertices(r.isolated_vertices);
+  info->set_non_manifold_vertices(r.non_manifold_vertices);
+  info->set_flipped_faces(r.flipped_faces);
+  info->set_orientation_cuts(r.orientation_cuts);
+  info->set_saddle_vertices(r.saddle_vertices);
+  info->set_boundary_vertices(r.boundary_vertices);
+  info->set_internal_vertices(s.internal_vertices);
+  info->set_mean_edge_length(s.mean_edge_length);
+  info->set_max_edge_length(s.max_edge_length);
+  PositionToProto(s.bbox_min, info->mutable_bbox_min());
+  PositionToProto(s.bbox_max, info->mutable_bbox_max());
+  info->set_mesh_bytes(s.bytes);
+}
+
+MeshSummary MeshSummaryFromProto(const v1::Mesh& m) {
+  MeshSummary s;
+  MeshReport& r = s.report;
+  const v1::MeshInfo& i = m.info();
+  r.file_vertices = m.vertex_count();
+  r.file_faces = m.face_count();
+  r.boundary_edges = m.boundary_edges();
+  r.components = m.components();
+  r.non_manifold_edges = m.non_manifold_edges();
+  r.degenerate_faces = m.degenerate_faces();
+  r.boundary_loops = i.boundary_loops();
+  r.vertex_connected_components = i.vertex_connected_components();
+  r.isolated_vertices = i.isolated_vertices();
+  r.non_manifold_vertices = i.non_manifold_vertices();
+  r.flipped_faces = i.flipped_faces();
+  r.orientation_cuts = i.orientation_cuts();
+  r.saddle_vertices = i.saddle_vertices();
+  r.boundary_vertices = i.boundary_vertices();
+  s.internal_vertices = i.internal_vertices();
+  s.mean_edge_length = i.mean_edge_length();
+  s.max_edge_length = i.max_edge_length();
+  s.bbox_min = PositionFromProto(i.bbox_min());
+  s.bbox_max = PositionFromProto(i.bbox_max());
+  s.bytes = i.mesh_bytes();
+  return s;
+}
+
 void SolverOptionsToProto(const GeodesicOptions& options, v1::SolverOptions* out) {
   out->set_lambda(options.lambda);
   out->set_lambda_scale(options.lambda_scale == LambdaScale::kMeanEdge

@@ -10,6 +10,7 @@
 #include "geodex/geodesic_solver.h"
 #include "geodex/shortest_path.h"
 #include "geodex/surface_point.h"
+#include "geodex/triangle_mesh.h"
 #include "geodex/v1/geodex.pb.h"
 
 namespace geodex::api {
@@ -26,6 +27,11 @@ PathPoint PathPointFromProto(const v1::PathPoint& point);
 void StatsToProto(const SolveStats& stats, v1::SolveStats* out);
 // The counters the API carries (windows_filtered goes to windows_filtered_at_pop).
 SolveStats StatsFromProto(const v1::SolveStats& stats);
+
+// A mesh's summary as the Mesh resource carries it (counts on Mesh, the rest in Mesh.info), and
+// back (file_vertices and file_faces from vertex_count and face_count).
+void MeshSummaryToProto(const MeshSummary& summary, v1::Mesh* out);
+MeshSummary MeshSummaryFromProto(const v1::Mesh& mesh);
 
 // The request's solver options: lambda, its scale and max_distance (the server's conversion back,
 // with validation and its window limit, is server/proto_convert.h's SolverOptionsFromProto).

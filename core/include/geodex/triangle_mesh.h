@@ -42,6 +42,18 @@ struct MeshReport {
   uint64_t boundary_vertices = 0;
 };
 
+class TriangleMesh;
+
+// What `geodex info` and geodexd's Mesh resource say about a built mesh: its report and geometry.
+struct MeshSummary {
+  MeshReport report;
+  uint64_t internal_vertices = 0;
+  double mean_edge_length = 0, max_edge_length = 0;
+  std::array<double, 3> bbox_min{}, bbox_max{};  // file coordinates
+  uint64_t bytes = 0;                            // TriangleMesh::MemoryBytes
+};
+MeshSummary Summarize(const TriangleMesh& mesh);
+
 // An immutable triangle mesh with everything the geodesic engine reads precomputed.
 //
 // Internal vertex ids: 0..file_vertex_count()-1 are the file's vertices; a file vertex that is

@@ -1,0 +1,65 @@
+#pragma once
+
+// The streamed section-6 geometry, both directions, in one place (geodex.proto, "Streaming of
+// long results"): isolines, Voronoi diagrams and Delaunay triangulations become stream messages
+// of about `budget_bytes` each (geodexd), and are reassembled message by message (the C++
+// client). A polyline, cell or edge too long for one message is split into pieces that repeat
+// its header and set `continued` on all but the last.
+
+#include <cstddef>
+#include <vector>
+
+#include "geodex/delaunay.h"
+#include "geodex/isolines.h"
+#include "geodex/surface_point.h"
+#include "geodex/voronoi.h"
+#include "geodex/v1/geodex.pb.h"
+
+namespace geodex::api {
+
+// At least one message each; stats (when wanted) go into the last one.
+std::vector<v1::ComputeIsolinesResponse> IsolinesToProto(const Isolines& isolines,
+                                                         size_t budget_bytes);
+std::vector<v1::ComputeVoronoiResponse> VoronoiToProto(
+    const VoronoiDiagram& diagram, const std::vector<SurfacePoint>& resolved_sources,
+    bool omit_cell_faces, size_t budget_bytes);
+std::vector<v1::ComputeDelaunayResponse> DelaunayToProto(
+    const DelaunayTriangulation& delaunay, const std::vector<SurfacePoint>& resolved_sources,
+    size_t budget_bytes);
+
+// Reassembly as the messages arrive: Add each in order, then take result().
+class IsolinesAssembler {
+ public:
+  void Add(const v1::ComputeIsolinesResponse& message);
+  Isolines& result() { return out_; }
+
+ private:
+  Isolines out_;
+  bool open_ = false;
+};
+
+class VoronoiAssembler {
+ public:
+  void Add(const v1::ComputeVoronoiResponse& message);
+  VoronoiDiagram& result() { return out_; }
+  const std::vector<SurfacePoint>& resolved_sources() const { return sources_; }
+
+ private:
+  VoronoiDiagram out_;
+  std::vector<SurfacePoint> sources_;
+  bool first_ = true, cell_open_ = false, boundary_open_ = false;
+};
+
+class DelaunayAssembler {
+ public:
+  void Add(const v1::ComputeDelaunayResponse& message);
+  DelaunayTriangulation& result() { return out_; }
+  const std::vector<SurfacePoint>& resolved_sources() const { return sources_; }
+
+ private:
+  DelaunayTriangulation out_;
+  std::vector<SurfacePoint> sources_;
+  bool kept_open_ = false, removed_open_ = false;
+};
+
+}  // namespace geodex::api

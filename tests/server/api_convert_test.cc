@@ -1,0 +1,194 @@
+// proto/convert's mappings, both directions: the streamed geometry (geometry_convert.h) cut into
+// many small messages (pieces split mid-polyline and mid-cell) and reassembled gives back exactly
+// what core computed; a mesh's summary survives the Mesh resource (api_convert.h).
+
+#include "geometry_convert.h"
+
+#include <string>
+#include <vector>
+
+#include "absl/strings/str_format.h"
+#include "api_convert.h"
+#include "geodex/delaunay.h"
+#include "geodex/geodesic_solver.h"
+#include "geodex/isolines.h"
+#include "geodex/voronoi.h"
+#include "gtest/gtest.h"
+#include "util/test_meshes.h"
+
+namespace geodex {
+namespace {
+
+constexpr size_t kTinyBudget = 300;  // bytes per message: forces pieces
+
+std::string Text(const std::vector<PathPoint>& points) {
+  std::string s;
+  for (const PathPoint& p : points) {
+    s += absl::StrFormat("%s@%.17g,%.17g,%.17g;", SurfacePointToString(p.where), p.position[0],
+                         p.position[1], p.position[2]);
+  }
+  return s;
+}
+
+struct Field {
+  TriangleMesh mesh;
+  DistanceField field;
+  std::vector<SurfacePoint> sites;
+};
+
+Field Solve() {
+  absl::StatusOr<TriangleMesh> mesh = LoadTestMesh("kitten.off");
+  EXPECT_TRUE(mesh.ok());
+  std::vector<SurfacePoint> sites = {SurfacePoint::AtVertex(0), SurfacePoint::AtVertex(800),
+                                     SurfacePoint::InFace(100, 0.2, 0.3, 0.5),
+                                     SurfacePoint::AtVertex(2400), SurfacePoint::AtVertex(1600)};
+  absl::StatusOr<DistanceField> field = ComputeDistanceField(*mesh, sites);
+  EXPECT_TRUE(field.ok());
+  return Field{*std::move(mesh), *std::move(field), sites};
+}
+
+template <typename Message>
+bool AnyContinued(const std::vector<Message>& messages, bool (*piece_continued)(const Message&)) {
+  for (const Message& m : messages) {
+    if (piece_continued(m)) return true;
+  }
+  return false;
+}
+
+TEST(ApiConvertTest, IsolinesRoundTripThroughManyMessages) {
+  const Field f = Solve();
+  IsolineOptions options;
+  options.count = 7;
+  const Isolines iso = *ExtractIsolines(f.mesh, f.field, options);
+  const std::vector<v1::ComputeIsolinesResponse> messages = api::IsolinesToProto(iso, kTinyBudget);
+  ASSERT_GT(messages.size(), 10u);
+  EXPECT_TRUE(AnyContinued<v1::ComputeIsolinesResponse>(
+      messages, [](const v1::ComputeIsolinesResponse& m) {
+        for (const auto& piece : m.isolines()) {
+          if (piece.continued()) return true;
+        }
+        return false;
+      }));
+  api::IsolinesAssembler back;
+  for (const auto& m : messages) back.Add(m);
+  const Isolines& got = back.result();
+  EXPECT_EQ(got.levels, iso.levels);
+  ASSERT_EQ(got.polylines.size(), iso.polylines.size());
+  for (size_t i = 0; i < iso.polylines.size(); ++i) {
+    EXPECT_EQ(got.polylines[i].level, iso.polylines[i].level);
+    EXPECT_EQ(got.polylines[i].closed, iso.polylines[i].closed);
+    EXPECT_EQ(Text(got.polylines[i].points), Text(iso.polylines[i].points)) << i;
+  }
+}
+
+TEST(ApiConvertTest, VoronoiRoundTripsWithCellsSplitAcrossMessages) {
+  const Field f = Solve();
+  const VoronoiDiagram vd = *BuildVoronoi(f.mesh, f.field);
+  const std::vector<v1::ComputeVoronoiResponse> messages =
+      api::VoronoiToProto(vd, f.sites, /*omit_cell_faces=*/false, kTinyBudget);
+  EXPECT_TRUE(AnyContinued<v1::ComputeVoronoiResponse>(
+      messages, [](const v1::ComputeVoronoiResponse& m) {
+        for (const auto& piece : m.cells()) {
+          if (piece.continued()) return true;
+        }
+        return false;
+      }));
+  api::VoronoiAssembler back;
+  for (const auto& m : messages) back.Add(m);
+  const VoronoiDiagram& got = back.result();
+  ASSERT_EQ(back.resolved_sources().size(), f.sites.size());
+  for (size_t i = 0; i < f.sites.size(); ++i) {
+    EXPECT_EQ(SurfacePointToString(back.resolved_sources()[i]), SurfacePointToString(f.sites[i]));
+  }
+  EXPECT_EQ(got.total_area, vd.total_area);
+  EXPECT_EQ(got.junction_faces, vd.junction_faces);
+  EXPECT_EQ(got.adjacency, vd.adjacency);
+  ASSERT_EQ(got.cells.size(), vd.cells.size());
+  for (size_t i = 0; i < vd.cells.size(); ++i) {
+    EXPECT_EQ(got.cells[i].site, vd.cells[i].site);
+    EXPECT_EQ(got.cells[i].area, vd.cells[i].area);
+    EXPECT_EQ(got.cells[i].whole_faces, vd.cells[i].whole_faces);
+    ASSERT_EQ(got.cells[i].fragments.size(), vd.cells[i].fragments.size());
+    for (size_t k = 0; k < vd.cells[i].fragments.size(); ++k) {
+      EXPECT_EQ(got.cells[i].fragments[k].face, vd.cells[i].fragments[k].face);
+      EXPECT_EQ(Text(got.cells[i].fragments[k].polygon), Text(vd.cells[i].fragments[k].polygon));
+    }
+  }
+  ASSERT_EQ(got.boundaries.size(), vd.boundaries.size());
+  for (size_t i = 0; i < vd.boundaries.size(); ++i) {
+    EXPECT_EQ(got.boundaries[i].site_a, vd.boundaries[i].site_a);
+    EXPECT_EQ(got.boundaries[i].site_b, vd.boundaries[i].site_b);
+    EXPECT_EQ(got.boundaries[i].closed, vd.boundaries[i].closed);
+    EXPECT_EQ(Text(got.boundaries[i].points), Text(vd.boundaries[i].points));
+  }
+  // Without cell faces: the cells' sites and areas only.
+  api::VoronoiAssembler light;
+  for (const auto& m : api::VoronoiToProto(vd, f.sites, true, kTinyBudget)) light.Add(m);
+  ASSERT_EQ(light.result().cells.size(), vd.cells.size());
+  EXPECT_TRUE(light.result().cells[0].whole_faces.empty());
+  EXPECT_EQ(light.result().cells[0].area, vd.cells[0].area);
+}
+
+TEST(ApiConvertTest, DelaunayRoundTrips) {
+  const Field f = Solve();
+  const DelaunayTriangulation dt = *BuildDelaunay(f.mesh, f.field);
+  ASSERT_FALSE(dt.edges.empty());
+  const std::vector<v1::ComputeDelaunayResponse> messages =
+      api::DelaunayToProto(dt, f.sites, kTinyBudget);
+  ASSERT_GT(messages.size(), 1u);
+  api::DelaunayAssembler back;
+  for (const auto& m : messages) back.Add(m);
+  const DelaunayTriangulation& got = back.result();
+  EXPECT_EQ(back.resolved_sources().size(), f.sites.size());
+  EXPECT_EQ(got.triangles, dt.triangles);
+  auto same_edges = [](const std::vector<DelaunayEdge>& a, const std::vector<DelaunayEdge>& b) {
+    ASSERT_EQ(a.size(), b.size());
+    for (size_t i = 0; i < a.size(); ++i) {
+      EXPECT_EQ(a[i].site_a, b[i].site_a);
+      EXPECT_EQ(a[i].site_b, b[i].site_b);
+      EXPECT_EQ(a[i].vertex_a, b[i].vertex_a);
+      EXPECT_EQ(a[i].vertex_b, b[i].vertex_b);
+      EXPECT_EQ(a[i].length, b[i].length);
+      EXPECT_EQ(a[i].edge_start, b[i].edge_start);
+      EXPECT_EQ(Text(a[i].points), Text(b[i].points));
+    }
+  };
+  same_edges(got.edges, dt.edges);
+  same_edges(got.removed_edges, dt.removed_edges);
+  ASSERT_EQ(got.xl_edges.size(), dt.xl_edges.size());
+  for (size_t i = 0; i < dt.xl_edges.size(); ++i) {
+    EXPECT_EQ(got.xl_edges[i].witness, dt.xl_edges[i].witness);
+    EXPECT_EQ(Text({got.xl_edges[i].point}), Text({dt.xl_edges[i].point}));
+  }
+}
+
+// A mesh's summary through the Mesh resource and back (what `geodex info` prints remotely).
+TEST(ApiConvertTest, MeshSummaryRoundTrips) {
+  absl::StatusOr<TriangleMesh> mesh = LoadTestMesh("three-peaks.off");
+  ASSERT_TRUE(mesh.ok());
+  const MeshSummary s = Summarize(*mesh);
+  ASSERT_GT(s.report.boundary_vertices, 0u);  // a mesh with a boundary: every count non-trivial
+  v1::Mesh proto;
+  api::MeshSummaryToProto(s, &proto);
+  const MeshSummary back = api::MeshSummaryFromProto(proto);
+  const MeshReport &a = s.report, &b = back.report;
+  EXPECT_EQ(std::vector<uint64_t>({a.file_vertices, a.file_faces, a.boundary_edges,
+                                   a.boundary_loops, a.components, a.vertex_connected_components,
+                                   a.isolated_vertices, a.non_manifold_edges,
+                                   a.non_manifold_vertices, a.degenerate_faces, a.flipped_faces,
+                                   a.orientation_cuts, a.saddle_vertices, a.boundary_vertices}),
+            std::vector<uint64_t>({b.file_vertices, b.file_faces, b.boundary_edges,
+                                   b.boundary_loops, b.components, b.vertex_connected_components,
+                                   b.isolated_vertices, b.non_manifold_edges,
+                                   b.non_manifold_vertices, b.degenerate_faces, b.flipped_faces,
+                                   b.orientation_cuts, b.saddle_vertices, b.boundary_vertices}));
+  EXPECT_EQ(back.internal_vertices, s.internal_vertices);
+  EXPECT_EQ(back.mean_edge_length, s.mean_edge_length);
+  EXPECT_EQ(back.max_edge_length, s.max_edge_length);
+  EXPECT_EQ(back.bbox_min, s.bbox_min);
+  EXPECT_EQ(back.bbox_max, s.bbox_max);
+  EXPECT_EQ(back.bytes, s.bytes);
+}
+
+}  // namespace
+}  // namespace geodex
