@@ -1,0 +1,247 @@
+// Unary queries: FindShortestPath(s), EstimateDistances, LocatePoints.
+
+#include "queries.h"
+#include "query_support.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "absl/strings/cord.h"
+#include "absl/strings/str_cat.h"
+#include "geodex/delaunay.h"
+#include "geodex/distance_matrix.h"
+#include "geodex/geodesic_solver.h"
+#include "geodex/isolines.h"
+#include "geodex/point_distance.h"
+#include "geodex/shortest_path.h"
+#include "geodex/voronoi.h"
+#include "field_cache.h"
+#include "mesh_id.h"
+#include "proto_convert.h"
+#include "service_limits.h"
+#include "status_convert.h"
+
+namespace geodex::server {
+
+// ------------------------------------------------------------------------------------------
+// Unary queries
+
+absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPathRequest& request,
+                                 v1::FindShortestPathResponse* response) {
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh =
+      LookupMesh(env, request.mesh(), "mesh");
+  if (!mesh.ok()) return mesh.status();
+  absl::StatusOr<SurfacePoint> from = ResolvePoint(**mesh, request.from(), "from");
+  if (!from.ok()) return from.status();
+  absl::StatusOr<SurfacePoint> to = ResolvePoint(**mesh, request.to(), "to");
+  if (!to.ok()) return to.status();
+  absl::StatusOr<GeodesicOptions> solver = Options(env, request.options());
+  if (!solver.ok()) return solver.status();
+  // From a cached field of `from` a path to a vertex is a trace, not a solve; the second query
+  // from the same point solves (and caches) the full field so that the following ones reuse it.
+  if (to->kind == SurfacePoint::Kind::kVertex && env.cache->enabled()) {
+    const std::string key = FieldCacheKey((*mesh)->id, {*from}, *solver);
+    std::shared_ptr<const DistanceField> field = env.cache->Find(key);
+    bool cached = field != nullptr;
+    if (field == nullptr && env.quick) return SolveLaneNeeded();
+    if (field == nullptr && env.cache->NotePathSource(key)) {
+      absl::StatusOr<std::shared_ptr<const DistanceField>> solved =
+          CachedField(env, **mesh, {*from}, *solver, &cached);
+      if (!solved.ok()) return NameSolveError(solved.status(), "from");
+      field = *std::move(solved);
+    }
+    if (field != nullptr) {
+      absl::StatusOr<GeodesicPath> path = TracePathFromVertex(*(*mesh)->mesh, *field, to->vertex);
+      if (absl::IsNotFound(path.status())) {
+        return UnreachableError("to: unreachable from `from`");
+      }
+      if (!path.ok()) return path.status();
+      response->set_distance(field->distance[to->vertex]);
+      for (auto it = path->points.rbegin(); it != path->points.rend(); ++it) {
+        PathPointToProto(*it, response->add_points());
+      }
+      if (request.want_stats()) FieldStatsToProto(*field, cached, response->mutable_stats());
+      return CheckUnaryResponseSize(env, *response, "paths");
+    }
+  }
+  if (env.quick) return SolveLaneNeeded();
+  PathQueryOptions options;
+  options.solver = *solver;
+  absl::StatusOr<PathQueryResult> result = ComputeShortestPath(*(*mesh)->mesh, *from, *to, options);
+  if (result.ok()) {
+    env.counters->solves.fetch_add(1, std::memory_order_relaxed);
+    env.counters->windows_processed.fetch_add(result->stats.windows_processed,
+                                              std::memory_order_relaxed);
+  }
+  if (!result.ok()) {
+    if (result.status().code() == absl::StatusCode::kNotFound) {
+      return UnreachableError(
+          absl::StrCat("to: unreachable from `from` (", result.status().message(), ")"));
+    }
+    return NameSolveError(result.status(), "from/to");
+  }
+  response->set_distance(result->distance);
+  for (const PathPoint& p : result->path.points) PathPointToProto(p, response->add_points());
+  if (request.want_stats()) StatsToProto(result->stats, response->mutable_stats());
+  return CheckUnaryResponseSize(env, *response, "paths");
+}
+
+absl::Status RunFindShortestPaths(const QueryEnv& env, const v1::FindShortestPathsRequest& request,
+                                  v1::FindShortestPathsResponse* response) {
+  if (env.quick) return SolveLaneNeeded();
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh = LookupMesh(env, request.mesh(), "mesh");
+  if (!mesh.ok()) return mesh.status();
+  if (request.pairs().empty()) {
+    return FieldError("pairs", "at least one pair is required");
+  }
+  if (static_cast<uint64_t>(request.pairs_size()) > env.limits->max_targets) {
+    return ServerLimitError("max_targets", absl::StrCat(
+        "pairs: ", request.pairs_size(), " pairs, over --max_targets=", env.limits->max_targets));
+  }
+  absl::StatusOr<GeodesicOptions> solver = Options(env, request.options());
+  if (!solver.ok()) return solver.status();
+  // Group the pairs by their source point (bit for bit), in order of first appearance.
+  std::vector<SurfacePoint> froms, tos;
+  std::map<std::string, size_t> group_of;
+  std::vector<std::vector<size_t>> groups;
+  for (int i = 0; i < request.pairs_size(); ++i) {
+    const std::string field = absl::StrCat("pairs[", i, "]");
+    absl::StatusOr<SurfacePoint> from = ResolvePoint(**mesh, request.pairs(i).from(), field + ".from");
+    if (!from.ok()) return from.status();
+    absl::StatusOr<SurfacePoint> to = ResolvePoint(**mesh, request.pairs(i).to(), field + ".to");
+    if (!to.ok()) return to.status();
+    const std::string key = FieldCacheKey("", {*from}, *solver);
+    auto [it, fresh] = group_of.emplace(key, groups.size());
+    if (fresh) {
+      groups.emplace_back();
+      froms.push_back(*from);
+    }
+    groups[it->second].push_back(static_cast<size_t>(i));
+    tos.push_back(*to);
+    response->add_paths();
+  }
+  PathQueryOptions options;
+  options.solver = *solver;
+  SolveStats total;
+  for (size_t g = 0; g < groups.size(); ++g) {
+    std::vector<SurfacePoint> targets;
+    for (size_t i : groups[g]) targets.push_back(tos[i]);
+    absl::StatusOr<PathsQueryResult> result =
+        ComputeShortestPaths(*(*mesh)->mesh, froms[g], targets, options);
+    if (!result.ok()) return NameSolveError(result.status(), "pairs");
+    env.counters->solves.fetch_add(1, std::memory_order_relaxed);
+    env.counters->windows_processed.fetch_add(result->stats.windows_processed,
+                                              std::memory_order_relaxed);
+    AddSolveStats(result->stats, &total);
+    for (size_t k = 0; k < groups[g].size(); ++k) {
+      v1::FindShortestPathResponse* out = response->mutable_paths(static_cast<int>(groups[g][k]));
+      out->set_distance(result->distance[k]);
+      for (const PathPoint& p : result->paths[k].points) PathPointToProto(p, out->add_points());
+    }
+  }
+  response->set_solves(static_cast<uint32_t>(groups.size()));
+  if (request.want_stats()) StatsToProto(total, response->mutable_stats());
+  return CheckUnaryResponseSize(env, *response, "pairs");
+}
+
+absl::Status RunEstimateDistances(const QueryEnv& env, const v1::EstimateDistancesRequest& request,
+                                  v1::EstimateDistancesResponse* response) {
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh =
+      LookupMesh(env, request.mesh(), "mesh");
+  if (!mesh.ok()) return mesh.status();
+  const TriangleMesh& tm = *(*mesh)->mesh;
+  absl::StatusOr<std::vector<SurfacePoint>> sources =
+      ResolveSources(env, **mesh, request.sources());
+  if (!sources.ok()) return sources.status();
+  absl::StatusOr<std::vector<SurfacePoint>> points =
+      ResolvePoints(**mesh, request.points(), "points", env.limits->max_targets, "max_targets");
+  if (!points.ok()) return points.status();
+  if (!v1::PointDistanceMode_IsValid(request.mode())) {
+    return FieldError("mode", absl::StrCat("unknown value ", request.mode()));
+  }
+  const bool estimate = request.mode() != v1::POINT_DISTANCE_MODE_EXACT;
+  const bool exact = request.mode() == v1::POINT_DISTANCE_MODE_EXACT ||
+                     request.mode() == v1::POINT_DISTANCE_MODE_BOTH;
+  if (exact && env.quick) return SolveLaneNeeded();
+  absl::StatusOr<GeodesicOptions> solver = Options(env, request.options());
+  if (!solver.ok()) return solver.status();
+  if (estimate) {
+    bool cached = false;
+    absl::StatusOr<std::shared_ptr<const DistanceField>> field =
+        CachedField(env, **mesh, *sources, *solver, &cached);
+    if (!field.ok()) return field.status();
+    for (size_t i = 0; i < points->size(); ++i) {
+      absl::StatusOr<PointEstimate> e = EstimateDistanceAt(tm, **field, (*points)[i]);
+      if (!e.ok()) return NameSolveError(e.status(), "points");
+      response->add_estimates(e->distance);
+      response->add_estimate_labels(e->source);
+    }
+    if (request.want_stats()) {
+      FieldStatsToProto(**field, cached, response->mutable_estimate_stats());
+    }
+  }
+  if (exact) {
+    SolveStats stats;
+    absl::StatusOr<std::vector<std::pair<double, uint32_t>>> values =
+        ComputeExactDistancesAt(tm, *sources, *points, *solver, &stats);
+    if (!values.ok()) return NameSolveError(values.status(), "points");
+    env.counters->solves.fetch_add(1, std::memory_order_relaxed);
+    env.counters->windows_processed.fetch_add(stats.windows_processed, std::memory_order_relaxed);
+    for (const auto& [distance, label] : *values) {
+      response->add_exact(distance);
+      response->add_exact_labels(label);
+    }
+    if (request.want_stats()) StatsToProto(stats, response->mutable_exact_stats());
+  }
+  return CheckUnaryResponseSize(env, *response, "points");
+}
+
+absl::Status RunLocatePoints(const QueryEnv& env, const v1::LocatePointsRequest& request,
+                             v1::LocatePointsResponse* response) {
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh =
+      LookupMesh(env, request.mesh(), "mesh");
+  if (!mesh.ok()) return mesh.status();
+  if (request.positions().empty()) {
+    return FieldError("positions", "at least one position is required");
+  }
+  if (static_cast<uint64_t>(request.positions_size()) > env.limits->max_targets) {
+    return ServerLimitError("max_targets", absl::StrCat("positions: ", request.positions_size(),
+                     " points, over --max_targets=", env.limits->max_targets));
+  }
+  const double max_snap =
+      request.has_max_snap() ? request.max_snap() : std::numeric_limits<double>::infinity();
+  if (!(max_snap > 0)) {  // also NaN
+    return FieldError("max_snap", absl::StrCat("must be > 0 when set, got ", request.max_snap()));
+  }
+  for (int i = 0; i < request.positions_size(); ++i) {
+    if ((i & 1023) == 0 && env.cancel->IsCancelled()) return absl::CancelledError("cancelled");
+    const v1::Position& q = request.positions(i);
+    absl::StatusOr<LocatedPoint> located = (*mesh)->locator->Locate({q.x(), q.y(), q.z()});
+    if (located.ok()) {
+      absl::Status snap = CheckSnapDistance({q.x(), q.y(), q.z()}, *located, max_snap);
+      if (!snap.ok()) located = snap;
+    }
+    if (!located.ok()) {
+      const std::string field = absl::StrCat("positions[", i, "]");
+      if (absl::IsInvalidArgument(located.status())) {
+        return FieldError(field, located.status().message());
+      }
+      return absl::Status(located.status().code(),
+                          absl::StrCat(field, ": ", located.status().message()));
+    }
+    v1::LocatedPoint* out = response->add_points();
+    SurfacePointToProto(located->point, out->mutable_point());
+    PositionToProto(located->position, out->mutable_position());
+    out->set_distance(located->distance);
+  }
+  return CheckUnaryResponseSize(env, *response, "positions");
+}
+
+}  // namespace geodex::server

@@ -1,0 +1,166 @@
+#include "query_support.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "absl/strings/cord.h"
+#include "absl/strings/str_cat.h"
+#include "geodex/delaunay.h"
+#include "geodex/distance_matrix.h"
+#include "geodex/geodesic_solver.h"
+#include "geodex/isolines.h"
+#include "geodex/point_distance.h"
+#include "geodex/shortest_path.h"
+#include "geodex/voronoi.h"
+#include "field_cache.h"
+#include "mesh_id.h"
+#include "proto_convert.h"
+#include "service_limits.h"
+#include "status_convert.h"
+
+namespace geodex::server {
+
+// Resolves a list of request points (sources or targets) after checking its size against a limit.
+absl::StatusOr<std::vector<SurfacePoint>> ResolvePoints(const StoredMesh& mesh,
+                                                        const PointList& points,
+                                                        const std::string& field, uint64_t limit,
+                                                        const char* flag) {
+  if (points.empty()) {
+    return FieldError(field, "at least one point is required");
+  }
+  if (static_cast<uint64_t>(points.size()) > limit) {
+    return ServerLimitError(
+        flag, absl::StrCat(field, ": ", points.size(), " points, over --", flag, "=", limit));
+  }
+  std::vector<SurfacePoint> out;
+  out.reserve(points.size());
+  for (int i = 0; i < points.size(); ++i) {
+    absl::StatusOr<SurfacePoint> p =
+        ResolvePoint(mesh, points[i], absl::StrCat(field, "[", i, "]"));
+    if (!p.ok()) return p.status();
+    out.push_back(*p);
+  }
+  return out;
+}
+
+absl::StatusOr<std::vector<SurfacePoint>> ResolveSources(const QueryEnv& env,
+                                                         const StoredMesh& mesh,
+                                                         const PointList& sources) {
+  return ResolvePoints(mesh, sources, "sources", env.limits->max_sources, "max_sources");
+}
+
+absl::StatusOr<GeodesicOptions> Options(const QueryEnv& env, const v1::SolverOptions& options) {
+  absl::StatusOr<GeodesicOptions> out =
+      SolverOptionsFromProto(options, env.limits->max_windows, "options");
+  if (out.ok()) out->cancel = env.cancel;
+  return out;
+}
+
+// Core's InvalidArgument from a solve concerns the points (e.g. two sources on one vertex of
+// different components is fine, but a point on a degenerate face is not): name the field.
+absl::Status NameSolveError(const absl::Status& status, const char* field) {
+  if (status.code() == absl::StatusCode::kInvalidArgument) {
+    return FieldError(field, status.message());
+  }
+  return status;
+}
+
+absl::Status CheckFieldSize(const QueryEnv& env, const StoredMesh& mesh) {
+  if (mesh.vertex_count > env.limits->max_output_values) {
+    return ServerLimitError("max_output_values", absl::StrCat("the field has ", mesh.vertex_count,
+                     " values, over --max_output_values=", env.limits->max_output_values));
+  }
+  return absl::OkStatus();
+}
+
+absl::Status CheckUnaryResponseSize(const QueryEnv& env, const google::protobuf::Message& response,
+                                    const char* what) {
+  const size_t bytes = response.ByteSizeLong();
+  if (bytes > env.limits->max_unary_response_bytes) {
+    return ServerLimitError("max_unary_response_bytes", absl::StrCat("the response would be ", bytes, " bytes, over --max_unary_response_bytes=",
+                     env.limits->max_unary_response_bytes, "; send fewer ", what, " per call"));
+  }
+  return absl::OkStatus();
+}
+
+// A distance field from the result cache, or solved (and then cached). `cached` tells which.
+absl::StatusOr<std::shared_ptr<const DistanceField>> CachedField(
+    const QueryEnv& env, const StoredMesh& mesh, const std::vector<SurfacePoint>& sources,
+    const GeodesicOptions& options, bool* cached) {
+  const std::string key = FieldCacheKey(mesh.id, sources, options);
+  if (std::shared_ptr<const DistanceField> hit = env.cache->Find(key)) {
+    *cached = true;
+    return hit;
+  }
+  *cached = false;
+  if (env.quick) return SolveLaneNeeded();
+  absl::StatusOr<DistanceField> field = ComputeDistanceField(*mesh.mesh, sources, options);
+  if (!field.ok()) return NameSolveError(field.status(), "sources");
+  env.counters->solves.fetch_add(1, std::memory_order_relaxed);
+  env.counters->windows_processed.fetch_add(field->stats.windows_processed,
+                                            std::memory_order_relaxed);
+  auto shared = std::make_shared<const DistanceField>(*std::move(field));
+  env.cache->Insert(key, shared);
+  return shared;
+}
+
+void FieldStatsToProto(const DistanceField& field, bool cached, v1::SolveStats* out) {
+  StatsToProto(field.stats, out);
+  out->set_cached(cached);
+}
+
+absl::StatusOr<SolvedField> SolveField(const QueryEnv& env, const std::string& mesh_name,
+                                       const PointList& sources,
+                                       const v1::SolverOptions& options) {
+  SolvedField out;
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh =
+      LookupMesh(env, mesh_name, "mesh");
+  if (!mesh.ok()) return mesh.status();
+  out.mesh = *std::move(mesh);
+  if (absl::Status s = CheckFieldSize(env, *out.mesh); !s.ok()) return s;
+  absl::StatusOr<std::vector<SurfacePoint>> resolved = ResolveSources(env, *out.mesh, sources);
+  if (!resolved.ok()) return resolved.status();
+  out.sources = *std::move(resolved);
+  absl::StatusOr<GeodesicOptions> solver = Options(env, options);
+  if (!solver.ok()) return solver.status();
+  absl::StatusOr<std::shared_ptr<const DistanceField>> field =
+      CachedField(env, *out.mesh, out.sources, *solver, &out.cached);
+  if (!field.ok()) return field.status();
+  out.field = *std::move(field);
+  return out;
+}
+
+absl::Status SolveLaneNeeded() {
+  absl::Status status = absl::UnavailableError("internal: needs the compute pool");
+  status.SetPayload("geodex/lane", absl::Cord("solve"));
+  return status;
+}
+
+bool IsSolveLaneNeeded(const absl::Status& status) {
+  return status.GetPayload("geodex/lane").has_value();
+}
+
+absl::StatusOr<std::shared_ptr<const StoredMesh>> LookupMesh(const QueryEnv& env,
+                                                             const std::string& name,
+                                                             const std::string& field) {
+  absl::StatusOr<std::string> key = ParseMeshName(name, field);
+  if (!key.ok()) return key.status();
+  if (env.quick) {
+    absl::StatusOr<std::shared_ptr<const StoredMesh>> record = env.store->GetRecord(*key);
+    if (record.ok() && (*record)->mesh == nullptr) return SolveLaneNeeded();  // on disk only
+  }
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh = env.store->Get(*key);
+  if (absl::IsNotFound(mesh.status())) {
+    return MeshNotFoundError(field, absl::StrCat("mesh ", QuoteInput(name), " not found"));
+  }
+  return mesh;  // or DataLoss (a corrupt file), ResourceExhausted (cannot be loaded back)
+}
+
+}  // namespace geodex::server

@@ -1,0 +1,54 @@
+#pragma once
+
+// What the query families (queries_*.cc) share: resolving request points and options, the result
+// cache in front of full fields, and response-size checks. Internal to the server.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "geodex/distance_field.h"
+#include "geodex/geodesic_solver.h"
+#include "geodex/surface_point.h"
+#include "geodex/v1/geodex.pb.h"
+#include "mesh_store.h"
+#include "queries.h"
+
+namespace geodex::server {
+
+using PointList = google::protobuf::RepeatedPtrField<v1::SurfacePoint>;
+
+// Resolves a list of request points (sources or targets) after checking its size against a limit.
+absl::StatusOr<std::vector<SurfacePoint>> ResolvePoints(const StoredMesh& mesh,
+                                                        const PointList& points,
+                                                        const std::string& field, uint64_t limit,
+                                                        const char* flag);
+absl::StatusOr<std::vector<SurfacePoint>> ResolveSources(const QueryEnv& env,
+                                                         const StoredMesh& mesh,
+                                                         const PointList& sources);
+// The request's solver options with the server's window budget and the call's cancel token.
+absl::StatusOr<GeodesicOptions> Options(const QueryEnv& env, const v1::SolverOptions& options);
+// Core's InvalidArgument from a solve concerns the points: name the field.
+absl::Status NameSolveError(const absl::Status& status, const char* field);
+absl::Status CheckFieldSize(const QueryEnv& env, const StoredMesh& mesh);
+absl::Status CheckUnaryResponseSize(const QueryEnv& env, const google::protobuf::Message& response,
+                                    const char* what);
+// A distance field from the result cache, or solved (and then cached). `cached` tells which.
+absl::StatusOr<std::shared_ptr<const DistanceField>> CachedField(
+    const QueryEnv& env, const StoredMesh& mesh, const std::vector<SurfacePoint>& sources,
+    const GeodesicOptions& options, bool* cached);
+void FieldStatsToProto(const DistanceField& field, bool cached, v1::SolveStats* out);
+
+// The field behind distance fields, isolines, Voronoi and Delaunay.
+struct SolvedField {
+  std::shared_ptr<const StoredMesh> mesh;  // keeps the mesh alive while the result is built
+  std::vector<SurfacePoint> sources;
+  std::shared_ptr<const DistanceField> field;
+  bool cached = false;
+};
+absl::StatusOr<SolvedField> SolveField(const QueryEnv& env, const std::string& mesh_name,
+                                       const PointList& sources, const v1::SolverOptions& options);
+
+}  // namespace geodex::server
