@@ -2,6 +2,8 @@
 // Delaunay edges and a shortest path) as PNG, or the coloured mesh as PLY or glTF, on either
 // backend (with --server the mesh file is read here too: it is what gets drawn).
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 
@@ -61,14 +63,14 @@ int RunRender(Backend& backend, const Args& args) {
   if (positional.size() != 1 || !args.options.count("sources") || !args.options.count("output")) {
     return Fail(kExitUsage,
                 "usage: geodex render MESH --sources SPEC [--isolines K] [--voronoi] [--delaunay] "
-                "[--path A B] --output out.png|.ply|.gltf [--view iso|top|front|...] [--size WxH]");
+                "[--path A B] --output out.png|.ply|.gltf [--view auto|iso|top|front|...] [--size WxH]");
   }
   const std::string output = args.options.at("output");
   if (!EndsWith(output, ".png") && !EndsWith(output, ".ply") && !EndsWith(output, ".gltf")) {
     return Fail(kExitUsage, absl::StrFormat("--output: '%s' must end in .png, .ply or .gltf", output));
   }
   absl::StatusOr<render::View> view =
-      render::ParseView(args.options.count("view") ? args.options.at("view") : "iso");
+      render::ParseView(args.options.count("view") ? args.options.at("view") : "auto");
   if (!view.ok()) return Fail(kExitUsage, std::string(view.status().message()));
   int width = 800, height = 600;
   if (args.options.count("size")) {
@@ -139,6 +141,9 @@ int RunRender(Backend& backend, const Args& args) {
   render::Scene scene;
   scene.mesh = *data;
   scene.vertex_colors = render::FieldColors(layers.field.distance);
+  for (double d : layers.field.distance) {
+    if (std::isfinite(d)) scene.max_distance = std::max(scene.max_distance, d);
+  }
   for (const IsolinePolyline& line : layers.isolines.polylines) {
     scene.lines.push_back({Positions(line.points), line.closed, Rgb{25, 25, 25}, 1.5});
   }

@@ -77,10 +77,14 @@ commands:
       .svg (top view) file; see docs/geometry.md.
 
   render MESH --sources SPEC [--isolines K] [--voronoi] [--delaunay] [--path A B]
-         --output out.png|.ply|.gltf [--view iso|top|bottom|front|back|left|right] [--size WxH]
+         --output out.png|.ply|.gltf [--view auto|iso|top|bottom|front|back|left|right]
+         [--size WxH]
       A picture of the field: the shaded mesh coloured by distance (viridis; grey where
-      unreachable), isolines (dark), Voronoi boundaries (white), Delaunay edges (orange), the path
-      (red) and the sources (black dots), framed automatically (z up; default view iso, 800x600).
+      unreachable) with a colour bar (0 to the largest distance, labelled, at least 320 pixels
+      wide), isolines (dark), Voronoi boundaries (white), Delaunay edges (orange), the path (red)
+      and the sources (black dots), framed automatically (z up; 800x600). The default view, auto,
+      is the one of iso and the six axis views that shows the most sources, then the most of the
+      lines.
       .ply and .gltf write the coloured mesh for 3D viewers instead.
 
 SPEC: comma-separated points: 17 (vertex), e:V1:V2:T (the point (1-T)*V1 + T*V2 on an edge),

@@ -51,6 +51,7 @@ Camera CameraFor(View view) {
     case View::kRight:
       return {{0, 1, 0}, {0, 0, 1}, {1, 0, 0}};
     case View::kIso:
+    case View::kAuto:
       break;
   }
   const Point3 toward = Normalize({1, -1, 1.2});
@@ -135,6 +136,12 @@ class Canvas {
     }
   }
 
+  // True when a point at (x, y, z) lies inside the picture and is not behind the surface.
+  bool Visible(double x, double y, double z, double bias) const {
+    if (!(x >= 0 && y >= 0 && x < width_ && y < height_)) return false;
+    return z + bias >= depth_[size_t(y) * width_ + static_cast<int>(x)];
+  }
+
   Image Take() { return std::move(image_); }
 
  private:
@@ -175,6 +182,7 @@ std::vector<Rgb> FieldColors(const std::vector<double>& distances) {
 }
 
 absl::StatusOr<View> ParseView(const std::string& name) {
+  if (name == "auto") return View::kAuto;
   if (name == "iso") return View::kIso;
   if (name == "top") return View::kTop;
   if (name == "bottom") return View::kBottom;
@@ -183,14 +191,16 @@ absl::StatusOr<View> ParseView(const std::string& name) {
   if (name == "left") return View::kLeft;
   if (name == "right") return View::kRight;
   return absl::InvalidArgumentError(absl::StrFormat(
-      "--view: '%s' is not one of iso, top, bottom, front, back, left, right", name));
+      "--view: '%s' is not one of auto, iso, top, bottom, front, back, left, right", name));
 }
 
-Image Render(const Scene& scene, View view, int width, int height) {
-  const MeshData& m = *scene.mesh;
+namespace {
+
+// The projector that frames the mesh (the projected bounding box of the vertices used by faces,
+// with a 5% margin) in a width x height picture.
+Projector Frame(const MeshData& m, View view, int width, int height) {
   Projector project;
   project.camera = CameraFor(view);
-  // Frame: the projected bounding box of the vertices used by faces, with a 5% margin.
   double lo[2] = {kInf, kInf}, hi[2] = {-kInf, -kInf};
   for (uint32_t v : m.faces) {
     const Point3 p = VertexOf(m, v);
@@ -203,37 +213,155 @@ Image Render(const Scene& scene, View view, int width, int height) {
   project.scale = 0.9 * std::min(width / extent_x, height / extent_y);
   project.offset_x = width / 2.0 - (lo[0] + hi[0]) / 2 * project.scale;
   project.offset_y = height / 2.0 - (lo[1] + hi[1]) / 2 * project.scale;
+  return project;
+}
 
-  Canvas canvas(width, height);
+// Rasterises the mesh's faces (shaded, or flat grey when only the depth matters).
+void DrawMesh(const Scene& scene, const Projector& project, Canvas* canvas) {
+  const MeshData& m = *scene.mesh;
   const Point3 light_dir = Normalize(
       {project.camera.toward[0] + 0.3 * project.camera.up[0],
        project.camera.toward[1] + 0.3 * project.camera.up[1],
        project.camera.toward[2] + 0.3 * project.camera.up[2]});
+  const Rgb grey{128, 128, 128};
   for (size_t f = 0; f < m.face_count(); ++f) {
     const uint32_t v[3] = {m.faces[3 * f], m.faces[3 * f + 1], m.faces[3 * f + 2]};
     const Point3 a = VertexOf(m, v[0]), b = VertexOf(m, v[1]), c = VertexOf(m, v[2]);
     const Point3 normal = Normalize(Cross(Sub(b, a), Sub(c, a)));
     const double light = 0.35 + 0.65 * std::abs(Dot(normal, light_dir));  // two-sided
     const std::array<double, 3> p[3] = {project(a), project(b), project(c)};
-    const Rgb colors[3] = {scene.vertex_colors[v[0]], scene.vertex_colors[v[1]],
-                           scene.vertex_colors[v[2]]};
-    canvas.Triangle(p, colors, light);
+    const bool colored = scene.vertex_colors.size() == m.vertex_count();
+    const Rgb colors[3] = {colored ? scene.vertex_colors[v[0]] : grey,
+                           colored ? scene.vertex_colors[v[1]] : grey,
+                           colored ? scene.vertex_colors[v[2]] : grey};
+    canvas->Triangle(p, colors, light);
   }
-  // Lines and markers lie on the surface: a depth bias of ~2 pixels keeps them visible on it.
-  const double bias = 2.0;
+}
+
+// Lines and markers lie on the surface: a depth bias of ~2 pixels keeps them visible on it.
+constexpr double kSurfaceBias = 2.0;
+
+// A 5x7 bitmap font for the colour bar's labels: digits, the characters of %g numbers and the
+// few letters of its caption. Each glyph: 7 rows of 5 bits (bit 4 = leftmost pixel).
+const uint8_t* Glyph(char c) {
+  static const std::pair<char, std::array<uint8_t, 7>> kFont[] = {
+      {'0', {14, 17, 19, 21, 25, 17, 14}}, {'1', {4, 12, 4, 4, 4, 4, 14}},
+      {'2', {14, 17, 1, 2, 4, 8, 31}},     {'3', {31, 2, 4, 2, 1, 17, 14}},
+      {'4', {2, 6, 10, 18, 31, 2, 2}},     {'5', {31, 16, 30, 1, 1, 17, 14}},
+      {'6', {6, 8, 16, 30, 17, 17, 14}},   {'7', {31, 1, 2, 4, 8, 8, 8}},
+      {'8', {14, 17, 17, 14, 17, 17, 14}}, {'9', {14, 17, 17, 15, 1, 2, 12}},
+      {'.', {0, 0, 0, 0, 0, 12, 12}},      {'-', {0, 0, 0, 31, 0, 0, 0}},
+      {'+', {0, 4, 4, 31, 4, 4, 0}},       {'e', {0, 0, 14, 17, 31, 16, 14}},
+      {'a', {0, 0, 14, 1, 15, 17, 15}},    {'c', {0, 0, 14, 16, 16, 17, 14}},
+      {'d', {1, 1, 13, 19, 17, 17, 15}},   {'h', {16, 16, 22, 25, 17, 17, 17}},
+      {'i', {4, 0, 12, 4, 4, 4, 14}},      {'m', {0, 0, 26, 21, 21, 17, 17}},
+      {'n', {0, 0, 22, 25, 17, 17, 17}},   {'s', {0, 0, 14, 16, 14, 1, 30}},
+      {'t', {8, 8, 28, 8, 8, 9, 6}},       {'u', {0, 0, 17, 17, 17, 19, 13}},
+      {'(', {2, 4, 8, 8, 8, 4, 2}},        {')', {8, 4, 2, 2, 2, 4, 8}},
+  };
+  for (const auto& [ch, rows] : kFont) {
+    if (ch == c) return rows.data();
+  }
+  return nullptr;  // a space, or a character the bar never needs
+}
+
+void Text(Image* image, int x, int y, const std::string& text, int scale) {
+  for (char c : text) {
+    if (const uint8_t* rows = Glyph(c)) {
+      for (int r = 0; r < 7; ++r) {
+        for (int col = 0; col < 5; ++col) {
+          if (!(rows[r] & (16 >> col))) continue;
+          for (int dy = 0; dy < scale; ++dy) {
+            for (int dx = 0; dx < scale; ++dx) {
+              const int px = x + col * scale + dx, py = y + r * scale + dy;
+              if (px < 0 || py < 0 || px >= image->width || py >= image->height) continue;
+              const size_t i = 3 * (size_t(py) * image->width + px);
+              image->rgb[i] = image->rgb[i + 1] = image->rgb[i + 2] = 30;
+            }
+          }
+        }
+      }
+    }
+    x += 6 * scale;
+  }
+}
+
+// The colour bar in the right strip: the map from 0 (bottom) to max (top), five labels, the
+// caption "distance" and the units.
+void DrawColorBar(Image* image, double max_distance, const std::string& units) {
+  const int x0 = image->width - kColorBarWidth + 8, bar = 16;
+  const int top = static_cast<int>(0.15 * image->height), bottom = static_cast<int>(0.85 * image->height);
+  for (int y = top; y < bottom; ++y) {
+    const Rgb c = ColorMap(double(bottom - 1 - y) / std::max(1, bottom - 1 - top));
+    for (int x = x0; x < x0 + bar; ++x) {
+      const size_t i = 3 * (size_t(y) * image->width + x);
+      for (int ch = 0; ch < 3; ++ch) image->rgb[i + ch] = c[ch];
+    }
+  }
+  for (int k = 0; k <= 4; ++k) {
+    const int y = bottom - 1 - (bottom - 1 - top) * k / 4;
+    for (int x = x0 + bar; x < x0 + bar + 4; ++x) {  // a tick
+      const size_t i = 3 * (size_t(y) * image->width + x);
+      image->rgb[i] = image->rgb[i + 1] = image->rgb[i + 2] = 30;
+    }
+    Text(image, x0 + bar + 9, y - 7, absl::StrFormat("%.4g", max_distance * k / 4), 2);
+  }
+  Text(image, x0 - 4, top - 40, "distance", 2);
+  Text(image, x0 - 4, top - 22, "(" + units + ")", 1);
+}
+
+}  // namespace
+
+View ChooseView(const Scene& scene) {
+  constexpr int kWidth = 200, kHeight = 150;  // a depth-only preview per candidate
+  View best = View::kIso;
+  std::pair<size_t, size_t> best_seen{0, 0};
+  for (View view : {View::kIso, View::kTop, View::kFront, View::kRight, View::kBack, View::kLeft,
+                    View::kBottom}) {
+    const Projector project = Frame(*scene.mesh, view, kWidth, kHeight);
+    Canvas canvas(kWidth, kHeight);
+    DrawMesh(Scene{scene.mesh, {}, {}, {}}, project, &canvas);
+    std::pair<size_t, size_t> seen{0, 0};
+    for (const Point3& marker : scene.markers) {
+      const auto p = project(marker);
+      seen.first += canvas.Visible(p[0], p[1], p[2], kSurfaceBias * 3);
+    }
+    for (const Polyline& line : scene.lines) {
+      for (const Point3& point : line.points) {
+        const auto p = project(point);
+        seen.second += canvas.Visible(p[0], p[1], p[2], kSurfaceBias);
+      }
+    }
+    if (seen > best_seen) {
+      best_seen = seen;
+      best = view;
+    }
+  }
+  return best;
+}
+
+Image Render(const Scene& scene, View view, int width, int height) {
+  if (view == View::kAuto) view = ChooseView(scene);
+  const bool bar = scene.max_distance > 0 && width >= kColorBarMinWidth;
+  const int mesh_width = bar ? width - kColorBarWidth : width;
+  const Projector project = Frame(*scene.mesh, view, mesh_width, height);
+  Canvas canvas(width, height);
+  DrawMesh(scene, project, &canvas);
   for (const Polyline& line : scene.lines) {
     for (size_t i = 0; i + 1 < line.points.size() + (line.closed ? 1 : 0); ++i) {
       const Point3& a = line.points[i];
       const Point3& b = line.points[(i + 1) % line.points.size()];
-      canvas.Segment(project(a), project(b), line.width, line.color, bias);
+      canvas.Segment(project(a), project(b), line.width, line.color, kSurfaceBias);
     }
   }
   for (const Point3& marker : scene.markers) {
     const auto p = project(marker);
-    canvas.Dot(p[0], p[1], p[2], 6, {255, 255, 255}, bias * 3);
-    canvas.Dot(p[0], p[1], p[2], 4, {0, 0, 0}, bias * 3);
+    canvas.Dot(p[0], p[1], p[2], 6, {255, 255, 255}, kSurfaceBias * 3);
+    canvas.Dot(p[0], p[1], p[2], 4, {0, 0, 0}, kSurfaceBias * 3);
   }
-  return canvas.Take();
+  Image image = canvas.Take();
+  if (bar) DrawColorBar(&image, scene.max_distance, scene.units);
+  return image;
 }
 
 absl::Status WritePng(const std::string& path, const Image& image) {

@@ -40,12 +40,23 @@ struct Scene {
   std::vector<Rgb> vertex_colors;  // one per mesh vertex
   std::vector<Polyline> lines;
   std::vector<Point3> markers;     // sources: black dots with a white ring
+  // The colour bar at the right (when max_distance > 0 and the image is at least kColorBarMinWidth
+  // wide): the colour map from 0 (bottom) to max_distance (top), labelled, with `units`.
+  double max_distance = 0;
+  std::string units = "mesh units";
 };
+// The colour bar's strip: the rightmost kColorBarWidth pixels; the bar itself is the 16 pixels
+// from width - kColorBarWidth + 8, from 15% to 85% of the height (tests sample it there).
+inline constexpr int kColorBarWidth = 112;
+inline constexpr int kColorBarMinWidth = 320;
 
-enum class View { kIso, kTop, kBottom, kFront, kBack, kLeft, kRight };
-// "iso", "top", "bottom", "front", "back", "left", "right" (z is up: top looks down -z, front
-// looks along +y).
+enum class View { kAuto, kIso, kTop, kBottom, kFront, kBack, kLeft, kRight };
+// "auto" (the default), "iso", "top", "bottom", "front", "back", "left", "right" (z is up: top
+// looks down -z, front looks along +y).
 absl::StatusOr<View> ParseView(const std::string& name);
+// The view `auto` picks: of iso and the six axis views, the first (in that order) from which the
+// most markers, then the most points of the lines, are visible (not hidden by the surface).
+View ChooseView(const Scene& scene);
 
 struct Image {
   int width = 0, height = 0;

@@ -23,22 +23,46 @@ cleanup() {
   rm -rf "$tmp"
 }
 trap cleanup EXIT
-probe() { /usr/bin/python3 "$PROBE" "$1"; }
+probe() { /usr/bin/python3 "$PROBE" "$@"; }
 value() { /usr/bin/python3 -c "import json,sys; d=json.load(open('$1')); print($2)"; }
 
 # Source in the bottom-left corner of the top view, then in the top-right corner.
 "$GEODEX" render sample:terrain --sources 0 --view top --size 320x200 --output "$tmp/a.png"
 check "render exits 0" test $? -eq 0
-probe "$tmp/a.png" >"$tmp/a.json"
+probe "$tmp/a.png" --bar-width 0 >"$tmp/a.json"  # 320 wide: no colour bar
 check "size 320x200" test "$(value "$tmp/a.json" "d['width'], d['height']")" = "320 200"
 check "not blank (many colours)" test "$(value "$tmp/a.json" "d['colours'] > 1000")" = True
 check "the mesh covers part of the picture" test "$(value "$tmp/a.json" "0.2 < d['painted'] < 0.95")" = True
 check "source corner darker than the far corner" \
   test "$(value "$tmp/a.json" "d['brightness']['bl'] < d['brightness']['tr'] - 50")" = True
 "$GEODEX" render sample:terrain --sources 4224 --view top --size 320x200 --output "$tmp/b.png"
-probe "$tmp/b.png" >"$tmp/b.json"
+probe "$tmp/b.png" --bar-width 0 >"$tmp/b.json"
 check "moving the source moves the dark corner" \
   test "$(value "$tmp/b.json" "d['brightness']['tr'] < d['brightness']['bl'] - 50")" = True
+
+# The colour bar (800 wide): the map from purple (0, bottom) to yellow (the largest distance, top)
+# in the rightmost 112 pixels, its bar at x = 800 - 112 + 8 .. +24, y from 15% to 85%.
+"$GEODEX" render sample:terrain --sources 0 --view top --output "$tmp/bar.png"
+probe "$tmp/bar.png" --bar-width 112 --pixel 700,95 --pixel 700,505 --pixel 700,300 >"$tmp/bar.json"
+check "colour bar: yellow at the top" test "$(value "$tmp/bar.json" "(lambda p: p[0] > 200 and p[1] > 200 and p[2] < 100)(d['pixels'][0])")" = True
+check "colour bar: purple at the bottom" test "$(value "$tmp/bar.json" "(lambda p: p[0] < 100 and p[2] > 70 and p[1] < 40)(d['pixels'][1])")" = True
+check "colour bar: green-blue in the middle" test "$(value "$tmp/bar.json" "(lambda p: p[1] > p[0])(d['pixels'][2])")" = True
+check "colour bar: the mesh keeps its corners (source at bottom-left)" \
+  test "$(value "$tmp/bar.json" "d['brightness']['bl'] < d['brightness']['tr'] - 50")" = True
+"$GEODEX" render sample:terrain --sources 0 --view top --size 319x300 --output "$tmp/nobar.png"
+probe "$tmp/nobar.png" --pixel 310,150 >"$tmp/nobar.json"
+check "no colour bar below 320 pixels" test "$(value "$tmp/nobar.json" "d['pixels'][0] == [255, 255, 255]")" = True
+
+# The default view shows the sources: on the sphere a source at its lowest vertex is hidden from
+# the iso view, and auto picks one that shows it (a black marker in the picture).
+lowest=$("$GEODEX" locate sample:sphere --points p:0:0:-100 | cut -f2)
+"$GEODEX" render sample:sphere --sources "$lowest" --view iso --output "$tmp/iso.png"
+"$GEODEX" render sample:sphere --sources "$lowest" --output "$tmp/auto.png"
+probe "$tmp/iso.png" --bar-width 112 >"$tmp/iso.json"
+probe "$tmp/auto.png" --bar-width 112 >"$tmp/auto.json"
+check "the lowest vertex ($lowest) is a vertex" test -n "$lowest" -a "${lowest#*:}" = "$lowest"
+check "iso hides the bottom source" test "$(value "$tmp/iso.json" "d['black']")" = 0
+check "auto shows it" test "$(value "$tmp/auto.json" "d['black'] > 10")" = True
 
 # Every layer and view.
 "$GEODEX" render "$DATA/kitten.off" --sources 0,1250 --isolines 12 --voronoi --delaunay \
