@@ -31,6 +31,7 @@ namespace geodex::cli {
 struct FieldOptions {
   GeodesicOptions solver;
   std::string method = "exact";  // exact | ich | dijkstra (the name, for --stats)
+  bool directions = false;       // also DistanceField::direction
 };
 
 // One point of `distances --at`: the unfolding estimate, the exact distance and its source.

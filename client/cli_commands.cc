@@ -236,7 +236,7 @@ int RunDistances(Backend& backend, const Args& args) {
   bool json = false;
   if (!CheckKnown(args, {"sources", "method", "lambda", "lambda-scale", "max-distance",
                          "max-windows", "stats", "output", "no-filter", "no-one-split", "at",
-                         "max-snap", "format"},
+                         "max-snap", "format", "directions"},
                   &error) ||
       !GetFormat(args, &json, &error) ||
       !backend.Supports(args, &error)) {
@@ -257,6 +257,10 @@ int RunDistances(Backend& backend, const Args& args) {
     return Fail(kExitUsage, "--method must be exact, ich or dijkstra");
   }
   if (!GetSolverFlags(args, &options.solver, &error)) return Fail(kExitUsage, error);
+  options.directions = args.options.count("directions") > 0;
+  if (options.directions && args.options.count("at")) {
+    return Fail(kExitUsage, "--directions: per vertex only, not with --at");
+  }
   options.solver.use_filter = !args.options.count("no-filter");
   options.solver.use_one_angle_one_split = !args.options.count("no-one-split");
   absl::StatusOr<std::vector<SurfacePoint>> parsed = ParseSurfacePoints(args.options.at("sources"));
@@ -292,7 +296,8 @@ int RunDistances(Backend& backend, const Args& args) {
   } else {
     absl::StatusOr<DistanceField> field = backend.Field(sources, options);
     if (!field.ok()) return FailQuery(field.status());
-    text = json ? FormatDistancesJson(field->distance) : FormatDistances(field->distance);
+    text = json ? FormatDistancesJson(field->distance, field->direction)
+                : FormatDistances(field->distance, field->direction);
     stats = field->stats;
   }
   if (stats.solve_ms == 0) stats.solve_ms = MsSince(t_solve);

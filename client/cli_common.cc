@@ -214,12 +214,16 @@ std::string FormatInfo(const InfoValues& v, bool json) {
   return out + "}\n";
 }
 
-std::string FormatDistances(const std::vector<double>& distances) {
+std::string FormatDistances(const std::vector<double>& distances,
+                            const std::vector<std::array<double, 3>>& directions) {
   std::string text;
-  text.reserve(distances.size() * 24);
-  char buf[64];
-  for (double d : distances) {
-    const int n = std::snprintf(buf, sizeof(buf), "%.17g\n", d);
+  text.reserve(distances.size() * (directions.empty() ? 24 : 96));
+  char buf[160];
+  for (size_t i = 0; i < distances.size(); ++i) {
+    const int n = directions.empty()
+                      ? std::snprintf(buf, sizeof(buf), "%.17g\n", distances[i])
+                      : std::snprintf(buf, sizeof(buf), "%.17g\t%.17g %.17g %.17g\n", distances[i],
+                                      directions[i][0], directions[i][1], directions[i][2]);
     text.append(buf, n);
   }
   return text;
@@ -295,12 +299,20 @@ std::string PathPointJson(const PathPoint& p) {
   return s + "\"position\": true}";
 }
 
-std::string FormatDistancesJson(const std::vector<double>& distances) {
+std::string FormatDistancesJson(const std::vector<double>& distances,
+                                const std::vector<std::array<double, 3>>& directions) {
   std::string text = "{\"distances\": [";
-  text.reserve(distances.size() * 24);
+  text.reserve(distances.size() * (directions.empty() ? 24 : 96));
   for (size_t i = 0; i < distances.size(); ++i) {
     if (i) text += ", ";
     text += JsonNumber(distances[i]);
+  }
+  if (!directions.empty()) {
+    text += "], \"directions\": [";
+    for (size_t i = 0; i < directions.size(); ++i) {
+      if (i) text += ", ";
+      text += std::isnan(directions[i][0]) ? "null" : JsonXyz(directions[i]);
+    }
   }
   return text + "]}\n";
 }

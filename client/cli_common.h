@@ -87,8 +87,10 @@ struct InfoValues : MeshSummary {
   double load_ms = 0, build_ms = 0;
 };
 std::string FormatInfo(const InfoValues& v, bool json);
-// One distance per line, %.17g ("inf" if unreachable).
-std::string FormatDistances(const std::vector<double>& distances);
+// One distance per line, %.17g ("inf" if unreachable); with `directions` (one per vertex),
+// "D<TAB>X Y Z" ("nan nan nan" where undefined).
+std::string FormatDistances(const std::vector<double>& distances,
+                            const std::vector<std::array<double, 3>>& directions = {});
 // "POINT<TAB>estimate D<TAB>exact D<TAB>source I" (I = -1 when unreachable).
 std::string FormatAtLine(const SurfacePoint& point, double estimate, double exact, uint32_t source);
 // Line 1 the length, then "x y z SIMPLEX" per point.
@@ -100,8 +102,9 @@ std::string JsonNumber(double x);
 std::string JsonXyz(const std::array<double, 3>& p);
 // {"p": [x, y, z], "v": id} / "e": [from, to, t] / "f": [face, b0, b1, b2]
 std::string PathPointJson(const PathPoint& p);
-// {"distances": [...]}
-std::string FormatDistancesJson(const std::vector<double>& distances);
+// {"distances": [...]}, and "directions": [[x, y, z] | null, ...] when given
+std::string FormatDistancesJson(const std::vector<double>& distances,
+                                const std::vector<std::array<double, 3>>& directions = {});
 // {"points": [{"point": SPEC, "estimate": e, "exact": d, "source": i}, ...]}
 std::string FormatAtJson(const std::vector<SurfacePoint>& points, const std::vector<double>& estimate,
                          const std::vector<double>& exact, const std::vector<int64_t>& source);

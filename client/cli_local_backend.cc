@@ -82,7 +82,9 @@ class LocalBackend final : public Backend {
                                       const FieldOptions& options) override {
     absl::StatusOr<const DistanceField*> f = CachedField(sources, options);
     if (!f.ok()) return f.status();
-    return **f;
+    DistanceField field = **f;
+    if (options.directions) field.direction = ComputeDirectionField(loaded_->mesh, field);
+    return field;
   }
 
   absl::StatusOr<std::vector<AtValue>> DistancesAt(const std::vector<SurfacePoint>& sources,

@@ -138,7 +138,7 @@ class RemoteBackend final : public Backend {
 
   absl::StatusOr<DistanceField> Field(const std::vector<SurfacePoint>& sources,
                                       const FieldOptions& options) override {
-    return client_->Field(mesh_, sources, ToProto(options.solver), &cached_);
+    return client_->Field(mesh_, sources, ToProto(options.solver), &cached_, options.directions);
   }
 
   absl::StatusOr<std::vector<AtValue>> DistancesAt(const std::vector<SurfacePoint>& sources,

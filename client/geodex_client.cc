@@ -277,12 +277,13 @@ absl::StatusOr<MeshRef> GeodexClient::ResolveMesh(const std::string& mesh) {
 absl::StatusOr<DistanceField> GeodexClient::Field(MeshRef& mesh,
                                                           const std::vector<SurfacePoint>& sources,
                                                           const v1::SolverOptions& options,
-                                                          bool* cached) {
+                                                          bool* cached, bool directions) {
   v1::ComputeDistanceFieldRequest request;
   request.set_mesh(mesh.name);
   for (const SurfacePoint& p : sources) api::SurfacePointToProto(p, request.add_sources());
   *request.mutable_options() = options;
   request.set_want_stats(true);
+  request.set_want_directions(directions);
   geodex::DistanceField field;
   grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
     field = geodex::DistanceField();
@@ -299,6 +300,10 @@ absl::StatusOr<DistanceField> GeodexClient::Field(MeshRef& mesh,
       field.distance.insert(field.distance.end(), response.distances_f64().begin(),
                             response.distances_f64().end());
       field.source.insert(field.source.end(), response.labels().begin(), response.labels().end());
+      for (int i = 0; i + 2 < response.directions_size(); i += 3) {
+        field.direction.push_back(
+            {response.directions(i), response.directions(i + 1), response.directions(i + 2)});
+      }
       if (response.has_stats()) {
         field.stats = api::StatsFromProto(response.stats());
         if (cached != nullptr) *cached = response.stats().cached();

@@ -80,8 +80,10 @@ class GeodexClient {
   absl::Status DeleteMesh(const std::string& name);
 
   // Queries (options: the proto's SolverOptions). Results in core's types.
+  // With `directions`, the field's direction field too (DistanceField::direction).
   absl::StatusOr<DistanceField> Field(MeshRef& mesh, const std::vector<SurfacePoint>& sources,
-                                              const v1::SolverOptions& options, bool* cached = nullptr);
+                                      const v1::SolverOptions& options, bool* cached = nullptr,
+                                      bool directions = false);
   absl::StatusOr<PathQueryResult> ShortestPath(MeshRef& mesh, const SurfacePoint& from,
                                                const SurfacePoint& to,
                                                const v1::SolverOptions& options);

@@ -42,11 +42,15 @@ commands:
       saddle_vertices, bytes, ...). Reports on any readable mesh, valid or messy.
   distances MESH --sources SPEC [--method exact|ich|dijkstra] [--lambda L] [--lambda-scale max|mean]
                  [--max-distance D] [--max-windows N] [--stats] [--output FILE] [--format json]
+                 [--directions]
       One distance per vertex in the file's vertex order (%.17g; 'inf' if unreachable).
       --stats prints one JSON object with counters and times (*_ms) on stderr.
       --no-filter / --no-one-split switch off Lemma 2 / Lemma 1 (slower; same answer).
       --at SPEC: instead, one line per surface point: its unfolding estimate (paper section 4)
       and its exact distance ('POINT<TAB>estimate D<TAB>exact D<TAB>source I').
+      --directions: also the geodesic direction field, 'D<TAB>X Y Z' per vertex: the unit
+      tangent of the vertex's shortest path towards its nearest source (0 0 0 at a source,
+      nan where unreachable), what a vector-field planner follows.
   path MESH --from SPEC --to SPEC [--method astar|full] [--stats] [--lambda L]
        [--max-distance D] [--format json]
       The exact shortest path: line 1 its length; then one line per polyline point,
@@ -187,7 +191,7 @@ int main(int argc, char** argv) {
   Args args;
   std::string error;
   if (!ParseArgs(argc, argv, first + 1,
-                 {"stats", "strict", "no-filter", "no-one-split", "voronoi", "delaunay"}, &args,
+                 {"stats", "strict", "no-filter", "no-one-split", "voronoi", "delaunay", "directions"}, &args,
                  &error)) {
     std::fprintf(stderr, "geodex: %s\n", error.c_str());
     return kExitUsage;

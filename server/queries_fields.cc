@@ -50,13 +50,19 @@ absl::StatusOr<MessageStream<v1::ComputeDistanceFieldResponse>> RunComputeDistan
   };
   auto state = std::make_shared<State>();
   state->solved = *std::move(solved);
+  std::vector<std::array<double, 3>> directions;  // the cached field stays as it is
+  if (request.want_directions()) {
+    directions = ComputeDirectionField(*state->solved.mesh->mesh, *state->solved.field);
+  }
   const bool f32 = request.value_type() == v1::VALUE_TYPE_FLOAT32;
   const bool want_stats = request.want_stats();
   const bool labels = !request.omit_labels();
-  const size_t bytes_per_value = (f32 ? 4 : 8) + (labels ? 4 : 0);
+  const size_t bytes_per_value =
+      (f32 ? 4 : 8) + (labels ? 4 : 0) + (request.want_directions() ? 24 : 0);
   const size_t chunk = std::max<size_t>(1, env.limits->stream_chunk_bytes / bytes_per_value);
   return MessageProducer<v1::ComputeDistanceFieldResponse>(
-      [state, f32, want_stats, labels, chunk](v1::ComputeDistanceFieldResponse* out) {
+      [state, f32, want_stats, labels, chunk,
+       directions = std::move(directions)](v1::ComputeDistanceFieldResponse* out) {
         const DistanceField& field = *state->solved.field;
         const size_t n = field.distance.size();
         if (state->started && state->next >= n) return false;
@@ -80,6 +86,12 @@ absl::StatusOr<MessageStream<v1::ComputeDistanceFieldResponse>> RunComputeDistan
         }
         if (labels) {
           out->mutable_labels()->Add(field.source.begin() + begin, field.source.begin() + end);
+        }
+        if (!directions.empty()) {
+          out->mutable_directions()->Reserve(static_cast<int>(3 * (end - begin)));
+          for (size_t i = begin; i < end; ++i) {
+            for (double c : directions[i]) out->mutable_directions()->AddAlreadyReserved(c);
+          }
         }
         if (end == n && want_stats) {
           FieldStatsToProto(field, state->solved.cached, out->mutable_stats());

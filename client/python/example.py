@@ -16,8 +16,8 @@ def main():
         mesh = client.upload(path)
         print("mesh:", mesh.name, mesh.vertex_count, "vertices", mesh.face_count, "faces")
         n = mesh.vertex_count
-        distances, labels, stats = client.distance_field(mesh.name, [vertex(0), vertex(n // 2)],
-                                                         want_stats=True)
+        distances, labels, stats, _ = client.distance_field(mesh.name, [vertex(0), vertex(n // 2)],
+                                                            want_stats=True)
         print("field: farthest vertex at", max(d for d in distances if d != float("inf")),
               "windows:", stats.windows_created)
         path = client.shortest_path(mesh.name, vertex(0), vertex(n - 1))

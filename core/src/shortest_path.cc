@@ -1,6 +1,7 @@
 #include "geodex/shortest_path.h"
 
 #include <cmath>
+#include <limits>
 
 #include "absl/strings/str_format.h"
 #include "path_trace.h"
@@ -271,6 +272,56 @@ absl::StatusOr<GeodesicPath> TracePathFromVertex(const TriangleMesh& mesh,
   Tracer tracer(mesh, VertexPaths{field.internal_distance.data(), field.internal_origin.data()});
   if (absl::Status s = tracer.FromVertex(start, &path); !s.ok()) return s;
   return path;
+}
+
+std::vector<std::array<double, 3>> ComputeDirectionField(const TriangleMesh& mesh,
+                                                         const DistanceField& field) {
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  const uint32_t nv = mesh.file_vertex_count();
+  std::vector<std::array<double, 3>> out(nv, {kNaN, kNaN, kNaN});
+  if (field.internal_origin.size() != mesh.vertex_count()) return out;
+  // Each file vertex speaks through its nearest internal copy (as TracePathFromVertex starts).
+  std::vector<uint32_t> best(nv);
+  for (uint32_t v = 0; v < nv; ++v) best[v] = v;
+  for (uint32_t v = nv; v < mesh.vertex_count(); ++v) {
+    const uint32_t f = mesh.FileVertex(v);
+    if (field.internal_distance[v] < field.internal_distance[best[f]]) best[f] = v;
+  }
+  const double* pos = mesh.positions();
+  for (uint32_t file = 0; file < nv; ++file) {
+    const uint32_t v = best[file];
+    if (!std::isfinite(field.internal_distance[v])) continue;  // undefined: NaN
+    const VertexOrigin& o = field.internal_origin[v];
+    double d[3] = {0, 0, 0};
+    if (o.half_edge == kNoIndex) {
+      // Along an edge towards a neighbour (edge relaxation); a source vertex has no direction.
+      if (o.pseudo_source != kNoIndex && o.pseudo_source != v && field.internal_distance[v] > 0) {
+        for (int k = 0; k < 3; ++k) d[k] = pos[3 * o.pseudo_source + k] - pos[3 * v + k];
+      }
+    } else {
+      // Straight from v towards the image of its origin, in the frame of o.half_edge.
+      const uint32_t g = o.half_edge;
+      const double len = mesh.Length(g);
+      const bool opposite = mesh.From(g) != v && mesh.To(g) != v;
+      const double px = mesh.From(g) == v ? 0 : mesh.To(g) == v ? len : mesh.OppX(g);
+      const double py = opposite ? mesh.OppY(g) : 0;
+      const double dx = o.ix - px, dy = o.iy - py;
+      const Frame3 f = FrameOf(mesh, g);
+      const uint32_t twin = mesh.Twin(g);
+      if (opposite || dy >= 0 || twin == kNoIndex) {
+        // The first step runs inside face(g) (from the opposite corner it heads for edge g).
+        for (int k = 0; k < 3; ++k) d[k] = dx * f.u[k] + dy * f.n[k];
+      } else {
+        // From an endpoint of g with the image below it: the first step runs in the twin's face,
+        // which the frame of g shows unfolded below the edge.
+        const Frame3 t = FrameOf(mesh, twin);
+        for (int k = 0; k < 3; ++k) d[k] = dx * f.u[k] - dy * t.n[k];
+      }
+    }
+    const double norm = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    for (int k = 0; k < 3; ++k) out[file][k] = norm > 0 ? d[k] / norm : 0;
+  }
+  return out;
 }
 
 }  // namespace geodex

@@ -186,6 +186,29 @@ PY
 check "info json bbox is numeric" /usr/bin/python3 -c "import json; d=json.load(open('$tmp/i.json')); assert all(isinstance(x, float) for x in d['bbox_min'] + d['bbox_max']) and d['bbox_min'][1] < d['bbox_max'][1]"
 expect_usage "bad format" "--format" matrix "$K" --sources 0 --targets 1 --format xml
 
+# --directions: on the flat domain every vertex's direction points straight at the source.
+"$GEODEX" distances "$DATA/bump-domain.off" --sources 0 --directions >"$tmp/dir.txt"
+check "directions: flat domain, straight at the source" /usr/bin/python3 - "$DATA/bump-domain.off" "$tmp/dir.txt" <<'PY'
+import math, sys
+lines = open(sys.argv[1]).read().split("\n")
+nv = int(lines[1].split()[0])
+p = [tuple(map(float, lines[2 + i].split())) for i in range(nv)]
+rows = [l.split("\t") for l in open(sys.argv[2]).read().splitlines()]
+assert len(rows) == nv and [float(c) for c in rows[0][1].split()] == [0, 0, 0]
+for i in range(1, nv):
+    d = [float(c) for c in rows[i][1].split()]
+    want = [(p[0][k] - p[i][k]) / math.dist(p[0], p[i]) for k in range(3)]
+    assert max(abs(a - b) for a, b in zip(d, want)) < 1e-9, (i, d, want)
+PY
+"$GEODEX" distances "$K" --sources 0 --directions --max-distance 20 --format json >"$tmp/dir.json"
+check "directions json: null beyond max-distance, unit vectors elsewhere" /usr/bin/python3 -c "
+import json, math
+d = json.load(open('$tmp/dir.json'))
+assert len(d['directions']) == 2500
+assert all((v is None) == (x is None) for v, x in zip(d['directions'], d['distances']))
+assert all(abs(math.hypot(*v) - 1) < 1e-12 for v in d['directions'][1:] if v is not None)"
+expect_usage "directions with --at" "--directions" distances "$K" --sources 0 --at 5 --directions
+
 # Snapping is never silent: locate reports it, --stats carries it, a far point is warned about,
 # --max-snap refuses it naming the point.
 "$GEODEX" locate "$K" --points p:0:0:0,p:0:100:0 >"$tmp/loc.txt"

@@ -88,6 +88,8 @@ same_error() {  # same_error NAME ARGS...: the same exit code and a one-line mes
   check "$name: exit codes ($lrc local, $rrc remote)" test "$lrc" -eq "$rrc" -a "$lrc" -ne 0
   check "$name: one line each" test "$(cat "$tmp/local.err" "$tmp/remote.err" | wc -l)" -eq 2
 }
+same "directions" distances "$DATA/kitten.off" --sources 0,f:100:0.2:0.3:0.5 --directions
+same "directions json" distances "$DATA/knight.off" --sources 3 --directions --format json --max-distance 0.3
 same "locate" locate "$DATA/kitten.off" --points p:0:0:0,p:0:100:0,p:3:40:2
 same "locate json" locate "$DATA/kitten.off" --points p:0:0:0 --format json
 same "distances json" distances "$DATA/kitten.off" --sources 0,p:1:50:2 --format json --max-distance 20

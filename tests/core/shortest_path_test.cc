@@ -100,6 +100,46 @@ TEST_P(PathTest, PathsFromFaceAndEdgeSourcesEndOnTheSource) {
   }
 }
 
+// The direction field (issue 18): at every vertex the unit vector of the first step of the path
+// TracePathFromVertex returns, for vertex, face-point and two-source fields; zero at sources.
+TEST_P(PathTest, DirectionFieldIsTheFirstStepOfEveryPath) {
+  absl::StatusOr<TriangleMesh> mesh = LoadTestMesh(GetParam());
+  ASSERT_TRUE(mesh.ok());
+  const uint32_t n = mesh->file_vertex_count();
+  for (const std::vector<SurfacePoint>& sources :
+       {std::vector<SurfacePoint>{SurfacePoint::AtVertex(0)},
+        std::vector<SurfacePoint>{SurfacePoint::InFace(7, 0.2, 0.3, 0.5), SurfacePoint::AtVertex(n / 2)}}) {
+    absl::StatusOr<DistanceField> field = ComputeDistanceField(*mesh, sources);
+    ASSERT_TRUE(field.ok());
+    const std::vector<std::array<double, 3>> dir = ComputeDirectionField(*mesh, *field);
+    ASSERT_EQ(dir.size(), n);
+    int checked = 0;
+    for (uint32_t v = 0; v < n; ++v) {
+      absl::StatusOr<GeodesicPath> path = TracePathFromVertex(*mesh, *field, v);
+      ASSERT_TRUE(path.ok()) << path.status();
+      const auto& p = path->points;
+      // The first point of the path away from v (an edge crossing may repeat v's position).
+      size_t k = 1;
+      const double scale = 1e-9 * (1 + field->distance[v]);
+      while (k < p.size() && std::hypot(p[k].position[0] - p[0].position[0],
+                                        p[k].position[1] - p[0].position[1],
+                                        p[k].position[2] - p[0].position[2]) <= scale) {
+        ++k;
+      }
+      if (k == p.size()) {  // v is a source
+        EXPECT_EQ(dir[v], (std::array<double, 3>{0, 0, 0})) << v;
+        continue;
+      }
+      std::array<double, 3> step;
+      for (int c = 0; c < 3; ++c) step[c] = p[k].position[c] - p[0].position[c];
+      const double len = std::hypot(step[0], step[1], step[2]);
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(dir[v][c], step[c] / len, 1e-7) << "vertex " << v;
+      ++checked;
+    }
+    EXPECT_GT(checked, 50);
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Meshes, PathTest,
                          ::testing::Values("knight.off", "three-peaks.off", "kitten.off",
                                            "bump-domain.off"),
@@ -131,6 +171,63 @@ TEST(PathTest, SaddleConePathBendsAtTheApex) {
   }
   EXPECT_TRUE(through_apex);
   EXPECT_NEAR(path->length, field->distance[b], 1e-12);
+}
+
+// On a plane the direction towards a vertex source is exactly the straight line to it; an
+// unreferenced vertex has none (NaN).
+TEST(PathTest, DirectionFieldOnAPlanePointsAtTheSource) {
+  GridSpec spec;
+  MeshData data = MakeGrid(spec);
+  const uint32_t n = static_cast<uint32_t>(data.vertex_count());
+  data.positions.insert(data.positions.end(), {5, 5, 5});
+  absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(data);
+  ASSERT_TRUE(mesh.ok());
+  const uint32_t source = n / 2 + 3;
+  absl::StatusOr<DistanceField> field =
+      ComputeDistanceField(*mesh, {SurfacePoint::AtVertex(source)});
+  ASSERT_TRUE(field.ok());
+  const std::vector<std::array<double, 3>> dir = ComputeDirectionField(*mesh, *field);
+  const Vec3 s = VertexPosition(data, source);
+  for (uint32_t v = 0; v < n; ++v) {
+    if (v == source) {
+      EXPECT_EQ(dir[v], (std::array<double, 3>{0, 0, 0}));
+      continue;
+    }
+    const Vec3 p = VertexPosition(data, v);
+    const double len = Distance3(s, p);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(dir[v][c], (s[c] - p[c]) / len, 1e-12) << v;
+  }
+  EXPECT_TRUE(std::isnan(dir[n][0]) && std::isnan(dir[n][1]) && std::isnan(dir[n][2]));
+}
+
+// The rare case a solve seldom produces: a vertex reached from a window on an edge it ends, with
+// the window's image below that edge, so its first step runs into the neighbouring face (here
+// folded out of the plane). A hand-made origin, against the unfolding done by hand.
+TEST(PathTest, DirectionFieldStepsIntoTheFaceAcrossTheEdge) {
+  MeshData data;
+  data.positions = {0, 0, 0, 1, 0, 0, 0.5, 1, 0, 0.5, -1, 0.5};  // A B C D
+  data.faces = {0, 1, 2, 1, 0, 3};                                // ABC, BAD (fold along AB)
+  absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(data);
+  ASSERT_TRUE(mesh.ok());
+  ASSERT_EQ(mesh->From(0), 0u);  // half-edge 0 runs A -> B in face ABC
+  ASSERT_EQ(mesh->To(0), 1u);
+  DistanceField field;
+  field.internal_distance.assign(4, 1.0);
+  field.internal_origin.assign(4, VertexOrigin{});
+  field.internal_origin[0] = VertexOrigin{0, kNoIndex, 0.5, -0.8};  // image below AB, from A
+  const std::vector<std::array<double, 3>> dir = ComputeDirectionField(*mesh, field);
+  // In face BAD the point 0.8 below AB: A + 0.5 * (1, 0, 0) + 0.8 * n, n the unit vector in BAD
+  // perpendicular to AB towards D.
+  const double n[3] = {0, -1 / std::sqrt(1.25), 0.5 / std::sqrt(1.25)};
+  double want[3] = {0.5, 0.8 * n[1], 0.8 * n[2]};
+  const double len = std::sqrt(want[0] * want[0] + want[1] * want[1] + want[2] * want[2]);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(dir[0][c], want[c] / len, 1e-12) << c;
+  // From C (the opposite corner) towards the same image: inside ABC, through AB.
+  field.internal_origin[2] = VertexOrigin{0, kNoIndex, 0.5, -0.8};
+  const std::vector<std::array<double, 3>> from_c = ComputeDirectionField(*mesh, field);
+  EXPECT_NEAR(from_c[2][0], 0, 1e-12);
+  EXPECT_NEAR(from_c[2][1], -1, 1e-12);
+  EXPECT_NEAR(from_c[2][2], 0, 1e-12);
 }
 
 TEST(PathTest, UnreachableAndUnknownVerticesAreErrors) {

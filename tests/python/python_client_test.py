@@ -67,7 +67,7 @@ class PythonClientTest(unittest.TestCase):
         self.assertEqual(self.client.get_mesh("meshes/kitten").name, self.mesh.name)
 
     def test_distance_field_equals_the_cli(self):
-        distances, labels, stats = self.client.distance_field(
+        distances, labels, stats, _ = self.client.distance_field(
             self.mesh.name, [vertex(0), face_point(10, 0.2, 0.3, 0.5)], want_stats=True)
         expected = [float(x) for x in
                     self.local("distances", os.path.join(DATA, "kitten.off"), "--sources",
@@ -75,6 +75,17 @@ class PythonClientTest(unittest.TestCase):
         self.assertEqual(distances, expected)  # bit for bit (%.17g round-trips)
         self.assertEqual(set(labels), {0, 1})
         self.assertGreater(stats.windows_created, 0)
+
+    def test_direction_field_equals_the_cli(self):
+        field = self.client.distance_field(self.mesh.name, [vertex(0), vertex(1250)],
+                                           want_directions=True)
+        lines = self.local("distances", os.path.join(DATA, "kitten.off"), "--sources", "0,1250",
+                           "--directions").splitlines()
+        self.assertEqual(len(field.directions), 2500)
+        for (x, y, z), line in zip(field.directions, lines):
+            self.assertEqual([x, y, z], [float(v) for v in line.split("\t")[1].split()])
+        self.assertEqual(field.directions[0], (0.0, 0.0, 0.0))  # a source
+        self.assertAlmostEqual(sum(c * c for c in field.directions[7]), 1.0, delta=1e-12)
 
     def test_shortest_path_equals_the_cli(self):
         length, points = self.client.shortest_path(self.mesh.name, vertex(0), vertex(1250))

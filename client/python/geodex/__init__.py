@@ -15,7 +15,7 @@ import pkgutil
 # The generated geodex.v1 modules may live in another directory of sys.path (build/python).
 __path__ = pkgutil.extend_path(__path__, __name__)
 
-from .client import (Delaunay, GeodexClient, Isolines, Located, Path, PathPoint,  # noqa: E402
+from .client import (Delaunay, Field, GeodexClient, Isolines, Located, Path, PathPoint,  # noqa: E402
                      PointDistances, Voronoi, edge_point, face_point, position, vertex)
 from .errors import (CancelledError, DataLossError, DeadlineExceededError,  # noqa: E402
                      GeodexError, InvalidArgumentError, NotFoundError, ResourceExhaustedError,
@@ -23,7 +23,7 @@ from .errors import (CancelledError, DataLossError, DeadlineExceededError,  # no
 
 __version__ = "0.1.0"
 __all__ = [
-    "GeodexClient", "vertex", "edge_point", "face_point", "position", "Path", "PathPoint",
+    "GeodexClient", "vertex", "edge_point", "face_point", "position", "Field", "Path", "PathPoint",
     "Located", "PointDistances", "Isolines", "Voronoi", "Delaunay", "GeodexError",
     "InvalidArgumentError", "NotFoundError", "UnreachableError", "ResourceExhaustedError",
     "UnauthenticatedError", "UnavailableError", "DeadlineExceededError", "CancelledError",

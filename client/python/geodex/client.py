@@ -40,6 +40,11 @@ def position(x, y, z):
 # A point of a path or polyline: its position (x, y, z) and the simplex it lies on,
 # ("v", vertex) / ("e", from, to, t) / ("f", face, b0, b1, b2).
 PathPoint = collections.namedtuple("PathPoint", "position simplex")
+# A distance field: per vertex the distance (inf where unreachable), the nearest source's index,
+# the solve's stats (with want_stats), and with want_directions the geodesic direction field:
+# per vertex the unit tangent (x, y, z) towards the nearest source, (0, 0, 0) at a source, NaNs
+# where unreachable ([] otherwise).
+Field = collections.namedtuple("Field", "distances labels stats directions")
 # An exact shortest path: its length and its points (a 2-tuple: `length, points = ...`).
 Path = collections.namedtuple("Path", "length points")
 # Where a 3D position lands: the surface point (a SurfacePoint), its position, how far it moved.
@@ -189,19 +194,22 @@ class GeodexClient:
     # --- queries ---
 
     @_typed_errors
-    def distance_field(self, mesh, sources, want_stats=False, **options):
-        """(distances, labels, stats) for every vertex, reassembled from the streamed chunks.
-        `options`: SolverOptions fields (lambda_, lambda_scale, max_distance)."""
+    def distance_field(self, mesh, sources, want_stats=False, want_directions=False, **options):
+        """Field(distances, labels, stats, directions) for every vertex, reassembled from the
+        streamed chunks. `options`: SolverOptions fields (lambda_, lambda_scale, max_distance)."""
         request = pb.ComputeDistanceFieldRequest(
-            mesh=mesh, sources=sources, options=_solver_options(options), want_stats=want_stats)
-        distances, labels, stats = [], [], None
+            mesh=mesh, sources=sources, options=_solver_options(options), want_stats=want_stats,
+            want_directions=want_directions)
+        distances, labels, stats, flat = [], [], None, []
         for chunk in self._call(self.stub.ComputeDistanceField, request, mesh):
             assert chunk.offset == len(distances)
             distances.extend(chunk.distances_f64)
             labels.extend(chunk.labels)
+            flat.extend(chunk.directions)
             if chunk.HasField("stats"):
                 stats = chunk.stats
-        return distances, labels, stats
+        directions = [tuple(flat[i:i + 3]) for i in range(0, len(flat), 3)]
+        return Field(distances, labels, stats, directions)
 
     @_typed_errors
     def shortest_path(self, mesh, start, end, **options):

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -53,6 +54,9 @@ struct DistanceField {
   std::vector<VertexOrigin> internal_origin;
   std::vector<SurfacePoint> sources;  // as given to the solve; labels index this list
   SolveStats stats;
+  // The geodesic direction per file vertex, when asked for (ComputeDirectionField in
+  // geodex/shortest_path.h; geodexd's want_directions); empty otherwise.
+  std::vector<std::array<double, 3>> direction;
 };
 
 }  // namespace geodex

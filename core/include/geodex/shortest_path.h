@@ -34,6 +34,14 @@ struct GeodesicPath {
 absl::StatusOr<GeodesicPath> TracePathFromVertex(const TriangleMesh& mesh,
                                                  const DistanceField& field, uint32_t vertex);
 
+// The geodesic direction field a robot controller follows (as mesh_navigation's vector-field
+// planners consume it): per file vertex, the unit tangent, in file coordinates, of its shortest
+// path towards its nearest source, i.e. the direction of the first step of the path
+// TracePathFromVertex returns. (0, 0, 0) at a source vertex; NaN components where the direction
+// is undefined (an unreachable vertex). Exact: read off the per-vertex origins, O(V).
+std::vector<std::array<double, 3>> ComputeDirectionField(const TriangleMesh& mesh,
+                                                         const DistanceField& field);
+
 }  // namespace geodex
 
 namespace geodex {
