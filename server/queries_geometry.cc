@@ -31,6 +31,17 @@
 #include "status_convert.h"
 
 namespace geodex::server {
+namespace {
+
+// The geometry's messages as a stream, the field's stats in the last one when asked for.
+template <typename Response>
+MessageProducer<Response> Streamed(std::vector<Response> messages, const SolvedField& solved,
+                                   bool want_stats) {
+  if (want_stats) FieldStatsToProto(*solved.field, solved.cached, messages.back().mutable_stats());
+  return ProducerOf(std::move(messages));
+}
+
+}  // namespace
 
 absl::StatusOr<MessageStream<v1::ComputeIsolinesResponse>> RunComputeIsolines(
     const QueryEnv& env, const v1::ComputeIsolinesRequest& request) {
@@ -65,10 +76,7 @@ absl::StatusOr<MessageStream<v1::ComputeIsolinesResponse>> RunComputeIsolines(
 
   std::vector<v1::ComputeIsolinesResponse> messages =
       api::IsolinesToProto(*isolines, env.limits->stream_chunk_bytes);
-  if (request.want_stats()) {
-    FieldStatsToProto(*solved->field, solved->cached, messages.back().mutable_stats());
-  }
-  return ProducerOf(std::move(messages));
+  return Streamed(std::move(messages), *solved, request.want_stats());
 }
 
 absl::StatusOr<MessageStream<v1::ComputeVoronoiResponse>> RunComputeVoronoi(
@@ -81,10 +89,7 @@ absl::StatusOr<MessageStream<v1::ComputeVoronoiResponse>> RunComputeVoronoi(
 
   std::vector<v1::ComputeVoronoiResponse> messages = api::VoronoiToProto(
       *diagram, solved->sources, request.omit_cell_faces(), env.limits->stream_chunk_bytes);
-  if (request.want_stats()) {
-    FieldStatsToProto(*solved->field, solved->cached, messages.back().mutable_stats());
-  }
-  return ProducerOf(std::move(messages));
+  return Streamed(std::move(messages), *solved, request.want_stats());
 }
 
 absl::StatusOr<MessageStream<v1::ComputeDelaunayResponse>> RunComputeDelaunay(
@@ -98,10 +103,7 @@ absl::StatusOr<MessageStream<v1::ComputeDelaunayResponse>> RunComputeDelaunay(
 
   std::vector<v1::ComputeDelaunayResponse> messages =
       api::DelaunayToProto(*delaunay, solved->sources, env.limits->stream_chunk_bytes);
-  if (request.want_stats()) {
-    FieldStatsToProto(*solved->field, solved->cached, messages.back().mutable_stats());
-  }
-  return ProducerOf(std::move(messages));
+  return Streamed(std::move(messages), *solved, request.want_stats());
 }
 
 }  // namespace geodex::server
