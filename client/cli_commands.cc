@@ -133,6 +133,23 @@ absl::Status OnePoint(Backend& backend, const Args& args, const std::string& key
 
 }  // namespace
 
+int QueryExitCode(const absl::Status& status) {
+  switch (status.code()) {
+    case absl::StatusCode::kInvalidArgument:
+    case absl::StatusCode::kOutOfRange:
+      return kExitUsage;
+    case absl::StatusCode::kNotFound:
+    case absl::StatusCode::kDataLoss:
+      return kExitInput;
+    default:
+      return kExitSolveFailed;
+  }
+}
+
+int FailQuery(const absl::Status& status) {
+  return Fail(QueryExitCode(status), std::string(status.message()));
+}
+
 int OpenMesh(Backend& backend, const std::string& mesh, const MeshBuildOptions& build) {
   absl::Status s = backend.Open(mesh, build);
   if (s.ok()) return kExitOk;

@@ -171,21 +171,4 @@ class LocalBackend final : public Backend {
 
 std::unique_ptr<Backend> MakeLocalBackend() { return std::make_unique<LocalBackend>(); }
 
-int QueryExitCode(const absl::Status& status) {
-  switch (status.code()) {
-    case absl::StatusCode::kInvalidArgument:
-    case absl::StatusCode::kOutOfRange:
-      return kExitUsage;
-    case absl::StatusCode::kNotFound:
-    case absl::StatusCode::kDataLoss:
-      return kExitInput;
-    default:
-      return kExitSolveFailed;
-  }
-}
-
-int FailQuery(const absl::Status& status) {
-  return Fail(QueryExitCode(status), std::string(status.message()));
-}
-
 }  // namespace geodex::cli
