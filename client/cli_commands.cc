@@ -1,30 +1,29 @@
 #include "cli_commands.h"
 
-#include "cli_backend.h"
-#include "cli_common.h"
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
 #include <chrono>
-#include <limits>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <set>
 
-#include <unistd.h>
-
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_format.h"
+#include "cli_backend.h"
+#include "cli_common.h"
 #include "geodex/distance_matrix.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/locate.h"
-#include "geodex/point_distance.h"
-#include "geodex/shortest_path.h"
 #include "geodex/mesh_io.h"
+#include "geodex/point_distance.h"
 #include "geodex/samples.h"
+#include "geodex/shortest_path.h"
 #include "geodex/surface_point.h"
 #include "geodex/triangle_mesh.h"
 
@@ -89,11 +88,12 @@ absl::Status ResolvePoints(Backend& backend, const Args& args, const std::string
         warn_above = kSnapWarnRel * std::sqrt(d2);
       }
       if (at.distance > warn_above) {
-        std::fprintf(stderr,
-                     "geodex: warning: --%s: %s is %.6g from the surface; snapped to %s (--max-snap "
-                     "D refuses such points)\n",
-                     option.c_str(), SurfacePointToString(p).c_str(), at.distance,
-                     SurfacePointToString(at.point).c_str());
+        std::fprintf(
+            stderr,
+            "geodex: warning: --%s: %s is %.6g from the surface; snapped to %s (--max-snap "
+            "D refuses such points)\n",
+            option.c_str(), SurfacePointToString(p).c_str(), at.distance,
+            SurfacePointToString(at.point).c_str());
       }
       if (report != nullptr && at.distance >= report->max_distance) {
         report->max_distance = at.distance;
@@ -119,8 +119,8 @@ absl::Status ResolveOption(Backend& backend, const Args& args, const std::string
 namespace {
 
 // A SPEC that must name exactly one point.
-absl::Status OnePoint(Backend& backend, const Args& args, const std::string& key,
-                      SurfacePoint* out, SnapReport* report) {
+absl::Status OnePoint(Backend& backend, const Args& args, const std::string& key, SurfacePoint* out,
+                      SnapReport* report) {
   std::vector<SurfacePoint> p;
   if (absl::Status s = ResolveOption(backend, args, key, &p, report); !s.ok()) return s;
   if (p.size() != 1) {
@@ -165,16 +165,15 @@ int OpenMesh(Backend& backend, const std::string& mesh, const MeshBuildOptions& 
   }
 }
 
-namespace {
-
-}  // namespace
+namespace {}  // namespace
 
 int RunInfo(Backend& backend, const Args& args) {
   std::string error;
   if (!CheckKnown(args, {"format", "strict"}, &error) || !backend.Supports(args, &error)) {
     return Fail(kExitUsage, error);
   }
-  if (args.positional.size() != 1) return Fail(kExitUsage, "usage: geodex info MESH [--format json]");
+  if (args.positional.size() != 1)
+    return Fail(kExitUsage, "usage: geodex info MESH [--format json]");
   const std::string format = args.options.count("format") ? args.options.at("format") : "text";
   if (format != "text" && format != "json") {
     return Fail(kExitUsage, "--format must be text or json");
@@ -251,12 +250,12 @@ std::string StatsJson(const Backend& backend, const std::string& leading, const 
 int RunDistances(Backend& backend, const Args& args) {
   std::string error;
   bool json = false;
-  if (!CheckKnown(args, {"sources", "method", "lambda", "lambda-scale", "max-distance",
-                         "max-windows", "stats", "output", "no-filter", "no-one-split", "at",
-                         "max-snap", "format", "directions"},
-                  &error) ||
-      !GetFormat(args, &json, &error) ||
-      !backend.Supports(args, &error)) {
+  if (!CheckKnown(
+          args,
+          {"sources", "method", "lambda", "lambda-scale", "max-distance", "max-windows", "stats",
+           "output", "no-filter", "no-one-split", "at", "max-snap", "format", "directions"},
+          &error) ||
+      !GetFormat(args, &json, &error) || !backend.Supports(args, &error)) {
     return Fail(kExitUsage, error);
   }
   if (args.positional.size() != 1 || !args.options.count("sources")) {
@@ -321,9 +320,8 @@ int RunDistances(Backend& backend, const Args& args) {
   const auto t_out = std::chrono::steady_clock::now();
   if (int code = WriteOutput(args, text); code != kExitOk) return code;
   if (args.options.count("stats")) {
-    const std::string leading =
-        absl::StrFormat("\"method\": \"%s\", \"sources\": %d, %s", options.method,
-                        sources.size(), SnapJson(snap));
+    const std::string leading = absl::StrFormat("\"method\": \"%s\", \"sources\": %d, %s",
+                                                options.method, sources.size(), SnapJson(snap));
     const std::string trailing = absl::StrFormat("\"output_ms\": %.3f, ", MsSince(t_out));
     std::fputs(StatsJson(backend, leading, stats, trailing).c_str(), stderr);
   }
@@ -333,11 +331,11 @@ int RunDistances(Backend& backend, const Args& args) {
 int RunPath(Backend& backend, const Args& args) {
   std::string error;
   bool json = false;
-  if (!CheckKnown(args, {"from", "to", "method", "stats", "lambda", "lambda-scale", "max-distance",
-                         "max-windows", "max-snap", "format"},
+  if (!CheckKnown(args,
+                  {"from", "to", "method", "stats", "lambda", "lambda-scale", "max-distance",
+                   "max-windows", "max-snap", "format"},
                   &error) ||
-      !GetFormat(args, &json, &error) ||
-      !backend.Supports(args, &error)) {
+      !GetFormat(args, &json, &error) || !backend.Supports(args, &error)) {
     return Fail(kExitUsage, error);
   }
   if (args.positional.size() != 1 || !args.options.count("from") || !args.options.count("to")) {
@@ -373,11 +371,11 @@ int RunPath(Backend& backend, const Args& args) {
 int RunMatrix(Backend& backend, const Args& args) {
   std::string error;
   bool json = false;
-  if (!CheckKnown(args, {"sources", "targets", "stats", "lambda", "lambda-scale", "max-distance",
-                         "max-windows", "k-nearest", "threads", "max-snap", "format"},
+  if (!CheckKnown(args,
+                  {"sources", "targets", "stats", "lambda", "lambda-scale", "max-distance",
+                   "max-windows", "k-nearest", "threads", "max-snap", "format"},
                   &error) ||
-      !GetFormat(args, &json, &error) ||
-      !backend.Supports(args, &error)) {
+      !GetFormat(args, &json, &error) || !backend.Supports(args, &error)) {
     return Fail(kExitUsage, error);
   }
   if (args.positional.size() != 1 || !args.options.count("sources") ||
@@ -412,9 +410,9 @@ int RunMatrix(Backend& backend, const Args& args) {
   const std::string text = json ? FormatMatrixJson(*m) : FormatMatrix(*m);
   std::fwrite(text.data(), 1, text.size(), stdout);
   if (args.options.count("stats")) {
-    const std::string leading = absl::StrFormat(
-        "\"rows\": %d, \"cols\": %d, \"threads\": %u, %s", m->rows, m->cols,
-        options.threads > 0 ? options.threads : UsableCores(), SnapJson(snap));
+    const std::string leading =
+        absl::StrFormat("\"rows\": %d, \"cols\": %d, \"threads\": %u, %s", m->rows, m->cols,
+                        options.threads > 0 ? options.threads : UsableCores(), SnapJson(snap));
     std::fputs(StatsJson(backend, leading, m->stats, "").c_str(), stderr);
   }
   return kExitOk;
@@ -438,8 +436,9 @@ int RunLocate(Backend& backend, const Args& args) {
   std::vector<std::array<double, 3>> xyz;
   for (const SurfacePoint& p : *points) {
     if (p.kind != SurfacePoint::Kind::kPosition) {
-      return Fail(kExitUsage, absl::StrFormat("--points: %s is not a position (locate takes p:X:Y:Z)",
-                                              SurfacePointToString(p)));
+      return Fail(kExitUsage,
+                  absl::StrFormat("--points: %s is not a position (locate takes p:X:Y:Z)",
+                                  SurfacePointToString(p)));
     }
     xyz.push_back(p.position);
   }

@@ -18,10 +18,10 @@ namespace geodex::cli {
 namespace {
 
 std::string Key(const std::vector<SurfacePoint>& sources, const FieldOptions& o) {
-  std::string key = absl::StrFormat("%s|%.17g|%d|%.17g|%d|%d|%d|", o.method, o.solver.lambda,
-                                    static_cast<int>(o.solver.lambda_scale), o.solver.max_distance,
-                                    o.solver.max_windows, o.solver.use_filter,
-                                    o.solver.use_one_angle_one_split);
+  std::string key =
+      absl::StrFormat("%s|%.17g|%d|%.17g|%d|%d|%d|", o.method, o.solver.lambda,
+                      static_cast<int>(o.solver.lambda_scale), o.solver.max_distance,
+                      o.solver.max_windows, o.solver.use_filter, o.solver.use_one_angle_one_split);
   for (const SurfacePoint& p : sources) absl::StrAppend(&key, SurfacePointToString(p), ",");
   return key;
 }

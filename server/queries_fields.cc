@@ -1,12 +1,10 @@
-// Streamed distances: ComputeDistanceField and ComputeDistanceMatrix (rows streamed as they finish).
-
-#include "queries.h"
-#include "query_support.h"
+// Streamed distances: ComputeDistanceField and ComputeDistanceMatrix (rows streamed as they
+// finish).
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <limits>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -15,6 +13,7 @@
 
 #include "absl/strings/cord.h"
 #include "absl/strings/str_cat.h"
+#include "field_cache.h"
 #include "geodex/delaunay.h"
 #include "geodex/distance_matrix.h"
 #include "geodex/geodesic_solver.h"
@@ -22,9 +21,10 @@
 #include "geodex/point_distance.h"
 #include "geodex/shortest_path.h"
 #include "geodex/voronoi.h"
-#include "field_cache.h"
 #include "mesh_id.h"
 #include "proto_convert.h"
+#include "queries.h"
+#include "query_support.h"
 #include "service_limits.h"
 #include "status_convert.h"
 
@@ -176,8 +176,8 @@ absl::StatusOr<DistanceMatrix> SolveMatrixRows(const QueryEnv& env, const Stored
     row_final[missing[i]] = 1;
     hand_out();
   };
-  absl::StatusOr<DistanceMatrix> matrix = ComputeDistanceMatrix(*mesh.mesh, rest, targets,
-                                                                matrix_options);
+  absl::StatusOr<DistanceMatrix> matrix =
+      ComputeDistanceMatrix(*mesh.mesh, rest, targets, matrix_options);
   if (!matrix.ok()) return NameSolveError(matrix.status(), "sources/targets");
   env.counters->solves.fetch_add(1, std::memory_order_relaxed);
   env.counters->windows_processed.fetch_add(matrix->stats.windows_processed,
@@ -196,8 +196,8 @@ struct MatrixStreamState {
   bool done = false;
   SolveStats stats;
   bool cached = false;
-  size_t next = 0;    // the next value to send
-  bool sent = false;  // a message went out (an empty matrix still gets one)
+  size_t next = 0;                         // the next value to send
+  bool sent = false;                       // a message went out (an empty matrix still gets one)
   double progress = 0, progress_sent = 0;  // fraction of the solves done; the last one sent
 };
 
@@ -240,8 +240,7 @@ absl::StatusOr<MessageStream<v1::ComputeDistanceMatrixResponse>> RunComputeDista
   if (!v1::ValueType_IsValid(request.value_type())) {
     return FieldError("value_type", absl::StrCat("unknown value ", request.value_type()));
   }
-  absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh =
-      LookupMesh(env, request.mesh(), "mesh");
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh = LookupMesh(env, request.mesh(), "mesh");
   if (!mesh.ok()) return mesh.status();
   absl::StatusOr<std::vector<SurfacePoint>> sources =
       ResolveSources(env, **mesh, request.sources());
@@ -251,7 +250,9 @@ absl::StatusOr<MessageStream<v1::ComputeDistanceMatrixResponse>> RunComputeDista
   if (!targets.ok()) return targets.status();
   const uint64_t values = uint64_t{sources->size()} * targets->size();
   if (values > env.limits->max_output_values) {
-    return ServerLimitError("max_output_values", absl::StrCat("the matrix has ", sources->size(), " x ", targets->size(), " = ", values,
+    return ServerLimitError(
+        "max_output_values",
+        absl::StrCat("the matrix has ", sources->size(), " x ", targets->size(), " = ", values,
                      " values, over --max_output_values=", env.limits->max_output_values));
   }
   absl::StatusOr<GeodesicOptions> solver = Options(env, request.options());

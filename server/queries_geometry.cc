@@ -1,14 +1,10 @@
-// The approximate geometry of paper section 6 streamed: ComputeIsolines, ComputeVoronoi, ComputeDelaunay.
-
-#include "queries.h"
-#include "query_support.h"
-
-#include "geometry_convert.h"
+// The approximate geometry of paper section 6 streamed: ComputeIsolines, ComputeVoronoi,
+// ComputeDelaunay.
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <limits>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -17,6 +13,7 @@
 
 #include "absl/strings/cord.h"
 #include "absl/strings/str_cat.h"
+#include "field_cache.h"
 #include "geodex/delaunay.h"
 #include "geodex/distance_matrix.h"
 #include "geodex/geodesic_solver.h"
@@ -24,9 +21,11 @@
 #include "geodex/point_distance.h"
 #include "geodex/shortest_path.h"
 #include "geodex/voronoi.h"
-#include "field_cache.h"
+#include "geometry_convert.h"
 #include "mesh_id.h"
 #include "proto_convert.h"
+#include "queries.h"
+#include "query_support.h"
 #include "service_limits.h"
 #include "status_convert.h"
 
@@ -47,7 +46,8 @@ absl::StatusOr<MessageStream<v1::ComputeIsolinesResponse>> RunComputeIsolines(
     const QueryEnv& env, const v1::ComputeIsolinesRequest& request) {
   const uint32_t max_levels = env.limits->max_levels;
   if (static_cast<uint64_t>(request.levels_size()) > max_levels) {
-    return ServerLimitError("max_levels", absl::StrCat("levels: ", request.levels_size(), " levels, over --max_levels=", max_levels));
+    return ServerLimitError("max_levels", absl::StrCat("levels: ", request.levels_size(),
+                                                       " levels, over --max_levels=", max_levels));
   }
   IsolineOptions options;
   for (int i = 0; i < request.levels_size(); ++i) {
@@ -59,12 +59,13 @@ absl::StatusOr<MessageStream<v1::ComputeIsolinesResponse>> RunComputeIsolines(
   }
   if (options.levels.empty()) {
     if (request.count() < 2) {
-      return FieldError("count", absl::StrCat("give levels, or a count >= 2 (got ", request.count(), ")"));
+      return FieldError("count",
+                        absl::StrCat("give levels, or a count >= 2 (got ", request.count(), ")"));
     }
     if (static_cast<uint64_t>(request.count()) > uint64_t{max_levels} + 1) {
-      return ServerLimitError("max_levels", absl::StrCat("count: ", request.count(), " gives ",
-                                                       request.count() - 1,
-                                                       " levels, over --max_levels=", max_levels));
+      return ServerLimitError(
+          "max_levels", absl::StrCat("count: ", request.count(), " gives ", request.count() - 1,
+                                     " levels, over --max_levels=", max_levels));
     }
     options.count = request.count();
   }

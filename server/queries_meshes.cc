@@ -1,12 +1,9 @@
 // Mesh resources: GetMesh, ListMeshes, DeleteMesh (answered inline: map look-ups).
 
-#include "queries.h"
-#include "query_support.h"
-
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <limits>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -15,6 +12,7 @@
 
 #include "absl/strings/cord.h"
 #include "absl/strings/str_cat.h"
+#include "field_cache.h"
 #include "geodex/delaunay.h"
 #include "geodex/distance_matrix.h"
 #include "geodex/geodesic_solver.h"
@@ -22,9 +20,10 @@
 #include "geodex/point_distance.h"
 #include "geodex/shortest_path.h"
 #include "geodex/voronoi.h"
-#include "field_cache.h"
 #include "mesh_id.h"
 #include "proto_convert.h"
+#include "queries.h"
+#include "query_support.h"
 #include "service_limits.h"
 #include "status_convert.h"
 
@@ -40,7 +39,8 @@ absl::Status RunGetMesh(const QueryEnv& env, const v1::GetMeshRequest& request,
   // The record: a mesh that is only on disk is described without loading it.
   absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh = env.store->GetRecord(*key);
   if (!mesh.ok()) {
-    return MeshNotFoundError("name", absl::StrCat("mesh ", QuoteInput(request.name()), " not found"));
+    return MeshNotFoundError("name",
+                             absl::StrCat("mesh ", QuoteInput(request.name()), " not found"));
   }
   MeshToProto(**mesh, response);
   return absl::OkStatus();
@@ -72,7 +72,8 @@ absl::Status RunDeleteMesh(const QueryEnv& env, const v1::DeleteMeshRequest& req
   if (!key.ok()) return key.status();
   absl::Status status = env.store->Delete(*key);
   if (absl::IsNotFound(status)) {
-    return MeshNotFoundError("name", absl::StrCat("mesh ", QuoteInput(request.name()), " not found"));
+    return MeshNotFoundError("name",
+                             absl::StrCat("mesh ", QuoteInput(request.name()), " not found"));
   }
   return status;
 }

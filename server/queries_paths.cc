@@ -1,12 +1,9 @@
 // Unary queries: FindShortestPath(s), EstimateDistances, LocatePoints.
 
-#include "queries.h"
-#include "query_support.h"
-
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <limits>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -15,6 +12,7 @@
 
 #include "absl/strings/cord.h"
 #include "absl/strings/str_cat.h"
+#include "field_cache.h"
 #include "geodex/delaunay.h"
 #include "geodex/distance_matrix.h"
 #include "geodex/geodesic_solver.h"
@@ -22,9 +20,10 @@
 #include "geodex/point_distance.h"
 #include "geodex/shortest_path.h"
 #include "geodex/voronoi.h"
-#include "field_cache.h"
 #include "mesh_id.h"
 #include "proto_convert.h"
+#include "queries.h"
+#include "query_support.h"
 #include "service_limits.h"
 #include "status_convert.h"
 
@@ -35,8 +34,7 @@ namespace geodex::server {
 
 absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPathRequest& request,
                                  v1::FindShortestPathResponse* response) {
-  absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh =
-      LookupMesh(env, request.mesh(), "mesh");
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh = LookupMesh(env, request.mesh(), "mesh");
   if (!mesh.ok()) return mesh.status();
   absl::StatusOr<SurfacePoint> from = ResolvePoint(**mesh, request.from(), "from");
   if (!from.ok()) return from.status();
@@ -102,8 +100,9 @@ absl::Status RunFindShortestPaths(const QueryEnv& env, const v1::FindShortestPat
     return FieldError("pairs", "at least one pair is required");
   }
   if (static_cast<uint64_t>(request.pairs_size()) > env.limits->max_targets) {
-    return ServerLimitError("max_targets", absl::StrCat(
-        "pairs: ", request.pairs_size(), " pairs, over --max_targets=", env.limits->max_targets));
+    return ServerLimitError("max_targets",
+                            absl::StrCat("pairs: ", request.pairs_size(),
+                                         " pairs, over --max_targets=", env.limits->max_targets));
   }
   absl::StatusOr<GeodesicOptions> solver = Options(env, request.options());
   if (!solver.ok()) return solver.status();
@@ -113,7 +112,8 @@ absl::Status RunFindShortestPaths(const QueryEnv& env, const v1::FindShortestPat
   std::vector<std::vector<size_t>> groups;
   for (int i = 0; i < request.pairs_size(); ++i) {
     const std::string field = absl::StrCat("pairs[", i, "]");
-    absl::StatusOr<SurfacePoint> from = ResolvePoint(**mesh, request.pairs(i).from(), field + ".from");
+    absl::StatusOr<SurfacePoint> from =
+        ResolvePoint(**mesh, request.pairs(i).from(), field + ".from");
     if (!from.ok()) return from.status();
     absl::StatusOr<SurfacePoint> to = ResolvePoint(**mesh, request.pairs(i).to(), field + ".to");
     if (!to.ok()) return to.status();
@@ -153,8 +153,7 @@ absl::Status RunFindShortestPaths(const QueryEnv& env, const v1::FindShortestPat
 
 absl::Status RunEstimateDistances(const QueryEnv& env, const v1::EstimateDistancesRequest& request,
                                   v1::EstimateDistancesResponse* response) {
-  absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh =
-      LookupMesh(env, request.mesh(), "mesh");
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh = LookupMesh(env, request.mesh(), "mesh");
   if (!mesh.ok()) return mesh.status();
   const TriangleMesh& tm = *(*mesh)->mesh;
   absl::StatusOr<std::vector<SurfacePoint>> sources =
@@ -205,15 +204,15 @@ absl::Status RunEstimateDistances(const QueryEnv& env, const v1::EstimateDistanc
 
 absl::Status RunLocatePoints(const QueryEnv& env, const v1::LocatePointsRequest& request,
                              v1::LocatePointsResponse* response) {
-  absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh =
-      LookupMesh(env, request.mesh(), "mesh");
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh = LookupMesh(env, request.mesh(), "mesh");
   if (!mesh.ok()) return mesh.status();
   if (request.positions().empty()) {
     return FieldError("positions", "at least one position is required");
   }
   if (static_cast<uint64_t>(request.positions_size()) > env.limits->max_targets) {
-    return ServerLimitError("max_targets", absl::StrCat("positions: ", request.positions_size(),
-                     " points, over --max_targets=", env.limits->max_targets));
+    return ServerLimitError("max_targets",
+                            absl::StrCat("positions: ", request.positions_size(),
+                                         " points, over --max_targets=", env.limits->max_targets));
   }
   const double max_snap =
       request.has_max_snap() ? request.max_snap() : std::numeric_limits<double>::infinity();

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <limits>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -12,6 +12,7 @@
 
 #include "absl/strings/cord.h"
 #include "absl/strings/str_cat.h"
+#include "field_cache.h"
 #include "geodex/delaunay.h"
 #include "geodex/distance_matrix.h"
 #include "geodex/geodesic_solver.h"
@@ -19,7 +20,6 @@
 #include "geodex/point_distance.h"
 #include "geodex/shortest_path.h"
 #include "geodex/voronoi.h"
-#include "field_cache.h"
 #include "mesh_id.h"
 #include "proto_convert.h"
 #include "service_limits.h"
@@ -75,7 +75,8 @@ absl::Status NameSolveError(const absl::Status& status, const char* field) {
 absl::Status CheckFieldSize(const QueryEnv& env, const StoredMesh& mesh) {
   if (mesh.vertex_count > env.limits->max_output_values) {
     return ServerLimitError("max_output_values", absl::StrCat("the field has ", mesh.vertex_count,
-                     " values, over --max_output_values=", env.limits->max_output_values));
+                                                              " values, over --max_output_values=",
+                                                              env.limits->max_output_values));
   }
   return absl::OkStatus();
 }
@@ -84,7 +85,9 @@ absl::Status CheckUnaryResponseSize(const QueryEnv& env, const google::protobuf:
                                     const char* what) {
   const size_t bytes = response.ByteSizeLong();
   if (bytes > env.limits->max_unary_response_bytes) {
-    return ServerLimitError("max_unary_response_bytes", absl::StrCat("the response would be ", bytes, " bytes, over --max_unary_response_bytes=",
+    return ServerLimitError(
+        "max_unary_response_bytes",
+        absl::StrCat("the response would be ", bytes, " bytes, over --max_unary_response_bytes=",
                      env.limits->max_unary_response_bytes, "; send fewer ", what, " per call"));
   }
   return absl::OkStatus();
@@ -117,11 +120,9 @@ void FieldStatsToProto(const DistanceField& field, bool cached, v1::SolveStats* 
 }
 
 absl::StatusOr<SolvedField> SolveField(const QueryEnv& env, const std::string& mesh_name,
-                                       const PointList& sources,
-                                       const v1::SolverOptions& options) {
+                                       const PointList& sources, const v1::SolverOptions& options) {
   SolvedField out;
-  absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh =
-      LookupMesh(env, mesh_name, "mesh");
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh = LookupMesh(env, mesh_name, "mesh");
   if (!mesh.ok()) return mesh.status();
   out.mesh = *std::move(mesh);
   if (absl::Status s = CheckFieldSize(env, *out.mesh); !s.ok()) return s;

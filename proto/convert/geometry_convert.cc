@@ -107,7 +107,8 @@ std::vector<v1::ComputeVoronoiResponse> VoronoiToProto(
   }
   first.set_junction_faces(diagram.junction_faces);
   first.set_total_area(diagram.total_area);
-  for (const SurfacePoint& p : resolved_sources) SurfacePointToProto(p, first.add_resolved_sources());
+  for (const SurfacePoint& p : resolved_sources)
+    SurfacePointToProto(p, first.add_resolved_sources());
   chunker.Account(first.ByteSizeLong());
 
   for (const VoronoiCell& cell : diagram.cells) {

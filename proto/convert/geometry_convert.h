@@ -12,8 +12,8 @@
 #include "geodex/delaunay.h"
 #include "geodex/isolines.h"
 #include "geodex/surface_point.h"
-#include "geodex/voronoi.h"
 #include "geodex/v1/geodex.pb.h"
+#include "geodex/voronoi.h"
 
 namespace geodex::api {
 

@@ -2,17 +2,17 @@
 // many small messages (pieces split mid-polyline and mid-cell) and reassembled gives back exactly
 // what core computed; a mesh's summary survives the Mesh resource (api_convert.h).
 
-#include "geometry_convert.h"
+#include "api_convert.h"
 
 #include <string>
 #include <vector>
 
 #include "absl/strings/str_format.h"
-#include "api_convert.h"
 #include "geodex/delaunay.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/isolines.h"
 #include "geodex/voronoi.h"
+#include "geometry_convert.h"
 #include "gtest/gtest.h"
 #include "util/test_meshes.h"
 
@@ -62,8 +62,8 @@ TEST(ApiConvertTest, IsolinesRoundTripThroughManyMessages) {
   const Isolines iso = *ExtractIsolines(f.mesh, f.field, options);
   const std::vector<v1::ComputeIsolinesResponse> messages = api::IsolinesToProto(iso, kTinyBudget);
   ASSERT_GT(messages.size(), 10u);
-  EXPECT_TRUE(AnyContinued<v1::ComputeIsolinesResponse>(
-      messages, [](const v1::ComputeIsolinesResponse& m) {
+  EXPECT_TRUE(
+      AnyContinued<v1::ComputeIsolinesResponse>(messages, [](const v1::ComputeIsolinesResponse& m) {
         for (const auto& piece : m.isolines()) {
           if (piece.continued()) return true;
         }
@@ -86,8 +86,8 @@ TEST(ApiConvertTest, VoronoiRoundTripsWithCellsSplitAcrossMessages) {
   const VoronoiDiagram vd = *BuildVoronoi(f.mesh, f.field);
   const std::vector<v1::ComputeVoronoiResponse> messages =
       api::VoronoiToProto(vd, f.sites, /*omit_cell_faces=*/false, kTinyBudget);
-  EXPECT_TRUE(AnyContinued<v1::ComputeVoronoiResponse>(
-      messages, [](const v1::ComputeVoronoiResponse& m) {
+  EXPECT_TRUE(
+      AnyContinued<v1::ComputeVoronoiResponse>(messages, [](const v1::ComputeVoronoiResponse& m) {
         for (const auto& piece : m.cells()) {
           if (piece.continued()) return true;
         }
