@@ -114,13 +114,11 @@ class RemoteBackend final : public Backend {
 
   absl::StatusOr<const MeshData*> Geometry() override {
     if (data_ == nullptr) {
-      absl::StatusOr<MeshData> data = LoadMeshData(mesh_arg_);
-      if (!data.ok()) {
-        return absl::NotFoundError(absl::StrFormat(
-            "%s (in remote mode isolines, voronoi, delaunay and render need the mesh file or "
-            "sample:NAME: its coordinates place the sites)",
-            data.status().message()));
-      }
+      // A file or sample given here is read here (its exact coordinates); a mesh named on the
+      // server comes from it (GetMeshGeometry).
+      absl::StatusOr<MeshData> data =
+          mesh_.file_bytes.empty() ? client_->GetMeshGeometry(mesh_) : LoadMeshData(mesh_arg_);
+      if (!data.ok()) return data.status();
       data_ = std::make_unique<MeshData>(*std::move(data));
     }
     return data_.get();

@@ -315,6 +315,21 @@ absl::StatusOr<DistanceField> GeodexClient::Field(MeshRef& mesh,
   return field;
 }
 
+absl::StatusOr<MeshData> GeodexClient::GetMeshGeometry(MeshRef& mesh) {
+  v1::GetMeshGeometryRequest request;
+  request.set_name(mesh.name);
+  api::MeshGeometryAssembler out;
+  grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
+    out = api::MeshGeometryAssembler();
+    auto reader = stub_->GetMeshGeometry(context, request);
+    v1::MeshGeometry message;
+    while (reader->Read(&message)) out.Add(message);
+    return reader->Finish();
+  });
+  if (!status.ok()) return ToAbsl(status);
+  return std::move(out.result());
+}
+
 absl::StatusOr<PathQueryResult> GeodexClient::ShortestPath(MeshRef& mesh, const SurfacePoint& from,
                                                            const SurfacePoint& to,
                                                            const v1::SolverOptions& options) {

@@ -76,6 +76,8 @@ class GeodexClient {
   absl::StatusOr<v1::Mesh> Upload(const std::string& file_name, const std::string& bytes,
                                   const std::string& alias, const std::string& expected_id);
   absl::StatusOr<v1::Mesh> GetMesh(const std::string& name);
+  // The mesh's positions and faces, as geodexd holds them (for drawing without the file).
+  absl::StatusOr<MeshData> GetMeshGeometry(MeshRef& mesh);
   absl::StatusOr<std::vector<v1::Mesh>> ListMeshes();  // every page
   absl::Status DeleteMesh(const std::string& name);
 

@@ -32,8 +32,8 @@ a geodexd and prints the same output. There MESH may also be a mesh id or a name
 server; a file is uploaded once (only if the server does not have it, by content hash).
   mesh upload FILE [--name NAME] | mesh list | mesh get MESH | mesh delete MESH   [--format json]
   health [--service NAME]      prints SERVING (exit 0) or NOT_SERVING (exit 1)
-isolines, voronoi and delaunay need MESH as a file or sample:NAME in remote mode too (its
-coordinates place the sites in the output).
+isolines, voronoi, delaunay and render take the mesh's coordinates from the file when MESH is one,
+else from the server (GetMeshGeometry).
 
 commands:
   info MESH [--format text|json] [--strict]

@@ -314,6 +314,8 @@ const std::vector<MethodRow>& MethodTable() {
   static const auto* table = new std::vector<MethodRow>{
       {{"CreateMesh", Lane::kSolve}, &Upload},
       {{"GetMesh", Lane::kInline}, &Unary<v1::GetMeshRequest, v1::Mesh, &RunGetMesh>},
+      {{"GetMeshGeometry", Lane::kQuick},  // a resident mesh: no solve; one on disk loads
+       &Stream<v1::GetMeshGeometryRequest, v1::MeshGeometry, &RunGetMeshGeometry>},
       {{"ListMeshes", Lane::kInline},
        &Unary<v1::ListMeshesRequest, v1::ListMeshesResponse, &RunListMeshes>},
       {{"DeleteMesh", Lane::kInline},

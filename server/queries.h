@@ -48,6 +48,9 @@ bool IsSolveLaneNeeded(const absl::Status& status);
 
 // Mesh resources (answered inline: map look-ups).
 absl::Status RunGetMesh(const QueryEnv& env, const v1::GetMeshRequest& request, v1::Mesh* response);
+// A stored mesh's positions and faces (loaded from disk if need be), streamed.
+absl::StatusOr<MessageStream<v1::MeshGeometry>> RunGetMeshGeometry(
+    const QueryEnv& env, const v1::GetMeshGeometryRequest& request);
 absl::Status RunListMeshes(const QueryEnv& env, const v1::ListMeshesRequest& request,
                            v1::ListMeshesResponse* response);
 absl::Status RunDeleteMesh(const QueryEnv& env, const v1::DeleteMeshRequest& request,

@@ -24,6 +24,8 @@
 #include "proto_convert.h"
 #include "queries.h"
 #include "query_support.h"
+
+#include "geometry_convert.h"
 #include "service_limits.h"
 #include "status_convert.h"
 
@@ -76,6 +78,14 @@ absl::Status RunDeleteMesh(const QueryEnv& env, const v1::DeleteMeshRequest& req
                              absl::StrCat("mesh ", QuoteInput(request.name()), " not found"));
   }
   return status;
+}
+
+absl::StatusOr<MessageStream<v1::MeshGeometry>> RunGetMeshGeometry(
+    const QueryEnv& env, const v1::GetMeshGeometryRequest& request) {
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh = LookupMesh(env, request.name(), "name");
+  if (!mesh.ok()) return mesh.status();
+  return ProducerOf(
+      api::MeshGeometryToProto((*mesh)->mesh->ToMeshData(), env.limits->stream_chunk_bytes));
 }
 
 }  // namespace geodex::server

@@ -535,6 +535,22 @@ uint64_t TriangleMesh::MemoryBytes() const {
          bytes(neighbor_length_);
 }
 
+MeshData TriangleMesh::ToMeshData() const {
+  MeshData out;
+  out.positions.resize(3 * size_t{file_vertex_count_});
+  for (uint32_t v = 0; v < file_vertex_count_; ++v) {
+    for (int k = 0; k < 3; ++k) out.positions[3 * v + k] = positions_[3 * v + k] + center_[k];
+  }
+  out.faces.resize(faces_.size());
+  for (uint32_t f = 0; f < face_count(); ++f) {
+    const bool flipped = FaceFlipped(f);  // Build swapped the 2nd and 3rd corners
+    out.faces[3 * f] = FileVertex(faces_[3 * f]);
+    out.faces[3 * f + 1] = FileVertex(faces_[3 * f + (flipped ? 2 : 1)]);
+    out.faces[3 * f + 2] = FileVertex(faces_[3 * f + (flipped ? 1 : 2)]);
+  }
+  return out;
+}
+
 MeshSummary Summarize(const TriangleMesh& mesh) {
   MeshSummary s;
   s.report = mesh.report();

@@ -1,5 +1,6 @@
 #include "geometry_convert.h"
 
+#include <algorithm>
 #include <utility>
 
 #include "api_convert.h"
@@ -204,6 +205,33 @@ std::vector<v1::ComputeDelaunayResponse> DelaunayToProto(
     chunker.Account(out->ByteSizeLong() + 2);
   }
   return chunker.Take();
+}
+
+std::vector<v1::MeshGeometry> MeshGeometryToProto(const MeshData& mesh, size_t budget_bytes) {
+  const size_t per_message = std::max<size_t>(1, budget_bytes / 8);  // doubles or ids per message
+  std::vector<v1::MeshGeometry> out;
+  auto next = [&]() -> v1::MeshGeometry& {
+    out.emplace_back();
+    out.back().set_vertex_count(mesh.vertex_count());
+    out.back().set_face_count(mesh.face_count());
+    return out.back();
+  };
+  for (size_t i = 0; i < mesh.positions.size(); i += per_message) {
+    const size_t end = std::min(mesh.positions.size(), i + per_message);
+    next().mutable_positions()->Add(mesh.positions.begin() + i, mesh.positions.begin() + end);
+  }
+  for (size_t i = 0; i < mesh.faces.size(); i += per_message) {
+    const size_t end = std::min(mesh.faces.size(), i + per_message);
+    next().mutable_faces()->Add(mesh.faces.begin() + i, mesh.faces.begin() + end);
+  }
+  if (out.empty()) next();
+  return out;
+}
+
+void MeshGeometryAssembler::Add(const v1::MeshGeometry& message) {
+  out_.positions.insert(out_.positions.end(), message.positions().begin(),
+                        message.positions().end());
+  out_.faces.insert(out_.faces.end(), message.faces().begin(), message.faces().end());
 }
 
 void IsolinesAssembler::Add(const v1::ComputeIsolinesResponse& message) {

@@ -11,6 +11,7 @@
 
 #include "geodex/delaunay.h"
 #include "geodex/isolines.h"
+#include "geodex/mesh_data.h"
 #include "geodex/surface_point.h"
 #include "geodex/v1/geodex.pb.h"
 #include "geodex/voronoi.h"
@@ -27,7 +28,19 @@ std::vector<v1::ComputeDelaunayResponse> DelaunayToProto(
     const DelaunayTriangulation& delaunay, const std::vector<SurfacePoint>& resolved_sources,
     size_t budget_bytes);
 
+// A mesh's geometry (GetMeshGeometry): positions first, then faces.
+std::vector<v1::MeshGeometry> MeshGeometryToProto(const MeshData& mesh, size_t budget_bytes);
+
 // Reassembly as the messages arrive: Add each in order, then take result().
+class MeshGeometryAssembler {
+ public:
+  void Add(const v1::MeshGeometry& message);
+  MeshData& result() { return out_; }
+
+ private:
+  MeshData out_;
+};
+
 class IsolinesAssembler {
  public:
   void Add(const v1::ComputeIsolinesResponse& message);

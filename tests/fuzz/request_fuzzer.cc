@@ -88,7 +88,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const QueryEnv env{&world->store, &world->limits, &cancel, &world->cache, &world->counters};
   const uint8_t* body = data + 1;
   const size_t n = size - 1;
-  switch (data[0] % 8) {
+  switch (data[0] % 9) {
     case 0: RunStream(body, n, env, &RunComputeDistanceField); break;
     case 1: RunUnary(body, n, env, &RunFindShortestPath); break;
     case 2: RunStream(body, n, env, &RunComputeDistanceMatrix); break;
@@ -97,6 +97,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     case 5: RunStream(body, n, env, &RunComputeIsolines); break;
     case 6: RunStream(body, n, env, &RunComputeVoronoi); break;
     case 7: RunStream(body, n, env, &RunComputeDelaunay); break;
+    case 8: RunStream(body, n, env, &RunGetMeshGeometry); break;
   }
   return 0;
 }

@@ -4,6 +4,7 @@
 
 #include "api_convert.h"
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -159,6 +160,42 @@ TEST(ApiConvertTest, DelaunayRoundTrips) {
   for (size_t i = 0; i < dt.xl_edges.size(); ++i) {
     EXPECT_EQ(got.xl_edges[i].witness, dt.xl_edges[i].witness);
     EXPECT_EQ(Text({got.xl_edges[i].point}), Text({dt.xl_edges[i].point}));
+  }
+}
+
+// A mesh's geometry as geodexd holds it (TriangleMesh::ToMeshData) through GetMeshGeometry's
+// messages: the file's faces exactly (flipped faces and split vertices undone), its positions
+// within round-off.
+TEST(ApiConvertTest, MeshGeometryRoundTripsToTheFile) {
+  // A messy one too: a bowtie vertex (split into two copies) and a face against its neighbour's
+  // orientation (flipped by Build).
+  MeshData messy;
+  messy.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0, -1, 0, 0, 0, -1, 0, 1, 1, 0.5};
+  messy.faces = {0, 1, 2, 0, 3, 4, 1, 2, 5};
+  {
+    absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(messy);
+    ASSERT_TRUE(mesh.ok());
+    ASSERT_GT(mesh->vertex_count(), mesh->file_vertex_count());  // the bowtie was split
+    ASSERT_TRUE(mesh->FaceFlipped(2));
+    EXPECT_EQ(mesh->ToMeshData().faces, messy.faces);
+  }
+  for (const char* name : {"kitten.off", "three-peaks.off"}) {
+    absl::StatusOr<MeshData> file = LoadTestMeshData(name);
+    ASSERT_TRUE(file.ok());
+    absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(*file);
+    ASSERT_TRUE(mesh.ok());
+    const std::vector<v1::MeshGeometry> messages =
+        api::MeshGeometryToProto(mesh->ToMeshData(), kTinyBudget);
+    ASSERT_GT(messages.size(), 10u);
+    api::MeshGeometryAssembler back;
+    for (const auto& m : messages) back.Add(m);
+    EXPECT_EQ(back.result().faces, file->faces) << name;
+    ASSERT_EQ(back.result().positions.size(), file->positions.size());
+    for (size_t i = 0; i < file->positions.size(); ++i) {
+      EXPECT_NEAR(back.result().positions[i], file->positions[i],
+                  1e-14 * (1 + std::abs(file->positions[i])))
+          << name << " " << i;
+    }
   }
 }
 

@@ -73,6 +73,9 @@ class TriangleMesh {
   // out of range, a face repeating a vertex, NaN/Inf coordinates; in strict mode also non-manifold
   // or inconsistently oriented input.
   static absl::StatusOr<TriangleMesh> Build(const MeshData& data, const MeshBuildOptions& options = {});
+  // The mesh as file data again: the file's vertices (recentred positions plus the centre, within
+  // a few ulps of the file's values) and faces (file vertex ids, the file's corner order).
+  MeshData ToMeshData() const;
 
   TriangleMesh(TriangleMesh&&) = default;
   TriangleMesh& operator=(TriangleMesh&&) = default;
