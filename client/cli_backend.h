@@ -62,8 +62,10 @@ class Backend {
   virtual absl::StatusOr<const MeshData*> Geometry() = 0;
 
   virtual absl::StatusOr<InfoValues> Info() = 0;
-  virtual absl::StatusOr<DistanceField> Field(const std::vector<SurfacePoint>& sources,
-                                              const FieldOptions& options) = 0;
+  // The field is the backend's, valid until it solves for other sources or options: a local
+  // backend keeps its last solve, so render's layers on the same sources share one, uncopied.
+  virtual absl::StatusOr<const DistanceField*> Field(const std::vector<SurfacePoint>& sources,
+                                                     const FieldOptions& options) = 0;
   virtual absl::StatusOr<std::vector<AtValue>> DistancesAt(const std::vector<SurfacePoint>& sources,
                                                            const std::vector<SurfacePoint>& at,
                                                            const GeodesicOptions& options) = 0;

@@ -310,11 +310,11 @@ int RunDistances(Backend& backend, const Args& args) {
     }
     if (json) text = FormatAtJson(at, estimate, exact, source);
   } else {
-    absl::StatusOr<DistanceField> field = backend.Field(sources, options);
+    absl::StatusOr<const DistanceField*> field = backend.Field(sources, options);
     if (!field.ok()) return FailQuery(field.status());
-    text = json ? FormatDistancesJson(field->distance, field->direction)
-                : FormatDistances(field->distance, field->direction);
-    stats = field->stats;
+    text = json ? FormatDistancesJson((*field)->distance, (*field)->direction)
+                : FormatDistances((*field)->distance, (*field)->direction);
+    stats = (*field)->stats;
   }
   if (stats.solve_ms == 0) stats.solve_ms = MsSince(t_solve);
   const auto t_out = std::chrono::steady_clock::now();

@@ -78,13 +78,14 @@ class LocalBackend final : public Backend {
     return v;
   }
 
-  absl::StatusOr<DistanceField> Field(const std::vector<SurfacePoint>& sources,
-                                      const FieldOptions& options) override {
+  absl::StatusOr<const DistanceField*> Field(const std::vector<SurfacePoint>& sources,
+                                             const FieldOptions& options) override {
     absl::StatusOr<const DistanceField*> f = CachedField(sources, options);
     if (!f.ok()) return f.status();
-    DistanceField field = **f;
-    if (options.directions) field.direction = ComputeDirectionField(loaded_->mesh, field);
-    return field;
+    if (options.directions && field_->direction.empty()) {
+      field_->direction = ComputeDirectionField(loaded_->mesh, *field_);
+    }
+    return field_.get();
   }
 
   absl::StatusOr<std::vector<AtValue>> DistancesAt(const std::vector<SurfacePoint>& sources,

@@ -134,9 +134,13 @@ class RemoteBackend final : public Backend {
     return v;
   }
 
-  absl::StatusOr<DistanceField> Field(const std::vector<SurfacePoint>& sources,
-                                      const FieldOptions& options) override {
-    return client_->Field(mesh_, sources, ToProto(options.solver), &cached_, options.directions);
+  absl::StatusOr<const DistanceField*> Field(const std::vector<SurfacePoint>& sources,
+                                             const FieldOptions& options) override {
+    absl::StatusOr<DistanceField> f =
+        client_->Field(mesh_, sources, ToProto(options.solver), &cached_, options.directions);
+    if (!f.ok()) return f.status();
+    field_ = *std::move(f);
+    return &field_;
   }
 
   absl::StatusOr<std::vector<AtValue>> DistancesAt(const std::vector<SurfacePoint>& sources,
@@ -189,6 +193,7 @@ class RemoteBackend final : public Backend {
   std::string mesh_arg_;
   MeshRef mesh_;
   std::unique_ptr<MeshData> data_;  // read from mesh_arg_ on first need
+  DistanceField field_;             // the last Field answer (Backend::Field hands out a pointer)
   bool cached_ = false;             // the last field came from the server's result cache
 };
 

@@ -37,7 +37,7 @@ bool EndsWith(const std::string& s, const std::string& suffix) {
 
 // What the picture shows, computed locally or by a server.
 struct Layers {
-  DistanceField field;
+  const DistanceField* field = nullptr;  // the backend's
   Isolines isolines;
   VoronoiDiagram voronoi;
   DelaunayTriangulation delaunay;
@@ -114,9 +114,9 @@ int RunRender(Backend& backend, const Args& args) {
   Layers layers;
   IsolineOptions levels;
   levels.count = isoline_count;
-  absl::StatusOr<DistanceField> field = backend.Field(*sources, FieldOptions{});
+  absl::StatusOr<const DistanceField*> field = backend.Field(*sources, FieldOptions{});
   if (!field.ok()) return FailQuery(field.status());
-  layers.field = *std::move(field);
+  layers.field = *field;
   if (isoline_count) {
     absl::StatusOr<Isolines> iso = backend.ComputeIsolines(*sources, levels);
     if (!iso.ok()) return FailQuery(iso.status());
@@ -140,8 +140,8 @@ int RunRender(Backend& backend, const Args& args) {
 
   render::Scene scene;
   scene.mesh = *data;
-  scene.vertex_colors = render::FieldColors(layers.field.distance);
-  for (double d : layers.field.distance) {
+  scene.vertex_colors = render::FieldColors(layers.field->distance);
+  for (double d : layers.field->distance) {
     if (std::isfinite(d)) scene.max_distance = std::max(scene.max_distance, d);
   }
   for (const IsolinePolyline& line : layers.isolines.polylines) {
@@ -163,7 +163,7 @@ int RunRender(Backend& backend, const Args& args) {
   if (EndsWith(output, ".png")) {
     written = render::WritePng(output, render::Render(scene, *view, width, height));
   } else if (EndsWith(output, ".ply")) {
-    written = render::WriteColoredPly(output, **data, scene.vertex_colors, layers.field.distance);
+    written = render::WriteColoredPly(output, **data, scene.vertex_colors, layers.field->distance);
   } else {
     written = render::WriteGltf(output, **data, scene.vertex_colors);
   }
