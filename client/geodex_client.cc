@@ -20,7 +20,7 @@
 #include "grpcpp/generic/generic_stub.h"
 #include "grpcpp/security/credentials.h"
 #include "grpcpp/support/byte_buffer.h"
-#include "mesh_id.h"
+#include "geodex/mesh_id.h"
 
 namespace geodex::client {
 namespace {
@@ -32,7 +32,7 @@ absl::Status ToAbsl(const grpc::Status& status) {
 
 // The mesh id in "meshes/{id}", or "" when the name holds an alias.
 std::string IdOfName(const std::string& name) {
-  return name.size() == 71 && server::IsMeshId(name.substr(7)) ? name.substr(7) : "";
+  return name.size() == 71 && IsMeshId(name.substr(7)) ? name.substr(7) : "";
 }
 
 }  // namespace
@@ -237,7 +237,7 @@ absl::StatusOr<MeshRef> GeodexClient::ResolveMesh(const std::string& mesh) {
   if (sample || std::filesystem::is_regular_file(mesh, ec)) {
     absl::StatusOr<MeshData> data = sample ? MakeSampleMesh(mesh) : ReadMeshFile(mesh);
     if (!data.ok()) return data.status();
-    ref.id = server::ComputeMeshId(*data);
+    ref.id = ComputeMeshId(*data);
     ref.name = absl::StrCat("meshes/", ref.id);
     if (sample) {
       ref.file_bytes = MeshToOffText(*data);
@@ -256,7 +256,7 @@ absl::StatusOr<MeshRef> GeodexClient::ResolveMesh(const std::string& mesh) {
     return ref;
   }
   const std::string key = mesh.rfind("meshes/", 0) == 0 ? mesh.substr(7) : mesh;
-  if (server::IsMeshId(key)) {
+  if (IsMeshId(key)) {
     ref.id = key;
     ref.name = absl::StrCat("meshes/", key);
     return ref;

@@ -18,6 +18,8 @@ packages=(
   grpc-proto
   # mesh I/O
   zlib1g-dev libpng-dev
+  # SHA-256 of mesh ids (OpenSSL, already a dependency of gRPC)
+  libssl-dev
   # tests and benchmarks (CGAL is a test-only reference)
   libgtest-dev libgmock-dev libbenchmark-dev libcgal-dev libgmp-dev libmpfr-dev
   # the Python client package, its example and tests (Debian's gRPC for Python; pip and venv for

@@ -14,7 +14,7 @@
 #include "geodex/mesh_io.h"
 #include "geodex/samples.h"
 #include "listen_address.h"
-#include "mesh_id.h"
+#include "geodex/mesh_id.h"
 
 namespace geodex::server {
 

@@ -11,7 +11,7 @@
 #include "geodex/mesh_io.h"
 #include "google/protobuf/descriptor.h"
 #include "grpcpp/support/server_callback.h"
-#include "mesh_id.h"
+#include "geodex/mesh_id.h"
 #include "proto_convert.h"
 #include "queries.h"
 #include "query_reactors.h"

@@ -20,7 +20,7 @@
 #include "geodex/point_distance.h"
 #include "geodex/shortest_path.h"
 #include "geodex/voronoi.h"
-#include "mesh_id.h"
+#include "geodex/mesh_id.h"
 #include "proto_convert.h"
 #include "service_limits.h"
 #include "status_convert.h"

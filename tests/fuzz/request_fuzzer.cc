@@ -12,7 +12,7 @@
 #include "field_cache.h"
 #include "geodex/cancel.h"
 #include "geodex/mesh_io.h"
-#include "mesh_id.h"
+#include "geodex/mesh_id.h"
 #include "mesh_store.h"
 #include "queries.h"
 #include "service_limits.h"

@@ -10,7 +10,7 @@
 #include "geodex/geodesic_solver.h"
 #include "geodex/samples.h"
 #include "geodex_client.h"
-#include "mesh_id.h"
+#include "geodex/mesh_id.h"
 #include "server_test_util.h"
 
 namespace geodex::server {

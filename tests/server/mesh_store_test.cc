@@ -1,7 +1,7 @@
 #include "mesh_store.h"
 
 #include "gtest/gtest.h"
-#include "mesh_id.h"
+#include "geodex/mesh_id.h"
 #include "server_test_util.h"
 
 namespace geodex::server {

@@ -10,7 +10,7 @@
 #include "geodex/shortest_path.h"
 #include "grpcpp/generic/generic_stub.h"
 #include "grpcpp/support/byte_buffer.h"
-#include "mesh_id.h"
+#include "geodex/mesh_id.h"
 #include "server_test_util.h"
 
 namespace geodex::server {

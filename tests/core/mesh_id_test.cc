@@ -1,10 +1,10 @@
-#include "mesh_id.h"
+#include "geodex/mesh_id.h"
 
 #include <cstring>
 
 #include "gtest/gtest.h"
 
-namespace geodex::server {
+namespace geodex {
 namespace {
 
 TEST(Sha256Test, KnownVectors) {
@@ -58,4 +58,4 @@ TEST(MeshIdTest, IsMeshId) {
 }
 
 }  // namespace
-}  // namespace geodex::server
+}  // namespace geodex
