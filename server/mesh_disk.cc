@@ -14,16 +14,16 @@
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
-#include "mesh_id.h"
+#include "geodex/mesh_id.h"
+#include "mesh_file_header.h"
 
 namespace geodex::server {
 namespace {
 
 constexpr char kMagic[8] = {'G', 'D', 'X', 'S', 'T', 'O', 'R', '1'};
-constexpr uint32_t kFormatVersion = 1;
 constexpr char kSuffix[] = ".gdxs";
 constexpr char kTempMarker[] = ".tmp.";
-// A header is a small Mesh message; anything larger means a corrupt length.
+// A header is a few hundred bytes; anything larger means a corrupt length.
 constexpr uint32_t kMaxHeaderBytes = 1 << 20;
 
 void PutU32(std::string* out, uint32_t v) {
@@ -69,7 +69,7 @@ absl::StatusOr<std::string> ReadWholeFile(const std::string& path) {
 }
 
 struct Parsed {
-  v1::Mesh header;
+  MeshRecord header;
   size_t payload_offset = 0;
   size_t payload_size = 0;
 };
@@ -81,9 +81,6 @@ absl::StatusOr<Parsed> ParseFile(const std::string& bytes, bool verify) {
   if (bytes.size() < 8 + 4 + 4 + 8 + 32) return absl::DataLossError("truncated (too short)");
   if (std::memcmp(bytes.data(), kMagic, 8) != 0) return absl::DataLossError("not a geodex mesh file");
   const uint32_t version = static_cast<uint32_t>(GetLE(bytes.data() + 8, 4));
-  if (version != kFormatVersion) {
-    return absl::DataLossError(absl::StrCat("unsupported format version ", version));
-  }
   const uint64_t header_size = GetLE(bytes.data() + 12, 4);
   if (header_size > kMaxHeaderBytes || 16 + header_size + 8 + 32 > bytes.size()) {
     return absl::DataLossError("truncated or corrupt header length");
@@ -94,9 +91,10 @@ absl::StatusOr<Parsed> ParseFile(const std::string& bytes, bool verify) {
                                             " bytes, its lengths say ",
                                             16 + header_size + 8 + payload_size + 32));
   }
-  if (!out.header.ParseFromArray(bytes.data() + 16, static_cast<int>(header_size))) {
-    return absl::DataLossError("corrupt header");
-  }
+  absl::StatusOr<MeshRecord> header =
+      DecodeMeshFileHeader(version, absl::string_view(bytes).substr(16, header_size));
+  if (!header.ok()) return header.status();
+  out.header = *std::move(header);
   out.payload_offset = 16 + header_size + 8;
   out.payload_size = payload_size;
   if (verify) {
@@ -111,7 +109,7 @@ absl::StatusOr<Parsed> ParseFile(const std::string& bytes, bool verify) {
 }
 
 // Reads only the first bytes of a file (magic, version, header) plus its size: the index check.
-absl::StatusOr<v1::Mesh> ReadHeaderOnly(const std::string& path) {
+absl::StatusOr<MeshRecord> ReadHeaderOnly(const std::string& path) {
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) return absl::DataLossError("cannot open");
   const uint64_t size = static_cast<uint64_t>(in.tellg());
@@ -120,9 +118,6 @@ absl::StatusOr<v1::Mesh> ReadHeaderOnly(const std::string& path) {
   if (size < 16 + 8 + 32 || !in.read(head, 16)) return absl::DataLossError("truncated (too short)");
   if (std::memcmp(head, kMagic, 8) != 0) return absl::DataLossError("not a geodex mesh file");
   const uint32_t version = static_cast<uint32_t>(GetLE(head + 8, 4));
-  if (version != kFormatVersion) {
-    return absl::DataLossError(absl::StrCat("unsupported format version ", version));
-  }
   const uint64_t header_size = GetLE(head + 12, 4);
   if (header_size > kMaxHeaderBytes || 16 + header_size + 8 + 32 > size) {
     return absl::DataLossError("truncated or corrupt header length");
@@ -137,38 +132,10 @@ absl::StatusOr<v1::Mesh> ReadHeaderOnly(const std::string& path) {
                                             " bytes, its lengths say ",
                                             16 + header_size + 8 + payload_size + 32));
   }
-  v1::Mesh mesh;
-  if (!mesh.ParseFromArray(header.data(), static_cast<int>(header_size))) {
-    return absl::DataLossError("corrupt header");
-  }
-  return mesh;
+  return DecodeMeshFileHeader(version, absl::string_view(header).substr(0, header_size));
 }
 
 }  // namespace
-
-absl::StatusOr<MeshData> DecodeCanonicalMesh(const std::string& bytes) {
-  if (bytes.size() < 12 || std::memcmp(bytes.data(), "GDXM", 4) != 0) {
-    return absl::InvalidArgumentError("not a canonical mesh encoding");
-  }
-  const uint64_t vertices = GetLE(bytes.data() + 4, 4), faces = GetLE(bytes.data() + 8, 4);
-  if (bytes.size() != 12 + 24 * vertices + 12 * faces) {
-    return absl::InvalidArgumentError("canonical mesh encoding has the wrong length");
-  }
-  MeshData mesh;
-  mesh.positions.resize(3 * vertices);
-  mesh.faces.resize(3 * faces);
-  const char* p = bytes.data() + 12;
-  for (double& x : mesh.positions) {
-    const uint64_t bits = GetLE(p, 8);
-    std::memcpy(&x, &bits, 8);
-    p += 8;
-  }
-  for (uint32_t& v : mesh.faces) {
-    v = static_cast<uint32_t>(GetLE(p, 4));
-    p += 4;
-  }
-  return mesh;
-}
 
 std::string MeshDisk::PathOf(const std::string& id) const {
   return absl::StrCat(dir_, "/", id, kSuffix);
@@ -196,12 +163,12 @@ absl::StatusOr<MeshDisk> MeshDisk::Open(const std::string& dir, Index* index) {
       index->skipped.push_back({path, "not a mesh file name (<64 hex digits>.gdxs)"});
       continue;
     }
-    absl::StatusOr<v1::Mesh> header = ReadHeaderOnly(path);
+    absl::StatusOr<MeshRecord> header = ReadHeaderOnly(path);
     if (!header.ok()) {
       index->skipped.push_back({path, std::string(header.status().message())});
       continue;
     }
-    if (header->name() != absl::StrCat("meshes/", id)) {
+    if (header->id != id) {
       index->skipped.push_back({path, "the header names another mesh"});
       continue;
     }
@@ -211,11 +178,11 @@ absl::StatusOr<MeshDisk> MeshDisk::Open(const std::string& dir, Index* index) {
   return MeshDisk(meshes);
 }
 
-absl::Status MeshDisk::Write(const std::string& id, const v1::Mesh& header,
-                             const std::string& canonical) const {
+absl::Status MeshDisk::Write(const MeshRecord& header, const std::string& canonical) const {
+  const std::string& id = header.id;
   std::string bytes(kMagic, 8);
-  PutU32(&bytes, kFormatVersion);
-  const std::string head = header.SerializeAsString();
+  PutU32(&bytes, kMeshFileVersion);
+  const std::string head = EncodeMeshFileHeader(header);
   PutU32(&bytes, static_cast<uint32_t>(head.size()));
   bytes += head;
   PutU64(&bytes, canonical.size());
@@ -250,7 +217,7 @@ absl::Status MeshDisk::Write(const std::string& id, const v1::Mesh& header,
   return absl::OkStatus();
 }
 
-absl::Status MeshDisk::Read(const std::string& id, v1::Mesh* header, std::string* canonical) const {
+absl::Status MeshDisk::Read(const std::string& id, MeshRecord* header, std::string* canonical) const {
   // Messages name the mesh, never the server's paths (they reach clients).
   const std::string path = PathOf(id);
   const std::string mesh = absl::StrCat("stored mesh meshes/", id);
@@ -268,11 +235,11 @@ absl::Status MeshDisk::Read(const std::string& id, v1::Mesh* header, std::string
   return absl::OkStatus();
 }
 
-absl::Status MeshDisk::UpdateHeader(const std::string& id, const v1::Mesh& header) const {
-  v1::Mesh old;
+absl::Status MeshDisk::UpdateHeader(const MeshRecord& header) const {
+  MeshRecord old;
   std::string canonical;
-  if (absl::Status s = Read(id, &old, &canonical); !s.ok()) return s;
-  return Write(id, header, canonical);
+  if (absl::Status s = Read(header.id, &old, &canonical); !s.ok()) return s;
+  return Write(header, canonical);
 }
 
 absl::Status MeshDisk::Remove(const std::string& id) const {

@@ -3,11 +3,11 @@
 // The data directory: one file per mesh, written atomically, so a restart loses nothing and a crash
 // (even kill -9 mid-upload) never leaves a partial mesh visible.
 //
-// Layout: DIR/meshes/<mesh_id>.gdxs. File format (version 1, integers little-endian):
+// Layout: DIR/meshes/<mesh_id>.gdxs. File format (integers little-endian):
 //   bytes 0..7   magic "GDXSTOR1"
-//   uint32       format version (1)
-//   uint32       header length H, then H bytes: a serialized geodex.v1.Mesh (the resource as
-//                created: alias, pin, counts, memory, create time)
+//   uint32       format version (2; version 1 files are still read, see mesh_file_header.h)
+//   uint32       header length H, then H bytes: the MeshRecord (id, aliases, pin, counts, memory,
+//                create time, summary) in storage's private layout (mesh_file_header.h)
 //   uint64       payload length P, then P bytes: the canonical mesh encoding whose SHA-256 is the
 //                mesh id (geodex.proto, Mesh.name)
 //   32 bytes     SHA-256 of every byte before it
@@ -21,19 +21,16 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "geodex/mesh_data.h"
-#include "geodex/v1/geodex.pb.h"
+#include "mesh_record.h"
 
 namespace geodex::server {
-
-// The canonical encoding (mesh_id.h) back into a mesh. InvalidArgument if malformed.
-absl::StatusOr<MeshData> DecodeCanonicalMesh(const std::string& bytes);
 
 class MeshDisk {
  public:
   // What Open found.
   struct IndexEntry {
     std::string id;
-    v1::Mesh header;
+    MeshRecord header;
   };
   struct Skipped {
     std::string path;
@@ -53,13 +50,12 @@ class MeshDisk {
 
   // Writes a mesh atomically (replacing an existing file of the same id). ResourceExhausted when
   // the disk is full, Internal/PermissionDenied for other I/O errors; on error nothing is left.
-  absl::Status Write(const std::string& id, const v1::Mesh& header,
-                     const std::string& canonical) const;
+  absl::Status Write(const MeshRecord& header, const std::string& canonical) const;
   // Reads and verifies a mesh file: its checksum, its header and that the payload's SHA-256 is
   // its id. DataLoss naming the file when it does not verify.
-  absl::Status Read(const std::string& id, v1::Mesh* header, std::string* canonical) const;
+  absl::Status Read(const std::string& id, MeshRecord* header, std::string* canonical) const;
   // Rewrites the header of a stored mesh (a new alias), keeping the payload.
-  absl::Status UpdateHeader(const std::string& id, const v1::Mesh& header) const;
+  absl::Status UpdateHeader(const MeshRecord& header) const;
   absl::Status Remove(const std::string& id) const;
 
   const std::string& dir() const { return dir_; }

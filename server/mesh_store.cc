@@ -1,14 +1,11 @@
 #include "mesh_store.h"
 
-#include "status_convert.h"
-
 #include <algorithm>
 #include <utility>
 
 #include "absl/strings/str_cat.h"
-#include "google/protobuf/util/time_util.h"
-#include "api_convert.h"
-#include "proto_convert.h"
+#include "geodex/mesh_id.h"
+#include "status_convert.h"
 
 namespace geodex::server {
 
@@ -24,22 +21,6 @@ std::shared_ptr<StoredMesh> MakeStoredMesh(std::string id, TriangleMesh mesh) {
   stored->create_time = absl::Now();
   stored->summary = Summarize(*stored->mesh);
   return stored;
-}
-
-std::shared_ptr<StoredMesh> RecordFromProto(const std::string& id, const v1::Mesh& proto) {
-  auto record = std::make_shared<StoredMesh>();
-  record->id = id;
-  record->display_name = proto.display_name();
-  record->aliases.assign(proto.aliases().begin(), proto.aliases().end());
-  record->vertex_count = proto.vertex_count();
-  record->face_count = proto.face_count();
-  record->upload_bytes = proto.upload_bytes();
-  record->memory_bytes = proto.memory_bytes();
-  record->pinned = proto.pinned();
-  record->create_time = absl::FromUnixNanos(
-      google::protobuf::util::TimeUtil::TimestampToNanoseconds(proto.create_time()));
-  record->summary = api::MeshSummaryFromProto(proto);
-  return record;
 }
 
 namespace {
@@ -58,7 +39,8 @@ void MeshStore::AttachDisk(MeshDisk disk, const MeshDisk::Index& index) {
   std::lock_guard<std::mutex> lock(mu_);
   disk_.emplace(std::move(disk));
   for (const MeshDisk::IndexEntry& entry : index.meshes) {
-    std::shared_ptr<StoredMesh> record = RecordFromProto(entry.id, entry.header);
+    auto record = std::make_shared<StoredMesh>();
+    static_cast<MeshRecord&>(*record) = entry.header;
     if (!record->display_name.empty()) {
       // Aliases are unique when written; a clash means hand-copied files: first one wins.
       if (aliases_.contains(record->display_name)) {
@@ -145,9 +127,7 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::Insert(
           updated->aliases.push_back(name);
         }
         if (disk_) {
-          v1::Mesh header;
-          MeshToProto(*Strip(*updated), &header);
-          if (absl::Status s = disk_->UpdateHeader(mesh->id, header); !s.ok()) return s;
+          if (absl::Status s = disk_->UpdateHeader(*updated); !s.ok()) return s;
         }
         aliases_[mesh->display_name] = mesh->id;
         slot.mesh = std::move(updated);
@@ -165,9 +145,7 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::Insert(
   }
   // Persist before acknowledging (outside the lock: writing a large mesh takes a while).
   if (disk_) {
-    v1::Mesh header;
-    MeshToProto(*mesh, &header);
-    if (absl::Status s = disk_->Write(mesh->id, header, canonical); !s.ok()) return s;
+    if (absl::Status s = disk_->Write(*mesh, canonical); !s.ok()) return s;
   }
   std::lock_guard<std::mutex> lock(mu_);
   if (auto existing = meshes_.find(mesh->id); existing != meshes_.end() && existing->second.resident) {
@@ -234,7 +212,7 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::Get(const std::stri
   }
   // Load from disk without holding the lock. Two concurrent first uses may both load; the second
   // to finish takes the first's entry.
-  v1::Mesh header;
+  MeshRecord header;
   std::string canonical;
   if (absl::Status s = disk_->Read(record->id, &header, &canonical); !s.ok()) return s;
   absl::StatusOr<MeshData> data = DecodeCanonicalMesh(canonical);

@@ -23,27 +23,16 @@
 #include "absl/time/time.h"
 #include "geodex/locate.h"
 #include "geodex/triangle_mesh.h"
-#include "geodex/v1/geodex.pb.h"
 #include "mesh_disk.h"
+#include "mesh_record.h"
 
 namespace geodex::server {
 
 // One stored mesh; immutable once built. A record of a mesh that is only on disk has no `mesh`
 // and `locator` (GetRecord); Get() always returns a loaded one.
-struct StoredMesh {
-  std::string id;            // SHA-256 hex (see mesh_id.h)
-  std::string display_name;  // optional alias
-  std::vector<std::string> aliases;  // further aliases (re-uploads under other names)
+struct StoredMesh : MeshRecord {
   std::shared_ptr<const TriangleMesh> mesh;
   std::shared_ptr<const SurfaceLocator> locator;  // points into *mesh
-  uint64_t vertex_count = 0;  // file vertices
-  uint64_t face_count = 0;
-  uint64_t upload_bytes = 0;
-  uint64_t memory_bytes = 0;  // mesh + locator, counted against the budget
-  bool pinned = false;
-  absl::Time create_time;
-  // The build report and geometry (kept so that records answer GetMesh without loading).
-  MeshSummary summary;
 };
 
 // Builds a StoredMesh (mesh + locator) from a built mesh; fills memory_bytes and counts.
@@ -122,8 +111,5 @@ class MeshStore {
   uint64_t evictions_ = 0;
   uint64_t disk_loads_ = 0;
 };
-
-// A record from a Mesh resource (the disk header; MeshToProto in proto_convert.h is the reverse).
-std::shared_ptr<StoredMesh> RecordFromProto(const std::string& id, const v1::Mesh& proto);
 
 }  // namespace geodex::server

@@ -14,7 +14,7 @@
 #include "call_descriptions.h"
 #include "compute_pool.h"
 #include "mesh_store.h"
-#include "stream_chunker.h"
+#include "message_stream.h"
 
 namespace geodex::server {
 

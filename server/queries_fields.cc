@@ -11,17 +11,10 @@
 #include <utility>
 #include <vector>
 
-#include "absl/strings/cord.h"
 #include "absl/strings/str_cat.h"
 #include "field_cache.h"
-#include "geodex/delaunay.h"
 #include "geodex/distance_matrix.h"
 #include "geodex/geodesic_solver.h"
-#include "geodex/isolines.h"
-#include "geodex/point_distance.h"
-#include "geodex/shortest_path.h"
-#include "geodex/voronoi.h"
-#include "mesh_id.h"
 #include "proto_convert.h"
 #include "queries.h"
 #include "query_support.h"

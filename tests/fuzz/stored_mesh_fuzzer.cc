@@ -18,7 +18,7 @@
 
 #include "geodex/triangle_mesh.h"
 #include "mesh_disk.h"
-#include "mesh_id.h"
+#include "geodex/mesh_id.h"
 
 namespace {
 
@@ -50,7 +50,7 @@ void StoreAndRead(const std::string& file_bytes) {
   }
   MeshDisk::Index reopened;
   (void)MeshDisk::Open(ScratchDir(), &reopened);
-  v1::Mesh header;
+  MeshRecord header;
   std::string canonical;
   (void)disk->Read(id, &header, &canonical);
   std::remove(path.c_str());

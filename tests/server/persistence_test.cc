@@ -6,7 +6,9 @@
 #include <fstream>
 
 #include "absl/strings/str_cat.h"
+#include "geodex/mesh_id.h"
 #include "mesh_disk.h"
+#include "mesh_file_header.h"
 #include "server_test_util.h"
 
 namespace geodex::server {
@@ -170,6 +172,126 @@ TEST_F(PersistenceTest, CorruptTruncatedAndForeignFilesAreSkippedAndTemporariesR
   EXPECT_EQ(GetMesh("meshes/cut", &got).error_code(), grpc::StatusCode::NOT_FOUND);
   // The skipped files are left in place for an operator to inspect.
   EXPECT_TRUE(fs::exists(MeshFile(cut.mesh)));
+}
+
+uint32_t FileVersion(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  char head[12] = {};
+  in.read(head, sizeof head);
+  uint32_t v = 0;
+  for (int i = 3; i >= 0; --i) v = (v << 8) | static_cast<uint8_t>(head[8 + i]);
+  return v;
+}
+
+TEST(MeshFileHeaderTest, RoundTripsEveryFieldAndRefusesTruncation) {
+  MeshRecord r;
+  r.id = std::string(64, 'c');
+  r.display_name = "hills";
+  r.aliases = {"a", "", "third name"};
+  r.vertex_count = 11;
+  r.face_count = 13;
+  r.upload_bytes = 1234567;
+  r.memory_bytes = 7654321;
+  r.pinned = true;
+  r.create_time = absl::FromUnixNanos(1764000000123456789);
+  r.summary.report.file_vertices = 1;
+  r.summary.report.boundary_vertices = 14;  // the first and the last count
+  r.summary.report.saddle_vertices = 9;
+  r.summary.internal_vertices = 12;
+  r.summary.mean_edge_length = 0.1;
+  r.summary.max_edge_length = 1.0 / 3;
+  r.summary.bbox_min = {-1.5, -2.5, -1e300};
+  r.summary.bbox_max = {1.5, 2.5, 5e-324};
+  r.summary.bytes = 999;
+  const std::string bytes = EncodeMeshFileHeader(r);
+  absl::StatusOr<MeshRecord> back = DecodeMeshFileHeader(kMeshFileVersion, bytes);
+  ASSERT_TRUE(back.ok()) << back.status();
+  EXPECT_EQ(back->id, r.id);
+  EXPECT_EQ(back->display_name, r.display_name);
+  EXPECT_EQ(back->aliases, r.aliases);
+  EXPECT_EQ(back->vertex_count, 11u);
+  EXPECT_EQ(back->face_count, 13u);
+  EXPECT_EQ(back->upload_bytes, r.upload_bytes);
+  EXPECT_EQ(back->memory_bytes, r.memory_bytes);
+  EXPECT_TRUE(back->pinned);
+  EXPECT_EQ(back->create_time, r.create_time);
+  EXPECT_EQ(back->summary.report.file_vertices, 1u);
+  EXPECT_EQ(back->summary.report.boundary_vertices, 14u);
+  EXPECT_EQ(back->summary.report.saddle_vertices, 9u);
+  EXPECT_EQ(back->summary.internal_vertices, 12u);
+  EXPECT_EQ(back->summary.max_edge_length, r.summary.max_edge_length);
+  EXPECT_EQ(back->summary.bbox_min, r.summary.bbox_min);
+  EXPECT_EQ(back->summary.bbox_max, r.summary.bbox_max);
+  EXPECT_EQ(back->summary.bytes, 999u);
+  for (size_t cut : {size_t{0}, size_t{3}, bytes.size() / 2, bytes.size() - 1}) {
+    EXPECT_EQ(DecodeMeshFileHeader(kMeshFileVersion, bytes.substr(0, cut)).status().code(),
+              absl::StatusCode::kDataLoss)
+        << cut;
+  }
+  EXPECT_EQ(DecodeMeshFileHeader(kMeshFileVersion, bytes + "x").status().code(),
+            absl::StatusCode::kDataLoss);
+  EXPECT_EQ(DecodeMeshFileHeader(kMeshFileVersion + 1, bytes).status().code(),
+            absl::StatusCode::kDataLoss);
+}
+
+// A data directory written before the private header (version 1: a geodex.v1.Mesh as the header)
+// is served as it was, and a file is rewritten as version 2 when its header next changes.
+TEST_F(PersistenceTest, VersionOneFilesAreStillServed) {
+  Restart();
+  testing::UploadResult up = Upload(*stub_, GridOff(10, 8, true), "old");
+  ASSERT_TRUE(up.status.ok());
+  const std::string path = MeshFile(up.mesh);
+  EXPECT_EQ(FileVersion(path), kMeshFileVersion);
+  testing::FieldResult before = ReadField(*stub_, FieldRequest("meshes/old", {0, 30}));
+  ASSERT_TRUE(before.status.ok());
+  server_->Shutdown(absl::Now() + absl::Seconds(10));
+  server_.reset();
+
+  // The file as version 1 wrote it: the resource itself as the header, the same payload.
+  std::string canonical;
+  {
+    MeshDisk::Index index;
+    absl::StatusOr<MeshDisk> disk = MeshDisk::Open(dir_.string(), &index);
+    ASSERT_TRUE(disk.ok());
+    MeshRecord header;
+    ASSERT_TRUE(disk->Read(up.mesh.name().substr(7), &header, &canonical).ok());
+  }
+  const std::string head = up.mesh.SerializeAsString();
+  std::string bytes = "GDXSTOR1";
+  auto put = [&](uint64_t v, int n) {
+    for (int i = 0; i < n; ++i) bytes.push_back(static_cast<char>((v >> (8 * i)) & 0xff));
+  };
+  put(1, 4);
+  put(head.size(), 4);
+  bytes += head;
+  put(canonical.size(), 8);
+  bytes += canonical;
+  Sha256 sha;
+  sha.Update(bytes.data(), bytes.size());
+  const std::array<uint8_t, 32> sum = sha.Finish();
+  bytes.append(reinterpret_cast<const char*>(sum.data()), sum.size());
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+  ASSERT_EQ(FileVersion(path), 1u);
+
+  Restart();
+  EXPECT_EQ(server_->startup_report().indexed, 1u);
+  v1::Mesh got;
+  ASSERT_TRUE(GetMesh("meshes/old", &got).ok());
+  EXPECT_EQ(got.name(), up.mesh.name());
+  EXPECT_EQ(got.vertex_count(), up.mesh.vertex_count());
+  EXPECT_EQ(got.memory_bytes(), up.mesh.memory_bytes());
+  EXPECT_EQ(got.info().mean_edge_length(), up.mesh.info().mean_edge_length());
+  EXPECT_GT(got.info().mean_edge_length(), 0);
+  testing::FieldResult after = ReadField(*stub_, FieldRequest("meshes/old", {0, 30}));
+  ASSERT_TRUE(after.status.ok()) << after.status.error_message();
+  EXPECT_EQ(after.distances, before.distances);
+
+  // A new name rewrites the header in the current layout; both names survive a restart.
+  ASSERT_TRUE(Upload(*stub_, GridOff(10, 8, true), "renamed").status.ok());
+  EXPECT_EQ(FileVersion(path), kMeshFileVersion);
+  Restart();
+  EXPECT_TRUE(GetMesh("meshes/old", &got).ok());
+  EXPECT_TRUE(GetMesh("meshes/renamed", &got).ok());
 }
 
 TEST_F(PersistenceTest, SamplesOnAFreshDirectoryOnly) {

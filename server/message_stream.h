@@ -11,9 +11,6 @@
 #include <vector>
 
 #include "absl/status/status.h"
-#include "geodex/shortest_path.h"
-#include "geodex/v1/geodex.pb.h"
-#include "proto_convert.h"
 
 namespace geodex::server {
 
