@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <initializer_list>
+#include <optional>
 
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
@@ -20,6 +22,8 @@
 namespace geodex::cli {
 namespace {
 
+using client::FieldViolation;
+using client::FieldViolationOf;
 using client::GeodexClient;
 using client::MeshRef;
 
@@ -59,6 +63,25 @@ v1::SolverOptions ToProto(const GeodesicOptions& options) {
   v1::SolverOptions out;
   api::SolverOptionsToProto(options, &out);
   return out;
+}
+
+// A request point the server refused, named as the flag that gave it, in local mode's words:
+// "sources[0].vertex: ..." from geodexd becomes "--sources: point 7: ..." (the field's head is
+// looked up in `flags`, request field -> CLI flag). Other errors pass unchanged.
+template <typename T>
+absl::StatusOr<T> Flagged(absl::StatusOr<T> result,
+                          std::initializer_list<std::pair<absl::string_view, absl::string_view>> flags) {
+  if (result.ok()) return result;
+  std::optional<FieldViolation> violation = FieldViolationOf(result.status());
+  if (!violation.has_value()) return result;
+  const absl::string_view head =
+      absl::string_view(violation->field).substr(0, violation->field.find_first_of("[."));
+  for (const auto& [field, flag] : flags) {
+    if (head == field) {
+      return absl::InvalidArgumentError(absl::StrCat("--", flag, ": ", violation->description));
+    }
+  }
+  return result;
 }
 
 // Queries on a geodexd: MESH resolves to the server's copy (uploaded once, by content hash),
@@ -136,8 +159,9 @@ class RemoteBackend final : public Backend {
 
   absl::StatusOr<const DistanceField*> Field(const std::vector<SurfacePoint>& sources,
                                              const FieldOptions& options) override {
-    absl::StatusOr<DistanceField> f =
-        client_->Field(mesh_, sources, ToProto(options.solver), &cached_, options.directions);
+    absl::StatusOr<DistanceField> f = Flagged(
+        client_->Field(mesh_, sources, ToProto(options.solver), &cached_, options.directions),
+        {{"sources", "sources"}});
     if (!f.ok()) return f.status();
     field_ = *std::move(f);
     return &field_;
@@ -146,8 +170,10 @@ class RemoteBackend final : public Backend {
   absl::StatusOr<std::vector<AtValue>> DistancesAt(const std::vector<SurfacePoint>& sources,
                                                    const std::vector<SurfacePoint>& at,
                                                    const GeodesicOptions& options) override {
-    absl::StatusOr<v1::EstimateDistancesResponse> r = client_->PointDistances(
-        mesh_, sources, at, v1::POINT_DISTANCE_MODE_BOTH, ToProto(options));
+    absl::StatusOr<v1::EstimateDistancesResponse> r =
+        Flagged(client_->PointDistances(mesh_, sources, at, v1::POINT_DISTANCE_MODE_BOTH,
+                                        ToProto(options)),
+                {{"sources", "sources"}, {"points", "at"}});
     if (!r.ok()) return r.status();
     std::vector<AtValue> out;
     for (int i = 0; i < static_cast<int>(at.size()); ++i) {
@@ -158,26 +184,31 @@ class RemoteBackend final : public Backend {
 
   absl::StatusOr<PathQueryResult> Path(const SurfacePoint& from, const SurfacePoint& to,
                                        const PathQueryOptions& options) override {
-    return client_->ShortestPath(mesh_, from, to, ToProto(options.solver));
+    return Flagged(client_->ShortestPath(mesh_, from, to, ToProto(options.solver)),
+                   {{"from", "from"}, {"to", "to"}});
   }
 
   absl::StatusOr<DistanceMatrix> Matrix(const std::vector<SurfacePoint>& sources,
                                         const std::vector<SurfacePoint>& targets,
                                         const MatrixOptions& options) override {
-    return client_->Matrix(mesh_, sources, targets, ToProto(options.solver), options.k_nearest,
-                           options.on_row);
+    return Flagged(client_->Matrix(mesh_, sources, targets, ToProto(options.solver),
+                                   options.k_nearest, options.on_row),
+                   {{"sources", "sources"}, {"targets", "targets"}});
   }
 
   absl::StatusOr<Isolines> ComputeIsolines(const std::vector<SurfacePoint>& sources,
                                            const IsolineOptions& levels) override {
-    return client_->ComputeIsolines(mesh_, sources, levels, v1::SolverOptions());
+    return Flagged(client_->ComputeIsolines(mesh_, sources, levels, v1::SolverOptions()),
+                   {{"sources", "sources"}});
   }
   absl::StatusOr<VoronoiDiagram> ComputeVoronoi(const std::vector<SurfacePoint>& sites) override {
-    return client_->ComputeVoronoi(mesh_, sites, v1::SolverOptions());
+    return Flagged(client_->ComputeVoronoi(mesh_, sites, v1::SolverOptions()),
+                   {{"sources", "sites"}});
   }
   absl::StatusOr<DelaunayTriangulation> ComputeDelaunay(
       const std::vector<SurfacePoint>& sites) override {
-    return client_->ComputeDelaunay(mesh_, sites, v1::SolverOptions());
+    return Flagged(client_->ComputeDelaunay(mesh_, sites, v1::SolverOptions()),
+                   {{"sources", "sites"}});
   }
 
   std::string StatsContext() const override {

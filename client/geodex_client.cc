@@ -14,6 +14,7 @@
 #include "geometry_convert.h"
 #include "geodex/mesh_io.h"
 #include "geodex/samples.h"
+#include "absl/strings/cord.h"
 #include "google/rpc/error_details.pb.h"
 #include "google/rpc/status.pb.h"
 #include "grpcpp/create_channel.h"
@@ -25,9 +26,26 @@
 namespace geodex::client {
 namespace {
 
+constexpr absl::string_view kFieldPayload = "geodex.client/field";
+constexpr absl::string_view kDescriptionPayload = "geodex.client/field-description";
+
+// The code and message, and a BadRequest's first field violation as payloads (FieldViolationOf).
 absl::Status ToAbsl(const grpc::Status& status) {
   if (status.ok()) return absl::OkStatus();
-  return absl::Status(static_cast<absl::StatusCode>(status.error_code()), status.error_message());
+  absl::Status out(static_cast<absl::StatusCode>(status.error_code()), status.error_message());
+  google::rpc::Status details;
+  if (!status.error_details().empty() && details.ParseFromString(status.error_details())) {
+    for (const google::protobuf::Any& any : details.details()) {
+      google::rpc::BadRequest bad_request;
+      if (any.UnpackTo(&bad_request) && bad_request.field_violations_size() > 0) {
+        out.SetPayload(kFieldPayload, absl::Cord(bad_request.field_violations(0).field()));
+        out.SetPayload(kDescriptionPayload,
+                       absl::Cord(bad_request.field_violations(0).description()));
+        break;
+      }
+    }
+  }
+  return out;
 }
 
 // The mesh id in "meshes/{id}", or "" when the name holds an alias.
@@ -36,6 +54,13 @@ std::string IdOfName(const std::string& name) {
 }
 
 }  // namespace
+
+std::optional<FieldViolation> FieldViolationOf(const absl::Status& status) {
+  auto field = status.GetPayload(kFieldPayload);  // absl::optional in Debian's Abseil
+  if (!field.has_value()) return std::nullopt;
+  auto description = status.GetPayload(kDescriptionPayload);
+  return FieldViolation{std::string(*field), description ? std::string(*description) : ""};
+}
 
 std::string MeshToOffText(const MeshData& mesh) {
   std::string out = absl::StrFormat("OFF\n%d %d 0\n", mesh.vertex_count(), mesh.face_count());
@@ -234,7 +259,8 @@ absl::StatusOr<MeshRef> GeodexClient::ResolveMesh(const std::string& mesh) {
   MeshRef ref;
   std::error_code ec;
   const bool sample = mesh.rfind("sample:", 0) == 0;
-  if (sample || std::filesystem::is_regular_file(mesh, ec)) {
+  // A directory is read too, so that it fails as in local mode ("is a directory").
+  if (sample || std::filesystem::exists(mesh, ec)) {
     absl::StatusOr<MeshData> data = sample ? MakeSampleMesh(mesh) : ReadMeshFile(mesh);
     if (!data.ok()) return data.status();
     ref.id = ComputeMeshId(*data);

@@ -36,6 +36,14 @@
 
 namespace geodex::client {
 
+// The request field a failed call named, read from the google.rpc.BadRequest geodexd attaches
+// (see server/status_convert.h): "sources[1].vertex" and what is wrong with it.
+struct FieldViolation {
+  std::string field;
+  std::string description;
+};
+std::optional<FieldViolation> FieldViolationOf(const absl::Status& status);
+
 struct ClientOptions {
   std::string target = "127.0.0.1:50051";  // HOST:PORT
   double deadline_seconds = 600;            // per call

@@ -57,7 +57,10 @@ absl::StatusOr<SurfacePoint> ResolvePoint(const StoredMesh& mesh, const v1::Surf
   switch (point.point_case()) {
     case v1::SurfacePoint::kVertex:
       if (point.vertex() >= mesh.vertex_count) {
-        return FieldError(absl::StrCat(field, ".vertex"), absl::StrCat(point.vertex(), " is out of range (the mesh has ", mesh.vertex_count, " vertices)"));
+        return FieldError(absl::StrCat(field, ".vertex"),
+                          VertexOutOfRange(SurfacePoint::AtVertex(point.vertex()), point.vertex(),
+                                           static_cast<uint32_t>(mesh.vertex_count))
+                              .message());
       }
       return SurfacePoint::AtVertex(point.vertex());
     case v1::SurfacePoint::kEdge: {

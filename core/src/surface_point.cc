@@ -72,21 +72,22 @@ absl::StatusOr<std::vector<SurfacePoint>> ParseSurfacePoints(absl::string_view s
   return points;
 }
 
+absl::Status VertexOutOfRange(const SurfacePoint& p, uint32_t vertex, uint32_t vertex_count) {
+  return absl::InvalidArgumentError(
+      absl::StrFormat("point %s: vertex %d does not exist (the mesh has %d vertices)",
+                      SurfacePointToString(p), vertex, vertex_count));
+}
+
 absl::Status ValidateSurfacePoint(const TriangleMesh& mesh, const SurfacePoint& p) {
   const std::string name = SurfacePointToString(p);
   const uint32_t nv = mesh.file_vertex_count();
   switch (p.kind) {
     case SurfacePoint::Kind::kVertex:
-      if (p.vertex >= nv) {
-        return absl::InvalidArgumentError(absl::StrFormat(
-            "point %s: vertex %d does not exist (the mesh has %d vertices)", name, p.vertex, nv));
-      }
+      if (p.vertex >= nv) return VertexOutOfRange(p, p.vertex, nv);
       return absl::OkStatus();
     case SurfacePoint::Kind::kEdge: {
       if (p.edge_from >= nv || p.edge_to >= nv) {
-        return absl::InvalidArgumentError(absl::StrFormat(
-            "point %s: vertex %d does not exist (the mesh has %d vertices)", name,
-            p.edge_from >= nv ? p.edge_from : p.edge_to, nv));
+        return VertexOutOfRange(p, p.edge_from >= nv ? p.edge_from : p.edge_to, nv);
       }
       if (!(p.t >= 0 && p.t <= 1)) {
         return absl::InvalidArgumentError(

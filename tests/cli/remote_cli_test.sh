@@ -135,7 +135,7 @@ check "deleted mesh: one-line error" test "$(wc -l <"$tmp/err.txt")" -eq 1
 # Errors: one line, non-zero exit.
 "${R[@]}" distances "$DATA/knight.off" --sources 9999 2>"$tmp/err.txt"
 check "bad vertex: exit 2" test $? -eq 2
-check "bad vertex: names the field" grep -q "sources\[0\].vertex" "$tmp/err.txt"
+check "bad vertex: names the flag as local mode does" grep -q -- "--sources: point 9999: vertex 9999 does not exist" "$tmp/err.txt"
 check "bad vertex: one line" test "$(wc -l <"$tmp/err.txt")" -eq 1
 "${R[@]}" distances no-such-mesh --sources 0 2>"$tmp/err.txt"
 check "unknown mesh: exit 3" test $? -eq 3

@@ -62,6 +62,9 @@ absl::StatusOr<std::vector<SurfacePoint>> ParseSurfacePoints(absl::string_view s
 // Range and consistency checks against a mesh: unknown vertex or face, an edge that does not
 // exist, T outside [0,1], negative barycentrics or ones that do not sum to 1 (within 1e-9).
 absl::Status ValidateSurfacePoint(const TriangleMesh& mesh, const SurfacePoint& p);
+// The one wording of "point P names vertex V, which does not exist": for checks that know only
+// the vertex count (geodexd's, before a stored mesh is loaded).
+absl::Status VertexOutOfRange(const SurfacePoint& p, uint32_t vertex, uint32_t vertex_count);
 
 std::string SurfacePointToString(const SurfacePoint& p);
 
