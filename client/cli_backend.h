@@ -24,6 +24,7 @@
 #include "geodex/mesh_data.h"
 #include "geodex/shortest_path.h"
 #include "geodex/surface_point.h"
+#include "geodex/terrain.h"
 #include "geodex/voronoi.h"
 
 namespace geodex::cli {
@@ -45,9 +46,13 @@ class Backend {
  public:
   virtual ~Backend() = default;
 
-  // Opens MESH: a file or sample:NAME; remotely also a mesh id or a name the server knows (a file
-  // is uploaded only if the server lacks it). Its errors are the mesh's (exit 3).
-  virtual absl::Status Open(const std::string& mesh, const MeshBuildOptions& build) = 0;
+  // Opens MESH: a file, a DEM (terrain::IsDemPath, read with `dem`) or sample:NAME; remotely also
+  // a mesh id or a name the server knows (a file is uploaded only if the server lacks it; a DEM is
+  // triangulated here and uploaded as that mesh). Its errors are the mesh's (exit 3).
+  virtual absl::Status Open(const std::string& mesh, const MeshBuildOptions& build,
+                            const terrain::DemOptions& dem) = 0;
+  // The DEM MESH was read from, or null (a mesh file, a sample, a mesh named on a server).
+  virtual const terrain::Dem* Terrain() const = 0;
   // False, with *error naming the flag, for an option this backend cannot honour (a remote call
   // leaves engine ablations, threads and the window budget to geodexd).
   virtual bool Supports(const Args& args, std::string* error) const = 0;
@@ -98,6 +103,11 @@ inline constexpr double kSnapWarnRel = 0.01;
 // given) and warning above kSnapWarnRel, then checks every point. Errors name --`option`.
 absl::Status ResolvePoints(Backend& backend, const Args& args, const std::string& option,
                            std::vector<SurfacePoint>* points, SnapReport* report);
+// Parses a SPEC list given as --`option`; `g:X:Y` and `ll:LON:LAT` items are dropped onto the
+// backend's DEM (without a backend, before MESH is open, only their syntax is checked).
+// InvalidArgument naming the option.
+absl::StatusOr<std::vector<SurfacePoint>> ParseSpec(const Backend* backend, const std::string& option,
+                                                    const std::string& spec);
 // Parses --`option` (which must be present), then ResolvePoints.
 absl::Status ResolveOption(Backend& backend, const Args& args, const std::string& option,
                            std::vector<SurfacePoint>* points, SnapReport* report);
@@ -114,6 +124,7 @@ int QueryExitCode(const absl::Status& status);
 int FailQuery(const absl::Status& status);
 // Backend::Open, or the one-line failure's exit code: 3 for the mesh (unreadable, invalid,
 // unknown), 1 when the service failed (unauthenticated, unavailable, over its limits).
-int OpenMesh(Backend& backend, const std::string& mesh, const MeshBuildOptions& build);
+int OpenMesh(Backend& backend, const Args& args, const std::string& mesh,
+             const MeshBuildOptions& build);
 
 }  // namespace geodex::cli

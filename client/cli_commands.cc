@@ -13,8 +13,12 @@
 #include <memory>
 #include <set>
 
+#include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
+#include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
+#include "absl/strings/str_split.h"
 #include "cli_backend.h"
 #include "cli_common.h"
 #include "geodex/distance_matrix.h"
@@ -105,12 +109,54 @@ absl::Status ResolvePoints(Backend& backend, const Args& args, const std::string
   return backend.Check(option, *points);
 }
 
-absl::Status ResolveOption(Backend& backend, const Args& args, const std::string& option,
-                           std::vector<SurfacePoint>* points, SnapReport* report) {
-  absl::StatusOr<std::vector<SurfacePoint>> p = ParseSurfacePoints(args.options.at(option));
+// Map coordinates in a SPEC list (`g:X:Y` in the DEM's CRS, `ll:LON:LAT` in WGS 84) dropped
+// vertically onto the DEM, each rewritten as the face point it lands on (lossless, %.17g).
+// Without a backend (before the mesh is open) only their syntax is checked (they become "0").
+absl::StatusOr<std::string> DropMapPoints(const Backend* backend, const std::string& spec) {
+  std::vector<std::string> items = absl::StrSplit(spec, ',');
+  for (std::string& item : items) {
+    const bool native = absl::StartsWith(item, "g:"), lonlat = absl::StartsWith(item, "ll:");
+    if (!native && !lonlat) continue;
+    std::vector<std::string> parts = absl::StrSplit(item, ':');
+    double a = 0, b = 0;
+    if (parts.size() != 3 || !absl::SimpleAtod(parts[1], &a) || !absl::SimpleAtod(parts[2], &b) ||
+        !std::isfinite(a) || !std::isfinite(b)) {
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "bad point '%s' (expected %s)", item, native ? "g:X:Y" : "ll:LON:LAT"));
+    }
+    if (backend == nullptr) {
+      item = "0";
+      continue;
+    }
+    const terrain::Dem* dem = backend->Terrain();
+    if (dem == nullptr) {
+      return absl::InvalidArgumentError(
+          absl::StrFormat("point %s: map coordinates need a DEM as MESH (a raster such as .tif)", item));
+    }
+    absl::StatusOr<SurfacePoint> p = native ? dem->DropMapPoint(a, b) : dem->DropLonLat(a, b);
+    if (!p.ok()) return absl::InvalidArgumentError(absl::StrCat("point ", p.status().message()));
+    item = SurfacePointToString(*p);
+  }
+  return absl::StrJoin(items, ",");
+}
+
+absl::StatusOr<std::vector<SurfacePoint>> ParseSpec(const Backend* backend, const std::string& option,
+                                                    const std::string& spec) {
+  absl::StatusOr<std::string> dropped = DropMapPoints(backend, spec);
+  if (!dropped.ok()) {
+    return absl::InvalidArgumentError(absl::StrFormat("--%s: %s", option, dropped.status().message()));
+  }
+  absl::StatusOr<std::vector<SurfacePoint>> p = ParseSurfacePoints(*dropped);
   if (!p.ok()) {
     return absl::InvalidArgumentError(absl::StrFormat("--%s: %s", option, p.status().message()));
   }
+  return p;
+}
+
+absl::Status ResolveOption(Backend& backend, const Args& args, const std::string& option,
+                           std::vector<SurfacePoint>* points, SnapReport* report) {
+  absl::StatusOr<std::vector<SurfacePoint>> p = ParseSpec(&backend, option, args.options.at(option));
+  if (!p.ok()) return p.status();
   if (absl::Status s = ResolvePoints(backend, args, option, &*p, report); !s.ok()) return s;
   *points = *std::move(p);
   return absl::OkStatus();
@@ -150,8 +196,19 @@ int FailQuery(const absl::Status& status) {
   return Fail(QueryExitCode(status), std::string(status.message()));
 }
 
-int OpenMesh(Backend& backend, const std::string& mesh, const MeshBuildOptions& build) {
-  absl::Status s = backend.Open(mesh, build);
+int OpenMesh(Backend& backend, const Args& args, const std::string& mesh,
+             const MeshBuildOptions& build) {
+  terrain::DemOptions dem;
+  uint64_t step = 1;
+  std::string error;
+  if (!GetUint(args, "dem-step", &step, &error)) return Fail(kExitUsage, error);
+  if (step < 1 || step > 1000000) return Fail(kExitUsage, "--dem-step must be in [1, 1000000]");
+  dem.step = static_cast<uint32_t>(step);
+  if (step != 1 && !terrain::IsDemPath(mesh)) {
+    return Fail(kExitUsage, absl::StrCat("--dem-step: ", mesh, " is not a DEM (a raster such as .tif)"));
+  }
+  absl::Status s = backend.Open(mesh, build, dem);
+  if (s.ok()) return kExitOk;
   if (s.ok()) return kExitOk;
   switch (s.code()) {  // the service failed, not the mesh
     case absl::StatusCode::kUnauthenticated:
@@ -180,7 +237,7 @@ int RunInfo(Backend& backend, const Args& args) {
   }
   MeshBuildOptions options;
   options.strict = args.options.count("strict") > 0;
-  if (int code = OpenMesh(backend, args.positional[0], options)) return code;
+  if (int code = OpenMesh(backend, args, args.positional[0], options)) return code;
   absl::StatusOr<InfoValues> info = backend.Info();
   if (!info.ok()) return FailQuery(info.status());
   std::fputs(FormatInfo(*info, format == "json").c_str(), stdout);
@@ -253,7 +310,8 @@ int RunDistances(Backend& backend, const Args& args) {
   if (!CheckKnown(
           args,
           {"sources", "method", "lambda", "lambda-scale", "max-distance", "max-windows", "stats",
-           "output", "no-filter", "no-one-split", "at", "max-snap", "format", "directions"},
+           "output", "no-filter", "no-one-split", "at", "max-snap", "format", "directions",
+           "labels-output"},
           &error) ||
       !GetFormat(args, &json, &error) || !backend.Supports(args, &error)) {
     return Fail(kExitUsage, error);
@@ -279,9 +337,30 @@ int RunDistances(Backend& backend, const Args& args) {
   }
   options.solver.use_filter = !args.options.count("no-filter");
   options.solver.use_one_angle_one_split = !args.options.count("no-one-split");
-  absl::StatusOr<std::vector<SurfacePoint>> parsed = ParseSurfacePoints(args.options.at("sources"));
-  if (!parsed.ok()) return Fail(kExitUsage, "--sources: " + std::string(parsed.status().message()));
-  if (int code = OpenMesh(backend, args.positional[0], MeshBuildOptions{})) return code;
+  absl::StatusOr<std::vector<SurfacePoint>> parsed = ParseSpec(nullptr, "sources", args.options.at("sources"));
+  if (!parsed.ok()) return Fail(kExitUsage, std::string(parsed.status().message()));
+  // Rasters (GeoTIFF, aligned with the DEM's grid): the distances with --output X.tif, the
+  // nearest source's index with --labels-output X.tif.
+  auto is_raster = [](const std::string& path) {
+    return absl::EndsWithIgnoreCase(path, ".tif") || absl::EndsWithIgnoreCase(path, ".tiff");
+  };
+  const std::string output = args.options.count("output") ? args.options.at("output") : "";
+  const std::string labels_output =
+      args.options.count("labels-output") ? args.options.at("labels-output") : "";
+  const bool raster = is_raster(output);
+  if (!labels_output.empty() && !is_raster(labels_output)) {
+    return Fail(kExitUsage, "--labels-output: a GeoTIFF path (.tif) is expected");
+  }
+  if ((raster || !labels_output.empty()) && (args.options.count("at") || options.directions || json)) {
+    return Fail(kExitUsage, "--output X.tif and --labels-output: per-vertex distances only (not with --at, --directions or --format json)");
+  }
+  if (int code = OpenMesh(backend, args, args.positional[0], MeshBuildOptions{})) return code;
+  const terrain::Dem* dem = backend.Terrain();
+  if ((raster || !labels_output.empty()) && dem == nullptr) {
+    return Fail(kExitUsage, absl::StrCat(raster ? "--output " : "--labels-output ",
+                                         raster ? output : labels_output,
+                                         ": a raster needs a DEM as MESH (a raster such as .tif)"));
+  }
   std::vector<SurfacePoint> sources, at;
   SnapReport snap;
   if (absl::Status s = ResolveOption(backend, args, "sources", &sources, &snap); !s.ok()) {
@@ -312,13 +391,26 @@ int RunDistances(Backend& backend, const Args& args) {
   } else {
     absl::StatusOr<const DistanceField*> field = backend.Field(sources, options);
     if (!field.ok()) return FailQuery(field.status());
-    text = json ? FormatDistancesJson((*field)->distance, (*field)->direction)
-                : FormatDistances((*field)->distance, (*field)->direction);
+    if (raster || !labels_output.empty()) {
+      stats = (*field)->stats;
+      if (stats.solve_ms == 0) stats.solve_ms = MsSince(t_solve);
+      absl::Status written = absl::OkStatus();
+      if (raster) written = dem->WriteFloatRaster(output, (*field)->distance);
+      if (written.ok() && !labels_output.empty()) {
+        written = dem->WriteIndexRaster(labels_output, (*field)->source);
+      }
+      if (!written.ok()) return Fail(kExitUsage, std::string(written.message()));
+    } else {
+      text = json ? FormatDistancesJson((*field)->distance, (*field)->direction)
+                  : FormatDistances((*field)->distance, (*field)->direction);
+    }
     stats = (*field)->stats;
   }
   if (stats.solve_ms == 0) stats.solve_ms = MsSince(t_solve);
   const auto t_out = std::chrono::steady_clock::now();
-  if (int code = WriteOutput(args, text); code != kExitOk) return code;
+  if (!raster) {
+    if (int code = WriteOutput(args, text); code != kExitOk) return code;
+  }
   if (args.options.count("stats")) {
     const std::string leading = absl::StrFormat("\"method\": \"%s\", \"sources\": %d, %s",
                                                 options.method, sources.size(), SnapJson(snap));
@@ -351,7 +443,7 @@ int RunPath(Backend& backend, const Args& args) {
     return Fail(kExitUsage, "--method must be astar or full");
   }
   if (!GetSolverFlags(args, &options.solver, &error)) return Fail(kExitUsage, error);
-  if (int code = OpenMesh(backend, args.positional[0], MeshBuildOptions{})) return code;
+  if (int code = OpenMesh(backend, args, args.positional[0], MeshBuildOptions{})) return code;
   SurfacePoint from, to;
   SnapReport snap;
   if (absl::Status s = OnePoint(backend, args, "from", &from, &snap); !s.ok()) return FailQuery(s);
@@ -395,7 +487,7 @@ int RunMatrix(Backend& backend, const Args& args) {
   options.threads = static_cast<unsigned>(threads);
   RowProgress progress;
   options.on_row = [&progress](size_t done, size_t total) { progress.Update(done, total); };
-  if (int code = OpenMesh(backend, args.positional[0], MeshBuildOptions{})) return code;
+  if (int code = OpenMesh(backend, args, args.positional[0], MeshBuildOptions{})) return code;
   std::vector<SurfacePoint> sources, targets;
   SnapReport snap;
   if (absl::Status s = ResolveOption(backend, args, "sources", &sources, &snap); !s.ok()) {
@@ -442,7 +534,7 @@ int RunLocate(Backend& backend, const Args& args) {
     }
     xyz.push_back(p.position);
   }
-  if (int code = OpenMesh(backend, args.positional[0], MeshBuildOptions{})) return code;
+  if (int code = OpenMesh(backend, args, args.positional[0], MeshBuildOptions{})) return code;
   absl::StatusOr<std::vector<LocatedPoint>> located = backend.Locate(xyz);
   if (!located.ok()) return FailQuery(located.status());
   std::string text = json ? "{\"points\": [" : "";

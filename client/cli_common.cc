@@ -22,6 +22,22 @@
 namespace geodex::cli {
 namespace {
 Progress* g_active_progress = nullptr;  // the one main shows, for Fail()
+// A JSON string literal (RFC 8259 escapes).
+std::string JsonString(const std::string& s) {
+  std::string out = "\"";
+  for (unsigned char c : s) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += static_cast<char>(c);
+    } else if (c < 0x20) {
+      out += absl::StrFormat("\\u%04x", c);
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  return out + "\"";
+}
+
 }  // namespace
 
 double MsSince(std::chrono::steady_clock::time_point t) {
@@ -35,16 +51,31 @@ int Fail(int code, const std::string& message) {
 }
 
 // Reads a mesh file, or a built-in sample ("sample:terrain").
-absl::StatusOr<MeshData> LoadMeshData(const std::string& path) {
+absl::StatusOr<MeshData> LoadMeshData(const std::string& path,
+                                      const terrain::DemOptions& dem_options,
+                                      std::shared_ptr<const terrain::Dem>* dem) {
   if (path.rfind("sample:", 0) == 0) return MakeSampleMesh(path);
+  if (terrain::IsDemPath(path)) {
+    absl::StatusOr<terrain::Dem> read = terrain::Dem::Read(path, dem_options);
+    if (!read.ok()) return read.status();
+    auto shared = std::make_shared<const terrain::Dem>(*std::move(read));
+    MeshData data = shared->mesh();
+    if (dem != nullptr) *dem = std::move(shared);
+    return data;
+  }
+  if (dem_options.step != 1) {
+    return absl::InvalidArgumentError(absl::StrCat("--dem-step: ", path, " is not a DEM (a raster such as .tif)"));
+  }
   absl::StatusOr<MeshData> data = ReadMeshFile(path);
   if (!data.ok()) return data.status();
   return data;
 }
 
-absl::StatusOr<LoadedMesh> LoadMesh(const std::string& path, const MeshBuildOptions& options) {
+absl::StatusOr<LoadedMesh> LoadMesh(const std::string& path, const MeshBuildOptions& options,
+                                    const terrain::DemOptions& dem_options) {
   const auto t0 = std::chrono::steady_clock::now();
-  absl::StatusOr<MeshData> data = LoadMeshData(path);
+  std::shared_ptr<const terrain::Dem> dem;
+  absl::StatusOr<MeshData> data = LoadMeshData(path, dem_options, &dem);
   if (!data.ok()) return data.status();
   const double load_ms = MsSince(t0);
   const auto t1 = std::chrono::steady_clock::now();
@@ -52,7 +83,7 @@ absl::StatusOr<LoadedMesh> LoadMesh(const std::string& path, const MeshBuildOpti
   if (!mesh.ok()) {
     return absl::Status(mesh.status().code(), path + ": " + std::string(mesh.status().message()));
   }
-  return LoadedMesh{std::move(*data), std::move(*mesh), load_ms, MsSince(t1)};
+  return LoadedMesh{std::move(*data), std::move(*mesh), load_ms, MsSince(t1), std::move(dem)};
 }
 
 bool GetDouble(const Args& args, const std::string& key, double* out, std::string* error) {
@@ -77,7 +108,7 @@ bool GetUint(const Args& args, const std::string& key, uint64_t* out, std::strin
 
 bool CheckKnown(const Args& args, const std::set<std::string>& known, std::string* error) {
   for (const auto& [key, value] : args.options) {
-    if (!known.count(key)) {
+    if (!known.count(key) && key != "dem-step") {  // --dem-step: how every MESH is read (OpenMesh)
       *error = absl::StrFormat("unknown option --%s (see geodex --help)", key);
       return false;
     }
@@ -197,9 +228,26 @@ std::string FormatInfo(const InfoValues& v, bool json) {
       {"load_ms", absl::StrFormat("%.3f", v.load_ms)},
       {"build_ms", absl::StrFormat("%.3f", v.build_ms)},
   };
+  // A DEM's map (strings are quoted in JSON).
+  std::vector<std::pair<std::string, std::string>> dem_rows;
+  if (v.dem != nullptr) {
+    const terrain::DemInfo& d = *v.dem;
+    dem_rows = {
+        {"crs", d.file_crs_name},
+        {"mesh_crs", d.mesh_crs_name},
+        {"units", "m"},
+        {"raster", absl::StrFormat("%d %d", d.raster_width, d.raster_height)},
+        {"dem_step", absl::StrFormat("%d", d.step)},
+        {"grid", absl::StrFormat("%d %d", d.grid_width, d.grid_height)},
+        {"nodata_cells", absl::StrFormat("%d", d.nodata_cells)},
+        {"vertical_unit", d.vertical_unit.empty() ? "m (assumed)" : d.vertical_unit},
+        {"driver", d.driver},
+    };
+  }
   std::string out;
   if (!json) {
     for (const auto& [k, value] : rows) absl::StrAppend(&out, k, ": ", value, "\n");
+    for (const auto& [k, value] : dem_rows) absl::StrAppend(&out, k, ": ", value, "\n");
     return out;
   }
   out = "{";
@@ -210,6 +258,14 @@ std::string FormatInfo(const InfoValues& v, bool json) {
                            triple ? absl::StrJoin(absl::StrSplit(rows[i].second, ' '), ", ")
                                   : rows[i].second,
                            triple ? "]" : "");
+  }
+  for (const auto& [k, value] : dem_rows) {
+    const bool pair = k == "raster" || k == "grid";
+    const bool number = k == "dem_step" || k == "nodata_cells";
+    out += absl::StrFormat(", \"%s\": %s", k,
+                           pair     ? absl::StrCat("[", absl::StrJoin(absl::StrSplit(value, ' '), ", "), "]")
+                           : number ? value
+                                    : JsonString(value));
   }
   return out + "}\n";
 }

@@ -17,6 +17,7 @@
 #include "geodex/shortest_path.h"
 #include "geodex/mesh_data.h"
 #include "geodex/surface_point.h"
+#include "geodex/terrain.h"
 #include "geodex/triangle_mesh.h"
 
 namespace geodex::cli {
@@ -26,16 +27,21 @@ double MsSince(std::chrono::steady_clock::time_point t);
 // Prints "geodex: MESSAGE" on stderr and returns `code`.
 int Fail(int code, const std::string& message);
 
-// Reads a mesh file, or a built-in sample ("sample:terrain").
-absl::StatusOr<MeshData> LoadMeshData(const std::string& path);
+// Reads a mesh file, or a built-in sample ("sample:terrain"); a DEM (terrain::IsDemPath) is read
+// with GDAL and triangulated, and kept in *dem when given.
+absl::StatusOr<MeshData> LoadMeshData(const std::string& path,
+                                      const terrain::DemOptions& dem_options = {},
+                                      std::shared_ptr<const terrain::Dem>* dem = nullptr);
 
 struct LoadedMesh {
   MeshData data;
   TriangleMesh mesh;
   double load_ms, build_ms;
+  std::shared_ptr<const terrain::Dem> dem;  // when read from a DEM
 };
 // Reads and builds; a Build error is prefixed with the path.
-absl::StatusOr<LoadedMesh> LoadMesh(const std::string& path, const MeshBuildOptions& options);
+absl::StatusOr<LoadedMesh> LoadMesh(const std::string& path, const MeshBuildOptions& options,
+                                    const terrain::DemOptions& dem_options = {});
 
 // --key as a number; absent leaves *out unchanged. False with *error naming the option.
 bool GetDouble(const Args& args, const std::string& key, double* out, std::string* error);
@@ -85,6 +91,7 @@ std::array<double, 3> PositionOf(const MeshData& mesh, const SurfacePoint& p);
 // What `geodex info` prints.
 struct InfoValues : MeshSummary {
   double load_ms = 0, build_ms = 0;
+  const terrain::DemInfo* dem = nullptr;  // a DEM's map: its CRS, grid, nodata and units
 };
 std::string FormatInfo(const InfoValues& v, bool json);
 // One distance per line, %.17g ("inf" if unreachable); with `directions` (one per vertex),

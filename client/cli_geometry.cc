@@ -44,11 +44,11 @@ struct Solved {
 // Opens the mesh on the backend, parses and resolves --`key`. Returns 0 or an exit code (after
 // printing the one-line message).
 int Prepare(Backend& backend, const Args& args, const std::string& key, Solved* out) {
-  absl::StatusOr<std::vector<SurfacePoint>> points = ParseSurfacePoints(args.options.at(key));
-  if (!points.ok()) {
-    return Fail(kExitUsage, "--" + key + ": " + std::string(points.status().message()));
-  }
-  if (int code = OpenMesh(backend, args.positional[0], MeshBuildOptions{})) return code;
+  absl::StatusOr<std::vector<SurfacePoint>> points = ParseSpec(nullptr, key, args.options.at(key));
+  if (!points.ok()) return Fail(kExitUsage, std::string(points.status().message()));
+  if (int code = OpenMesh(backend, args, args.positional[0], MeshBuildOptions{})) return code;
+  points = ParseSpec(&backend, key, args.options.at(key));  // map points onto the DEM
+  if (!points.ok()) return FailQuery(points.status());
   if (absl::Status s = ResolvePoints(backend, args, key, &*points, nullptr); !s.ok()) {
     return FailQuery(s);
   }

@@ -38,14 +38,16 @@ absl::StatusOr<T> Reachable(absl::StatusOr<T> result) {
 
 class LocalBackend final : public Backend {
  public:
-  absl::Status Open(const std::string& mesh, const MeshBuildOptions& build) override {
-    absl::StatusOr<LoadedMesh> loaded = LoadMesh(mesh, build);
+  absl::Status Open(const std::string& mesh, const MeshBuildOptions& build,
+                    const terrain::DemOptions& dem) override {
+    absl::StatusOr<LoadedMesh> loaded = LoadMesh(mesh, build, dem);
     if (!loaded.ok()) return loaded.status();
     loaded_ = std::make_unique<LoadedMesh>(*std::move(loaded));
     return absl::OkStatus();
   }
 
   bool Supports(const Args&, std::string*) const override { return true; }
+  const terrain::Dem* Terrain() const override { return loaded_->dem.get(); }
 
   absl::StatusOr<std::vector<LocatedPoint>> Locate(
       const std::vector<std::array<double, 3>>& xyz) override {
@@ -74,6 +76,7 @@ class LocalBackend final : public Backend {
     InfoValues v;
     static_cast<MeshSummary&>(v) = Summarize(loaded_->mesh);
     v.load_ms = loaded_->load_ms;
+    v.dem = loaded_->dem ? &loaded_->dem->info() : nullptr;
     v.build_ms = loaded_->build_ms;
     return v;
   }

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <initializer_list>
 #include <optional>
@@ -90,9 +91,19 @@ class RemoteBackend final : public Backend {
  public:
   explicit RemoteBackend(std::unique_ptr<GeodexClient> client) : client_(std::move(client)) {}
 
-  absl::Status Open(const std::string& mesh, const MeshBuildOptions&) override {
+  absl::Status Open(const std::string& mesh, const MeshBuildOptions&,
+                    const terrain::DemOptions& dem_options) override {
     mesh_arg_ = mesh;
-    absl::StatusOr<MeshRef> ref = client_->ResolveMesh(mesh);
+    std::error_code ec;
+    absl::StatusOr<MeshRef> ref;
+    if (terrain::IsDemPath(mesh) && std::filesystem::exists(mesh, ec)) {
+      // geodexd reads meshes, not rasters (yet): the DEM is triangulated here and uploaded.
+      absl::StatusOr<MeshData> data = LoadMeshData(mesh, dem_options, &dem_);
+      if (!data.ok()) return data.status();
+      ref = client_->ResolveMeshData(std::filesystem::path(mesh).stem().string() + ".off", *data);
+    } else {
+      ref = client_->ResolveMesh(mesh);
+    }
     if (!ref.ok()) return ref.status();
     mesh_ = *std::move(ref);
     return absl::OkStatus();
@@ -135,7 +146,10 @@ class RemoteBackend final : public Backend {
     return absl::OkStatus();  // the server checks them with the query, naming the field
   }
 
+  const terrain::Dem* Terrain() const override { return dem_.get(); }
+
   absl::StatusOr<const MeshData*> Geometry() override {
+    if (dem_ != nullptr) return &dem_->mesh();
     if (data_ == nullptr) {
       // A file or sample given here is read here (its exact coordinates); a mesh named on the
       // server comes from it (GetMeshGeometry).
@@ -154,6 +168,7 @@ class RemoteBackend final : public Backend {
     InfoValues v;
     static_cast<MeshSummary&>(v) = api::MeshSummaryFromProto(*m);
     v.load_ms = MsSince(t0);  // remote: the time to describe the mesh
+    v.dem = dem_ ? &dem_->info() : nullptr;
     return v;
   }
 
@@ -224,6 +239,7 @@ class RemoteBackend final : public Backend {
   std::string mesh_arg_;
   MeshRef mesh_;
   std::unique_ptr<MeshData> data_;  // read from mesh_arg_ on first need
+  std::shared_ptr<const terrain::Dem> dem_;  // when MESH is a DEM (read here)
   DistanceField field_;             // the last Field answer (Backend::Field hands out a pointer)
   bool cached_ = false;             // the last field came from the server's result cache
 };

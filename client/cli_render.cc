@@ -88,17 +88,23 @@ int RunRender(Backend& backend, const Args& args) {
   }
   const bool voronoi = args.options.count("voronoi") > 0, delaunay = args.options.count("delaunay") > 0;
 
-  absl::StatusOr<std::vector<SurfacePoint>> sources = ParseSurfacePoints(args.options.at("sources"));
-  if (!sources.ok()) return Fail(kExitUsage, "--sources: " + std::string(sources.status().message()));
+  absl::StatusOr<std::vector<SurfacePoint>> sources = ParseSpec(nullptr, "sources", args.options.at("sources"));
+  if (!sources.ok()) return Fail(kExitUsage, std::string(sources.status().message()));
   std::vector<SurfacePoint> ends;
   if (!path_spec.empty()) {
-    absl::StatusOr<std::vector<SurfacePoint>> p = ParseSurfacePoints(path_spec);
+    absl::StatusOr<std::vector<SurfacePoint>> p = ParseSpec(nullptr, "path", path_spec);
     if (!p.ok() || p->size() != 2) {
       return Fail(kExitUsage, "--path: expected two points (--path A B or --path A,B)");
     }
+  }
+  if (int code = OpenMesh(backend, args, positional[0], MeshBuildOptions{})) return code;
+  sources = ParseSpec(&backend, "sources", args.options.at("sources"));  // map points onto the DEM
+  if (!sources.ok()) return FailQuery(sources.status());
+  if (!path_spec.empty()) {
+    absl::StatusOr<std::vector<SurfacePoint>> p = ParseSpec(&backend, "path", path_spec);
+    if (!p.ok()) return FailQuery(p.status());
     ends = *std::move(p);
   }
-  if (int code = OpenMesh(backend, positional[0], MeshBuildOptions{})) return code;
   absl::StatusOr<const MeshData*> data = backend.Geometry();
   if (!data.ok()) return FailQuery(data.status());
   if (absl::Status s = ResolvePoints(backend, args, "sources", &*sources, nullptr); !s.ok()) {

@@ -255,31 +255,44 @@ absl::Status GeodexClient::DeleteMesh(const std::string& name) {
   }));
 }
 
+absl::StatusOr<MeshRef> GeodexClient::UploadIfAbsent(MeshRef ref) {
+  absl::StatusOr<v1::Mesh> existing = GetMesh(ref.name);
+  if (existing.ok()) return ref;
+  if (!absl::IsNotFound(existing.status())) return existing.status();
+  absl::StatusOr<v1::Mesh> uploaded = Upload(ref.file_name, ref.file_bytes, "", ref.id);
+  if (!uploaded.ok()) return uploaded.status();
+  ref.uploaded = true;
+  return ref;
+}
+
+absl::StatusOr<MeshRef> GeodexClient::ResolveMeshData(const std::string& file_name,
+                                                      const MeshData& data) {
+  MeshRef ref;
+  ref.id = ComputeMeshId(data);
+  ref.name = absl::StrCat("meshes/", ref.id);
+  ref.file_bytes = MeshToOffText(data);
+  ref.file_name = file_name;
+  return UploadIfAbsent(std::move(ref));
+}
+
 absl::StatusOr<MeshRef> GeodexClient::ResolveMesh(const std::string& mesh) {
   MeshRef ref;
   std::error_code ec;
-  const bool sample = mesh.rfind("sample:", 0) == 0;
+  if (mesh.rfind("sample:", 0) == 0) {
+    absl::StatusOr<MeshData> data = MakeSampleMesh(mesh);
+    if (!data.ok()) return data.status();
+    return ResolveMeshData(mesh.substr(7) + ".off", *data);
+  }
   // A directory is read too, so that it fails as in local mode ("is a directory").
-  if (sample || std::filesystem::exists(mesh, ec)) {
-    absl::StatusOr<MeshData> data = sample ? MakeSampleMesh(mesh) : ReadMeshFile(mesh);
+  if (std::filesystem::exists(mesh, ec)) {
+    absl::StatusOr<MeshData> data = ReadMeshFile(mesh);
     if (!data.ok()) return data.status();
     ref.id = ComputeMeshId(*data);
     ref.name = absl::StrCat("meshes/", ref.id);
-    if (sample) {
-      ref.file_bytes = MeshToOffText(*data);
-      ref.file_name = mesh.substr(7) + ".off";
-    } else {
-      std::ifstream in(mesh, std::ios::binary);
-      ref.file_bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-      ref.file_name = std::filesystem::path(mesh).filename().string();
-    }
-    absl::StatusOr<v1::Mesh> existing = GetMesh(ref.name);
-    if (existing.ok()) return ref;
-    if (!absl::IsNotFound(existing.status())) return existing.status();
-    absl::StatusOr<v1::Mesh> uploaded = Upload(ref.file_name, ref.file_bytes, "", ref.id);
-    if (!uploaded.ok()) return uploaded.status();
-    ref.uploaded = true;
-    return ref;
+    std::ifstream in(mesh, std::ios::binary);
+    ref.file_bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    ref.file_name = std::filesystem::path(mesh).filename().string();
+    return UploadIfAbsent(std::move(ref));
   }
   const std::string key = mesh.rfind("meshes/", 0) == 0 ? mesh.substr(7) : mesh;
   if (IsMeshId(key)) {

@@ -80,6 +80,9 @@ class GeodexClient {
   // MESH argument -> reference: a readable file or "sample:NAME" (uploaded if the server lacks
   // it), a 64-hex id, or an alias.
   absl::StatusOr<MeshRef> ResolveMesh(const std::string& mesh);
+  // A mesh read here (a sample, a DEM triangulated by the CLI): uploaded as OFF text named
+  // `file_name` unless the server has its id already.
+  absl::StatusOr<MeshRef> ResolveMeshData(const std::string& file_name, const MeshData& data);
   // Uploads file bytes (idempotent). `expected_id` is checked by the server when set.
   absl::StatusOr<v1::Mesh> Upload(const std::string& file_name, const std::string& bytes,
                                   const std::string& alias, const std::string& expected_id);
@@ -134,6 +137,8 @@ class GeodexClient {
   const std::string& last_replica() const { return last_replica_; }
 
  private:
+  // Uploads ref's file bytes unless the server has ref.id.
+  absl::StatusOr<MeshRef> UploadIfAbsent(MeshRef ref);
   // Runs `call(context)` with a fresh context (deadline, x-mesh-id) per attempt, retrying on
   // UNAVAILABLE and on a full queue.
   grpc::Status Call(const std::string& mesh_id,

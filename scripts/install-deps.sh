@@ -20,11 +20,15 @@ packages=(
   zlib1g-dev libpng-dev
   # SHA-256 of mesh ids (OpenSSL, already a dependency of gRPC)
   libssl-dev
+  # terrain: DEMs in, rasters out, map coordinates (GDAL, and through it PROJ)
+  libgdal-dev libproj-dev
   # tests and benchmarks (CGAL is a test-only reference)
   libgtest-dev libgmock-dev libbenchmark-dev libcgal-dev libgmp-dev libmpfr-dev
   # the Python client package, its example and tests (Debian's gRPC for Python; pip and venv for
   # `pip install ./client/python`)
   python3-grpcio python3-protobuf python3-pip python3-venv python3-setuptools python3-wheel
+  # the terrain tests: fixtures made and outputs read back with GDAL's Python bindings
+  python3-gdal python3-numpy python3-shapely
   # the Kubernetes manifest checks (tests/deploy)
   python3-yaml
   # the mesh-affine gateway (deploy/gateway) and its end-to-end test

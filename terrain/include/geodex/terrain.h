@@ -1,0 +1,103 @@
+#pragma once
+
+// Terrain input: a digital elevation model (any single-band raster GDAL reads; GeoTIFF first) as
+// a triangle mesh in metres, with the map it came from.
+//
+// The mesh: each used cell centre is a vertex (every `step`-th cell in each direction), each 2x2
+// block of used cells two triangles split along the same diagonal, a triangle only where its
+// three cells have data (nodata cells leave holes with their own boundaries). Vertices are
+// numbered row by row, skipping nodata cells; faces block by block.
+//
+// Coordinates: a projected CRS is used as is (its linear unit converted to metres); a geographic
+// CRS (longitude/latitude) is projected to the UTM zone of the DEM's centre (WGS 84 datum), so
+// every distance is in metres. Heights are converted to metres from the band's unit ("m", "ft",
+// "US survey foot"; none given: metres).
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "geodex/mesh_data.h"
+#include "geodex/surface_point.h"
+
+namespace geodex::terrain {
+
+struct DemOptions {
+  uint32_t step = 1;  // use every step-th cell (a quick look at a large DEM)
+};
+
+// What a DEM mesh knows about its map.
+struct DemInfo {
+  std::string driver;                     // GDAL's short name ("GTiff")
+  uint32_t raster_width = 0, raster_height = 0;  // the file's grid
+  uint32_t step = 1;
+  uint32_t grid_width = 0, grid_height = 0;      // the used cells
+  uint64_t nodata_cells = 0;                     // used cells without data
+  std::string file_crs_name;  // the file's CRS ("WGS 84 / UTM zone 33N", "WGS 84")
+  std::string file_crs_wkt;
+  bool reprojected = false;   // the file's CRS is geographic: the mesh is in mesh_crs
+  std::string mesh_crs_name;  // the CRS of the mesh's x and y (metres)
+  std::string mesh_crs_wkt;
+  double horizontal_scale = 1;  // file CRS units to metres (1 when reprojected)
+  std::string vertical_unit;    // the band's unit as the file says it ("" = none given)
+  double vertical_scale = 1;    // file heights to metres
+  // The used grid's geotransform in the file's CRS (the file's own when step = 1): pixel (i, j)
+  // has its corner at (gt[0] + i gt[1] + j gt[2], gt[3] + i gt[4] + j gt[5]).
+  std::array<double, 6> geotransform{};
+};
+
+inline constexpr uint32_t kNoVertex = 0xffffffffu;
+
+class Dem {
+ public:
+  // Errors: InvalidArgument naming the file (GDAL cannot read it, not one band, no CRS or
+  // geotransform, a rotated grid, fewer than 2x2 used cells, an unknown height unit, no
+  // triangle with data), NotFound when the file does not exist.
+  static absl::StatusOr<Dem> Read(const std::string& path, const DemOptions& options = {});
+
+  Dem(Dem&&) noexcept;
+  Dem& operator=(Dem&&) noexcept;
+  ~Dem();
+
+  const MeshData& mesh() const { return mesh_; }
+  const DemInfo& info() const { return info_; }
+  // The vertex of used cell (col, row), or kNoVertex (nodata).
+  uint32_t VertexAt(uint32_t col, uint32_t row) const {
+    return vertex_of_cell_[size_t{row} * info_.grid_width + col];
+  }
+
+  // A map point dropped vertically onto the surface, as a face point: (x, y) in the file's CRS
+  // (`g:X:Y`) or WGS 84 longitude/latitude (`ll:LON:LAT`). InvalidArgument naming the point when
+  // it lies outside the used grid or in a nodata hole.
+  absl::StatusOr<SurfacePoint> DropMapPoint(double x, double y) const;
+  absl::StatusOr<SurfacePoint> DropLonLat(double lon, double lat) const;
+
+  // Writes one value per vertex as a single-band GeoTIFF aligned with the used grid (its
+  // geotransform and the file's CRS): float32 with nodata -1 where a cell has no vertex or the
+  // value is not finite (unreachable). Errors name the path (with the OS's reason).
+  absl::Status WriteFloatRaster(const std::string& path, const std::vector<double>& values) const;
+  // The same for indices (int32, nodata -1; kNoVertex-like values >= 2^31 are nodata).
+  absl::Status WriteIndexRaster(const std::string& path, const std::vector<uint32_t>& values) const;
+
+ private:
+  Dem() = default;
+  // DropMapPoint, naming the point `name` in errors.
+  absl::StatusOr<SurfacePoint> DropNamed(double x, double y, const std::string& name) const;
+  // Drops a point given in the mesh's CRS (metres); `name` spells it in errors.
+  absl::StatusOr<SurfacePoint> DropMeshPoint(double mx, double my, double u, double v,
+                                             const std::string& name) const;
+
+  MeshData mesh_;
+  DemInfo info_;
+  std::vector<uint32_t> vertex_of_cell_;  // grid_width * grid_height
+  std::vector<uint32_t> face_of_block_;   // 2 per block ((grid_width-1) * (grid_height-1))
+};
+
+// True when `path` names a raster by its extension (.tif, .tiff, .vrt, .asc, .img, .hgt, .dem,
+// .bil, .nc): what the CLI reads as a DEM instead of a mesh file.
+bool IsDemPath(const std::string& path);
+
+}  // namespace geodex::terrain

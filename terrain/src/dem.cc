@@ -1,0 +1,376 @@
+#include "geodex/terrain.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <functional>
+#include <limits>
+#include <mutex>
+#include <utility>
+
+#include "absl/strings/ascii.h"
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "cpl_conv.h"
+#include "cpl_error.h"
+#include "gdal_priv.h"
+#include "ogr_spatialref.h"
+
+namespace geodex::terrain {
+namespace {
+
+// GDAL reports errors through a global handler that prints; geodex reports them itself, so GDAL
+// is quiet while a call runs and its last message is read back.
+class QuietGdal {
+ public:
+  QuietGdal() {
+    static std::once_flag once;
+    std::call_once(once, [] { GDALAllRegister(); });
+    CPLPushErrorHandler(CPLQuietErrorHandler);
+    CPLErrorReset();
+  }
+  ~QuietGdal() { CPLPopErrorHandler(); }
+  static std::string LastMessage() {
+    const char* m = CPLGetLastErrorMsg();
+    return m != nullptr && *m != '\0' ? std::string(m) : std::string("unknown GDAL error");
+  }
+};
+
+std::string WktOf(const OGRSpatialReference& srs) {
+  char* wkt = nullptr;
+  srs.exportToWkt(&wkt);
+  std::string out = wkt != nullptr ? wkt : "";
+  CPLFree(wkt);
+  return out;
+}
+
+using TransformPtr = std::unique_ptr<OGRCoordinateTransformation,
+                                     decltype(&OGRCoordinateTransformation::DestroyCT)>;
+TransformPtr MakeTransform(const OGRSpatialReference& from, const OGRSpatialReference& to) {
+  return TransformPtr(OGRCreateCoordinateTransformation(&from, &to),
+                      &OGRCoordinateTransformation::DestroyCT);
+}
+
+// Metres per unit of a band's height unit; 0 when the unit is not one geodex knows.
+double MetresPerHeightUnit(std::string unit) {
+  unit = absl::AsciiStrToLower(unit);
+  if (unit.empty() || unit == "m" || unit == "metre" || unit == "meter" || unit == "metres" ||
+      unit == "meters") {
+    return 1;
+  }
+  if (unit == "ft" || unit == "foot" || unit == "feet" || unit == "international foot") return 0.3048;
+  if (unit == "us survey foot" || unit == "us-ft" || unit == "ftus") return 1200.0 / 3937.0;
+  return 0;
+}
+
+}  // namespace
+
+Dem::Dem(Dem&&) noexcept = default;
+Dem& Dem::operator=(Dem&&) noexcept = default;
+Dem::~Dem() = default;
+
+bool IsDemPath(const std::string& path) {
+  std::string ext = absl::AsciiStrToLower(std::filesystem::path(path).extension().string());
+  for (const char* known : {".tif", ".tiff", ".vrt", ".asc", ".img", ".hgt", ".dem", ".bil", ".nc"}) {
+    if (ext == known) return true;
+  }
+  return false;
+}
+
+absl::StatusOr<Dem> Dem::Read(const std::string& path, const DemOptions& options) {
+  if (options.step < 1) return absl::InvalidArgumentError("--dem-step must be at least 1");
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) {
+    return absl::NotFoundError(absl::StrCat(path, ": cannot open: No such file or directory"));
+  }
+  QuietGdal quiet;
+  GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY));
+  auto bad = [&](const std::string& why) {
+    return absl::InvalidArgumentError(absl::StrCat(path, ": ", why));
+  };
+  if (ds == nullptr) return bad(absl::StrCat("not a raster GDAL reads (", QuietGdal::LastMessage(), ")"));
+  if (ds->GetRasterCount() != 1) {
+    return bad(absl::StrCat("a DEM has one band; this raster has ", ds->GetRasterCount()));
+  }
+  Dem dem;
+  DemInfo& info = dem.info_;
+  info.driver = ds->GetDriver() != nullptr ? ds->GetDriver()->GetDescription() : "";
+  info.raster_width = static_cast<uint32_t>(ds->GetRasterXSize());
+  info.raster_height = static_cast<uint32_t>(ds->GetRasterYSize());
+  info.step = options.step;
+  info.grid_width = (info.raster_width + options.step - 1) / options.step;
+  info.grid_height = (info.raster_height + options.step - 1) / options.step;
+  if (info.grid_width < 2 || info.grid_height < 2) {
+    return bad(absl::StrFormat("%ux%u cells at --dem-step %u; a DEM needs at least 2x2",
+                               info.grid_width, info.grid_height, options.step));
+  }
+  double gt[6];
+  if (ds->GetGeoTransform(gt) != CE_None) return bad("no geotransform (not georeferenced)");
+  if (gt[2] != 0 || gt[4] != 0) return bad("a rotated grid (geotransform terms 2 and 4 not 0)");
+  const OGRSpatialReference* file_srs = ds->GetSpatialRef();
+  if (file_srs == nullptr || file_srs->IsEmpty()) return bad("no coordinate reference system");
+  OGRSpatialReference file_crs(*file_srs);
+  file_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  info.file_crs_name = file_crs.GetName() != nullptr ? file_crs.GetName() : "";
+  info.file_crs_wkt = WktOf(file_crs);
+
+  // The used grid: cell centre (i, j) is the file's pixel centre (i step + 0.5, j step + 0.5).
+  const double s = options.step;
+  const double corner = 0.5 - s / 2;
+  info.geotransform = {gt[0] + corner * gt[1], s * gt[1], 0, gt[3] + corner * gt[5], 0, s * gt[5]};
+
+  // Mesh coordinates: metres, in the file's CRS or (geographic) the UTM zone of the centre.
+  TransformPtr to_mesh(nullptr, &OGRCoordinateTransformation::DestroyCT);
+  if (file_crs.IsGeographic()) {
+    double lon = gt[0] + gt[1] * info.raster_width / 2.0, lat = gt[3] + gt[5] * info.raster_height / 2.0;
+    OGRSpatialReference wgs84;
+    wgs84.SetWellKnownGeogCS("WGS84");
+    wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    TransformPtr to_wgs84 = MakeTransform(file_crs, wgs84);
+    if (to_wgs84 == nullptr || !to_wgs84->Transform(1, &lon, &lat)) {
+      return bad(absl::StrCat("cannot find the DEM's centre in WGS 84 (", QuietGdal::LastMessage(), ")"));
+    }
+    const int zone = std::clamp(static_cast<int>(std::floor((lon + 180) / 6)) + 1, 1, 60);
+    OGRSpatialReference utm;
+    utm.importFromEPSG((lat >= 0 ? 32600 : 32700) + zone);
+    utm.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    to_mesh = MakeTransform(file_crs, utm);
+    if (to_mesh == nullptr) {
+      return bad(absl::StrCat("cannot project to UTM (", QuietGdal::LastMessage(), ")"));
+    }
+    info.reprojected = true;
+    info.mesh_crs_name = utm.GetName() != nullptr ? utm.GetName() : "";
+    info.mesh_crs_wkt = WktOf(utm);
+  } else if (file_crs.IsProjected() || file_crs.IsLocal()) {
+    info.horizontal_scale = file_crs.GetLinearUnits();
+    if (!(info.horizontal_scale > 0)) return bad("the CRS has no linear unit");
+    info.mesh_crs_name = info.file_crs_name;
+    info.mesh_crs_wkt = info.file_crs_wkt;
+  } else {
+    return bad("the CRS is neither projected nor geographic");
+  }
+
+  GDALRasterBand* band = ds->GetRasterBand(1);
+  info.vertical_unit = band->GetUnitType() != nullptr ? band->GetUnitType() : "";
+  const double unit = MetresPerHeightUnit(info.vertical_unit);
+  if (unit == 0) {
+    return bad(absl::StrCat("height unit '", info.vertical_unit, "' is not m, ft or US survey foot"));
+  }
+  int has_scale = 0, has_offset = 0, has_nodata = 0;
+  double scale = band->GetScale(&has_scale), offset = band->GetOffset(&has_offset);
+  if (!has_scale) scale = 1;
+  if (!has_offset) offset = 0;
+  info.vertical_scale = unit * scale;
+  const double nodata = band->GetNoDataValue(&has_nodata);
+
+  // Vertices: the used cells with data, row by row (one file row read at a time).
+  const uint32_t W = info.grid_width, H = info.grid_height;
+  dem.vertex_of_cell_.assign(size_t{W} * H, kNoVertex);
+  std::vector<double> row(info.raster_width);
+  std::vector<double> xs, ys;
+  uint32_t next = 0;
+  for (uint32_t j = 0; j < H; ++j) {
+    if (band->RasterIO(GF_Read, 0, static_cast<int>(j * options.step), info.raster_width, 1,
+                       row.data(), info.raster_width, 1, GDT_Float64, 0, 0) != CE_None) {
+      return bad(absl::StrCat("read error (", QuietGdal::LastMessage(), ")"));
+    }
+    for (uint32_t i = 0; i < W; ++i) {
+      const double raw = row[size_t{i} * options.step];
+      if (!std::isfinite(raw) || (has_nodata && raw == nodata)) {
+        ++info.nodata_cells;
+        continue;
+      }
+      dem.vertex_of_cell_[size_t{j} * W + i] = next++;
+      const double px = (i + 0.5) * info.geotransform[1] + info.geotransform[0];
+      const double py = (j + 0.5) * info.geotransform[5] + info.geotransform[3];
+      xs.push_back(px);
+      ys.push_back(py);
+      dem.mesh_.positions.insert(dem.mesh_.positions.end(),
+                                 {px * info.horizontal_scale, py * info.horizontal_scale,
+                                  (raw * scale + offset) * unit});
+    }
+  }
+  if (to_mesh != nullptr && next > 0) {
+    std::vector<int> ok(next);
+    if (!to_mesh->Transform(static_cast<int>(next), xs.data(), ys.data(), nullptr, ok.data()) ||
+        std::find(ok.begin(), ok.end(), 0) != ok.end()) {
+      return bad(absl::StrCat("cannot project the cells to ", info.mesh_crs_name));
+    }
+    for (uint32_t v = 0; v < next; ++v) {
+      dem.mesh_.positions[3 * size_t{v}] = xs[v];
+      dem.mesh_.positions[3 * size_t{v} + 1] = ys[v];
+    }
+  }
+
+  // Faces: per block, corners a (i, j), b (i+1, j), c (i, j+1), d (i+1, j+1), split along a-d:
+  // (a, c, d) and (a, d, b), counter-clockwise seen from above when rows run south (gt[5] < 0).
+  const bool flip = gt[1] * gt[5] > 0;  // rows run north: mirror the winding
+  dem.face_of_block_.assign(2 * size_t{W - 1} * (H - 1), kNoVertex);
+  for (uint32_t j = 0; j + 1 < H; ++j) {
+    for (uint32_t i = 0; i + 1 < W; ++i) {
+      const uint32_t a = dem.VertexAt(i, j), b = dem.VertexAt(i + 1, j);
+      const uint32_t c = dem.VertexAt(i, j + 1), d = dem.VertexAt(i + 1, j + 1);
+      const std::array<std::array<uint32_t, 3>, 2> tris = {{{a, c, d}, {a, d, b}}};
+      for (int k = 0; k < 2; ++k) {
+        std::array<uint32_t, 3> t = tris[k];
+        if (t[0] == kNoVertex || t[1] == kNoVertex || t[2] == kNoVertex) continue;
+        if (flip) std::swap(t[1], t[2]);
+        dem.face_of_block_[2 * (size_t{j} * (W - 1) + i) + k] =
+            static_cast<uint32_t>(dem.mesh_.face_count());
+        dem.mesh_.faces.insert(dem.mesh_.faces.end(), t.begin(), t.end());
+      }
+    }
+  }
+  if (dem.mesh_.faces.empty()) return bad("no 2x2 block of cells with data: nothing to triangulate");
+  return dem;
+}
+
+absl::StatusOr<SurfacePoint> Dem::DropMapPoint(double x, double y) const {
+  return DropNamed(x, y, absl::StrFormat("g:%.17g:%.17g", x, y));
+}
+
+absl::StatusOr<SurfacePoint> Dem::DropNamed(double x, double y, const std::string& name) const {
+  const std::array<double, 6>& gt = info_.geotransform;
+  const double u = (x - gt[0]) / gt[1] - 0.5, v = (y - gt[3]) / gt[5] - 0.5;
+  double mx = x * info_.horizontal_scale, my = y * info_.horizontal_scale;
+  if (info_.reprojected) {
+    QuietGdal quiet;
+    OGRSpatialReference file_crs, utm;
+    file_crs.importFromWkt(info_.file_crs_wkt.c_str());
+    utm.importFromWkt(info_.mesh_crs_wkt.c_str());
+    file_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    utm.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    TransformPtr t = MakeTransform(file_crs, utm);
+    if (t == nullptr || !t->Transform(1, &mx, &my)) {
+      return absl::InvalidArgumentError(absl::StrCat(name, ": cannot project it (",
+                                                     QuietGdal::LastMessage(), ")"));
+    }
+  }
+  return DropMeshPoint(mx, my, u, v, name);
+}
+
+absl::StatusOr<SurfacePoint> Dem::DropLonLat(double lon, double lat) const {
+  const std::string name = absl::StrFormat("ll:%.17g:%.17g", lon, lat);
+  if (!(std::abs(lon) <= 180 && std::abs(lat) <= 90)) {
+    return absl::InvalidArgumentError(absl::StrCat(name, ": longitude must be in [-180, 180] and latitude in [-90, 90]"));
+  }
+  QuietGdal quiet;
+  OGRSpatialReference wgs84, file_crs;
+  wgs84.SetWellKnownGeogCS("WGS84");
+  wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  file_crs.importFromWkt(info_.file_crs_wkt.c_str());
+  file_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  TransformPtr t = MakeTransform(wgs84, file_crs);
+  double x = lon, y = lat;
+  if (t == nullptr || !t->Transform(1, &x, &y)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(name, ": cannot project it to the DEM's CRS (", QuietGdal::LastMessage(), ")"));
+  }
+  return DropNamed(x, y, name);
+}
+
+absl::StatusOr<SurfacePoint> Dem::DropMeshPoint(double mx, double my, double u, double v,
+                                               const std::string& name) const {
+  const uint32_t W = info_.grid_width, H = info_.grid_height;
+  constexpr double kEdge = 1e-9;  // grid units: a point on the outer boundary is inside
+  if (!(u >= -kEdge && u <= W - 1 + kEdge && v >= -kEdge && v <= H - 1 + kEdge)) {
+    return absl::InvalidArgumentError(absl::StrCat(name, ": outside the DEM"));
+  }
+  const int bi = std::clamp(static_cast<int>(std::floor(u)), 0, static_cast<int>(W) - 2);
+  const int bj = std::clamp(static_cast<int>(std::floor(v)), 0, static_cast<int>(H) - 2);
+  // The point's block first, then its neighbours (a reprojected grid is not exactly affine).
+  uint32_t best_face = kNoVertex;
+  std::array<double, 3> best{};
+  double best_min = -std::numeric_limits<double>::infinity();
+  for (int dj = 0; dj <= 2; ++dj) {
+    for (int di = 0; di <= 2; ++di) {
+      const int i = bi + (di == 2 ? -1 : di == 1 ? 1 : 0), j = bj + (dj == 2 ? -1 : dj == 1 ? 1 : 0);
+      if (i < 0 || j < 0 || i > static_cast<int>(W) - 2 || j > static_cast<int>(H) - 2) continue;
+      if ((di != 0 || dj != 0) && !info_.reprojected) continue;
+      for (int k = 0; k < 2; ++k) {
+        const uint32_t f = face_of_block_[2 * (size_t(j) * (W - 1) + i) + k];
+        if (f == kNoVertex) continue;
+        const double* p[3];
+        for (int c = 0; c < 3; ++c) p[c] = &mesh_.positions[3 * size_t{mesh_.faces[3 * size_t{f} + c]}];
+        // Barycentrics of (mx, my) in the face's projection onto the map plane.
+        const double det = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) -
+                           (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]);
+        if (det == 0) continue;
+        const double b1 = ((mx - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (my - p[0][1])) / det;
+        const double b2 = ((p[1][0] - p[0][0]) * (my - p[0][1]) - (mx - p[0][0]) * (p[1][1] - p[0][1])) / det;
+        const std::array<double, 3> b = {1 - b1 - b2, b1, b2};
+        const double lowest = std::min({b[0], b[1], b[2]});
+        if (lowest > best_min) {
+          best_min = lowest;
+          best = b;
+          best_face = f;
+        }
+      }
+    }
+  }
+  if (best_face == kNoVertex || best_min < -1e-7) {
+    return absl::InvalidArgumentError(absl::StrCat(name, ": in a nodata hole of the DEM"));
+  }
+  double sum = 0;
+  for (double& b : best) sum += (b = b > 0 ? b : 0.0);  // also turns -0 into 0
+  return SurfacePoint::InFace(best_face, best[0] / sum, best[1] / sum, best[2] / sum);
+}
+
+namespace {
+
+absl::Status WriteRaster(const DemInfo& info, const std::vector<uint32_t>& vertex_of_cell,
+                         const std::string& path, GDALDataType type,
+                         const std::function<double(uint32_t)>& value_of_vertex) {
+  QuietGdal quiet;
+  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GTiff");
+  if (driver == nullptr) return absl::InternalError("GDAL has no GTiff driver");
+  const char* create_options[] = {"COMPRESS=DEFLATE", "TILED=YES", nullptr};
+  GDALDatasetUniquePtr ds(driver->Create(path.c_str(), static_cast<int>(info.grid_width),
+                                         static_cast<int>(info.grid_height), 1, type,
+                                         const_cast<char**>(create_options)));
+  auto failed = [&] {
+    return absl::PermissionDeniedError(absl::StrCat("cannot write ", path, ": ", QuietGdal::LastMessage()));
+  };
+  if (ds == nullptr) return failed();
+  double gt[6];
+  std::copy(info.geotransform.begin(), info.geotransform.end(), gt);
+  ds->SetGeoTransform(gt);
+  OGRSpatialReference crs;
+  crs.importFromWkt(info.file_crs_wkt.c_str());
+  ds->SetSpatialRef(&crs);
+  GDALRasterBand* band = ds->GetRasterBand(1);
+  band->SetNoDataValue(-1);
+  std::vector<double> row(info.grid_width);
+  for (uint32_t j = 0; j < info.grid_height; ++j) {
+    for (uint32_t i = 0; i < info.grid_width; ++i) {
+      const uint32_t v = vertex_of_cell[size_t{j} * info.grid_width + i];
+      row[i] = v == kNoVertex ? -1 : value_of_vertex(v);
+    }
+    if (band->RasterIO(GF_Write, 0, static_cast<int>(j), static_cast<int>(info.grid_width), 1,
+                       row.data(), static_cast<int>(info.grid_width), 1, GDT_Float64, 0, 0) != CE_None) {
+      return failed();
+    }
+  }
+  ds->FlushCache(true);
+  ds.reset();  // closes the file: a late write error shows in GDAL's last error
+  if (CPLGetLastErrorType() >= CE_Failure) return failed();
+  return absl::OkStatus();
+}
+
+}  // namespace
+
+absl::Status Dem::WriteFloatRaster(const std::string& path, const std::vector<double>& values) const {
+  if (values.size() < mesh_.vertex_count()) return absl::InternalError("one value per vertex expected");
+  return WriteRaster(info_, vertex_of_cell_, path, GDT_Float32, [&](uint32_t v) {
+    return std::isfinite(values[v]) ? values[v] : -1.0;
+  });
+}
+
+absl::Status Dem::WriteIndexRaster(const std::string& path, const std::vector<uint32_t>& values) const {
+  if (values.size() < mesh_.vertex_count()) return absl::InternalError("one value per vertex expected");
+  return WriteRaster(info_, vertex_of_cell_, path, GDT_Int32, [&](uint32_t v) {
+    return values[v] >= 0x80000000u ? -1.0 : static_cast<double>(values[v]);
+  });
+}
+
+}  // namespace geodex::terrain

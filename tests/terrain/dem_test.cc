@@ -1,0 +1,338 @@
+// DEMs as meshes (terrain/include/geodex/terrain.h): fixtures are made at test time with GDAL in a
+// temporary directory; answers are analytic (geodesics on a plane are straight lines, and around a
+// polygonal hole they are taut strings through its corners).
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "gdal_priv.h"
+#include "geodex/distance_matrix.h"
+#include "geodex/geodesic_solver.h"
+#include "geodex/terrain.h"
+#include "geodex/triangle_mesh.h"
+#include "gtest/gtest.h"
+#include "ogr_spatialref.h"
+
+namespace geodex::terrain {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Grid {
+  int epsg = 32633;
+  double x0 = 500000, y0 = 5000000;  // the top-left corner
+  double dx = 10, dy = 10;           // pixel size (rows run south)
+  int width = 40, height = 30;
+  std::function<double(double x, double y, int col, int row)> height_at;
+  bool has_nodata = false;
+  double nodata = -9999;
+  std::string unit;
+};
+
+class DemTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    GDALAllRegister();
+    dir_ = fs::path(::testing::TempDir()) /
+           absl::StrCat("geodex-dem-", ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string Write(const std::string& name, const Grid& g) {
+    const std::string path = (dir_ / name).string();
+    GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GTiff");
+    GDALDataset* ds = driver->Create(path.c_str(), g.width, g.height, 1, GDT_Float64, nullptr);
+    double gt[6] = {g.x0, g.dx, 0, g.y0, 0, -g.dy};
+    ds->SetGeoTransform(gt);
+    OGRSpatialReference srs;
+    srs.importFromEPSG(g.epsg);
+    ds->SetSpatialRef(&srs);
+    GDALRasterBand* band = ds->GetRasterBand(1);
+    if (g.has_nodata) band->SetNoDataValue(g.nodata);
+    if (!g.unit.empty()) band->SetUnitType(g.unit.c_str());
+    std::vector<double> row(g.width);
+    for (int j = 0; j < g.height; ++j) {
+      for (int i = 0; i < g.width; ++i) {
+        row[i] = g.height_at(g.x0 + (i + 0.5) * g.dx, g.y0 - (j + 0.5) * g.dy, i, j);
+      }
+      EXPECT_EQ(band->RasterIO(GF_Write, 0, j, g.width, 1, row.data(), g.width, 1, GDT_Float64, 0, 0),
+                CE_None);
+    }
+    GDALClose(ds);
+    return path;
+  }
+
+  fs::path dir_;
+};
+
+// The tilted plane z = 0.1 (x - 500000) + 0.2 (y - 4999700).
+double Plane(double x, double y) { return 0.1 * (x - 500000) + 0.2 * (y - 4999700); }
+
+std::array<double, 3> PositionOf(const MeshData& mesh, const SurfacePoint& p) {
+  std::array<double, 3> out{};
+  for (int c = 0; c < 3; ++c) {
+    const uint32_t v = mesh.faces[3 * size_t{p.face} + c];
+    for (int k = 0; k < 3; ++k) out[k] += p.bary[c] * mesh.positions[3 * size_t{v} + k];
+  }
+  return out;
+}
+
+double Dist(const std::array<double, 3>& a, const std::array<double, 3>& b) {
+  return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+}
+
+TEST_F(DemTest, ProjectedPlaneIsItsOwnGridAndGeodesicsAreStraight) {
+  Grid g;
+  g.height_at = [](double x, double y, int, int) { return Plane(x, y); };
+  absl::StatusOr<Dem> dem = Dem::Read(Write("plane.tif", g));
+  ASSERT_TRUE(dem.ok()) << dem.status();
+  const DemInfo& info = dem->info();
+  EXPECT_EQ(info.grid_width, 40u);
+  EXPECT_EQ(info.grid_height, 30u);
+  EXPECT_EQ(info.nodata_cells, 0u);
+  EXPECT_FALSE(info.reprojected);
+  EXPECT_NE(info.file_crs_name.find("UTM zone 33N"), std::string::npos) << info.file_crs_name;
+  EXPECT_EQ(dem->mesh().vertex_count(), 40u * 30u);
+  EXPECT_EQ(dem->mesh().face_count(), 2u * 39u * 29u);
+  // Vertex (i, j) sits at the cell centre, at the cell's height.
+  const uint32_t v = dem->VertexAt(7, 11);
+  EXPECT_DOUBLE_EQ(dem->mesh().positions[3 * v], 500075);
+  EXPECT_DOUBLE_EQ(dem->mesh().positions[3 * v + 1], 5000000 - 115);
+  EXPECT_DOUBLE_EQ(dem->mesh().positions[3 * v + 2], Plane(500075, 4999885));
+
+  absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(dem->mesh());
+  ASSERT_TRUE(mesh.ok());
+  EXPECT_EQ(mesh->report().flipped_faces, 0u);  // every face wound the same way
+  // Map points (not on vertices) dropped vertically: on the plane, at their x and y.
+  const std::vector<std::array<double, 2>> xy = {{500013.3, 4999981.7}, {500301.9, 4999722.2},
+                                                 {500390, 4999900}, {500150.5, 4999850.5}};
+  std::vector<SurfacePoint> points;
+  for (const auto& [x, y] : xy) {
+    absl::StatusOr<SurfacePoint> p = dem->DropMapPoint(x, y);
+    ASSERT_TRUE(p.ok()) << p.status();
+    const std::array<double, 3> at = PositionOf(dem->mesh(), *p);
+    EXPECT_NEAR(at[0], x, 1e-8);
+    EXPECT_NEAR(at[1], y, 1e-8);
+    EXPECT_NEAR(at[2], Plane(x, y), 1e-8);
+    points.push_back(*p);
+  }
+  absl::StatusOr<std::vector<std::pair<double, uint32_t>>> d =
+      ComputeExactDistancesAt(*mesh, {points[0]}, points);
+  ASSERT_TRUE(d.ok()) << d.status();
+  for (size_t k = 0; k < points.size(); ++k) {
+    const std::array<double, 3> a = {xy[0][0], xy[0][1], Plane(xy[0][0], xy[0][1])};
+    const std::array<double, 3> b = {xy[k][0], xy[k][1], Plane(xy[k][0], xy[k][1])};
+    EXPECT_NEAR((*d)[k].first, Dist(a, b), 1e-9 * 500) << k;
+  }
+}
+
+// The same plane on a longitude/latitude grid: the mesh is in the UTM zone of the centre (33N),
+// where each cell centre is given the plane's height at its UTM position, so the surface is that
+// plane again and distances are the straight-line ones, in metres.
+TEST_F(DemTest, GeographicGridIsProjectedToUtmInMetres) {
+  OGRSpatialReference wgs84, utm;
+  wgs84.importFromEPSG(4326);
+  wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  utm.importFromEPSG(32633);
+  utm.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  OGRCoordinateTransformation* to_utm = OGRCreateCoordinateTransformation(&wgs84, &utm);
+  ASSERT_NE(to_utm, nullptr);
+  auto utm_of = [&](double lon, double lat) {
+    double x = lon, y = lat;
+    EXPECT_TRUE(to_utm->Transform(1, &x, &y));
+    return std::array<double, 2>{x, y};
+  };
+  Grid g;
+  g.epsg = 4326;
+  g.x0 = 14.99;
+  g.y0 = 45.16;
+  g.dx = g.dy = 0.0002;  // about 16 by 22 m
+  g.width = 40;
+  g.height = 35;
+  g.height_at = [&](double lon, double lat, int, int) {
+    const auto [x, y] = utm_of(lon, lat);
+    return Plane(x, y);
+  };
+  absl::StatusOr<Dem> dem = Dem::Read(Write("geo.tif", g));
+  ASSERT_TRUE(dem.ok()) << dem.status();
+  EXPECT_TRUE(dem->info().reprojected);
+  EXPECT_NE(dem->info().mesh_crs_name.find("UTM zone 33N"), std::string::npos)
+      << dem->info().mesh_crs_name;
+  absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(dem->mesh());
+  ASSERT_TRUE(mesh.ok());
+  const std::vector<std::array<double, 2>> ll = {
+      {14.99131, 45.15873}, {14.99711, 45.15412}, {14.9977, 45.1581}, {14.9912, 45.1538}};
+  std::vector<SurfacePoint> points;
+  std::vector<std::array<double, 3>> expected;
+  for (const auto& [lon, lat] : ll) {
+    absl::StatusOr<SurfacePoint> p = dem->DropLonLat(lon, lat);
+    ASSERT_TRUE(p.ok()) << p.status();
+    points.push_back(*p);
+    const auto [x, y] = utm_of(lon, lat);
+    expected.push_back({x, y, Plane(x, y)});
+    const std::array<double, 3> at = PositionOf(dem->mesh(), *p);
+    EXPECT_NEAR(at[0], x, 1e-6);
+    EXPECT_NEAR(at[1], y, 1e-6);
+  }
+  OGRCoordinateTransformation::DestroyCT(to_utm);
+  absl::StatusOr<std::vector<std::pair<double, uint32_t>>> d =
+      ComputeExactDistancesAt(*mesh, {points[0]}, points);
+  ASSERT_TRUE(d.ok()) << d.status();
+  for (size_t k = 1; k < points.size(); ++k) {
+    const double want = Dist(expected[0], expected[k]);
+    EXPECT_GT(want, 300);
+    // The cell centres lie on the plane exactly; the surface between them is that plane.
+    EXPECT_NEAR((*d)[k].first, want, 1e-6) << k;
+  }
+}
+
+// A slot of nodata cells (columns 14-15, rows 5 to the bottom edge) on flat ground: the shortest
+// path from one side to the other goes over the slot's top, a taut string through its corners.
+TEST_F(DemTest, NodataHoleIsGoneAround) {
+  Grid g;
+  g.width = g.height = 30;
+  g.has_nodata = true;
+  g.height_at = [&](double, double, int col, int row) {
+    return (col == 14 || col == 15) && row >= 5 ? g.nodata : 0.0;
+  };
+  absl::StatusOr<Dem> dem = Dem::Read(Write("slot.tif", g));
+  ASSERT_TRUE(dem.ok()) << dem.status();
+  EXPECT_EQ(dem->info().nodata_cells, 2u * 25u);
+  EXPECT_EQ(dem->VertexAt(14, 5), kNoVertex);
+  absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(dem->mesh());
+  ASSERT_TRUE(mesh.ok());
+  auto centre = [&](double col, double row) {
+    return std::array<double, 3>{g.x0 + (col + 0.5) * g.dx, g.y0 - (row + 0.5) * g.dy, 0};
+  };
+  const std::array<double, 3> a = centre(10, 15), b = centre(20, 15);
+  absl::StatusOr<SurfacePoint> pa = dem->DropMapPoint(a[0], a[1]);
+  absl::StatusOr<SurfacePoint> pb = dem->DropMapPoint(b[0], b[1]);
+  ASSERT_TRUE(pa.ok() && pb.ok());
+  absl::StatusOr<std::vector<std::pair<double, uint32_t>>> d =
+      ComputeExactDistancesAt(*mesh, {*pa}, {*pb});
+  ASSERT_TRUE(d.ok()) << d.status();
+  // Over the top: the left edge's top (13, 4), the top edge to (15, 4), and the cut corner (16, 5)
+  // (block (15, 4) keeps its triangle (15,4)-(16,5)-(16,4)).
+  const double want = Dist(a, centre(13, 4)) + Dist(centre(13, 4), centre(15, 4)) +
+                      Dist(centre(15, 4), centre(16, 5)) + Dist(centre(16, 5), b);
+  EXPECT_NEAR((*d)[0].first, want, 1e-9 * want);
+  EXPECT_GT((*d)[0].first, 2.5 * Dist(a, b));
+  // A point in the slot, and one outside the grid, are errors naming them.
+  absl::StatusOr<SurfacePoint> in_hole = dem->DropMapPoint(centre(14.5, 20)[0], centre(14.5, 20)[1]);
+  EXPECT_EQ(in_hole.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(in_hole.status().message().find("nodata hole"), std::string::npos) << in_hole.status();
+  absl::StatusOr<SurfacePoint> outside = dem->DropMapPoint(g.x0 - 1, g.y0 - 100);
+  EXPECT_NE(outside.status().message().find("outside the DEM"), std::string::npos)
+      << outside.status();
+  EXPECT_NE(outside.status().message().find("g:499999:"), std::string::npos) << outside.status();
+}
+
+TEST_F(DemTest, RastersOutAreAlignedWithTheGridAndMarkNodata) {
+  Grid g;
+  g.width = 21;
+  g.height = 17;
+  g.has_nodata = true;
+  g.height_at = [&](double x, double y, int col, int row) {
+    return col == 5 && row == 6 ? g.nodata : Plane(x, y);
+  };
+  for (uint32_t step : {1u, 2u}) {
+    absl::StatusOr<Dem> dem = Dem::Read(Write("out.tif", g), DemOptions{step});
+    ASSERT_TRUE(dem.ok()) << dem.status();
+    std::vector<double> values(dem->mesh().vertex_count());
+    std::vector<uint32_t> labels(values.size());
+    for (size_t v = 0; v < values.size(); ++v) {
+      values[v] = dem->mesh().positions[3 * v] - 500000;  // the cell centre's x, offset
+      labels[v] = v % 3 == 0 ? 0xffffffffu : static_cast<uint32_t>(v % 5);
+    }
+    values[1] = std::numeric_limits<double>::infinity();  // unreachable
+    const std::string dist = (dir_ / "d.tif").string(), lab = (dir_ / "l.tif").string();
+    ASSERT_TRUE(dem->WriteFloatRaster(dist, values).ok());
+    ASSERT_TRUE(dem->WriteIndexRaster(lab, labels).ok());
+    GDALDataset* ds = static_cast<GDALDataset*>(GDALOpen(dist.c_str(), GA_ReadOnly));
+    ASSERT_NE(ds, nullptr);
+    EXPECT_EQ(ds->GetRasterXSize(), static_cast<int>(dem->info().grid_width));
+    EXPECT_EQ(ds->GetRasterYSize(), static_cast<int>(dem->info().grid_height));
+    EXPECT_EQ(ds->GetRasterBand(1)->GetRasterDataType(), GDT_Float32);
+    double gt[6];
+    ASSERT_EQ(ds->GetGeoTransform(gt), CE_None);
+    for (int k = 0; k < 6; ++k) EXPECT_DOUBLE_EQ(gt[k], dem->info().geotransform[k]) << k;
+    const OGRSpatialReference file_crs(dem->info().file_crs_wkt.c_str());
+    EXPECT_TRUE(ds->GetSpatialRef() != nullptr && ds->GetSpatialRef()->IsSame(&file_crs));
+    std::vector<double> read(size_t{dem->info().grid_width} * dem->info().grid_height);
+    ASSERT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, dem->info().grid_width,
+                                             dem->info().grid_height, read.data(),
+                                             dem->info().grid_width, dem->info().grid_height,
+                                             GDT_Float64, 0, 0),
+              CE_None);
+    GDALClose(ds);
+    for (uint32_t j = 0; j < dem->info().grid_height; ++j) {
+      for (uint32_t i = 0; i < dem->info().grid_width; ++i) {
+        const uint32_t v = dem->VertexAt(i, j);
+        const double got = read[size_t{j} * dem->info().grid_width + i];
+        // The pixel's centre, by the output's own geotransform, is the vertex's x.
+        const double centre_x = gt[0] + (i + 0.5) * gt[1] - 500000;
+        if (v == kNoVertex || v == 1) {
+          EXPECT_EQ(got, -1) << i << "," << j;
+        } else {
+          EXPECT_NEAR(got, centre_x, 1e-3) << i << "," << j;
+        }
+      }
+    }
+    if (step == 1) {
+      EXPECT_EQ(dem->VertexAt(5, 6), kNoVertex);
+    }
+    GDALDataset* ls = static_cast<GDALDataset*>(GDALOpen(lab.c_str(), GA_ReadOnly));
+    ASSERT_NE(ls, nullptr);
+    EXPECT_EQ(ls->GetRasterBand(1)->GetRasterDataType(), GDT_Int32);
+    int32_t first = 0;
+    ASSERT_EQ(ls->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, 1, 1, &first, 1, 1, GDT_Int32, 0, 0),
+              CE_None);
+    EXPECT_EQ(first, -1);  // vertex 0: no label
+    GDALClose(ls);
+  }
+}
+
+TEST_F(DemTest, BadRastersAreClearErrors) {
+  Grid g;
+  g.height_at = [](double, double, int, int) { return 1.0; };
+  const std::string ok = Write("ok.tif", g);
+  // No CRS.
+  {
+    const std::string path = (dir_ / "nocrs.tif").string();
+    GDALDataset* ds =
+        GetGDALDriverManager()->GetDriverByName("GTiff")->Create(path.c_str(), 4, 4, 1, GDT_Float32, nullptr);
+    double gt[6] = {0, 1, 0, 0, 0, -1};
+    ds->SetGeoTransform(gt);
+    GDALClose(ds);
+    absl::StatusOr<Dem> dem = Dem::Read(path);
+    EXPECT_EQ(dem.status().code(), absl::StatusCode::kInvalidArgument);
+    EXPECT_NE(dem.status().message().find("no coordinate reference system"), std::string::npos)
+        << dem.status();
+  }
+  // Not a raster, missing, too coarse a step, an unknown height unit.
+  std::ofstream(dir_ / "junk.tif") << "not a tiff";
+  EXPECT_EQ(Dem::Read((dir_ / "junk.tif").string()).status().code(),
+            absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(Dem::Read((dir_ / "missing.tif").string()).status().code(),
+            absl::StatusCode::kNotFound);
+  absl::StatusOr<Dem> coarse = Dem::Read(ok, DemOptions{40});
+  EXPECT_NE(coarse.status().message().find("at least 2x2"), std::string::npos) << coarse.status();
+  g.unit = "furlong";
+  absl::StatusOr<Dem> odd = Dem::Read(Write("odd.tif", g));
+  EXPECT_NE(odd.status().message().find("furlong"), std::string::npos) << odd.status();
+  // Feet are converted to metres.
+  g.unit = "ft";
+  absl::StatusOr<Dem> feet = Dem::Read(Write("feet.tif", g));
+  ASSERT_TRUE(feet.ok()) << feet.status();
+  EXPECT_DOUBLE_EQ(feet->mesh().positions[2], 0.3048);
+}
+
+}  // namespace
+}  // namespace geodex::terrain
