@@ -46,7 +46,7 @@ TEST_F(LifecycleTest, ErrorsCarryBadRequestAndErrorInfoDetails) {
   ASSERT_TRUE(details.details(0).UnpackTo(&bad_request));
   ASSERT_EQ(bad_request.field_violations_size(), 1);
   EXPECT_EQ(bad_request.field_violations(0).field(), "sources[1].vertex");
-  EXPECT_NE(bad_request.field_violations(0).description().find("out of range"), std::string::npos);
+  EXPECT_NE(bad_request.field_violations(0).description().find("vertex 99 does not exist"), std::string::npos);
 
   s = ReadField(*stub_, FieldRequest(up.mesh.name(), {0, 1, 2}), 30).status;
   ASSERT_EQ(s.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
