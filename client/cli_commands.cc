@@ -204,6 +204,8 @@ int OpenMesh(Backend& backend, const Args& args, const std::string& mesh,
   if (!GetUint(args, "dem-step", &step, &error)) return Fail(kExitUsage, error);
   if (step < 1 || step > 1000000) return Fail(kExitUsage, "--dem-step must be in [1, 1000000]");
   dem.step = static_cast<uint32_t>(step);
+  if (!GetDouble(args, "barrier-below", &dem.barrier_below, &error)) return Fail(kExitUsage, error);
+  if (std::isnan(dem.barrier_below)) return Fail(kExitUsage, "--barrier-below must be a number");
   if (step != 1 && !terrain::IsDemPath(mesh)) {
     return Fail(kExitUsage, absl::StrCat("--dem-step: ", mesh, " is not a DEM (a raster such as .tif)"));
   }

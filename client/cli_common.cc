@@ -54,8 +54,7 @@ int Fail(int code, const std::string& message) {
 absl::StatusOr<MeshData> LoadMeshData(const std::string& path,
                                       const terrain::DemOptions& dem_options,
                                       std::shared_ptr<const terrain::Dem>* dem) {
-  if (path.rfind("sample:", 0) == 0) return MakeSampleMesh(path);
-  if (terrain::IsDemPath(path)) {
+  if (terrain::IsDemPath(path) && path.rfind("sample:", 0) != 0) {
     absl::StatusOr<terrain::Dem> read = terrain::Dem::Read(path, dem_options);
     if (!read.ok()) return read.status();
     auto shared = std::make_shared<const terrain::Dem>(*std::move(read));
@@ -63,11 +62,12 @@ absl::StatusOr<MeshData> LoadMeshData(const std::string& path,
     if (dem != nullptr) *dem = std::move(shared);
     return data;
   }
-  if (dem_options.step != 1) {
-    return absl::InvalidArgumentError(absl::StrCat("--dem-step: ", path, " is not a DEM (a raster such as .tif)"));
-  }
-  absl::StatusOr<MeshData> data = ReadMeshFile(path);
+  absl::StatusOr<MeshData> data =
+      path.rfind("sample:", 0) == 0 ? MakeSampleMesh(path) : ReadMeshFile(path);
   if (!data.ok()) return data.status();
+  if (std::isfinite(dem_options.barrier_below)) {
+    return terrain::RemoveFacesBelow(*data, dem_options.barrier_below);
+  }
   return data;
 }
 
@@ -108,7 +108,8 @@ bool GetUint(const Args& args, const std::string& key, uint64_t* out, std::strin
 
 bool CheckKnown(const Args& args, const std::set<std::string>& known, std::string* error) {
   for (const auto& [key, value] : args.options) {
-    if (!known.count(key) && key != "dem-step") {  // --dem-step: how every MESH is read (OpenMesh)
+    // --dem-step and --barrier-below: how every MESH is read (OpenMesh).
+    if (!known.count(key) && key != "dem-step" && key != "barrier-below") {
       *error = absl::StrFormat("unknown option --%s (see geodex --help)", key);
       return false;
     }
@@ -233,6 +234,7 @@ std::string FormatInfo(const InfoValues& v, bool json) {
   if (v.dem != nullptr) {
     const terrain::DemInfo& d = *v.dem;
     dem_rows = {
+        {"barrier_cells", absl::StrFormat("%d", d.barrier_cells)},
         {"crs", d.file_crs_name},
         {"mesh_crs", d.mesh_crs_name},
         {"units", "m"},
@@ -261,7 +263,7 @@ std::string FormatInfo(const InfoValues& v, bool json) {
   }
   for (const auto& [k, value] : dem_rows) {
     const bool pair = k == "raster" || k == "grid";
-    const bool number = k == "dem_step" || k == "nodata_cells";
+    const bool number = k == "dem_step" || k == "nodata_cells" || k == "barrier_cells";
     out += absl::StrFormat(", \"%s\": %s", k,
                            pair     ? absl::StrCat("[", absl::StrJoin(absl::StrSplit(value, ' '), ", "), "]")
                            : number ? value

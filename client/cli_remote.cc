@@ -96,8 +96,15 @@ class RemoteBackend final : public Backend {
     mesh_arg_ = mesh;
     std::error_code ec;
     absl::StatusOr<MeshRef> ref;
-    if (terrain::IsDemPath(mesh) && std::filesystem::exists(mesh, ec)) {
-      // geodexd reads meshes, not rasters (yet): the DEM is triangulated here and uploaded.
+    const bool barrier = std::isfinite(dem_options.barrier_below);
+    const bool here = std::filesystem::exists(mesh, ec) || mesh.rfind("sample:", 0) == 0;
+    if (barrier && !here) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          "--barrier-below: ", mesh, " must be a file or a sample (the barrier is applied here)"));
+    }
+    if ((terrain::IsDemPath(mesh) || barrier) && here) {
+      // geodexd reads meshes, not rasters (yet): a DEM is triangulated here, a barrier applied
+      // here, and the mesh they make uploaded (by its content's id, like any other).
       absl::StatusOr<MeshData> data = LoadMeshData(mesh, dem_options, &dem_);
       if (!data.ok()) return data.status();
       ref = client_->ResolveMeshData(std::filesystem::path(mesh).stem().string() + ".off", *data);

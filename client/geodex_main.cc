@@ -22,8 +22,12 @@ constexpr char kUsage[] = R"(geodex - exact geodesic distances on triangle meshe
 
 usage: geodex [--server HOST:PORT] COMMAND MESH [options]
 
-MESH is a mesh file (OFF, OBJ, PLY, STL, optionally .gz) or a built-in sample:
-sample:terrain, sample:torus, sample:sphere.
+MESH is a mesh file (OFF, OBJ, PLY, STL, optionally .gz), a built-in sample (sample:terrain,
+sample:torus, sample:sphere), or a DEM: a raster GDAL reads (.tif, .tiff, .vrt, .asc, .img, .hgt,
+.dem, .bil, .nc), triangulated cell centre by cell centre, nodata cells left out, in metres (a
+longitude/latitude grid is projected to the UTM zone of its centre). --dem-step N uses every Nth
+cell (a quick look). --barrier-below Z (any MESH) removes what lies below Z (the sea at 0): a DEM's
+cells, a mesh's faces with a corner below Z; paths go around it, exactly, and beyond it is inf.
 
 Local by default; remote with --server HOST:PORT (or GEODEX_SERVER=HOST:PORT), plus --tls,
 --ca FILE (PEM roots; implies --tls) and --token-file FILE (or GEODEX_TOKEN) for a server with TLS
@@ -42,8 +46,11 @@ commands:
       saddle_vertices, bytes, ...). Reports on any readable mesh, valid or messy.
   distances MESH --sources SPEC [--method exact|ich|dijkstra] [--lambda L] [--lambda-scale max|mean]
                  [--max-distance D] [--max-windows N] [--stats] [--output FILE] [--format json]
-                 [--directions]
+                 [--directions] [--labels-output FILE.tif]
       One distance per vertex in the file's vertex order (%.17g; 'inf' if unreachable).
+      On a DEM, --output FILE.tif writes a float32 GeoTIFF aligned with the DEM's grid (same
+      geotransform and CRS; nodata -1 where unreachable or no data) and --labels-output
+      FILE.tif the nearest source's index (int32, nodata -1).
       --stats prints one JSON object with counters and times (*_ms) on stderr.
       --no-filter / --no-one-split switch off Lemma 2 / Lemma 1 (slower; same answer).
       --at SPEC: instead, one line per surface point: its unfolding estimate (paper section 4)
@@ -93,6 +100,9 @@ commands:
 
 SPEC: comma-separated points: 17 (vertex), e:V1:V2:T (the point (1-T)*V1 + T*V2 on an edge),
       f:FACE:B0:B1:B2 (barycentric in the face's vertex order as in the file),
+      g:X:Y and ll:LON:LAT (on a DEM: map coordinates in the DEM's CRS, or WGS 84 longitude and
+      latitude, dropped vertically onto the surface; outside the DEM or in a nodata hole is an
+      error naming the point),
       p:X:Y:Z (a 3D position, snapped to the nearest point of the surface). Snapping is never
       silent: --stats reports the farthest snap (snap_max), a snap beyond 1% of the mesh's
       diagonal is warned about on stderr, and --max-snap D (every command taking a SPEC)

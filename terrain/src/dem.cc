@@ -69,6 +69,21 @@ Dem::Dem(Dem&&) noexcept = default;
 Dem& Dem::operator=(Dem&&) noexcept = default;
 Dem::~Dem() = default;
 
+MeshData RemoveFacesBelow(const MeshData& mesh, double z) {
+  MeshData out;
+  out.positions = mesh.positions;
+  for (size_t f = 0; f < mesh.face_count(); ++f) {
+    bool keep = true;
+    for (int c = 0; c < 3; ++c) {
+      const size_t v = mesh.faces[3 * f + c];
+      // An out-of-range corner is kept for TriangleMesh::Build to report.
+      keep &= !(v < mesh.vertex_count() && mesh.positions[3 * v + 2] < z);
+    }
+    if (keep) out.faces.insert(out.faces.end(), &mesh.faces[3 * f], &mesh.faces[3 * f] + 3);
+  }
+  return out;
+}
+
 bool IsDemPath(const std::string& path) {
   std::string ext = absl::AsciiStrToLower(std::filesystem::path(path).extension().string());
   for (const char* known : {".tif", ".tiff", ".vrt", ".asc", ".img", ".hgt", ".dem", ".bil", ".nc"}) {
@@ -180,6 +195,10 @@ absl::StatusOr<Dem> Dem::Read(const std::string& path, const DemOptions& options
         ++info.nodata_cells;
         continue;
       }
+      if ((raw * scale + offset) * unit < options.barrier_below) {
+        ++info.barrier_cells;
+        continue;
+      }
       dem.vertex_of_cell_[size_t{j} * W + i] = next++;
       const double px = (i + 0.5) * info.geotransform[1] + info.geotransform[0];
       const double py = (j + 0.5) * info.geotransform[5] + info.geotransform[3];
@@ -221,7 +240,11 @@ absl::StatusOr<Dem> Dem::Read(const std::string& path, const DemOptions& options
       }
     }
   }
-  if (dem.mesh_.faces.empty()) return bad("no 2x2 block of cells with data: nothing to triangulate");
+  if (dem.mesh_.faces.empty()) {
+    return bad(info.barrier_cells > 0
+                   ? "no 2x2 block of cells above the barrier: nothing to triangulate"
+                   : "no 2x2 block of cells with data: nothing to triangulate");
+  }
   return dem;
 }
 

@@ -2,6 +2,7 @@
 // temporary directory; answers are analytic (geodesics on a plane are straight lines, and around a
 // polygonal hole they are taut strings through its corners).
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -232,6 +233,57 @@ TEST_F(DemTest, NodataHoleIsGoneAround) {
   EXPECT_NE(outside.status().message().find("outside the DEM"), std::string::npos)
       << outside.status();
   EXPECT_NE(outside.status().message().find("g:499999:"), std::string::npos) << outside.status();
+}
+
+// The same slot as sea (cells at -5 m) with a barrier below 0: the same detour, and the mesh file
+// rule (a face with a corner below the barrier is removed) agrees with the DEM's.
+TEST_F(DemTest, BarrierBelowIsGoneAroundLikeNodata) {
+  Grid g;
+  g.width = g.height = 30;
+  g.height_at = [&](double, double, int col, int row) {
+    return (col == 14 || col == 15) && row >= 5 ? -5.0 : 1.0;
+  };
+  const std::string path = Write("sea.tif", g);
+  DemOptions options;
+  options.barrier_below = 0;
+  absl::StatusOr<Dem> dem = Dem::Read(path, options);
+  ASSERT_TRUE(dem.ok()) << dem.status();
+  EXPECT_EQ(dem->info().barrier_cells, 50u);
+  EXPECT_EQ(dem->info().nodata_cells, 0u);
+  auto centre = [&](double col, double row) {
+    return std::array<double, 3>{g.x0 + (col + 0.5) * g.dx, g.y0 - (row + 0.5) * g.dy, 1};
+  };
+  const std::array<double, 3> a = centre(10, 15), b = centre(20, 15);
+  const double want = Dist(a, centre(13, 4)) + Dist(centre(13, 4), centre(15, 4)) +
+                      Dist(centre(15, 4), centre(16, 5)) + Dist(centre(16, 5), b);
+  absl::StatusOr<Dem> open = Dem::Read(path);  // no barrier: the sea is crossed
+  ASSERT_TRUE(open.ok());
+  const MeshData file_rule = RemoveFacesBelow(open->mesh(), 0);
+  EXPECT_EQ(file_rule.face_count(), dem->mesh().face_count());
+  for (const MeshData* data : {&dem->mesh(), &file_rule}) {
+    absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(*data);
+    ASSERT_TRUE(mesh.ok());
+    // The same map points on either mesh (faces keep their order among the kept ones).
+    absl::StatusOr<SurfacePoint> pa = dem->DropMapPoint(a[0], a[1]);
+    absl::StatusOr<SurfacePoint> pb = dem->DropMapPoint(b[0], b[1]);
+    ASSERT_TRUE(pa.ok() && pb.ok());
+    if (data == &file_rule) {  // vertex ids differ (the sea's vertices stay, isolated)
+      pa = open->DropMapPoint(a[0], a[1]);
+      pb = open->DropMapPoint(b[0], b[1]);
+      ASSERT_TRUE(pa.ok() && pb.ok());
+      // Faces are renumbered by the removal: find the kept face holding the same corners.
+      for (SurfacePoint* p : {&*pa, &*pb}) {
+        const uint32_t* corners = &open->mesh().faces[3 * size_t{p->face}];
+        for (size_t f = 0; f < file_rule.face_count(); ++f) {
+          if (std::equal(corners, corners + 3, &file_rule.faces[3 * f])) p->face = static_cast<uint32_t>(f);
+        }
+      }
+    }
+    absl::StatusOr<std::vector<std::pair<double, uint32_t>>> d =
+        ComputeExactDistancesAt(*mesh, {*pa}, {*pb});
+    ASSERT_TRUE(d.ok()) << d.status();
+    EXPECT_NEAR((*d)[0].first, want, 1e-9 * want);
+  }
 }
 
 TEST_F(DemTest, RastersOutAreAlignedWithTheGridAndMarkNodata) {

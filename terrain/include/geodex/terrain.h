@@ -15,6 +15,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -27,7 +28,14 @@ namespace geodex::terrain {
 
 struct DemOptions {
   uint32_t step = 1;  // use every step-th cell (a quick look at a large DEM)
+  // A barrier: cells lower than this (metres; the sea at 0) are left out like nodata, so paths
+  // go around them. -inf: none.
+  double barrier_below = -std::numeric_limits<double>::infinity();
 };
+
+// The faces of `mesh` with no corner lower than `z` (the same barrier on a mesh file: a face
+// with a corner below it is removed; vertices keep their ids).
+MeshData RemoveFacesBelow(const MeshData& mesh, double z);
 
 // What a DEM mesh knows about its map.
 struct DemInfo {
@@ -36,6 +44,7 @@ struct DemInfo {
   uint32_t step = 1;
   uint32_t grid_width = 0, grid_height = 0;      // the used cells
   uint64_t nodata_cells = 0;                     // used cells without data
+  uint64_t barrier_cells = 0;                    // used cells below DemOptions::barrier_below
   std::string file_crs_name;  // the file's CRS ("WGS 84 / UTM zone 33N", "WGS 84")
   std::string file_crs_wkt;
   bool reprojected = false;   // the file's CRS is geographic: the mesh is in mesh_crs

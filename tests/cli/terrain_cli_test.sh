@@ -1,0 +1,142 @@
+#!/usr/bin/env bash
+# geodex on DEMs, as a GIS user runs it: fixtures are GeoTIFFs made here with GDAL's Python
+# bindings (a tilted plane in UTM 33N, the same area on a longitude/latitude grid, a flat DEM
+# with a nodata slot); answers are analytic; rasters written are read back with GDAL.
+# Also run in remote mode (remote_mode.sh): the DEM is then triangulated here and uploaded.
+# Env: GEODEX (the binary).
+set -u
+pass=0
+fail=0
+check() {
+  local name="$1"
+  shift
+  if "$@"; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAIL: $name"; fi
+}
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+PY=/usr/bin/python3
+
+$PY - "$tmp" <<'PY'
+import sys
+import numpy as np
+from osgeo import gdal, osr
+gdal.UseExceptions()
+out = sys.argv[1]
+def write(name, epsg, x0, y0, dx, dy, a, nodata=None):
+    h, w = a.shape
+    ds = gdal.GetDriverByName("GTiff").Create(f"{out}/{name}", w, h, 1, gdal.GDT_Float64)
+    ds.SetGeoTransform((x0, dx, 0, y0, 0, -dy))
+    s = osr.SpatialReference(); s.ImportFromEPSG(epsg); ds.SetProjection(s.ExportToWkt())
+    b = ds.GetRasterBand(1)
+    if nodata is not None: b.SetNoDataValue(nodata)
+    b.WriteArray(a)
+    ds = None
+# plane.tif: z = 0.1 (x - 500000) + 0.2 (y - 4999700) on 40 x 30 cells of 10 m.
+i, j = np.meshgrid(np.arange(40), np.arange(30))
+x, y = 500000 + (i + 0.5) * 10, 5000000 - (j + 0.5) * 10
+write("plane.tif", 32633, 500000, 5000000, 10, 10, 0.1 * (x - 500000) + 0.2 * (y - 4999700))
+# slot.tif: flat, nodata in columns 14-15 from row 5 to the bottom edge.
+a = np.zeros((30, 30)); a[5:, 14:16] = -9999
+write("slot.tif", 32633, 500000, 5000000, 10, 10, a, nodata=-9999)
+# strait.tif: land at 3 m, a sea strait at -2 m across the whole map in columns 9-10.
+s = np.full((10, 20), 3.0); s[:, 9:11] = -2
+write("strait.tif", 32633, 500000, 5000000, 10, 10, s)
+PY
+check "fixtures made" test -s "$tmp/plane.tif"
+
+# info: the CRS, the grid, the nodata count, metres.
+"$GEODEX" info "$tmp/slot.tif" >"$tmp/info.txt"
+check "info exits 0" test $? -eq 0
+check "info: crs" grep -q "^crs: WGS 84 / UTM zone 33N$" "$tmp/info.txt"
+check "info: grid" grep -qx "grid: 30 30" "$tmp/info.txt"
+check "info: nodata cells" grep -qx "nodata_cells: 50" "$tmp/info.txt"
+check "info: units" grep -qx "units: m" "$tmp/info.txt"
+"$GEODEX" info "$tmp/plane.tif" --format json --dem-step 3 >"$tmp/info.json"
+check "info json: step, grid, crs" $PY -c "
+import json; d = json.load(open('$tmp/info.json'))
+assert d['dem_step'] == 3 and d['grid'] == [14, 10] and 'UTM zone 33N' in d['crs'], d"
+
+# A straight geodesic on the plane between two map points (g:X:Y in the DEM's CRS, ll:LON:LAT).
+ll=$($PY -c "
+from osgeo import osr
+a = osr.SpatialReference(); a.ImportFromEPSG(32633)
+b = osr.SpatialReference(); b.ImportFromEPSG(4326); b.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
+lon, lat, _ = osr.CoordinateTransformation(a, b).TransformPoint(500301.9, 4999722.2)
+print(f'll:{lon!r}:{lat!r}')")
+"$GEODEX" distances "$tmp/plane.tif" --sources g:500013.3:4999981.7 --at "g:500301.9:4999722.2,$ll" \
+  --format json >"$tmp/at.json"
+check "map points: exit 0" test $? -eq 0
+check "map points: straight-line distance (g: and ll:)" $PY - "$tmp/at.json" <<'PY'
+import json, math, sys
+z = lambda x, y: 0.1 * (x - 500000) + 0.2 * (y - 4999700)
+a, b = (500013.3, 4999981.7), (500301.9, 4999722.2)
+want = math.dist((*a, z(*a)), (*b, z(*b)))
+pts = json.load(open(sys.argv[1]))["points"]
+assert abs(pts[0]["exact"] - want) <= 1e-9 * want, (pts[0], want)
+assert abs(pts[1]["exact"] - want) <= 1e-6, (pts[1], want)  # through WGS 84 and back
+PY
+
+# A distance raster and the nearest source's index, aligned with the grid; the slot is nodata.
+"$GEODEX" distances "$tmp/slot.tif" --sources g:500105:4999845,g:500255:4999845 \
+  --output "$tmp/dist.tif" --labels-output "$tmp/near.tif"
+check "rasters: exit 0" test $? -eq 0
+check "rasters: aligned, nodata in the slot, the detour over the slot" $PY - "$tmp" <<'PY'
+import math, sys
+import numpy as np
+from osgeo import gdal
+t = sys.argv[1]
+src, d, n = (gdal.Open(f"{t}/{f}.tif") for f in ("slot", "dist", "near"))
+assert d.GetGeoTransform() == src.GetGeoTransform() and d.RasterXSize == 30 and d.RasterYSize == 30
+assert d.GetSpatialRef().IsSame(src.GetSpatialRef())
+a, lab = d.ReadAsArray(), n.ReadAsArray()
+assert d.GetRasterBand(1).GetNoDataValue() == -1 and n.GetRasterBand(1).GetNoDataValue() == -1
+assert (a[5:, 14:16] == -1).all() and (lab[5:, 14:16] == -1).all()
+assert a[15, 10] == 0 and a[15, 25] == 0 and lab[15, 10] == 0 and lab[15, 25] == 1
+# Cell (12, 20) sits beside source 0 (10, 15); (17, 20) beside source 1 (25, 15).
+assert lab[20, 12] == 0 and lab[20, 17] == 1
+assert abs(a[20, 12] - 10 * math.hypot(2, 5)) < 1e-3
+PY
+
+# A barrier: with the sea (below 0 m) removed, the far shore is unreachable (inf, nodata in the
+# raster); without it the sea is crossed like land.
+"$GEODEX" info "$tmp/strait.tif" --barrier-below 0 >"$tmp/info.txt"
+check "barrier: cells counted" grep -qx "barrier_cells: 20" "$tmp/info.txt"
+"$GEODEX" distances "$tmp/strait.tif" --sources g:500005:4999995 --barrier-below 0 >"$tmp/b.txt"
+check "barrier: exit 0" test $? -eq 0
+check "barrier: the near shore finite, the far shore inf" $PY - "$tmp/b.txt" <<'PY'
+import math, sys
+d = [float(x) for x in open(sys.argv[1])]
+assert len(d) == 180, len(d)  # 200 cells less the 20 of sea
+# Vertices run row by row: 9 near-shore cells, then 9 far-shore cells, per row.
+near = [d[r * 18 + c] for r in range(10) for c in range(9)]
+far = [d[r * 18 + 9 + c] for r in range(10) for c in range(9)]
+assert all(math.isfinite(x) for x in near) and all(math.isinf(x) for x in far)
+assert abs(near[8] - 80) < 1e-9  # along the first row to the shore
+PY
+"$GEODEX" distances "$tmp/strait.tif" --sources g:500005:4999995 --barrier-below 0 \
+  --output "$tmp/b.tif"
+check "barrier raster: far shore and sea nodata" $PY -c "
+from osgeo import gdal; a = gdal.Open('$tmp/b.tif').ReadAsArray()
+assert (a[:, 9:] == -1).all() and (a[:, :9] >= 0).all()"
+"$GEODEX" distances "$tmp/strait.tif" --sources g:500005:4999995 >"$tmp/nb.txt"
+check "no barrier: the sea is crossed" $PY -c "
+import math; d = [float(x) for x in open('$tmp/nb.txt')]; assert len(d) == 200 and all(map(math.isfinite, d))"
+
+# Errors: map points need a DEM, a point outside or in the slot is named, --dem-step needs a DEM.
+printf 'OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' >"$tmp/tri.off"
+"$GEODEX" distances "$tmp/tri.off" --sources g:1:2 2>"$tmp/err.txt" >/dev/null
+check "g: on a mesh: exit 2" test $? -eq 2
+check "g: on a mesh: says why" grep -q "map coordinates need a DEM" "$tmp/err.txt"
+"$GEODEX" distances "$tmp/slot.tif" --sources g:400000:4999845 2>"$tmp/err.txt" >/dev/null
+check "outside: exit 2" test $? -eq 2
+check "outside: names the point" grep -q -- "--sources: point g:400000:4999845: outside the DEM" "$tmp/err.txt"
+"$GEODEX" distances "$tmp/slot.tif" --sources g:500148:4999800 2>"$tmp/err.txt" >/dev/null
+check "in the slot: named" grep -q "g:500148:4999800: in a nodata hole" "$tmp/err.txt"
+"$GEODEX" info "$tmp/tri.off" --dem-step 2 2>"$tmp/err.txt" >/dev/null
+check "--dem-step on a mesh: exit 2" test $? -eq 2
+"$GEODEX" distances "$tmp/tri.off" --sources 0 --output "$tmp/x.tif" 2>"$tmp/err.txt" >/dev/null
+check "raster from a mesh: exit 2" test $? -eq 2
+check "raster from a mesh: says why" grep -q "needs a DEM" "$tmp/err.txt"
+
+echo "terrain cli: $pass passed, $fail failed"
+test "$fail" -eq 0
