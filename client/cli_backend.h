@@ -24,6 +24,7 @@
 #include "geodex/mesh_data.h"
 #include "geodex/shortest_path.h"
 #include "geodex/surface_point.h"
+#include "geodex/geojson.h"
 #include "geodex/terrain.h"
 #include "geodex/voronoi.h"
 
@@ -122,6 +123,12 @@ std::unique_ptr<Backend> MakeRemoteBackend(const std::string& target);
 int QueryExitCode(const absl::Status& status);
 // Prints the status as one line and returns QueryExitCode.
 int FailQuery(const absl::Status& status);
+// --output FILE.geojson: writes `features` (mesh coordinates of the backend's DEM) as RFC 7946
+// GeoJSON, or in the DEM's own CRS with --crs native. Exit 2 without a DEM, or when FILE cannot be
+// written (the reason given).
+bool IsGeoJsonPath(const Args& args);  // --output ends in .geojson
+int WriteGeoJsonOutput(const Backend& backend, const Args& args,
+                       const std::vector<terrain::GeoFeature>& features);
 // Backend::Open, or the one-line failure's exit code: 3 for the mesh (unreadable, invalid,
 // unknown), 1 when the service failed (unauthenticated, unavailable, over its limits).
 int OpenMesh(Backend& backend, const Args& args, const std::string& mesh,

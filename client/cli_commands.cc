@@ -196,6 +196,25 @@ int FailQuery(const absl::Status& status) {
   return Fail(QueryExitCode(status), std::string(status.message()));
 }
 
+bool IsGeoJsonPath(const Args& args) {
+  return args.options.count("output") && absl::EndsWithIgnoreCase(args.options.at("output"), ".geojson");
+}
+
+int WriteGeoJsonOutput(const Backend& backend, const Args& args,
+                       const std::vector<terrain::GeoFeature>& features) {
+  const std::string& path = args.options.at("output");
+  const terrain::Dem* dem = backend.Terrain();
+  if (dem == nullptr) {
+    return Fail(kExitUsage, absl::StrCat("--output ", path,
+                                         ": GeoJSON needs a DEM as MESH (map coordinates)"));
+  }
+  const std::string crs = args.options.count("crs") ? args.options.at("crs") : "wgs84";
+  if (crs != "wgs84" && crs != "native") return Fail(kExitUsage, "--crs must be wgs84 or native");
+  absl::Status written = terrain::WriteGeoJson(dem->info(), features, path, crs == "native");
+  if (!written.ok()) return Fail(kExitUsage, std::string(written.message()));
+  return kExitOk;
+}
+
 int OpenMesh(Backend& backend, const Args& args, const std::string& mesh,
              const MeshBuildOptions& build) {
   terrain::DemOptions dem;
@@ -356,6 +375,9 @@ int RunDistances(Backend& backend, const Args& args) {
   if ((raster || !labels_output.empty()) && (args.options.count("at") || options.directions || json)) {
     return Fail(kExitUsage, "--output X.tif and --labels-output: per-vertex distances only (not with --at, --directions or --format json)");
   }
+  if (IsGeoJsonPath(args) && !args.options.count("at")) {
+    return Fail(kExitUsage, "--output X.geojson: GeoJSON of distances is per point: use --at SPEC (or --output X.tif for a raster)");
+  }
   if (int code = OpenMesh(backend, args, args.positional[0], MeshBuildOptions{})) return code;
   const terrain::Dem* dem = backend.Terrain();
   if ((raster || !labels_output.empty()) && dem == nullptr) {
@@ -390,6 +412,23 @@ int RunDistances(Backend& backend, const Args& args) {
       source.push_back(v.source == kNoIndex ? -1 : int64_t{v.source});
     }
     if (json) text = FormatAtJson(at, estimate, exact, source);
+    if (IsGeoJsonPath(args)) {  // Point features with the exact distance and the nearest source
+      absl::StatusOr<const MeshData*> data = backend.Geometry();
+      if (!data.ok()) return FailQuery(data.status());
+      std::vector<terrain::GeoFeature> features;
+      for (size_t i = 0; i < at.size(); ++i) {
+        terrain::GeoFeature f;
+        f.points = {PositionOf(**data, at[i])};
+        f.properties = {{"point", SurfacePointToString(at[i])}};
+        if (std::isfinite(exact[i])) {  // unreachable: distance and source stay null
+          f.properties.push_back({"distance", exact[i]});
+          f.properties.push_back({"source", source[i]});
+        }
+        features.push_back(std::move(f));
+      }
+      if (int code = WriteGeoJsonOutput(backend, args, features); code != kExitOk) return code;
+      text.clear();
+    }
   } else {
     absl::StatusOr<const DistanceField*> field = backend.Field(sources, options);
     if (!field.ok()) return FailQuery(field.status());
@@ -410,7 +449,7 @@ int RunDistances(Backend& backend, const Args& args) {
   }
   if (stats.solve_ms == 0) stats.solve_ms = MsSince(t_solve);
   const auto t_out = std::chrono::steady_clock::now();
-  if (!raster) {
+  if (!raster && !IsGeoJsonPath(args)) {
     if (int code = WriteOutput(args, text); code != kExitOk) return code;
   }
   if (args.options.count("stats")) {
@@ -427,7 +466,7 @@ int RunPath(Backend& backend, const Args& args) {
   bool json = false;
   if (!CheckKnown(args,
                   {"from", "to", "method", "stats", "lambda", "lambda-scale", "max-distance",
-                   "max-windows", "max-snap", "format"},
+                   "max-windows", "max-snap", "format", "output"},
                   &error) ||
       !GetFormat(args, &json, &error) || !backend.Supports(args, &error)) {
     return Fail(kExitUsage, error);
@@ -452,8 +491,16 @@ int RunPath(Backend& backend, const Args& args) {
   if (absl::Status s = OnePoint(backend, args, "to", &to, &snap); !s.ok()) return FailQuery(s);
   absl::StatusOr<PathQueryResult> result = backend.Path(from, to, options);
   if (!result.ok()) return FailQuery(result.status());
-  const std::string text = json ? FormatPathJson(*result) : FormatPath(*result);
-  std::fwrite(text.data(), 1, text.size(), stdout);
+  if (IsGeoJsonPath(args)) {  // a 3D LineString with its length
+    terrain::GeoFeature f;
+    f.kind = terrain::GeoFeature::Kind::kLine;
+    for (const PathPoint& q : result->path.points) f.points.push_back(q.position);
+    f.properties = {{"length", result->distance}, {"units", std::string("m")}};
+    if (int code = WriteGeoJsonOutput(backend, args, {f}); code != kExitOk) return code;
+  } else {
+    const std::string text = json ? FormatPathJson(*result) : FormatPath(*result);
+    if (int code = WriteOutput(args, text); code != kExitOk) return code;
+  }
   if (args.options.count("stats")) {
     const std::string leading = absl::StrFormat("\"method\": \"%s\", \"path_points\": %d, %s",
                                                 method, result->path.points.size(), SnapJson(snap));

@@ -146,6 +146,7 @@ int RunRender(Backend& backend, const Args& args) {
 
   render::Scene scene;
   scene.mesh = *data;
+  if (backend.Terrain() != nullptr) scene.units = "m";  // a DEM is in metres
   scene.vertex_colors = render::FieldColors(layers.field->distance);
   for (double d : layers.field->distance) {
     if (std::isfinite(d)) scene.max_distance = std::max(scene.max_distance, d);

@@ -41,8 +41,12 @@ write("slot.tif", 32633, 500000, 5000000, 10, 10, a, nodata=-9999)
 # strait.tif: land at 3 m, a sea strait at -2 m across the whole map in columns 9-10.
 s = np.full((10, 20), 3.0); s[:, 9:11] = -2
 write("strait.tif", 32633, 500000, 5000000, 10, 10, s)
+# pond.tif: flat, 40 x 40 cells of 10 m, a nodata pond in rows and columns 15-24.
+p = np.zeros((40, 40)); p[15:25, 15:25] = -9999
+write("pond.tif", 32633, 500000, 5000000, 10, 10, p, nodata=-9999)
 PY
 check "fixtures made" test -s "$tmp/plane.tif"
+printf 'OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' >"$tmp/tri.off"
 
 # info: the CRS, the grid, the nodata count, metres.
 "$GEODEX" info "$tmp/slot.tif" >"$tmp/info.txt"
@@ -122,8 +126,79 @@ assert (a[:, 9:] == -1).all() and (a[:, :9] >= 0).all()"
 check "no barrier: the sea is crossed" $PY -c "
 import math; d = [float(x) for x in open('$tmp/nb.txt')]; assert len(d) == 200 and all(map(math.isfinite, d))"
 
+# GeoJSON (RFC 7946): isochrone polygons, Voronoi cells, Delaunay and path lines, points; checked
+# with a real parser (json) and shapely: every polygon valid, rings right-hand, cells that tile the
+# surface without overlap (measured in the DEM's own CRS, metres, with --crs native).
+P="$tmp/pond.tif"
+"$GEODEX" isolines "$P" --sources g:500055:4999795 --levels 60,150,400 --output "$tmp/iso.geojson"
+check "isochrones: exit 0" test $? -eq 0
+"$GEODEX" isolines "$P" --sources g:500055:4999795 --levels 60,150,400 --output "$tmp/iso_native.geojson" --crs native
+"$GEODEX" voronoi "$P" --sites g:500055:4999795,g:500355:4999955,g:500305:4999655 --output "$tmp/vor.geojson" --crs native
+check "voronoi geojson: exit 0" test $? -eq 0
+"$GEODEX" delaunay "$P" --sites g:500055:4999795,g:500355:4999955,g:500305:4999655 --output "$tmp/del.geojson"
+check "delaunay geojson: exit 0" test $? -eq 0
+"$GEODEX" path "$P" --from g:500055:4999795 --to g:500355:4999795 --output "$tmp/path.geojson"
+check "path geojson: exit 0" test $? -eq 0
+"$GEODEX" path "$P" --from g:500055:4999795 --to g:500355:4999795 >"$tmp/path.txt"
+"$GEODEX" distances "$P" --sources g:500055:4999795 --at g:500355:4999795,g:500005:4999995 \
+  --output "$tmp/at.geojson"
+check "points geojson: exit 0" test $? -eq 0
+"$GEODEX" distances "$P" --sources g:500055:4999795 --at g:500355:4999795,g:500005:4999995 >"$tmp/at.txt"
+"$GEODEX" info "$P" --format json >"$tmp/pond.json"
+check "geojson: valid, right-hand, isochrones with the pond as a hole, cells tiling the surface" \
+  $PY - "$tmp" <<'PY'
+import json, math, sys
+from shapely.geometry import shape
+from shapely.geometry.polygon import orient
+t = sys.argv[1]
+load = lambda n: json.load(open(f"{t}/{n}.geojson"))
+def polygons(g):
+    return list(g.geoms) if g.geom_type == "MultiPolygon" else [g]
+for name in ("iso", "vor", "del", "path", "at", "iso_native"):
+    d = load(name)
+    assert d["type"] == "FeatureCollection" and d["features"], name
+    assert ("crs" in d) == (name in ("vor", "iso_native")), name  # --crs native says so
+iso = load("iso")["features"]
+assert [f["properties"]["level"] for f in iso] == [60, 150, 400]
+assert all(f["properties"]["units"] == "m" for f in iso)
+for f in iso:
+    g = shape(f["geometry"])
+    assert g.is_valid and g.geom_type in ("Polygon", "MultiPolygon"), f["properties"]
+    for p in polygons(g):  # RFC 7946: exterior counter-clockwise, holes clockwise
+        assert p.exterior.is_ccw and all(not r.is_ccw for r in p.interiors)
+    lon, lat = g.representative_point().coords[0]
+    assert 14.9 < lon < 15.1 and 45.1 < lat < 45.2, (lon, lat)  # WGS 84 degrees
+native = [shape(f["geometry"]) for f in load("iso_native")["features"]]
+# Level 60 is a disc around the source (piecewise linear: a little inside the circle).
+assert 0.95 * math.pi * 60**2 < native[0].area <= math.pi * 60**2 * 1.001, native[0].area
+# Level 400 reaches around the pond: the pond is a hole in it, the rest of the map inside.
+big = native[2]
+assert big.geom_type == "Polygon" and len(big.interiors) == 1, big.geom_type
+land = json.load(open(f"{t}/pond.json"))["faces"] * 50  # each face half a 10 m cell
+assert abs(big.area - land) < 1e-6 * land, (big.area, land)
+cells = [shape(f["geometry"]) for f in load("vor")["features"]]
+assert [f["properties"]["site"] for f in load("vor")["features"]] == [0, 1, 2]
+assert all(c.is_valid for c in cells)
+total = sum(c.area for c in cells)
+assert abs(total - land) < 1e-6 * land, (total, land)
+for i in range(3):
+    for j in range(i + 1, 3):
+        assert cells[i].intersection(cells[j]).area < 1e-6 * land
+lines = load("del")["features"]
+assert len(lines) == 3 and all(f["geometry"]["type"] == "LineString" for f in lines)
+path = load("path")["features"][0]
+want = float(open(f"{t}/path.txt").readline())
+assert path["geometry"]["type"] == "LineString" and len(path["geometry"]["coordinates"][0]) == 3
+assert abs(path["properties"]["length"] - want) <= 1e-12 * want and want > 300  # around the pond
+pts = load("at")["features"]
+exact = [float(l.split("\t")[2].split()[1]) for l in open(f"{t}/at.txt")]
+assert [f["properties"]["distance"] for f in pts] == exact, (pts, exact)
+PY
+"$GEODEX" isolines "$tmp/tri.off" --sources 0 --count 3 --output "$tmp/x.geojson" 2>"$tmp/err.txt"
+check "geojson from a mesh: exit 2" test $? -eq 2
+check "geojson from a mesh: says why" grep -q "GeoJSON needs a DEM" "$tmp/err.txt"
+
 # Errors: map points need a DEM, a point outside or in the slot is named, --dem-step needs a DEM.
-printf 'OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' >"$tmp/tri.off"
 "$GEODEX" distances "$tmp/tri.off" --sources g:1:2 2>"$tmp/err.txt" >/dev/null
 check "g: on a mesh: exit 2" test $? -eq 2
 check "g: on a mesh: says why" grep -q "map coordinates need a DEM" "$tmp/err.txt"

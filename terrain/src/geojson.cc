@@ -1,0 +1,165 @@
+#include "geodex/geojson.h"
+
+#include <cmath>
+#include <filesystem>
+#include <memory>
+
+#include "absl/strings/str_cat.h"
+#include "cpl_error.h"
+#include "gdal_priv.h"
+#include "ogr_geometry.h"
+#include "ogrsf_frmts.h"
+
+namespace geodex::terrain {
+namespace {
+
+// As in dem.cc: GDAL quiet while a call runs, its last message read back.
+class QuietGdal {
+ public:
+  QuietGdal() {
+    GDALAllRegister();
+    CPLPushErrorHandler(CPLQuietErrorHandler);
+    CPLErrorReset();
+  }
+  ~QuietGdal() { CPLPopErrorHandler(); }
+  static std::string LastMessage() {
+    const char* m = CPLGetLastErrorMsg();
+    return m != nullptr && *m != '\0' ? std::string(m) : std::string("unknown GDAL error");
+  }
+};
+
+// Mesh x y back to the CRS the geometry is built in: the mesh's when reprojected (UTM), else the
+// file's (whose unit may be feet: the mesh is in metres).
+std::array<double, 2> ToCrs(const DemInfo& dem, double x, double y) {
+  return {x / dem.horizontal_scale, y / dem.horizontal_scale};
+}
+
+std::unique_ptr<OGRGeometry> AreaOf(const DemInfo& dem, const std::vector<Polygon2>& pieces) {
+  auto all = std::make_unique<OGRMultiPolygon>();
+  for (const Polygon2& piece : pieces) {
+    if (piece.size() < 3) continue;
+    auto ring = std::make_unique<OGRLinearRing>();
+    for (const auto& p : piece) {
+      const auto q = ToCrs(dem, p[0], p[1]);
+      ring->addPoint(q[0], q[1]);
+    }
+    ring->closeRings();
+    if (std::abs(ring->get_Area()) <= 0) continue;  // a sliver of nothing
+    auto polygon = std::make_unique<OGRPolygon>();
+    polygon->addRingDirectly(ring.release());
+    all->addGeometryDirectly(polygon.release());
+  }
+  if (all->IsEmpty()) return all;
+  std::unique_ptr<OGRGeometry> merged(all->UnionCascaded());
+  if (merged == nullptr) return nullptr;
+  return merged;
+}
+
+}  // namespace
+
+std::vector<Polygon2> SublevelPieces(const MeshData& mesh, const std::vector<double>& value,
+                                     double level) {
+  std::vector<Polygon2> out;
+  for (size_t f = 0; f < mesh.face_count(); ++f) {
+    Polygon2 piece;
+    for (int c = 0; c < 3; ++c) {
+      const size_t u = mesh.faces[3 * f + c], v = mesh.faces[3 * f + (c + 1) % 3];
+      const double du = value[u], dv = value[v];
+      const double* pu = &mesh.positions[3 * u];
+      const double* pv = &mesh.positions[3 * v];
+      if (du <= level) piece.push_back({pu[0], pu[1]});
+      if ((du <= level) != (dv <= level)) {  // the level crosses edge u-v
+        double t = std::isinf(du) || std::isinf(dv) ? (du <= level ? 0.0 : 1.0)
+                                                    : (level - du) / (dv - du);
+        t = std::clamp(t, 0.0, 1.0);
+        piece.push_back({pu[0] + t * (pv[0] - pu[0]), pu[1] + t * (pv[1] - pu[1])});
+      }
+    }
+    if (piece.size() >= 3) out.push_back(std::move(piece));
+  }
+  return out;
+}
+
+absl::Status WriteGeoJson(const DemInfo& dem, const std::vector<GeoFeature>& features,
+                          const std::string& path, bool native_crs) {
+  QuietGdal quiet;
+  auto failed = [&](const std::string& why) {
+    return absl::PermissionDeniedError(absl::StrCat("cannot write ", path, ": ", why));
+  };
+  if (!OGRGeometryFactory::haveGEOS()) return absl::InternalError("GDAL was built without GEOS");
+  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GeoJSON");
+  if (driver == nullptr) return absl::InternalError("GDAL has no GeoJSON driver");
+  std::error_code ec;
+  std::filesystem::remove(path, ec);  // the driver will not overwrite
+  GDALDatasetUniquePtr ds(driver->Create(path.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
+  if (ds == nullptr) return failed(QuietGdal::LastMessage());
+  // Geometries are built in the mesh's CRS when it was reprojected, else in the file's.
+  OGRSpatialReference built, file;
+  built.importFromWkt((dem.reprojected ? dem.mesh_crs_wkt : dem.file_crs_wkt).c_str());
+  built.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  file.importFromWkt(dem.file_crs_wkt.c_str());
+  file.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  const char* rfc[] = {"RFC7946=YES", "WRITE_NAME=NO", nullptr};
+  const char* native[] = {"WRITE_NAME=NO", nullptr};
+  OGRLayer* layer = ds->CreateLayer("geodex", native_crs ? &file : &built, wkbUnknown,
+                                    const_cast<char**>(native_crs ? native : rfc));
+  if (layer == nullptr) return failed(QuietGdal::LastMessage());
+  std::unique_ptr<OGRCoordinateTransformation, decltype(&OGRCoordinateTransformation::DestroyCT)>
+      to_file(nullptr, &OGRCoordinateTransformation::DestroyCT);
+  if (native_crs && dem.reprojected) to_file.reset(OGRCreateCoordinateTransformation(&built, &file));
+
+  // The fields: every property name, typed by its first value.
+  for (const GeoFeature& f : features) {
+    for (const auto& [name, value] : f.properties) {
+      if (layer->GetLayerDefn()->GetFieldIndex(name.c_str()) >= 0) continue;
+      OGRFieldType type = std::holds_alternative<double>(value)    ? OFTReal
+                          : std::holds_alternative<int64_t>(value) ? OFTInteger64
+                                                                   : OFTString;
+      OGRFieldDefn field(name.c_str(), type);
+      if (layer->CreateField(&field) != OGRERR_NONE) return failed(QuietGdal::LastMessage());
+    }
+  }
+  for (const GeoFeature& f : features) {
+    std::unique_ptr<OGRGeometry> geometry;
+    switch (f.kind) {
+      case GeoFeature::Kind::kArea:
+        geometry = AreaOf(dem, f.pieces);
+        if (geometry == nullptr) return absl::InternalError("the polygon union failed");
+        break;
+      case GeoFeature::Kind::kLine: {
+        auto line = std::make_unique<OGRLineString>();
+        for (const auto& p : f.points) {
+          const auto q = ToCrs(dem, p[0], p[1]);
+          line->addPoint(q[0], q[1], p[2]);
+        }
+        geometry = std::move(line);
+        break;
+      }
+      case GeoFeature::Kind::kPoint: {
+        const auto q = ToCrs(dem, f.points.at(0)[0], f.points.at(0)[1]);
+        geometry = std::make_unique<OGRPoint>(q[0], q[1], f.points.at(0)[2]);
+        break;
+      }
+    }
+    if (to_file != nullptr && !geometry->IsEmpty() && geometry->transform(to_file.get()) != OGRERR_NONE) {
+      return failed(absl::StrCat("cannot project to the DEM's CRS (", QuietGdal::LastMessage(), ")"));
+    }
+    OGRFeatureUniquePtr feature(OGRFeature::CreateFeature(layer->GetLayerDefn()));
+    for (const auto& [name, value] : f.properties) {
+      if (const double* d = std::get_if<double>(&value)) {
+        feature->SetField(name.c_str(), *d);
+      } else if (const int64_t* i = std::get_if<int64_t>(&value)) {
+        feature->SetField(name.c_str(), static_cast<GIntBig>(*i));
+      } else {
+        feature->SetField(name.c_str(), std::get<std::string>(value).c_str());
+      }
+    }
+    if (!geometry->IsEmpty()) feature->SetGeometryDirectly(geometry.release());
+    if (layer->CreateFeature(feature.get()) != OGRERR_NONE) return failed(QuietGdal::LastMessage());
+  }
+  ds.reset();
+  if (CPLGetLastErrorType() >= CE_Failure) return failed(QuietGdal::LastMessage());
+  return absl::OkStatus();
+}
+
+}  // namespace geodex::terrain
