@@ -225,8 +225,12 @@ int OpenMesh(Backend& backend, const Args& args, const std::string& mesh,
   dem.step = static_cast<uint32_t>(step);
   if (!GetDouble(args, "barrier-below", &dem.barrier_below, &error)) return Fail(kExitUsage, error);
   if (std::isnan(dem.barrier_below)) return Fail(kExitUsage, "--barrier-below must be a number");
-  if (step != 1 && !terrain::IsDemPath(mesh)) {
-    return Fail(kExitUsage, absl::StrCat("--dem-step: ", mesh, " is not a DEM (a raster such as .tif)"));
+  if (args.options.count("barrier")) dem.barrier_file = args.options.at("barrier");
+  for (const char* flag : {"dem-step", "barrier"}) {
+    if (args.options.count(flag) && !terrain::IsDemPath(mesh)) {
+      return Fail(kExitUsage,
+                  absl::StrCat("--", flag, ": ", mesh, " is not a DEM (a raster such as .tif)"));
+    }
   }
   absl::Status s = backend.Open(mesh, build, dem);
   if (s.ok()) return kExitOk;

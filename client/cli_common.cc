@@ -108,9 +108,10 @@ bool GetUint(const Args& args, const std::string& key, uint64_t* out, std::strin
 
 bool CheckKnown(const Args& args, const std::set<std::string>& known, std::string* error) {
   for (const auto& [key, value] : args.options) {
-    // --dem-step and --barrier-below: how every MESH is read (OpenMesh); --crs: how GeoJSON
+    // --dem-step, --barrier-below and --barrier: how every MESH is read (OpenMesh); --crs: how GeoJSON
     // output is written (WriteGeoJsonOutput).
-    if (!known.count(key) && key != "dem-step" && key != "barrier-below" && key != "crs") {
+    if (!known.count(key) && key != "dem-step" && key != "barrier-below" && key != "barrier" &&
+        key != "crs") {
       *error = absl::StrFormat("unknown option --%s (see geodex --help)", key);
       return false;
     }
@@ -236,6 +237,7 @@ std::string FormatInfo(const InfoValues& v, bool json) {
     const terrain::DemInfo& d = *v.dem;
     dem_rows = {
         {"barrier_cells", absl::StrFormat("%d", d.barrier_cells)},
+        {"barrier_faces", absl::StrFormat("%d", d.barrier_faces)},
         {"crs", d.file_crs_name},
         {"mesh_crs", d.mesh_crs_name},
         {"units", "m"},
@@ -264,7 +266,8 @@ std::string FormatInfo(const InfoValues& v, bool json) {
   }
   for (const auto& [k, value] : dem_rows) {
     const bool pair = k == "raster" || k == "grid";
-    const bool number = k == "dem_step" || k == "nodata_cells" || k == "barrier_cells";
+    const bool number =
+        k == "dem_step" || k == "nodata_cells" || k == "barrier_cells" || k == "barrier_faces";
     out += absl::StrFormat(", \"%s\": %s", k,
                            pair     ? absl::StrCat("[", absl::StrJoin(absl::StrSplit(value, ' '), ", "), "]")
                            : number ? value

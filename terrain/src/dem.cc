@@ -14,7 +14,10 @@
 #include "cpl_conv.h"
 #include "cpl_error.h"
 #include "gdal_priv.h"
+#include "ogr_api.h"
+#include "ogr_geometry.h"
 #include "ogr_spatialref.h"
+#include "ogrsf_frmts.h"
 
 namespace geodex::terrain {
 namespace {
@@ -61,6 +64,48 @@ double MetresPerHeightUnit(std::string unit) {
   if (unit == "ft" || unit == "foot" || unit == "feet" || unit == "international foot") return 0.3048;
   if (unit == "us survey foot" || unit == "us-ft" || unit == "ftus") return 1200.0 / 3937.0;
   return 0;
+}
+
+// Every polygon of a vector file, in `crs`, unioned. Errors name the file.
+absl::StatusOr<std::unique_ptr<OGRGeometry>> ReadBarrierPolygons(const std::string& path,
+                                                                 const OGRSpatialReference& crs) {
+  auto bad = [&](const std::string& why) {
+    return absl::InvalidArgumentError(absl::StrCat("--barrier ", path, ": ", why));
+  };
+  GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY));
+  if (ds == nullptr) return bad(absl::StrCat("not a vector file GDAL reads (", QuietGdal::LastMessage(), ")"));
+  OGRSpatialReference wgs84;
+  wgs84.SetWellKnownGeogCS("WGS84");
+  wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  auto all = std::make_unique<OGRMultiPolygon>();
+  for (OGRLayer* layer : ds->GetLayers()) {
+    const OGRSpatialReference* layer_crs = layer->GetSpatialRef();
+    OGRSpatialReference from(layer_crs != nullptr ? *layer_crs : wgs84);
+    from.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    TransformPtr to_dem = MakeTransform(from, crs);
+    if (to_dem == nullptr) return bad(absl::StrCat("cannot project it to the DEM's CRS (", QuietGdal::LastMessage(), ")"));
+    for (const auto& feature : *layer) {
+      const OGRGeometry* g = feature->GetGeometryRef();
+      if (g == nullptr) continue;
+      std::unique_ptr<OGRGeometry> copy(g->clone());
+      if (copy->transform(to_dem.get()) != OGRERR_NONE) {
+        return bad(absl::StrCat("cannot project a feature to the DEM's CRS (", QuietGdal::LastMessage(), ")"));
+      }
+      const OGRwkbGeometryType type = wkbFlatten(copy->getGeometryType());
+      if (type == wkbPolygon) {
+        all->addGeometry(copy.get());
+      } else if (type == wkbMultiPolygon) {
+        for (const OGRPolygon* p : *copy->toMultiPolygon()) all->addGeometry(p);
+      } else {
+        return bad(absl::StrCat("feature ", feature->GetFID(), " is a ", copy->getGeometryName(),
+                                "; a barrier is polygons"));
+      }
+    }
+  }
+  if (all->IsEmpty()) return bad("no polygon");
+  std::unique_ptr<OGRGeometry> merged(all->UnionCascaded());
+  if (merged == nullptr) return bad(absl::StrCat("the polygons do not merge (", QuietGdal::LastMessage(), ")"));
+  return merged;
 }
 
 }  // namespace
@@ -221,6 +266,23 @@ absl::StatusOr<Dem> Dem::Read(const std::string& path, const DemOptions& options
     }
   }
 
+  // A barrier drawn as polygons: one union, in the file's CRS, tested against triangle centres.
+  OGRPreparedGeometryUniquePtr barrier;
+  std::unique_ptr<OGRGeometry> barrier_union;
+  if (!options.barrier_file.empty()) {
+    absl::StatusOr<std::unique_ptr<OGRGeometry>> polygons =
+        ReadBarrierPolygons(options.barrier_file, file_crs);
+    if (!polygons.ok()) return polygons.status();
+    barrier_union = *std::move(polygons);
+    barrier.reset(OGRCreatePreparedGeometry(OGRGeometry::ToHandle(barrier_union.get())));
+  }
+  auto in_barrier = [&](double u, double v) {  // used-grid coordinates of a cell-centre frame
+    if (barrier == nullptr) return false;
+    OGRPoint p(info.geotransform[0] + (u + 0.5) * info.geotransform[1],
+               info.geotransform[3] + (v + 0.5) * info.geotransform[5]);
+    return OGRPreparedGeometryContains(barrier.get(), OGRGeometry::ToHandle(&p)) != 0;
+  };
+
   // Faces: per block, corners a (i, j), b (i+1, j), c (i, j+1), d (i+1, j+1), split along a-d:
   // (a, c, d) and (a, d, b), counter-clockwise seen from above when rows run south (gt[5] < 0).
   const bool flip = gt[1] * gt[5] > 0;  // rows run north: mirror the winding
@@ -233,6 +295,11 @@ absl::StatusOr<Dem> Dem::Read(const std::string& path, const DemOptions& options
       for (int k = 0; k < 2; ++k) {
         std::array<uint32_t, 3> t = tris[k];
         if (t[0] == kNoVertex || t[1] == kNoVertex || t[2] == kNoVertex) continue;
+        // The triangle's centre: (i + 1/3, j + 2/3) for (a, c, d), (i + 2/3, j + 1/3) for (a, d, b).
+        if (in_barrier(i + (k == 0 ? 1.0 : 2.0) / 3, j + (k == 0 ? 2.0 : 1.0) / 3)) {
+          ++info.barrier_faces;
+          continue;
+        }
         if (flip) std::swap(t[1], t[2]);
         dem.face_of_block_[2 * (size_t{j} * (W - 1) + i) + k] =
             static_cast<uint32_t>(dem.mesh_.face_count());
@@ -332,7 +399,7 @@ absl::StatusOr<SurfacePoint> Dem::DropMeshPoint(double mx, double my, double u, 
     }
   }
   if (best_face == kNoVertex || best_min < -1e-7) {
-    return absl::InvalidArgumentError(absl::StrCat(name, ": in a nodata hole of the DEM"));
+    return absl::InvalidArgumentError(absl::StrCat(name, ": in a hole of the DEM (nodata or a barrier)"));
   }
   double sum = 0;
   for (double& b : best) sum += (b = b > 0 ? b : 0.0);  // also turns -0 into 0

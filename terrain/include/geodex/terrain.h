@@ -31,6 +31,9 @@ struct DemOptions {
   // A barrier: cells lower than this (metres; the sea at 0) are left out like nodata, so paths
   // go around them. -inf: none.
   double barrier_below = -std::numeric_limits<double>::infinity();
+  // A barrier drawn as polygons (any vector file GDAL reads, GeoJSON first; its own CRS, WGS 84
+  // when it names none): the triangles whose centre lies inside one are left out. "": none.
+  std::string barrier_file;
 };
 
 // The faces of `mesh` with no corner lower than `z` (the same barrier on a mesh file: a face
@@ -45,6 +48,7 @@ struct DemInfo {
   uint32_t grid_width = 0, grid_height = 0;      // the used cells
   uint64_t nodata_cells = 0;                     // used cells without data
   uint64_t barrier_cells = 0;                    // used cells below DemOptions::barrier_below
+  uint64_t barrier_faces = 0;                    // triangles inside DemOptions::barrier_file
   std::string file_crs_name;  // the file's CRS ("WGS 84 / UTM zone 33N", "WGS 84")
   std::string file_crs_wkt;
   bool reprojected = false;   // the file's CRS is geographic: the mesh is in mesh_crs
@@ -80,7 +84,7 @@ class Dem {
 
   // A map point dropped vertically onto the surface, as a face point: (x, y) in the file's CRS
   // (`g:X:Y`) or WGS 84 longitude/latitude (`ll:LON:LAT`). InvalidArgument naming the point when
-  // it lies outside the used grid or in a nodata hole.
+  // it lies outside the used grid or in a hole (nodata or a barrier).
   absl::StatusOr<SurfacePoint> DropMapPoint(double x, double y) const;
   absl::StatusOr<SurfacePoint> DropLonLat(double lon, double lat) const;
 
