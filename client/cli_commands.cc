@@ -208,9 +208,9 @@ int WriteGeoJsonOutput(const Backend& backend, const Args& args,
     return Fail(kExitUsage, absl::StrCat("--output ", path,
                                          ": GeoJSON needs a DEM as MESH (map coordinates)"));
   }
-  const std::string crs = args.options.count("crs") ? args.options.at("crs") : "wgs84";
-  if (crs != "wgs84" && crs != "native") return Fail(kExitUsage, "--crs must be wgs84 or native");
-  absl::Status written = terrain::WriteGeoJson(dem->info(), features, path, crs == "native");
+  // --crs was checked with the mesh's other reading options (OpenMesh).
+  const bool native = args.options.count("crs") && args.options.at("crs") == "native";
+  absl::Status written = terrain::WriteGeoJson(dem->info(), features, path, native);
   if (!written.ok()) return Fail(kExitUsage, std::string(written.message()));
   return kExitOk;
 }
@@ -232,8 +232,11 @@ int OpenMesh(Backend& backend, const Args& args, const std::string& mesh,
                   absl::StrCat("--", flag, ": ", mesh, " is not a DEM (a raster such as .tif)"));
     }
   }
+  if (args.options.count("crs") && args.options.at("crs") != "wgs84" &&
+      args.options.at("crs") != "native") {
+    return Fail(kExitUsage, "--crs must be wgs84 or native");
+  }
   absl::Status s = backend.Open(mesh, build, dem);
-  if (s.ok()) return kExitOk;
   if (s.ok()) return kExitOk;
   switch (s.code()) {  // the service failed, not the mesh
     case absl::StatusCode::kUnauthenticated:
@@ -246,8 +249,6 @@ int OpenMesh(Backend& backend, const Args& args, const std::string& mesh,
       return Fail(kExitInput, std::string(s.message()));
   }
 }
-
-namespace {}  // namespace
 
 int RunInfo(Backend& backend, const Args& args) {
   std::string error;
@@ -376,8 +377,10 @@ int RunDistances(Backend& backend, const Args& args) {
   if (!labels_output.empty() && !is_raster(labels_output)) {
     return Fail(kExitUsage, "--labels-output: a GeoTIFF path (.tif) is expected");
   }
-  if ((raster || !labels_output.empty()) && (args.options.count("at") || options.directions || json)) {
-    return Fail(kExitUsage, "--output X.tif and --labels-output: per-vertex distances only (not with --at, --directions or --format json)");
+  if ((raster && (args.options.count("at") || options.directions || json)) ||
+      (!labels_output.empty() && args.options.count("at"))) {
+    return Fail(kExitUsage, "--output X.tif and --labels-output: per-vertex values only (a raster "
+                            "has no --at points, --directions or JSON)");
   }
   if (IsGeoJsonPath(args) && !args.options.count("at")) {
     return Fail(kExitUsage, "--output X.geojson: GeoJSON of distances is per point: use --at SPEC (or --output X.tif for a raster)");
@@ -436,20 +439,18 @@ int RunDistances(Backend& backend, const Args& args) {
   } else {
     absl::StatusOr<const DistanceField*> field = backend.Field(sources, options);
     if (!field.ok()) return FailQuery(field.status());
-    if (raster || !labels_output.empty()) {
-      stats = (*field)->stats;
-      if (stats.solve_ms == 0) stats.solve_ms = MsSince(t_solve);
-      absl::Status written = absl::OkStatus();
-      if (raster) written = dem->WriteFloatRaster(output, (*field)->distance);
-      if (written.ok() && !labels_output.empty()) {
-        written = dem->WriteIndexRaster(labels_output, (*field)->source);
-      }
-      if (!written.ok()) return Fail(kExitUsage, std::string(written.message()));
-    } else {
+    stats = (*field)->stats;
+    if (stats.solve_ms == 0) stats.solve_ms = MsSince(t_solve);
+    absl::Status written = absl::OkStatus();
+    if (raster) written = dem->WriteFloatRaster(output, (*field)->distance);
+    if (written.ok() && !labels_output.empty()) {
+      written = dem->WriteIndexRaster(labels_output, (*field)->source);
+    }
+    if (!written.ok()) return Fail(kExitUsage, std::string(written.message()));
+    if (!raster) {
       text = json ? FormatDistancesJson((*field)->distance, (*field)->direction)
                   : FormatDistances((*field)->distance, (*field)->direction);
     }
-    stats = (*field)->stats;
   }
   if (stats.solve_ms == 0) stats.solve_ms = MsSince(t_solve);
   const auto t_out = std::chrono::steady_clock::now();

@@ -69,7 +69,7 @@ bool OutputFormat(const Args& args, Format* format, std::string* error) {
     const std::string e(ext);
     return path.size() > e.size() && path.compare(path.size() - e.size(), e.size(), e) == 0;
   };
-  if (ends(".geojson")) {
+  if (IsGeoJsonPath(args)) {
     *format = Format::kGeoJson;
     return true;
   }

@@ -107,6 +107,8 @@ class RemoteBackend final : public Backend {
       // here, and the mesh they make uploaded (by its content's id, like any other).
       absl::StatusOr<MeshData> data = LoadMeshData(mesh, dem_options, &dem_);
       if (!data.ok()) return data.status();
+      // The mesh the server gets is this one (the barrier applied): draw and place sites on it.
+      if (dem_ == nullptr) data_ = std::make_unique<MeshData>(*data);
       ref = client_->ResolveMeshData(std::filesystem::path(mesh).stem().string() + ".off", *data);
     } else {
       ref = client_->ResolveMesh(mesh);

@@ -14,6 +14,7 @@
 #include "cpl_conv.h"
 #include "cpl_error.h"
 #include "gdal_priv.h"
+#include "gdal_quiet.h"
 #include "ogr_api.h"
 #include "ogr_geometry.h"
 #include "ogr_spatialref.h"
@@ -22,22 +23,6 @@
 namespace geodex::terrain {
 namespace {
 
-// GDAL reports errors through a global handler that prints; geodex reports them itself, so GDAL
-// is quiet while a call runs and its last message is read back.
-class QuietGdal {
- public:
-  QuietGdal() {
-    static std::once_flag once;
-    std::call_once(once, [] { GDALAllRegister(); });
-    CPLPushErrorHandler(CPLQuietErrorHandler);
-    CPLErrorReset();
-  }
-  ~QuietGdal() { CPLPopErrorHandler(); }
-  static std::string LastMessage() {
-    const char* m = CPLGetLastErrorMsg();
-    return m != nullptr && *m != '\0' ? std::string(m) : std::string("unknown GDAL error");
-  }
-};
 
 std::string WktOf(const OGRSpatialReference& srs) {
   char* wkt = nullptr;
@@ -93,7 +78,7 @@ absl::StatusOr<std::unique_ptr<OGRGeometry>> ReadBarrierPolygons(const std::stri
       }
       const OGRwkbGeometryType type = wkbFlatten(copy->getGeometryType());
       if (type == wkbPolygon) {
-        all->addGeometry(copy.get());
+        all->addGeometryDirectly(copy.release());
       } else if (type == wkbMultiPolygon) {
         for (const OGRPolygon* p : *copy->toMultiPolygon()) all->addGeometry(p);
       } else {
@@ -216,12 +201,19 @@ absl::StatusOr<Dem> Dem::Read(const std::string& path, const DemOptions& options
   if (unit == 0) {
     return bad(absl::StrCat("height unit '", info.vertical_unit, "' is not m, ft or US survey foot"));
   }
-  int has_scale = 0, has_offset = 0, has_nodata = 0;
+  int has_scale = 0, has_offset = 0;
   double scale = band->GetScale(&has_scale), offset = band->GetOffset(&has_offset);
   if (!has_scale) scale = 1;
   if (!has_offset) offset = 0;
   info.vertical_scale = unit * scale;
-  const double nodata = band->GetNoDataValue(&has_nodata);
+  // Which cells have data: GDAL's mask (the nodata value compared in the band's own type, or a
+  // per-dataset mask or alpha band), plus NaN.
+  GDALRasterBand* mask = band->GetMaskBand();
+  std::vector<uint8_t> valid(info.raster_width);
+  if (uint64_t{info.grid_width} * info.grid_height >= kNoVertex) {
+    return bad(absl::StrFormat("%ux%u cells: more than a mesh can index; use --dem-step",
+                               info.grid_width, info.grid_height));
+  }
 
   // Vertices: the used cells with data, row by row (one file row read at a time).
   const uint32_t W = info.grid_width, H = info.grid_height;
@@ -234,9 +226,13 @@ absl::StatusOr<Dem> Dem::Read(const std::string& path, const DemOptions& options
                        row.data(), info.raster_width, 1, GDT_Float64, 0, 0) != CE_None) {
       return bad(absl::StrCat("read error (", QuietGdal::LastMessage(), ")"));
     }
+    if (mask->RasterIO(GF_Read, 0, static_cast<int>(j * options.step), info.raster_width, 1,
+                       valid.data(), info.raster_width, 1, GDT_Byte, 0, 0) != CE_None) {
+      return bad(absl::StrCat("read error in the nodata mask (", QuietGdal::LastMessage(), ")"));
+    }
     for (uint32_t i = 0; i < W; ++i) {
       const double raw = row[size_t{i} * options.step];
-      if (!std::isfinite(raw) || (has_nodata && raw == nodata)) {
+      if (!std::isfinite(raw) || valid[size_t{i} * options.step] == 0) {
         ++info.nodata_cells;
         continue;
       }
@@ -275,6 +271,9 @@ absl::StatusOr<Dem> Dem::Read(const std::string& path, const DemOptions& options
     if (!polygons.ok()) return polygons.status();
     barrier_union = *std::move(polygons);
     barrier.reset(OGRCreatePreparedGeometry(OGRGeometry::ToHandle(barrier_union.get())));
+    if (barrier == nullptr) {
+      return absl::InternalError("--barrier: GDAL cannot prepare polygons (built without GEOS?)");
+    }
   }
   auto in_barrier = [&](double u, double v) {  // used-grid coordinates of a cell-centre frame
     if (barrier == nullptr) return false;
@@ -368,7 +367,8 @@ absl::StatusOr<SurfacePoint> Dem::DropMeshPoint(double mx, double my, double u, 
   }
   const int bi = std::clamp(static_cast<int>(std::floor(u)), 0, static_cast<int>(W) - 2);
   const int bj = std::clamp(static_cast<int>(std::floor(v)), 0, static_cast<int>(H) - 2);
-  // The point's block first, then its neighbours (a reprojected grid is not exactly affine).
+  // The point's block and its neighbours: a point on a grid line belongs to two blocks (one may be
+  // a hole), and a reprojected grid is not exactly affine. The face holding it best wins.
   uint32_t best_face = kNoVertex;
   std::array<double, 3> best{};
   double best_min = -std::numeric_limits<double>::infinity();
@@ -376,7 +376,6 @@ absl::StatusOr<SurfacePoint> Dem::DropMeshPoint(double mx, double my, double u, 
     for (int di = 0; di <= 2; ++di) {
       const int i = bi + (di == 2 ? -1 : di == 1 ? 1 : 0), j = bj + (dj == 2 ? -1 : dj == 1 ? 1 : 0);
       if (i < 0 || j < 0 || i > static_cast<int>(W) - 2 || j > static_cast<int>(H) - 2) continue;
-      if ((di != 0 || dj != 0) && !info_.reprojected) continue;
       for (int k = 0; k < 2; ++k) {
         const uint32_t f = face_of_block_[2 * (size_t(j) * (W - 1) + i) + k];
         if (f == kNoVertex) continue;

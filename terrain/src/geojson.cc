@@ -1,5 +1,6 @@
 #include "geodex/geojson.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <memory>
@@ -7,26 +8,13 @@
 #include "absl/strings/str_cat.h"
 #include "cpl_error.h"
 #include "gdal_priv.h"
+#include "gdal_quiet.h"
 #include "ogr_geometry.h"
 #include "ogrsf_frmts.h"
 
 namespace geodex::terrain {
 namespace {
 
-// As in dem.cc: GDAL quiet while a call runs, its last message read back.
-class QuietGdal {
- public:
-  QuietGdal() {
-    GDALAllRegister();
-    CPLPushErrorHandler(CPLQuietErrorHandler);
-    CPLErrorReset();
-  }
-  ~QuietGdal() { CPLPopErrorHandler(); }
-  static std::string LastMessage() {
-    const char* m = CPLGetLastErrorMsg();
-    return m != nullptr && *m != '\0' ? std::string(m) : std::string("unknown GDAL error");
-  }
-};
 
 // Mesh x y back to the CRS the geometry is built in: the mesh's when reprojected (UTM), else the
 // file's (whose unit may be feet: the mesh is in metres).
@@ -64,15 +52,19 @@ std::vector<Polygon2> SublevelPieces(const MeshData& mesh, const std::vector<dou
     Polygon2 piece;
     for (int c = 0; c < 3; ++c) {
       const size_t u = mesh.faces[3 * f + c], v = mesh.faces[3 * f + (c + 1) % 3];
-      const double du = value[u], dv = value[v];
       const double* pu = &mesh.positions[3 * u];
-      const double* pv = &mesh.positions[3 * v];
-      if (du <= level) piece.push_back({pu[0], pu[1]});
-      if ((du <= level) != (dv <= level)) {  // the level crosses edge u-v
-        double t = std::isinf(du) || std::isinf(dv) ? (du <= level ? 0.0 : 1.0)
-                                                    : (level - du) / (dv - du);
+      if (value[u] <= level) piece.push_back({pu[0], pu[1]});
+      if ((value[u] <= level) != (value[v] <= level)) {  // the level crosses edge u-v
+        // From the lower vertex id, so that both faces of an edge make the very same point and
+        // their pieces meet without a sliver.
+        const size_t a = std::min(u, v), b = std::max(u, v);
+        const double da = value[a], db = value[b];
+        const double* pa = &mesh.positions[3 * a];
+        const double* pb = &mesh.positions[3 * b];
+        double t = std::isinf(da) || std::isinf(db) ? (da <= level ? 0.0 : 1.0)
+                                                    : (level - da) / (db - da);
         t = std::clamp(t, 0.0, 1.0);
-        piece.push_back({pu[0] + t * (pv[0] - pu[0]), pu[1] + t * (pv[1] - pu[1])});
+        piece.push_back({pa[0] + t * (pb[0] - pa[0]), pa[1] + t * (pb[1] - pa[1])});
       }
     }
     if (piece.size() >= 3) out.push_back(std::move(piece));
@@ -90,7 +82,7 @@ absl::Status WriteGeoJson(const DemInfo& dem, const std::vector<GeoFeature>& fea
   GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GeoJSON");
   if (driver == nullptr) return absl::InternalError("GDAL has no GeoJSON driver");
   std::error_code ec;
-  std::filesystem::remove(path, ec);  // the driver will not overwrite
+  if (std::filesystem::is_regular_file(path, ec)) std::filesystem::remove(path, ec);  // the driver will not overwrite
   GDALDatasetUniquePtr ds(driver->Create(path.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
   if (ds == nullptr) return failed(QuietGdal::LastMessage());
   // Geometries are built in the mesh's CRS when it was reprojected, else in the file's.
@@ -106,7 +98,12 @@ absl::Status WriteGeoJson(const DemInfo& dem, const std::vector<GeoFeature>& fea
   if (layer == nullptr) return failed(QuietGdal::LastMessage());
   std::unique_ptr<OGRCoordinateTransformation, decltype(&OGRCoordinateTransformation::DestroyCT)>
       to_file(nullptr, &OGRCoordinateTransformation::DestroyCT);
-  if (native_crs && dem.reprojected) to_file.reset(OGRCreateCoordinateTransformation(&built, &file));
+  if (native_crs && dem.reprojected) {
+    to_file.reset(OGRCreateCoordinateTransformation(&built, &file));
+    if (to_file == nullptr) {
+      return failed(absl::StrCat("cannot project to the DEM's CRS (", QuietGdal::LastMessage(), ")"));
+    }
+  }
 
   // The fields: every property name, typed by its first value.
   for (const GeoFeature& f : features) {

@@ -219,6 +219,11 @@ PY
 check "geojson from a mesh: exit 2" test $? -eq 2
 check "geojson from a mesh: says why" grep -q "GeoJSON needs a DEM" "$tmp/err.txt"
 
+# --labels-output beside a text --output: both written.
+"$GEODEX" distances "$tmp/slot.tif" --sources g:500105:4999845 --labels-output "$tmp/n2.tif" \
+  --output "$tmp/d2.txt"
+check "labels raster beside text distances" test "$(wc -l <"$tmp/d2.txt")" -eq 850
+
 # Errors: map points need a DEM, a point outside or in the slot is named, --dem-step needs a DEM.
 "$GEODEX" distances "$tmp/tri.off" --sources g:1:2 2>"$tmp/err.txt" >/dev/null
 check "g: on a mesh: exit 2" test $? -eq 2

@@ -231,6 +231,16 @@ TEST_F(DemTest, NodataHoleIsGoneAround) {
                       Dist(centre(15, 4), centre(16, 5)) + Dist(centre(16, 5), b);
   EXPECT_NEAR((*d)[0].first, want, 1e-9 * want);
   EXPECT_GT((*d)[0].first, 2.5 * Dist(a, b));
+  // The cell centres on the slot's edges are vertices of the surface: they drop (a point on a grid
+  // line is in two blocks, one of them the hole's).
+  for (double col : {13.0, 16.0}) {
+    const std::array<double, 3> edge = centre(col, 12);
+    absl::StatusOr<SurfacePoint> p = dem->DropMapPoint(edge[0], edge[1]);
+    ASSERT_TRUE(p.ok()) << col << ": " << p.status();
+    const std::array<double, 3> at = PositionOf(dem->mesh(), *p);
+    EXPECT_NEAR(at[0], edge[0], 1e-9);
+    EXPECT_NEAR(at[1], edge[1], 1e-9);
+  }
   // A point in the slot, and one outside the grid, are errors naming them.
   absl::StatusOr<SurfacePoint> in_hole = dem->DropMapPoint(centre(14.5, 20)[0], centre(14.5, 20)[1]);
   EXPECT_EQ(in_hole.status().code(), absl::StatusCode::kInvalidArgument);

@@ -34,8 +34,10 @@ absl::Status WriteGeoJson(const DemInfo& dem, const std::vector<GeoFeature>& fea
                           const std::string& path, bool native_crs);
 
 // The part of each face where the field, linear on the face between its vertices' values, is at
-// most `level`: a convex polygon per face (faces with a vertex at +inf are clipped where their
-// finite vertices are). In the mesh's x y: what an isochrone polygon is the union of.
+// most `level`: a convex polygon per face (an edge to a vertex at +inf contributes only its finite
+// end). In the mesh's x y: what an isochrone polygon is the union of. `value` is per file vertex
+// (a DistanceField's `distance`): where fans of faces meet at one vertex only (a nodata corner),
+// every fan sees that vertex's smallest value, a small approximation next to such vertices.
 std::vector<Polygon2> SublevelPieces(const MeshData& mesh, const std::vector<double>& value,
                                      double level);
 
