@@ -284,6 +284,7 @@ int RunIsolines(Backend& backend, const Args& args) {
       terrain::GeoFeature f;
       f.kind = terrain::GeoFeature::Kind::kArea;
       f.pieces = terrain::SublevelPieces(*s.data, (*field)->distance, level);
+      f.exact_tiling = true;
       f.properties = {{"level", level}, {"units", std::string("m")}};
       features.push_back(std::move(f));
     }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <memory>
 
 #include "absl/strings/str_cat.h"
@@ -41,6 +42,86 @@ std::unique_ptr<OGRGeometry> AreaOf(const DemInfo& dem, const std::vector<Polygo
   std::unique_ptr<OGRGeometry> merged(all->UnionCascaded());
   if (merged == nullptr) return nullptr;
   return merged;
+}
+
+// The union of pieces that tile it exactly: every piece edge shared with a neighbour (the same two
+// points, the other way round) is inside; the rest are the boundary, with the area on their left.
+// Chained into rings (at a vertex where several boundary edges leave, the sharpest left turn, so
+// that lobes touching at a point stay separate rings), they are organised into polygons by their
+// orientation: counter-clockwise shells, clockwise holes (reversed for organizePolygons).
+std::unique_ptr<OGRGeometry> TiledAreaOf(const DemInfo& dem, const std::vector<Polygon2>& pieces) {
+  using Point = std::array<double, 2>;
+  std::map<std::pair<Point, Point>, int> edges;  // directed edge -> count (ordered: deterministic)
+  for (const Polygon2& piece : pieces) {
+    double twice_area = 0;
+    for (size_t k = 0; k < piece.size(); ++k) {
+      const Point& a = piece[k];
+      const Point& b = piece[(k + 1) % piece.size()];
+      twice_area += a[0] * b[1] - b[0] * a[1];
+    }
+    if (!(twice_area > 0)) continue;  // degenerate (or not counter-clockwise: not a tile)
+    for (size_t k = 0; k < piece.size(); ++k) {
+      const Point& a = piece[k];
+      const Point& b = piece[(k + 1) % piece.size()];
+      if (a == b) continue;
+      auto reverse = edges.find({b, a});
+      if (reverse != edges.end()) {  // shared with a neighbour: inside the union
+        if (--reverse->second == 0) edges.erase(reverse);
+      } else {
+        ++edges[{a, b}];
+      }
+    }
+  }
+  std::multimap<Point, Point> from;  // boundary edges by their start
+  for (const auto& [edge, count] : edges) {
+    for (int c = 0; c < count; ++c) from.emplace(edge.first, edge.second);
+  }
+  std::vector<OGRGeometry*> rings;  // each as a polygon, for organizePolygons
+  while (!from.empty()) {
+    auto ring = std::make_unique<OGRLinearRing>();
+    const Point start = from.begin()->first;
+    Point at = start, next = from.begin()->second;
+    from.erase(from.begin());
+    auto add = [&](const Point& p) {
+      const auto q = ToCrs(dem, p[0], p[1]);
+      ring->addPoint(q[0], q[1]);
+    };
+    add(at);
+    while (next != start) {
+      add(next);
+      auto [lo, hi] = from.equal_range(next);
+      if (lo == hi) break;  // an open chain cannot happen for a tiling; close it anyway
+      // The sharpest left turn from the incoming direction.
+      const double in = std::atan2(next[1] - at[1], next[0] - at[0]);
+      auto best = lo;
+      double best_turn = -10;
+      for (auto it = lo; it != hi; ++it) {
+        double turn = std::atan2(it->second[1] - next[1], it->second[0] - next[0]) - in;
+        while (turn <= -M_PI) turn += 2 * M_PI;
+        while (turn > M_PI) turn -= 2 * M_PI;
+        if (turn > best_turn) {
+          best_turn = turn;
+          best = it;
+        }
+      }
+      at = next;
+      next = best->second;
+      from.erase(best);
+    }
+    ring->closeRings();
+    if (ring->getNumPoints() < 4) continue;
+    // organizePolygons' ONLY_CCW takes counter-clockwise rings for holes (the shapefile's
+    // convention): turn ours round. The writer orients rings as the output format wants.
+    ring->reverseWindingOrder();
+    auto polygon = std::make_unique<OGRPolygon>();
+    polygon->addRingDirectly(ring.release());
+    rings.push_back(polygon.release());
+  }
+  if (rings.empty()) return std::make_unique<OGRMultiPolygon>();
+  int valid = 0;
+  const char* options[] = {"METHOD=ONLY_CCW", nullptr};
+  return std::unique_ptr<OGRGeometry>(OGRGeometryFactory::organizePolygons(
+      rings.data(), static_cast<int>(rings.size()), &valid, options));
 }
 
 }  // namespace
@@ -120,7 +201,7 @@ absl::Status WriteGeoJson(const DemInfo& dem, const std::vector<GeoFeature>& fea
     std::unique_ptr<OGRGeometry> geometry;
     switch (f.kind) {
       case GeoFeature::Kind::kArea:
-        geometry = AreaOf(dem, f.pieces);
+        geometry = f.exact_tiling ? TiledAreaOf(dem, f.pieces) : AreaOf(dem, f.pieces);
         if (geometry == nullptr) return absl::InternalError("the polygon union failed");
         break;
       case GeoFeature::Kind::kLine: {

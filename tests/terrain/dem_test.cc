@@ -15,10 +15,12 @@
 #include "gdal_priv.h"
 #include "geodex/distance_matrix.h"
 #include "geodex/geodesic_solver.h"
+#include "geodex/geojson.h"
 #include "geodex/terrain.h"
 #include "geodex/triangle_mesh.h"
 #include "gtest/gtest.h"
 #include "ogr_spatialref.h"
+#include "ogrsf_frmts.h"
 
 namespace geodex::terrain {
 namespace {
@@ -400,6 +402,58 @@ TEST_F(DemTest, BadRastersAreClearErrors) {
   absl::StatusOr<Dem> feet = Dem::Read(Write("feet.tif", g));
   ASSERT_TRUE(feet.ok()) << feet.status();
   EXPECT_DOUBLE_EQ(feet->mesh().positions[2], 0.3048);
+}
+
+}  // namespace
+}  // namespace geodex::terrain
+
+namespace geodex::terrain {
+namespace {
+
+// The isochrone's fast union (exact tiling: unshared edges chained into rings) gives the same
+// valid area as GEOS's general union, also where lobes touch at a point: a checkerboard field
+// below its mid level is diamonds around every other vertex, touching diagonally.
+TEST_F(DemTest, TiledUnionEqualsTheGeneralUnionWithTouchingLobes) {
+  Grid g;
+  g.width = 12;
+  g.height = 9;
+  g.height_at = [](double, double, int, int) { return 0.0; };
+  absl::StatusOr<Dem> dem = Dem::Read(Write("flat.tif", g));
+  ASSERT_TRUE(dem.ok()) << dem.status();
+  std::vector<double> value(dem->mesh().vertex_count());
+  for (uint32_t j = 0; j < 9; ++j) {
+    for (uint32_t i = 0; i < 12; ++i) value[dem->VertexAt(i, j)] = (i + j) % 2 == 0 ? 0 : 10;
+  }
+  value[dem->VertexAt(11, 8)] = std::numeric_limits<double>::infinity();  // unreachable corner
+  auto area_of = [&](bool tiled, const std::string& name) {
+    GeoFeature f;
+    f.kind = GeoFeature::Kind::kArea;
+    f.pieces = SublevelPieces(dem->mesh(), value, 5);
+    f.exact_tiling = tiled;
+    const std::string path = (dir_ / name).string();
+    EXPECT_TRUE(WriteGeoJson(dem->info(), {f}, path, /*native_crs=*/true).ok());
+    GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR));
+    EXPECT_NE(ds, nullptr);
+    OGRFeatureUniquePtr feature(ds->GetLayer(0)->GetNextFeature());
+    return std::unique_ptr<OGRGeometry>(feature->StealGeometry());
+  };
+  std::unique_ptr<OGRGeometry> tiled = area_of(true, "tiled.geojson");
+  std::unique_ptr<OGRGeometry> general = area_of(false, "general.geojson");
+  ASSERT_TRUE(tiled != nullptr && general != nullptr);
+  EXPECT_TRUE(tiled->IsValid());
+  EXPECT_TRUE(general->IsValid());
+  const double area = tiled->toMultiPolygon() != nullptr && wkbFlatten(tiled->getGeometryType()) == wkbMultiPolygon
+                          ? tiled->toMultiPolygon()->get_Area()
+                          : tiled->toPolygon()->get_Area();
+  EXPECT_GT(area, 1000);
+  std::unique_ptr<OGRGeometry> difference(tiled->SymDifference(general.get()));
+  ASSERT_NE(difference, nullptr);
+  const double diff = wkbFlatten(difference->getGeometryType()) == wkbMultiPolygon
+                          ? difference->toMultiPolygon()->get_Area()
+                      : wkbFlatten(difference->getGeometryType()) == wkbPolygon
+                          ? difference->toPolygon()->get_Area()
+                          : 0.0;
+  EXPECT_LT(diff, 1e-9 * area);
 }
 
 }  // namespace
