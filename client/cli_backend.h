@@ -129,6 +129,9 @@ int FailQuery(const absl::Status& status);
 bool IsGeoJsonPath(const Args& args);  // --output ends in .geojson
 int WriteGeoJsonOutput(const Backend& backend, const Args& args,
                        const std::vector<terrain::GeoFeature>& features);
+// How MESH is read (--dem-step, --barrier-below, --barrier) and GeoJSON written (--crs), checked:
+// InvalidArgument naming the flag.
+absl::StatusOr<terrain::DemOptions> MeshReadOptions(const Args& args, const std::string& mesh);
 // Backend::Open, or the one-line failure's exit code: 3 for the mesh (unreadable, invalid,
 // unknown), 1 when the service failed (unauthenticated, unavailable, over its limits).
 int OpenMesh(Backend& backend, const Args& args, const std::string& mesh,

@@ -215,28 +215,40 @@ int WriteGeoJsonOutput(const Backend& backend, const Args& args,
   return kExitOk;
 }
 
-int OpenMesh(Backend& backend, const Args& args, const std::string& mesh,
-             const MeshBuildOptions& build) {
+absl::StatusOr<terrain::DemOptions> MeshReadOptions(const Args& args, const std::string& mesh) {
   terrain::DemOptions dem;
   uint64_t step = 1;
   std::string error;
-  if (!GetUint(args, "dem-step", &step, &error)) return Fail(kExitUsage, error);
-  if (step < 1 || step > 1000000) return Fail(kExitUsage, "--dem-step must be in [1, 1000000]");
+  if (!GetUint(args, "dem-step", &step, &error)) return absl::InvalidArgumentError(error);
+  if (step < 1 || step > 1000000) {
+    return absl::InvalidArgumentError("--dem-step must be in [1, 1000000]");
+  }
   dem.step = static_cast<uint32_t>(step);
-  if (!GetDouble(args, "barrier-below", &dem.barrier_below, &error)) return Fail(kExitUsage, error);
-  if (std::isnan(dem.barrier_below)) return Fail(kExitUsage, "--barrier-below must be a number");
+  if (!GetDouble(args, "barrier-below", &dem.barrier_below, &error)) {
+    return absl::InvalidArgumentError(error);
+  }
+  if (std::isnan(dem.barrier_below)) {
+    return absl::InvalidArgumentError("--barrier-below must be a number");
+  }
   if (args.options.count("barrier")) dem.barrier_file = args.options.at("barrier");
   for (const char* flag : {"dem-step", "barrier"}) {
     if (args.options.count(flag) && !terrain::IsDemPath(mesh)) {
-      return Fail(kExitUsage,
-                  absl::StrCat("--", flag, ": ", mesh, " is not a DEM (a raster such as .tif)"));
+      return absl::InvalidArgumentError(
+          absl::StrCat("--", flag, ": ", mesh, " is not a DEM (a raster such as .tif)"));
     }
   }
   if (args.options.count("crs") && args.options.at("crs") != "wgs84" &&
       args.options.at("crs") != "native") {
-    return Fail(kExitUsage, "--crs must be wgs84 or native");
+    return absl::InvalidArgumentError("--crs must be wgs84 or native");
   }
-  absl::Status s = backend.Open(mesh, build, dem);
+  return dem;
+}
+
+int OpenMesh(Backend& backend, const Args& args, const std::string& mesh,
+             const MeshBuildOptions& build) {
+  absl::StatusOr<terrain::DemOptions> dem = MeshReadOptions(args, mesh);
+  if (!dem.ok()) return Fail(kExitUsage, std::string(dem.status().message()));
+  absl::Status s = backend.Open(mesh, build, *dem);
   if (s.ok()) return kExitOk;
   switch (s.code()) {  // the service failed, not the mesh
     case absl::StatusCode::kUnauthenticated:

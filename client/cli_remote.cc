@@ -301,9 +301,15 @@ int RemoteMesh(GeodexClient& client, const Args& args) {
     return kExitOk;
   }
   if (sub == "upload" && p.size() == 2) {
-    absl::StatusOr<MeshData> data = LoadMeshData(p[1]);
+    absl::StatusOr<terrain::DemOptions> dem = MeshReadOptions(args, p[1]);
+    if (!dem.ok()) return Fail(kExitUsage, std::string(dem.status().message()));
+    absl::StatusOr<MeshData> data = LoadMeshData(p[1], *dem);
     if (!data.ok()) return Fail(kExitInput, std::string(data.status().message()));
-    absl::StatusOr<MeshRef> ref = client.ResolveMesh(p[1]);  // uploads only if missing
+    // A DEM (or a barrier) is turned into its mesh here; that mesh is what the server stores.
+    const bool derived = terrain::IsDemPath(p[1]) || std::isfinite(dem->barrier_below);
+    absl::StatusOr<MeshRef> ref =  // uploads only if missing
+        derived ? client.ResolveMeshData(std::filesystem::path(p[1]).stem().string() + ".off", *data)
+                : client.ResolveMesh(p[1]);
     if (!ref.ok()) return FailQuery(ref.status());
     absl::StatusOr<v1::Mesh> m =
         args.options.count("name")

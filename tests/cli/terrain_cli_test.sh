@@ -224,6 +224,17 @@ check "geojson from a mesh: says why" grep -q "GeoJSON needs a DEM" "$tmp/err.tx
   --output "$tmp/d2.txt"
 check "labels raster beside text distances" test "$(wc -l <"$tmp/d2.txt")" -eq 850
 
+# Remotely, `mesh upload DEM` stores the DEM's mesh (triangulated here) under a name that queries
+# then use; it is the same mesh the DEM's path gives.
+if [ "${GEODEX_MODE:-local}" = remote ]; then
+  "$GEODEX" mesh upload "$tmp/slot.tif" --name slot >"$tmp/up.txt"
+  check "mesh upload DEM: exit 0" test $? -eq 0
+  check "mesh upload DEM: its mesh" grep -q "slot	850 vertices" "$tmp/up.txt"
+  "$GEODEX" distances slot --sources 0 >"$tmp/byname.txt"
+  "$GEODEX" distances "$tmp/slot.tif" --sources 0 >"$tmp/bypath.txt"
+  check "mesh upload DEM: by name = by path" cmp -s "$tmp/byname.txt" "$tmp/bypath.txt"
+fi
+
 # Errors: map points need a DEM, a point outside or in the slot is named, --dem-step needs a DEM.
 "$GEODEX" distances "$tmp/tri.off" --sources g:1:2 2>"$tmp/err.txt" >/dev/null
 check "g: on a mesh: exit 2" test $? -eq 2
