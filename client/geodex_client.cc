@@ -283,8 +283,10 @@ absl::StatusOr<MeshRef> GeodexClient::ResolveMesh(const std::string& mesh) {
     if (!data.ok()) return data.status();
     return ResolveMeshData(mesh.substr(7) + ".off", *data);
   }
-  // A directory is read too, so that it fails as in local mode ("is a directory").
-  if (std::filesystem::exists(mesh, ec)) {
+  // A directory is a mesh name the server may know (a "terrain" directory beside "terrain" the
+  // sample); if it does not, it fails as in local mode ("is a directory").
+  const bool directory = std::filesystem::is_directory(mesh, ec);
+  if (!directory && std::filesystem::exists(mesh, ec)) {
     absl::StatusOr<MeshData> data = ReadMeshFile(mesh);
     if (!data.ok()) return data.status();
     ref.id = ComputeMeshId(*data);
@@ -303,6 +305,9 @@ absl::StatusOr<MeshRef> GeodexClient::ResolveMesh(const std::string& mesh) {
   absl::StatusOr<v1::Mesh> found = GetMesh(absl::StrCat("meshes/", key));
   if (!found.ok()) {
     if (absl::IsNotFound(found.status()) || absl::IsInvalidArgument(found.status())) {
+      if (directory) {
+        return absl::InvalidArgumentError(absl::StrCat(mesh, ": is a directory, not a mesh file"));
+      }
       return absl::NotFoundError(absl::StrCat(
           mesh, ": no such file, and the server has no mesh with that id or name"));
     }

@@ -152,6 +152,14 @@ check "geodex --help lists p:X:Y:Z" test $? -eq 0
 "$GEODEX" info "$tmp" >/dev/null 2>"$tmp/err.txt"
 check "directory exits 3" test $? -eq 3
 check "directory: says it is a directory" grep -q "is a directory" "$tmp/err.txt"
+# Remotely a directory may share its name with a mesh on the server (the sample "terrain" beside a
+# "terrain" directory): the server's mesh is meant.
+if ! local_mode; then
+  geodex_abs=$(realpath "$GEODEX")
+  mkdir -p "$tmp/cwd/terrain"
+  (cd "$tmp/cwd" && "$geodex_abs" info terrain >"$tmp/named.txt" 2>"$tmp/err.txt")
+  check "a directory named like a server mesh: the mesh" grep -qx "vertices: 4225" "$tmp/named.txt"
+fi
 
 # --format json: the same numbers as the text formats, parsed by a real JSON parser.
 K="$DATA/kitten.off"
