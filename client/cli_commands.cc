@@ -434,11 +434,14 @@ int RunDistances(Backend& backend, const Args& args) {
     if (IsGeoJsonPath(args)) {  // Point features with the exact distance and the nearest source
       absl::StatusOr<const MeshData*> data = backend.Geometry();
       if (!data.ok()) return FailQuery(data.status());
+      // Each feature names its point as the user wrote it (g:, ll:, a vertex...), and where it is.
+      const std::vector<std::string> written = absl::StrSplit(args.options.at("at"), ',');
       std::vector<terrain::GeoFeature> features;
       for (size_t i = 0; i < at.size(); ++i) {
         terrain::GeoFeature f;
         f.points = {PositionOf(**data, at[i])};
-        f.properties = {{"point", SurfacePointToString(at[i])}};
+        f.properties = {{"point", written.size() == at.size() ? written[i] : SurfacePointToString(at[i])},
+                        {"surface_point", SurfacePointToString(at[i])}};
         if (std::isfinite(exact[i])) {  // unreachable: distance and source stay null
           f.properties.push_back({"distance", exact[i]});
           f.properties.push_back({"source", source[i]});

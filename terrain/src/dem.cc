@@ -189,7 +189,10 @@ absl::StatusOr<Dem> Dem::Read(const std::string& path, const DemOptions& options
   } else if (file_crs.IsProjected() || file_crs.IsLocal()) {
     info.horizontal_scale = file_crs.GetLinearUnits();
     if (!(info.horizontal_scale > 0)) return bad("the CRS has no linear unit");
-    info.mesh_crs_name = info.file_crs_name;
+    // A foot-based CRS: the mesh is in metres, in that CRS's frame.
+    info.mesh_crs_name = info.horizontal_scale == 1
+                             ? info.file_crs_name
+                             : absl::StrCat(info.file_crs_name, " (x and y in metres)");
     info.mesh_crs_wkt = info.file_crs_wkt;
   } else {
     return bad("the CRS is neither projected nor geographic");

@@ -214,6 +214,8 @@ assert abs(path["properties"]["length"] - want) <= 1e-12 * want and want > 300  
 pts = load("at")["features"]
 exact = [float(l.split("\t")[2].split()[1]) for l in open(f"{t}/at.txt")]
 assert [f["properties"]["distance"] for f in pts] == exact, (pts, exact)
+assert [f["properties"]["point"] for f in pts] == ["g:500355:4999795", "g:500005:4999995"]
+assert all(f["properties"]["surface_point"].startswith("f:") for f in pts)
 PY
 "$GEODEX" isolines "$tmp/tri.off" --sources 0 --count 3 --output "$tmp/x.geojson" 2>"$tmp/err.txt"
 check "geojson from a mesh: exit 2" test $? -eq 2

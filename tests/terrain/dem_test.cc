@@ -369,6 +369,35 @@ TEST_F(DemTest, RastersOutAreAlignedWithTheGridAndMarkNodata) {
   }
 }
 
+// A CRS in US survey feet (NAD83 / California zone 3, EPSG:2227): the mesh is in metres, in that
+// CRS's frame, and map points are given in feet.
+TEST_F(DemTest, FootBasedCrsGivesAMeshInMetres) {
+  Grid g;
+  g.epsg = 2227;
+  g.x0 = 6000000;
+  g.y0 = 2100000;
+  g.dx = g.dy = 100;  // feet
+  g.width = 10;
+  g.height = 8;
+  g.height_at = [](double, double, int, int) { return 5.0; };
+  absl::StatusOr<Dem> dem = Dem::Read(Write("feet_crs.tif", g));
+  ASSERT_TRUE(dem.ok()) << dem.status();
+  const double foot = 1200.0 / 3937.0;
+  EXPECT_NEAR(dem->info().horizontal_scale, foot, 1e-12);
+  EXPECT_NE(dem->info().mesh_crs_name.find("in metres"), std::string::npos);
+  const uint32_t v = dem->VertexAt(3, 2);
+  EXPECT_NEAR(dem->mesh().positions[3 * v], (6000000 + 350) * foot, 1e-6);
+  EXPECT_NEAR(dem->mesh().positions[3 * v + 1], (2100000 - 250) * foot, 1e-6);
+  absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(dem->mesh());
+  ASSERT_TRUE(mesh.ok());
+  absl::StatusOr<SurfacePoint> a = dem->DropMapPoint(6000120, 2099880);
+  absl::StatusOr<SurfacePoint> b = dem->DropMapPoint(6000720, 2099280);
+  ASSERT_TRUE(a.ok() && b.ok());
+  absl::StatusOr<std::vector<std::pair<double, uint32_t>>> d = ComputeExactDistancesAt(*mesh, {*a}, {*b});
+  ASSERT_TRUE(d.ok());
+  EXPECT_NEAR((*d)[0].first, std::hypot(600, 600) * foot, 1e-6);  // flat: straight, in metres
+}
+
 TEST_F(DemTest, BadRastersAreClearErrors) {
   Grid g;
   g.height_at = [](double, double, int, int) { return 1.0; };
