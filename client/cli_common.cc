@@ -108,10 +108,7 @@ bool GetUint(const Args& args, const std::string& key, uint64_t* out, std::strin
 
 bool CheckKnown(const Args& args, const std::set<std::string>& known, std::string* error) {
   for (const auto& [key, value] : args.options) {
-    // --dem-step, --barrier-below and --barrier: how every MESH is read (OpenMesh); --crs: how GeoJSON
-    // output is written (WriteGeoJsonOutput).
-    if (!known.count(key) && key != "dem-step" && key != "barrier-below" && key != "barrier" &&
-        key != "crs") {
+    if (!known.count(key) && !kMeshReadingFlags.count(key)) {
       *error = absl::StrFormat("unknown option --%s (see geodex --help)", key);
       return false;
     }

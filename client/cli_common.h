@@ -46,7 +46,11 @@ absl::StatusOr<LoadedMesh> LoadMesh(const std::string& path, const MeshBuildOpti
 // --key as a number; absent leaves *out unchanged. False with *error naming the option.
 bool GetDouble(const Args& args, const std::string& key, double* out, std::string* error);
 bool GetUint(const Args& args, const std::string& key, uint64_t* out, std::string* error);
-// False with *error naming the first option not in `known`.
+// How MESH is read (--dem-step, --barrier-below, --barrier) and GeoJSON written (--crs): options
+// of every command that takes a MESH, checked by MeshReadOptions (cli_backend.h).
+inline const std::set<std::string> kMeshReadingFlags = {"dem-step", "barrier-below", "barrier",
+                                                        "crs"};
+// False with *error naming the first option neither in `known` nor in kMeshReadingFlags.
 bool CheckKnown(const Args& args, const std::set<std::string>& known, std::string* error);
 
 // While alive, shows "geodex: WHAT... 3.4 s" on stderr, refreshed, once the work has taken more than

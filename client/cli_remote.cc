@@ -85,6 +85,17 @@ absl::StatusOr<T> Flagged(absl::StatusOr<T> result,
   return result;
 }
 
+// geodexd reads meshes, not rasters, and applies no barrier: a DEM, or a mesh with
+// --barrier-below, is turned into its mesh here, and that mesh is what the server gets.
+bool DerivedHere(const std::string& mesh, const terrain::DemOptions& options) {
+  return terrain::IsDemPath(mesh) || std::isfinite(options.barrier_below);
+}
+absl::StatusOr<MeshRef> UploadDerived(GeodexClient& client, const std::string& mesh,
+                                      const MeshData& data) {
+  // By its content's id, uploaded only if the server lacks it.
+  return client.ResolveMeshData(std::filesystem::path(mesh).stem().string() + ".off", data);
+}
+
 // Queries on a geodexd: MESH resolves to the server's copy (uploaded once, by content hash),
 // p:X:Y:Z points are snapped there, so every printed point matches local mode.
 class RemoteBackend final : public Backend {
@@ -102,14 +113,12 @@ class RemoteBackend final : public Backend {
       return absl::InvalidArgumentError(absl::StrCat(
           "--barrier-below: ", mesh, " must be a file or a sample (the barrier is applied here)"));
     }
-    if ((terrain::IsDemPath(mesh) || barrier) && here) {
-      // geodexd reads meshes, not rasters (yet): a DEM is triangulated here, a barrier applied
-      // here, and the mesh they make uploaded (by its content's id, like any other).
+    if (DerivedHere(mesh, dem_options) && here) {
       absl::StatusOr<MeshData> data = LoadMeshData(mesh, dem_options, &dem_);
       if (!data.ok()) return data.status();
       // The mesh the server gets is this one (the barrier applied): draw and place sites on it.
       if (dem_ == nullptr) data_ = std::make_unique<MeshData>(*data);
-      ref = client_->ResolveMeshData(std::filesystem::path(mesh).stem().string() + ".off", *data);
+      ref = UploadDerived(*client_, mesh, *data);
     } else {
       ref = client_->ResolveMesh(mesh);
     }
@@ -305,11 +314,8 @@ int RemoteMesh(GeodexClient& client, const Args& args) {
     if (!dem.ok()) return Fail(kExitUsage, std::string(dem.status().message()));
     absl::StatusOr<MeshData> data = LoadMeshData(p[1], *dem);
     if (!data.ok()) return Fail(kExitInput, std::string(data.status().message()));
-    // A DEM (or a barrier) is turned into its mesh here; that mesh is what the server stores.
-    const bool derived = terrain::IsDemPath(p[1]) || std::isfinite(dem->barrier_below);
     absl::StatusOr<MeshRef> ref =  // uploads only if missing
-        derived ? client.ResolveMeshData(std::filesystem::path(p[1]).stem().string() + ".off", *data)
-                : client.ResolveMesh(p[1]);
+        DerivedHere(p[1], *dem) ? UploadDerived(client, p[1], *data) : client.ResolveMesh(p[1]);
     if (!ref.ok()) return FailQuery(ref.status());
     absl::StatusOr<v1::Mesh> m =
         args.options.count("name")
