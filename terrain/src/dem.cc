@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <functional>
 #include <limits>
+#include <atomic>
 #include <mutex>
 #include <utility>
 
@@ -13,6 +14,7 @@
 #include "absl/strings/str_format.h"
 #include "cpl_conv.h"
 #include "cpl_error.h"
+#include "cpl_vsi.h"
 #include "gdal_priv.h"
 #include "gdal_quiet.h"
 #include "ogr_api.h"
@@ -122,6 +124,11 @@ bool IsDemPath(const std::string& path) {
   return false;
 }
 
+bool LooksLikeTiff(const std::string& bytes) {
+  return bytes.size() >= 4 && ((bytes[0] == 'I' && bytes[1] == 'I' && (bytes[2] == 42 || bytes[2] == 43) && bytes[3] == 0) ||
+                               (bytes[0] == 'M' && bytes[1] == 'M' && bytes[2] == 0 && (bytes[3] == 42 || bytes[3] == 43)));
+}
+
 absl::StatusOr<Dem> Dem::Read(const std::string& path, const DemOptions& options) {
   if (options.step < 1) return absl::InvalidArgumentError("--dem-step must be at least 1");
   std::error_code ec;
@@ -130,10 +137,51 @@ absl::StatusOr<Dem> Dem::Read(const std::string& path, const DemOptions& options
   }
   QuietGdal quiet;
   GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY));
+  if (ds == nullptr) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(path, ": not a raster GDAL reads (", QuietGdal::LastMessage(), ")"));
+  }
+  return ReadDataset(*ds, path, options);
+}
+
+absl::StatusOr<Dem> Dem::ReadGeoTiffBytes(const std::string& bytes, const std::string& name,
+                                          const DemOptions& options) {
+  if (options.step < 1) return absl::InvalidArgumentError("the DEM step must be at least 1");
+  if (!options.barrier_file.empty()) {
+    return absl::InvalidArgumentError("a barrier file is read with the DEM's path, not its bytes");
+  }
+  if (!LooksLikeTiff(bytes)) {
+    return absl::InvalidArgumentError(absl::StrCat(name, ": not a GeoTIFF (no TIFF header)"));
+  }
+  QuietGdal quiet;
+  // An in-memory file over the caller's bytes (not copied), unique per call: uploads run in
+  // parallel on the server's pool.
+  static std::atomic<uint64_t> serial{0};
+  const std::string path = absl::StrCat("/vsimem/geodex-dem-", serial.fetch_add(1), ".tif");
+  VSILFILE* file = VSIFileFromMemBuffer(
+      path.c_str(), reinterpret_cast<GByte*>(const_cast<char*>(bytes.data())), bytes.size(), FALSE);
+  if (file == nullptr) return absl::InternalError("GDAL cannot make an in-memory file");
+  VSIFCloseL(file);
+  // Only the GTiff driver parses untrusted bytes, and it looks for no side-car files.
+  const char* const drivers[] = {"GTiff", nullptr};
+  const char* const open_options[] = {nullptr};
+  GDALDatasetUniquePtr ds(GDALDataset::FromHandle(
+      GDALOpenEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, drivers, open_options, nullptr)));
+  absl::StatusOr<Dem> dem =
+      ds == nullptr ? absl::InvalidArgumentError(absl::StrCat(
+                          name, ": not a GeoTIFF GDAL reads (", QuietGdal::LastMessage(), ")"))
+                    : ReadDataset(*ds, name, options);
+  ds.reset();
+  VSIUnlink(path.c_str());
+  return dem;
+}
+
+absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& path,
+                                     const DemOptions& options) {
+  GDALDataset* ds = &dataset;
   auto bad = [&](const std::string& why) {
     return absl::InvalidArgumentError(absl::StrCat(path, ": ", why));
   };
-  if (ds == nullptr) return bad(absl::StrCat("not a raster GDAL reads (", QuietGdal::LastMessage(), ")"));
   if (ds->GetRasterCount() != 1) {
     return bad(absl::StrCat("a DEM has one band; this raster has ", ds->GetRasterCount()));
   }
@@ -142,6 +190,12 @@ absl::StatusOr<Dem> Dem::Read(const std::string& path, const DemOptions& options
   info.driver = ds->GetDriver() != nullptr ? ds->GetDriver()->GetDescription() : "";
   info.raster_width = static_cast<uint32_t>(ds->GetRasterXSize());
   info.raster_height = static_cast<uint32_t>(ds->GetRasterYSize());
+  if (options.max_cells != 0 &&
+      uint64_t{info.raster_width} * info.raster_height > options.max_cells) {
+    return absl::ResourceExhaustedError(absl::StrFormat(
+        "%s: %ux%u cells, more than the %u a DEM may have here", path, info.raster_width,
+        info.raster_height, options.max_cells));
+  }
   info.step = options.step;
   info.grid_width = (info.raster_width + options.step - 1) / options.step;
   info.grid_height = (info.raster_height + options.step - 1) / options.step;
@@ -314,6 +368,94 @@ absl::StatusOr<Dem> Dem::Read(const std::string& path, const DemOptions& options
                    ? "no 2x2 block of cells above the barrier: nothing to triangulate"
                    : "no 2x2 block of cells with data: nothing to triangulate");
   }
+  return dem;
+}
+
+absl::StatusOr<Dem> Dem::FromMesh(MeshData mesh, DemInfo info) {
+  auto bad = [](const std::string& why) {
+    return absl::InvalidArgumentError(absl::StrCat("not the mesh of this DEM: ", why));
+  };
+  const uint32_t W = info.grid_width, H = info.grid_height;
+  const std::array<double, 6>& gt = info.geotransform;
+  if (W < 2 || H < 2 || uint64_t{W} * H >= kNoVertex || gt[1] == 0 || gt[5] == 0 ||
+      !(info.horizontal_scale > 0)) {
+    return bad("its grid is not a DEM's");
+  }
+  const size_t n = mesh.vertex_count();
+  if (n > size_t{W} * H) return bad("more vertices than cells");
+  // Each vertex's map position in the file's CRS.
+  std::vector<double> xs(n), ys(n);
+  for (size_t v = 0; v < n; ++v) {
+    xs[v] = mesh.positions[3 * v];
+    ys[v] = mesh.positions[3 * v + 1];
+  }
+  if (info.reprojected) {
+    QuietGdal quiet;
+    OGRSpatialReference file_crs, mesh_crs;
+    if (file_crs.importFromWkt(info.file_crs_wkt.c_str()) != OGRERR_NONE ||
+        mesh_crs.importFromWkt(info.mesh_crs_wkt.c_str()) != OGRERR_NONE) {
+      return bad("its CRS does not parse");
+    }
+    file_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    mesh_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    TransformPtr back = MakeTransform(mesh_crs, file_crs);
+    std::vector<int> ok(n);
+    if (back == nullptr || (n > 0 && !back->Transform(static_cast<int>(n), xs.data(), ys.data(),
+                                                       nullptr, ok.data())) ||
+        std::find(ok.begin(), ok.end(), 0) != ok.end()) {
+      return bad("its vertices do not project back to the file's CRS");
+    }
+  } else {
+    for (size_t v = 0; v < n; ++v) {
+      xs[v] /= info.horizontal_scale;
+      ys[v] /= info.horizontal_scale;
+    }
+  }
+  Dem dem;
+  dem.vertex_of_cell_.assign(size_t{W} * H, kNoVertex);
+  std::vector<uint32_t> cell_of_vertex(n);
+  size_t previous = 0;
+  for (size_t v = 0; v < n; ++v) {
+    const double u = (xs[v] - gt[0]) / gt[1] - 0.5, w = (ys[v] - gt[3]) / gt[5] - 0.5;
+    const double i = std::round(u), j = std::round(w);
+    // A cell centre to far better than a cell (projections round-trip to ~1e-9 of one).
+    if (!(std::abs(u - i) < 1e-3 && std::abs(w - j) < 1e-3 && i >= 0 && j >= 0 && i < W && j < H)) {
+      return bad(absl::StrCat("vertex ", v, " is not at a cell centre"));
+    }
+    const size_t cell = static_cast<size_t>(j) * W + static_cast<size_t>(i);
+    if (v > 0 && cell <= previous) return bad(absl::StrCat("vertex ", v, " is out of row order"));
+    previous = cell;
+    dem.vertex_of_cell_[cell] = static_cast<uint32_t>(v);
+    cell_of_vertex[v] = static_cast<uint32_t>(cell);
+  }
+  dem.face_of_block_.assign(2 * size_t{W - 1} * (H - 1), kNoVertex);
+  for (size_t f = 0; f < mesh.face_count(); ++f) {
+    uint32_t ci[3], cj[3];
+    for (int c = 0; c < 3; ++c) {
+      const uint32_t v = mesh.faces[3 * f + c];
+      if (v >= n) return bad(absl::StrCat("face ", f, " has no vertex ", v));
+      ci[c] = cell_of_vertex[v] % W;
+      cj[c] = cell_of_vertex[v] / W;
+    }
+    const uint32_t i = std::min({ci[0], ci[1], ci[2]}), j = std::min({cj[0], cj[1], cj[2]});
+    // (a, c, d) has the block's lower-left corner c (i, j + 1); (a, d, b) its b (i + 1, j).
+    int k = -1, corners = 0;
+    for (int c = 0; c < 3; ++c) {
+      const uint32_t di = ci[c] - i, dj = cj[c] - j;
+      if (di > 1 || dj > 1) break;
+      corners |= 1 << (di + 2 * dj);  // a 1, b 2, c 4, d 8
+    }
+    if (corners == (1 | 4 | 8)) k = 0;
+    if (corners == (1 | 8 | 2)) k = 1;
+    if (k < 0 || i + 1 >= W || j + 1 >= H) {
+      return bad(absl::StrCat("face ", f, " is not one of a block's two triangles"));
+    }
+    uint32_t& slot = dem.face_of_block_[2 * (size_t{j} * (W - 1) + i) + k];
+    if (slot != kNoVertex) return bad(absl::StrCat("face ", f, " repeats face ", slot));
+    slot = static_cast<uint32_t>(f);
+  }
+  dem.mesh_ = std::move(mesh);
+  dem.info_ = std::move(info);
   return dem;
 }
 

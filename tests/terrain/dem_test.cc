@@ -485,5 +485,104 @@ TEST_F(DemTest, TiledUnionEqualsTheGeneralUnionWithTouchingLobes) {
   EXPECT_LT(diff, 1e-9 * area);
 }
 
+
+std::string Slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// Every map point of `points` drops onto the same face point from `a` and `b`.
+void ExpectSameDrops(const Dem& a, const Dem& b, const std::vector<std::array<double, 2>>& points) {
+  for (const auto& [x, y] : points) {
+    absl::StatusOr<SurfacePoint> pa = a.DropMapPoint(x, y), pb = b.DropMapPoint(x, y);
+    ASSERT_EQ(pa.ok(), pb.ok()) << x << " " << y << ": " << pa.status() << " / " << pb.status();
+    if (!pa.ok()) {
+      EXPECT_EQ(pa.status().message(), pb.status().message());
+      continue;
+    }
+    EXPECT_EQ(pa->face, pb->face) << x << " " << y;
+    for (int c = 0; c < 3; ++c) EXPECT_DOUBLE_EQ(pa->bary[c], pb->bary[c]) << x << " " << y;
+  }
+}
+
+// geodexd reads uploaded GeoTIFF bytes (GTiff only) into the same mesh the file gives, and rebuilds
+// a stored DEM from its mesh and info: the same vertices, faces and dropped points.
+TEST_F(DemTest, BytesAndStoredMeshGiveTheSameDem) {
+  Grid g;
+  g.width = g.height = 30;
+  g.has_nodata = true;
+  g.height_at = [&](double x, double y, int col, int row) {
+    return (col == 14 || col == 15) && row >= 5 ? g.nodata : Plane(x, y);
+  };
+  const std::string path = Write("slot.tif", g);
+  DemOptions options;
+  options.step = 2;
+  absl::StatusOr<Dem> file = Dem::Read(path, options);
+  ASSERT_TRUE(file.ok()) << file.status();
+  absl::StatusOr<Dem> bytes = Dem::ReadGeoTiffBytes(Slurp(path), "upload.tif", options);
+  ASSERT_TRUE(bytes.ok()) << bytes.status();
+  EXPECT_EQ(bytes->mesh().positions, file->mesh().positions);
+  EXPECT_EQ(bytes->mesh().faces, file->mesh().faces);
+  EXPECT_EQ(bytes->info().file_crs_wkt, file->info().file_crs_wkt);
+  EXPECT_EQ(bytes->info().geotransform, file->info().geotransform);
+
+  std::vector<std::array<double, 2>> points;
+  for (double u = -1.3; u < 32; u += 0.77) {
+    for (double v = 0.2; v < 31; v += 1.9) points.push_back({g.x0 + u * g.dx, g.y0 - v * g.dy});
+  }
+  absl::StatusOr<Dem> stored = Dem::FromMesh(file->mesh(), file->info());
+  ASSERT_TRUE(stored.ok()) << stored.status();
+  ExpectSameDrops(*file, *stored, points);
+  for (uint32_t j = 0; j < file->info().grid_height; ++j) {
+    for (uint32_t i = 0; i < file->info().grid_width; ++i) {
+      ASSERT_EQ(stored->VertexAt(i, j), file->VertexAt(i, j)) << i << " " << j;
+    }
+  }
+  // A mesh that is not this DEM's is refused: vertices out of row order, a face across blocks.
+  MeshData swapped = file->mesh();
+  std::swap_ranges(swapped.positions.begin(), swapped.positions.begin() + 3,
+                   swapped.positions.begin() + 3);
+  EXPECT_EQ(Dem::FromMesh(swapped, file->info()).status().code(), absl::StatusCode::kInvalidArgument);
+  MeshData stretched = file->mesh();
+  stretched.faces[2] = stretched.faces[2] + 5;
+  absl::Status across = Dem::FromMesh(stretched, file->info()).status();
+  EXPECT_NE(across.message().find("not one of a block's two triangles"), std::string::npos) << across;
+
+  // Bad bytes are clear errors, and the cell limit holds before any row is read.
+  EXPECT_NE(Dem::ReadGeoTiffBytes("solid\nfacet", "x.tif").status().message().find("not a GeoTIFF"),
+            std::string::npos);
+  std::string cut = Slurp(path);
+  cut.resize(cut.size() / 3);
+  EXPECT_EQ(Dem::ReadGeoTiffBytes(cut, "cut.tif").status().code(), absl::StatusCode::kInvalidArgument);
+  DemOptions small;
+  small.max_cells = 899;
+  EXPECT_EQ(Dem::ReadGeoTiffBytes(Slurp(path), "big.tif", small).status().code(),
+            absl::StatusCode::kResourceExhausted);
+  small.max_cells = 900;
+  EXPECT_TRUE(Dem::ReadGeoTiffBytes(Slurp(path), "big.tif", small).ok());
+}
+
+// The same for a geographic grid (the mesh in UTM): cells are found by projecting back.
+TEST_F(DemTest, StoredGeographicMeshGivesTheSameDem) {
+  Grid g;
+  g.epsg = 4326;
+  g.x0 = 14.99;
+  g.y0 = 45.16;
+  g.dx = g.dy = 0.0002;
+  g.width = 25;
+  g.height = 20;
+  g.height_at = [&](double lon, double lat, int, int) { return 1000 * (lon - 14.99) + 300 * (lat - 45); };
+  absl::StatusOr<Dem> file = Dem::Read(Write("geo.tif", g));
+  ASSERT_TRUE(file.ok()) << file.status();
+  ASSERT_TRUE(file->info().reprojected);
+  absl::StatusOr<Dem> stored = Dem::FromMesh(file->mesh(), file->info());
+  ASSERT_TRUE(stored.ok()) << stored.status();
+  std::vector<std::array<double, 2>> points;
+  for (double u = 0.1; u < 25; u += 1.37) {
+    for (double v = 0.3; v < 21; v += 2.1) points.push_back({g.x0 + u * g.dx, g.y0 - v * g.dy});
+  }
+  ExpectSameDrops(*file, *stored, points);
+}
+
 }  // namespace
 }  // namespace geodex::terrain

@@ -24,6 +24,8 @@
 #include "geodex/mesh_data.h"
 #include "geodex/surface_point.h"
 
+class GDALDataset;
+
 namespace geodex::terrain {
 
 struct DemOptions {
@@ -34,6 +36,9 @@ struct DemOptions {
   // A barrier drawn as polygons (any vector file GDAL reads, GeoJSON first; its own CRS, WGS 84
   // when it names none): the triangles whose centre lies inside one are left out. "": none.
   std::string barrier_file;
+  // The most cells (width x height of the file) a raster may have; 0: any. What a server sets
+  // before GDAL reads untrusted bytes (ResourceExhausted above it).
+  uint64_t max_cells = 0;
 };
 
 // The faces of `mesh` with no corner lower than `z` (the same barrier on a mesh file: a face
@@ -70,6 +75,15 @@ class Dem {
   // geotransform, a rotated grid, fewer than 2x2 used cells, an unknown height unit, no
   // triangle with data), NotFound when the file does not exist.
   static absl::StatusOr<Dem> Read(const std::string& path, const DemOptions& options = {});
+  // The same from a GeoTIFF's bytes (an upload to geodexd; only GDAL's GTiff driver parses them,
+  // and options.barrier_file must be empty). `name` spells the raster in errors.
+  static absl::StatusOr<Dem> ReadGeoTiffBytes(const std::string& bytes, const std::string& name,
+                                              const DemOptions& options = {});
+  // A DEM mesh again from the mesh and its info, as stored by geodexd or fetched from it: each
+  // vertex's cell is found from its position and each face's block from its corners.
+  // InvalidArgument when the mesh is not such a DEM's (a vertex off the grid, out of row order,
+  // a face that is not one of a block's two triangles).
+  static absl::StatusOr<Dem> FromMesh(MeshData mesh, DemInfo info);
 
   Dem(Dem&&) noexcept;
   Dem& operator=(Dem&&) noexcept;
@@ -97,6 +111,9 @@ class Dem {
 
  private:
   Dem() = default;
+  // Read's work once GDAL has opened the raster (`name` spells it in errors).
+  static absl::StatusOr<Dem> ReadDataset(GDALDataset& ds, const std::string& name,
+                                         const DemOptions& options);
   // DropMapPoint, naming the point `name` in errors.
   absl::StatusOr<SurfacePoint> DropNamed(double x, double y, const std::string& name) const;
   // Drops a point given in the mesh's CRS (metres); `name` spells it in errors.
@@ -112,5 +129,7 @@ class Dem {
 // True when `path` names a raster by its extension (.tif, .tiff, .vrt, .asc, .img, .hgt, .dem,
 // .bil, .nc): what the CLI reads as a DEM instead of a mesh file.
 bool IsDemPath(const std::string& path);
+// True when `bytes` start like a TIFF file (either byte order; BigTIFF too).
+bool LooksLikeTiff(const std::string& bytes);
 
 }  // namespace geodex::terrain
