@@ -1,5 +1,7 @@
 #include "geodex_service.h"
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -9,6 +11,7 @@
 #include "absl/strings/str_cat.h"
 #include "geodex/cancel.h"
 #include "geodex/mesh_io.h"
+#include "geodex/terrain.h"
 #include "google/protobuf/descriptor.h"
 #include "grpcpp/support/server_callback.h"
 #include "geodex/mesh_id.h"
@@ -33,8 +36,10 @@ absl::Status ValidateDisplayName(const std::string& name) {
   return absl::OkStatus();
 }
 
+// MESH_FORMAT_GEOTIFF is not a mesh file format: a DEM (the reactor reads it through terrain/).
 absl::StatusOr<MeshFormat> FormatFromProto(int format) {
   switch (format) {
+    case v1::MESH_FORMAT_GEOTIFF:
     case v1::MESH_FORMAT_UNSPECIFIED:
       return MeshFormat::kAuto;
     case v1::MESH_FORMAT_OFF:
@@ -126,6 +131,19 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
       absl::StatusOr<MeshFormat> format = FormatFromProto(metadata_.format());
       if (!format.ok()) return format.status();
       format_ = *format;
+      // A DEM: said so, or guessed from the name now (from the bytes' TIFF header at the end).
+      dem_ = metadata_.format() == v1::MESH_FORMAT_GEOTIFF ||
+             (metadata_.format() == v1::MESH_FORMAT_UNSPECIFIED &&
+              terrain::IsGeoTiffPath(metadata_.file_name()));
+      if (metadata_.has_dem()) {
+        if (metadata_.format() != v1::MESH_FORMAT_GEOTIFF &&
+            metadata_.format() != v1::MESH_FORMAT_UNSPECIFIED) {
+          return FieldError("metadata.dem", "DEM options are for a GeoTIFF upload (format MESH_FORMAT_GEOTIFF)");
+        }
+        if (metadata_.dem().has_barrier_below() && !std::isfinite(metadata_.dem().barrier_below())) {
+          return FieldError("metadata.dem.barrier_below", "must be finite");
+        }
+      }
       if (!metadata_.expected_mesh_id().empty() && !IsMeshId(metadata_.expected_mesh_id())) {
         return FieldError("metadata.expected_mesh_id", "must be 64 lowercase hex digits");
       }
@@ -202,6 +220,21 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
     Finish(ToGrpcStatus(status));
   }
 
+  // A GeoTIFF upload's mesh, through GDAL's GTiff driver only, at most --max_dem_cells cells.
+  absl::StatusOr<terrain::Dem> ReadDem(const std::string& file_name) const {
+    terrain::DemOptions options;
+    options.step = std::max<uint32_t>(1, metadata_.dem().step());
+    if (metadata_.dem().has_barrier_below()) options.barrier_below = metadata_.dem().barrier_below();
+    options.max_cells = env_.limits->max_dem_cells;
+    absl::StatusOr<terrain::Dem> dem = terrain::Dem::ReadGeoTiffBytes(bytes_, file_name, options);
+    if (absl::IsResourceExhausted(dem.status())) {
+      return ServerLimitError("max_dem_cells", absl::StrCat(dem.status().message(), " (--max_dem_cells=",
+                                                            env_.limits->max_dem_cells, ")"));
+    }
+    if (!dem.ok()) return FieldError("chunk", dem.status().message());
+    return dem;
+  }
+
   absl::Status BuildAndStore(v1::Mesh* response) {
     const ServiceLimits& limits = *env_.limits;
     ReadLimits read_limits;
@@ -213,8 +246,17 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
         metadata_.file_name().empty()
             ? "upload"
             : std::string(metadata_.file_name().substr(0, kMaxEchoBytes));
-    absl::StatusOr<MeshData> data = ReadMeshFromBuffer(
-        absl::string_view(bytes_), format_, file_name, read_limits);
+    std::shared_ptr<const terrain::Dem> dem;
+    if (dem_ || (metadata_.format() == v1::MESH_FORMAT_UNSPECIFIED && terrain::LooksLikeTiff(bytes_))) {
+      absl::StatusOr<terrain::Dem> read = ReadDem(file_name);
+      if (!read.ok()) return read.status();
+      dem = std::make_shared<const terrain::Dem>(*std::move(read));
+    } else if (metadata_.has_dem()) {
+      return FieldError("metadata.dem", "DEM options are for a GeoTIFF upload, and this upload is not one");
+    }
+    absl::StatusOr<MeshData> data = dem != nullptr ? absl::StatusOr<MeshData>(dem->mesh())
+                                                   : ReadMeshFromBuffer(absl::string_view(bytes_),
+                                                                        format_, file_name, read_limits);
     if (!data.ok()) {
       if (data.status().code() == absl::StatusCode::kResourceExhausted) return data.status();
       return FieldError("chunk", data.status().message());
@@ -232,7 +274,9 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
       return FieldError("metadata.expected_mesh_id", absl::StrCat(metadata_.expected_mesh_id(), " differs from the uploaded mesh's id ", id));
     }
     std::shared_ptr<StoredMesh> candidate;
-    if (env_.store->Contains(id)) {
+    // A stored mesh that is this DEM's but was uploaded as a mesh file gains its map: build it.
+    absl::StatusOr<std::shared_ptr<const StoredMesh>> known = env_.store->GetRecord(id);
+    if (known.ok() && (dem == nullptr || (*known)->terrain.has_value())) {
       // Idempotent re-upload: no rebuild. (Insert adds the new alias to the stored mesh.)
       candidate = std::make_shared<StoredMesh>();
       candidate->id = id;
@@ -244,7 +288,7 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
         return FieldError("chunk", mesh.status().message());
       }
       if (cancel_.IsCancelled()) return absl::CancelledError("upload cancelled");
-      candidate = MakeStoredMesh(id, *std::move(mesh));
+      candidate = MakeStoredMesh(id, *std::move(mesh), std::move(dem));
       candidate->upload_bytes = bytes_.size();
       candidate->pinned = metadata_.pin();
     }
@@ -268,6 +312,7 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
   uint64_t messages_ = 0;
   v1::CreateMeshMetadata metadata_;
   MeshFormat format_ = MeshFormat::kAuto;  // metadata_.format(), checked
+  bool dem_ = false;                       // a GeoTIFF upload, by its format or file name
   bool have_metadata_ = false;
   std::string bytes_;
   CancelToken cancel_;

@@ -52,6 +52,8 @@ ABSL_FLAG(uint32_t, queue_capacity, 64,
 ABSL_FLAG(uint64_t, max_upload_bytes, uint64_t{1} << 30, "Largest mesh file accepted by CreateMesh");
 ABSL_FLAG(uint64_t, max_vertices, 20'000'000, "Most vertices in an uploaded mesh");
 ABSL_FLAG(uint64_t, max_faces, 40'000'000, "Most faces in an uploaded mesh");
+ABSL_FLAG(uint64_t, max_dem_cells, 25'000'000,
+          "Most cells (width x height) in an uploaded GeoTIFF DEM, checked before GDAL reads them");
 ABSL_FLAG(uint32_t, max_names_per_mesh, 16,
           "Most names (display name and aliases from re-uploads under other names) one mesh may have");
 ABSL_FLAG(uint32_t, max_sources, 100'000, "Most sources in one query");
@@ -136,6 +138,7 @@ int main(int argc, char** argv) {
   options.limits.max_upload_bytes = absl::GetFlag(FLAGS_max_upload_bytes);
   options.limits.max_vertices = absl::GetFlag(FLAGS_max_vertices);
   options.limits.max_faces = absl::GetFlag(FLAGS_max_faces);
+  options.limits.max_dem_cells = absl::GetFlag(FLAGS_max_dem_cells);
   options.limits.max_sources = absl::GetFlag(FLAGS_max_sources);
   options.limits.max_names_per_mesh = absl::GetFlag(FLAGS_max_names_per_mesh);
   options.limits.max_targets = absl::GetFlag(FLAGS_max_targets);
@@ -171,14 +174,14 @@ int main(int argc, char** argv) {
   spdlog::info(
       "config replica={} listen={} data_dir={} samples={} mesh_budget_bytes={} result_cache_bytes={} "
       "pool_threads={} quick_threads={} "
-      "queue_capacity={} max_upload_bytes={} max_vertices={} max_faces={} max_sources={} "
+      "queue_capacity={} max_upload_bytes={} max_vertices={} max_faces={} max_dem_cells={} max_sources={} "
       "max_targets={} max_levels={} max_output_values={} max_windows={} "
       "max_unary_response_bytes={} stream_chunk_bytes={} shutdown_grace_seconds={}",
       options.replica_name, options.listen, options.data_dir.empty() ? "(none)" : options.data_dir,
       options.samples,
       options.mesh_budget_bytes, options.result_cache_bytes, (*server)->pool().threads(),
       options.quick_threads, options.queue_capacity, options.limits.max_upload_bytes, options.limits.max_vertices, options.limits.max_faces,
-      options.limits.max_sources, options.limits.max_targets, options.limits.max_levels,
+      options.limits.max_dem_cells, options.limits.max_sources, options.limits.max_targets, options.limits.max_levels,
       options.limits.max_output_values, options.limits.max_windows,
       options.limits.max_unary_response_bytes, options.limits.stream_chunk_bytes,
       absl::GetFlag(FLAGS_shutdown_grace_seconds));

@@ -121,12 +121,28 @@ std::string EncodeMeshFileHeader(const MeshRecord& record) {
   for (double v : s.bbox_min) w.F64(v);
   for (double v : s.bbox_max) w.F64(v);
   w.U64(s.bytes);
+  w.U8(record.terrain.has_value() ? 1 : 0);
+  if (record.terrain) {
+    const terrain::DemInfo& t = *record.terrain;
+    w.Str(t.driver);
+    for (uint32_t v : {t.raster_width, t.raster_height, t.step, t.grid_width, t.grid_height}) w.U32(v);
+    for (uint64_t v : {t.nodata_cells, t.barrier_cells, t.barrier_faces}) w.U64(v);
+    w.Str(t.file_crs_name);
+    w.Str(t.file_crs_wkt);
+    w.U8(t.reprojected ? 1 : 0);
+    w.Str(t.mesh_crs_name);
+    w.Str(t.mesh_crs_wkt);
+    w.F64(t.horizontal_scale);
+    w.Str(t.vertical_unit);
+    w.F64(t.vertical_scale);
+    for (double v : t.geotransform) w.F64(v);
+  }
   return w.Take();
 }
 
 absl::StatusOr<MeshRecord> DecodeMeshFileHeader(uint32_t version, absl::string_view bytes) {
   if (version == 1) return DecodeVersion1(bytes);
-  if (version != kMeshFileVersion) {
+  if (version != 2 && version != 3) {
     return absl::DataLossError(absl::StrCat("unsupported format version ", version));
   }
   Reader r(bytes);
@@ -149,6 +165,23 @@ absl::StatusOr<MeshRecord> DecodeMeshFileHeader(uint32_t version, absl::string_v
   for (double& v : s.bbox_min) v = r.F64();
   for (double& v : s.bbox_max) v = r.F64();
   s.bytes = r.U64();
+  if (version >= 3 && r.U8() != 0) {
+    terrain::DemInfo& t = record.terrain.emplace();
+    t.driver = r.Str();
+    for (uint32_t* v : {&t.raster_width, &t.raster_height, &t.step, &t.grid_width, &t.grid_height}) {
+      *v = r.U32();
+    }
+    for (uint64_t* v : {&t.nodata_cells, &t.barrier_cells, &t.barrier_faces}) *v = r.U64();
+    t.file_crs_name = r.Str();
+    t.file_crs_wkt = r.Str();
+    t.reprojected = r.U8() != 0;
+    t.mesh_crs_name = r.Str();
+    t.mesh_crs_wkt = r.Str();
+    t.horizontal_scale = r.F64();
+    t.vertical_unit = r.Str();
+    t.vertical_scale = r.F64();
+    for (double& v : t.geotransform) v = r.F64();
+  }
   if (!r.ok() || !r.done()) return absl::DataLossError("corrupt header");
   return record;
 }

@@ -5,10 +5,12 @@
 // each file's header (mesh_file_header.h), and the Mesh resource shows it (proto_convert.h).
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "absl/time/time.h"
+#include "geodex/terrain.h"
 #include "geodex/triangle_mesh.h"
 
 namespace geodex::server {
@@ -25,6 +27,8 @@ struct MeshRecord {
   absl::Time create_time;
   // The build report and geometry (kept so that records answer GetMesh without loading).
   MeshSummary summary;
+  // A mesh made from a DEM (a GeoTIFF upload): its map, for map points and GIS outputs.
+  std::optional<terrain::DemInfo> terrain;
 };
 
 }  // namespace geodex::server

@@ -9,7 +9,8 @@
 
 namespace geodex::server {
 
-std::shared_ptr<StoredMesh> MakeStoredMesh(std::string id, TriangleMesh mesh) {
+std::shared_ptr<StoredMesh> MakeStoredMesh(std::string id, TriangleMesh mesh,
+                                           std::shared_ptr<const terrain::Dem> dem) {
   auto stored = std::make_shared<StoredMesh>();
   stored->id = std::move(id);
   auto built = std::make_shared<const TriangleMesh>(std::move(mesh));
@@ -20,6 +21,11 @@ std::shared_ptr<StoredMesh> MakeStoredMesh(std::string id, TriangleMesh mesh) {
   stored->memory_bytes = stored->mesh->MemoryBytes() + stored->locator->MemoryBytes();
   stored->create_time = absl::Now();
   stored->summary = Summarize(*stored->mesh);
+  if (dem != nullptr) {
+    stored->memory_bytes += dem->MemoryBytes();
+    stored->terrain = dem->info();
+    stored->dem = std::move(dem);
+  }
   return stored;
 }
 
@@ -30,6 +36,7 @@ std::shared_ptr<const StoredMesh> Strip(const StoredMesh& mesh) {
   auto record = std::make_shared<StoredMesh>(mesh);
   record->mesh.reset();
   record->locator.reset();
+  record->dem.reset();
   return record;
 }
 
@@ -113,14 +120,30 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::Insert(
       const StoredMesh& old = *slot.mesh;
       const bool known = name.empty() || old.display_name == name ||
                          std::find(old.aliases.begin(), old.aliases.end(), name) != old.aliases.end();
+      // The same mesh uploaded as its DEM: the record gains the map (and, resident, the grid).
+      const bool gains_terrain = !old.terrain && mesh->terrain && mesh->dem != nullptr;
+      if (gains_terrain) {
+        auto updated = std::make_shared<StoredMesh>(old);
+        updated->terrain = mesh->terrain;
+        if (slot.resident) {
+          updated->dem = mesh->dem;
+          updated->memory_bytes += mesh->dem->MemoryBytes();
+          used_bytes_ += mesh->dem->MemoryBytes();
+        }
+        if (disk_) {
+          if (absl::Status s = disk_->UpdateHeader(*updated); !s.ok()) return s;
+        }
+        slot.mesh = std::move(updated);
+      }
+      const StoredMesh& current = *slot.mesh;
       if (!known) {
-        const size_t names = (old.display_name.empty() ? 0 : 1) + old.aliases.size();
+        const size_t names = (current.display_name.empty() ? 0 : 1) + current.aliases.size();
         if (names >= max_names) {
           return ServerLimitError("max_names_per_mesh", absl::StrCat(
               "metadata.display_name: mesh ", mesh->id, " already has ", names,
               " names, the most a mesh may have (--max_names_per_mesh=", max_names, ")"));
         }
-        auto updated = std::make_shared<StoredMesh>(old);
+        auto updated = std::make_shared<StoredMesh>(current);
         if (updated->display_name.empty()) {
           updated->display_name = name;
         } else {
@@ -226,7 +249,16 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::Get(const std::stri
     return absl::DataLossError(
         absl::StrCat("stored mesh meshes/", record->id, ": ", built.status().message()));
   }
-  std::shared_ptr<StoredMesh> loaded = MakeStoredMesh(record->id, *std::move(built));
+  std::shared_ptr<const terrain::Dem> dem;
+  if (header.terrain) {
+    absl::StatusOr<terrain::Dem> grid = terrain::Dem::FromMesh(*std::move(data), *header.terrain);
+    if (!grid.ok()) {
+      return absl::DataLossError(
+          absl::StrCat("stored mesh meshes/", record->id, ": ", grid.status().message()));
+    }
+    dem = std::make_shared<const terrain::Dem>(*std::move(grid));
+  }
+  std::shared_ptr<StoredMesh> loaded = MakeStoredMesh(record->id, *std::move(built), std::move(dem));
   loaded->display_name = record->display_name;
   loaded->aliases = record->aliases;
   loaded->pinned = record->pinned;

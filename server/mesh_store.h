@@ -33,10 +33,14 @@ namespace geodex::server {
 struct StoredMesh : MeshRecord {
   std::shared_ptr<const TriangleMesh> mesh;
   std::shared_ptr<const SurfaceLocator> locator;  // points into *mesh
+  // A DEM's mesh (`terrain` set): its grid, which drops map points onto the surface. Else null.
+  std::shared_ptr<const terrain::Dem> dem;
 };
 
-// Builds a StoredMesh (mesh + locator) from a built mesh; fills memory_bytes and counts.
-std::shared_ptr<StoredMesh> MakeStoredMesh(std::string id, TriangleMesh mesh);
+// Builds a StoredMesh (mesh + locator) from a built mesh; fills memory_bytes and counts. `dem`:
+// the DEM the mesh was made from, if any (its info becomes the record's terrain).
+std::shared_ptr<StoredMesh> MakeStoredMesh(std::string id, TriangleMesh mesh,
+                                           std::shared_ptr<const terrain::Dem> dem = nullptr);
 
 class MeshStore {
  public:

@@ -49,6 +49,7 @@ void MeshToProto(const StoredMesh& mesh, v1::Mesh* out) {
   *out->mutable_create_time() =
       google::protobuf::util::TimeUtil::NanosecondsToTimestamp(absl::ToUnixNanos(mesh.create_time));
   out->set_pinned(mesh.pinned);
+  if (mesh.terrain) api::TerrainToProto(*mesh.terrain, out->mutable_terrain());
 }
 
 absl::StatusOr<SurfacePoint> ResolvePoint(const StoredMesh& mesh, const v1::SurfacePoint& point,
@@ -87,8 +88,21 @@ absl::StatusOr<SurfacePoint> ResolvePoint(const StoredMesh& mesh, const v1::Surf
       }
       return located->point;
     }
+    case v1::SurfacePoint::kMapPoint:
+    case v1::SurfacePoint::kLonLat: {
+      const bool map = point.point_case() == v1::SurfacePoint::kMapPoint;
+      const std::string where = absl::StrCat(field, map ? ".map_point" : ".lon_lat");
+      if (mesh.dem == nullptr) {
+        return FieldError(where, "the mesh is not a DEM's (upload a GeoTIFF): map points need its map");
+      }
+      absl::StatusOr<SurfacePoint> dropped =
+          map ? mesh.dem->DropMapPoint(point.map_point().x(), point.map_point().y())
+              : mesh.dem->DropLonLat(point.lon_lat().lon(), point.lon_lat().lat());
+      if (!dropped.ok()) return FieldError(where, dropped.status().message());
+      return *dropped;
+    }
     case v1::SurfacePoint::POINT_NOT_SET:
-      return FieldError(field, "no point set (vertex, edge, face or position)");
+      return FieldError(field, "no point set (vertex, edge, face, position, map_point or lon_lat)");
   }
   absl::Status valid = ValidateSurfacePoint(*mesh.mesh, p);
   if (!valid.ok()) {

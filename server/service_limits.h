@@ -14,6 +14,7 @@ struct ServiceLimits {
   uint64_t max_upload_bytes = uint64_t{1} << 30;  // --max_upload_bytes
   uint64_t max_vertices = 20'000'000;              // --max_vertices
   uint64_t max_faces = 40'000'000;                 // --max_faces
+  uint64_t max_dem_cells = 25'000'000;             // --max_dem_cells (a GeoTIFF upload's cells)
   uint32_t max_names_per_mesh = 16;                // --max_names_per_mesh (display name + aliases)
   uint32_t max_sources = 100'000;                  // --max_sources
   uint32_t max_targets = 50'000;                   // --max_targets (matrix columns, points)

@@ -124,6 +124,11 @@ bool IsDemPath(const std::string& path) {
   return false;
 }
 
+bool IsGeoTiffPath(const std::string& path) {
+  const std::string ext = absl::AsciiStrToLower(std::filesystem::path(path).extension().string());
+  return ext == ".tif" || ext == ".tiff";
+}
+
 bool LooksLikeTiff(const std::string& bytes) {
   return bytes.size() >= 4 && ((bytes[0] == 'I' && bytes[1] == 'I' && (bytes[2] == 42 || bytes[2] == 43) && bytes[3] == 0) ||
                                (bytes[0] == 'M' && bytes[1] == 'M' && bytes[2] == 0 && (bytes[3] == 42 || bytes[3] == 43)));

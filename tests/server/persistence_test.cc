@@ -223,6 +223,45 @@ TEST(MeshFileHeaderTest, RoundTripsEveryFieldAndRefusesTruncation) {
   EXPECT_EQ(back->summary.bbox_min, r.summary.bbox_min);
   EXPECT_EQ(back->summary.bbox_max, r.summary.bbox_max);
   EXPECT_EQ(back->summary.bytes, 999u);
+  EXPECT_FALSE(back->terrain.has_value());
+  // Version 2 is version 3 without the terrain byte.
+  absl::StatusOr<MeshRecord> v2 =
+      DecodeMeshFileHeader(2, absl::string_view(bytes).substr(0, bytes.size() - 1));
+  ASSERT_TRUE(v2.ok()) << v2.status();
+  EXPECT_EQ(v2->summary.bytes, 999u);
+  EXPECT_FALSE(v2->terrain.has_value());
+
+  // A DEM's mesh keeps its map, every field.
+  terrain::DemInfo& t = r.terrain.emplace();
+  t.driver = "GTiff";
+  t.raster_width = 1001;
+  t.raster_height = 999;
+  t.step = 3;
+  t.grid_width = 334;
+  t.grid_height = 333;
+  t.nodata_cells = 17;
+  t.barrier_cells = 19;
+  t.barrier_faces = 23;
+  t.file_crs_name = "WGS 84";
+  t.file_crs_wkt = "GEOGCRS[...]";
+  t.reprojected = true;
+  t.mesh_crs_name = "WGS 84 / UTM zone 33N";
+  t.mesh_crs_wkt = "PROJCRS[...]";
+  t.horizontal_scale = 0.3048;
+  t.vertical_unit = "US survey foot";
+  t.vertical_scale = 1200.0 / 3937;
+  t.geotransform = {14.99, 0.0002, 0, 45.16, 0, -0.0002};
+  const std::string with_terrain = EncodeMeshFileHeader(r);
+  absl::StatusOr<MeshRecord> dem = DecodeMeshFileHeader(kMeshFileVersion, with_terrain);
+  ASSERT_TRUE(dem.ok()) << dem.status();
+  ASSERT_TRUE(dem->terrain.has_value());
+  EXPECT_EQ(*dem->terrain, t);
+  EXPECT_EQ(dem->display_name, r.display_name);
+  for (size_t cut : {size_t{0}, size_t{3}, bytes.size() / 2, bytes.size() - 1, with_terrain.size() - 9}) {
+    EXPECT_EQ(DecodeMeshFileHeader(kMeshFileVersion, with_terrain.substr(0, cut)).status().code(),
+              absl::StatusCode::kDataLoss)
+        << cut;
+  }
   for (size_t cut : {size_t{0}, size_t{3}, bytes.size() / 2, bytes.size() - 1}) {
     EXPECT_EQ(DecodeMeshFileHeader(kMeshFileVersion, bytes.substr(0, cut)).status().code(),
               absl::StatusCode::kDataLoss)
@@ -235,7 +274,7 @@ TEST(MeshFileHeaderTest, RoundTripsEveryFieldAndRefusesTruncation) {
 }
 
 // A data directory written before the private header (version 1: a geodex.v1.Mesh as the header)
-// is served as it was, and a file is rewritten as version 2 when its header next changes.
+// is served as it was, and a file is rewritten in the current version when its header next changes.
 TEST_F(PersistenceTest, VersionOneFilesAreStillServed) {
   Restart();
   testing::UploadResult up = Upload(*stub_, GridOff(10, 8, true), "old");

@@ -65,6 +65,8 @@ struct DemInfo {
   // The used grid's geotransform in the file's CRS (the file's own when step = 1): pixel (i, j)
   // has its corner at (gt[0] + i gt[1] + j gt[2], gt[3] + i gt[4] + j gt[5]).
   std::array<double, 6> geotransform{};
+
+  bool operator==(const DemInfo&) const = default;
 };
 
 inline constexpr uint32_t kNoVertex = 0xffffffffu;
@@ -91,6 +93,12 @@ class Dem {
 
   const MeshData& mesh() const { return mesh_; }
   const DemInfo& info() const { return info_; }
+  // The memory it holds (mesh copy and grid maps).
+  uint64_t MemoryBytes() const {
+    return mesh_.positions.capacity() * sizeof(double) +
+           (mesh_.faces.capacity() + vertex_of_cell_.capacity() + face_of_block_.capacity()) *
+               sizeof(uint32_t);
+  }
   // The vertex of used cell (col, row), or kNoVertex (nodata).
   uint32_t VertexAt(uint32_t col, uint32_t row) const {
     return vertex_of_cell_[size_t{row} * info_.grid_width + col];
@@ -129,6 +137,8 @@ class Dem {
 // True when `path` names a raster by its extension (.tif, .tiff, .vrt, .asc, .img, .hgt, .dem,
 // .bil, .nc): what the CLI reads as a DEM instead of a mesh file.
 bool IsDemPath(const std::string& path);
+// True for .tif and .tiff: what an upload sends as GeoTIFF bytes instead of a mesh.
+bool IsGeoTiffPath(const std::string& path);
 // True when `bytes` start like a TIFF file (either byte order; BigTIFF too).
 bool LooksLikeTiff(const std::string& bytes);
 

@@ -1,0 +1,271 @@
+// DEMs through geodexd: GeoTIFF bytes uploaded (MESH_FORMAT_GEOTIFF), the map kept with the stored
+// mesh (Mesh.terrain, across restarts), and map points (SurfacePoint.map_point, lon_lat) dropped
+// by the server exactly as the CLI drops them locally. Fixtures are made with GDAL at test time.
+
+#include <array>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "gdal_priv.h"
+#include "geodex/mesh_id.h"
+#include "geodex/mesh_io.h"
+#include "geodex/terrain.h"
+#include "google/rpc/error_details.pb.h"
+#include "google/rpc/status.pb.h"
+#include "gtest/gtest.h"
+#include "ogr_spatialref.h"
+#include "server_test_util.h"
+
+namespace geodex::server {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string BadField(const grpc::Status& status) {
+  google::rpc::Status details;
+  google::rpc::BadRequest bad;
+  EXPECT_TRUE(details.ParseFromString(status.error_details())) << status.error_message();
+  for (const auto& any : details.details()) {
+    if (any.UnpackTo(&bad) && bad.field_violations_size() > 0) return bad.field_violations(0).field();
+  }
+  return "";
+}
+
+bool Contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+class TerrainServiceTest : public testing::ServerFixture {
+ protected:
+  void SetUp() override {
+    GDALAllRegister();
+    dir_ = fs::path(::testing::TempDir()) /
+           absl::StrCat("geodex-terrain-svc-", ::testing::UnitTest::GetInstance()->random_seed(), "-",
+                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_ / "in");
+    // A tilted plane in UTM 33N, 10 m cells, with a nodata slot (columns 14-15, rows 5 down).
+    tif_ = (dir_ / "in" / "slot.tif").string();
+    GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GTiff");
+    GDALDataset* ds = driver->Create(tif_.c_str(), 30, 30, 1, GDT_Float32, nullptr);
+    double gt[6] = {500000, 10, 0, 5000000, 0, -10};
+    ds->SetGeoTransform(gt);
+    OGRSpatialReference srs;
+    srs.importFromEPSG(32633);
+    ds->SetSpatialRef(&srs);
+    GDALRasterBand* band = ds->GetRasterBand(1);
+    band->SetNoDataValue(-9999);
+    std::vector<float> row(30);
+    for (int j = 0; j < 30; ++j) {
+      for (int i = 0; i < 30; ++i) {
+        row[i] = (i == 14 || i == 15) && j >= 5 ? -9999.0f : static_cast<float>(0.5 * i + 0.25 * j);
+      }
+      EXPECT_EQ(band->RasterIO(GF_Write, 0, j, 30, 1, row.data(), 30, 1, GDT_Float32, 0, 0), CE_None);
+    }
+    GDALClose(ds);
+    std::ifstream in(tif_, std::ios::binary);
+    bytes_.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  void TearDown() override {
+    testing::ServerFixture::TearDown();
+    server_.reset();
+    fs::remove_all(dir_);
+  }
+  void Restart(ServerOptions options = {}) {
+    if (server_) server_->Shutdown(absl::Now() + absl::Seconds(10));
+    server_.reset();
+    options.data_dir = (dir_ / "data").string();
+    StartServer(options);
+  }
+
+  testing::UploadResult UploadDem(const std::string& bytes, const std::string& name,
+                                  v1::MeshFormat format = v1::MESH_FORMAT_GEOTIFF,
+                                  const std::string& file_name = "slot.tif", uint32_t step = 0) {
+    testing::UploadResult result;
+    grpc::ClientContext context;
+    context.set_deadline(testing::In(120));
+    auto writer = stub_->CreateMesh(&context, &result.mesh);
+    v1::CreateMeshRequest request;
+    request.mutable_metadata()->set_format(format);
+    request.mutable_metadata()->set_file_name(file_name);
+    request.mutable_metadata()->set_display_name(name);
+    if (step != 0) request.mutable_metadata()->mutable_dem()->set_step(step);
+    writer->Write(request);
+    request.Clear();
+    request.set_chunk(bytes);
+    writer->Write(request);
+    writer->WritesDone();
+    result.status = writer->Finish();
+    return result;
+  }
+
+  // The field of one source given as a v1 point.
+  testing::FieldResult FieldFrom(const std::string& mesh, const v1::SurfacePoint& source) {
+    v1::ComputeDistanceFieldRequest request;
+    request.set_mesh(mesh);
+    *request.add_sources() = source;
+    return testing::ReadField(*stub_, request);
+  }
+  static v1::SurfacePoint FacePointOf(const SurfacePoint& p) {
+    v1::SurfacePoint out;
+    out.mutable_face()->set_face(p.face);
+    out.mutable_face()->set_b0(p.bary[0]);
+    out.mutable_face()->set_b1(p.bary[1]);
+    out.mutable_face()->set_b2(p.bary[2]);
+    return out;
+  }
+
+  fs::path dir_;
+  std::string tif_, bytes_;
+};
+
+TEST_F(TerrainServiceTest, GeoTiffUploadKeepsItsMapAndTakesMapPoints) {
+  StartServer();
+  absl::StatusOr<terrain::Dem> local = terrain::Dem::Read(tif_);
+  ASSERT_TRUE(local.ok()) << local.status();
+  testing::UploadResult up = UploadDem(bytes_, "slot");
+  ASSERT_TRUE(up.status.ok()) << up.status.error_message();
+  // The same mesh (the same id) the CLI makes of the file, with its map.
+  EXPECT_EQ(up.mesh.name(), absl::StrCat("meshes/", ComputeMeshId(local->mesh())));
+  ASSERT_TRUE(up.mesh.has_terrain());
+  const v1::Terrain& t = up.mesh.terrain();
+  EXPECT_TRUE(Contains(t.crs_name(), "UTM zone 33N")) << t.crs_name();
+  EXPECT_EQ(t.grid_width(), 30u);
+  EXPECT_EQ(t.nodata_cells(), 50u);
+  EXPECT_EQ(t.driver(), "GTiff");
+  ASSERT_EQ(t.geotransform_size(), 6);
+  EXPECT_EQ(t.geotransform(1), 10);
+
+  // A map point in the raster's CRS, and a longitude/latitude: the server drops them where the
+  // CLI does, and the fields are the same to the bit.
+  OGRSpatialReference utm, wgs84;
+  utm.importFromEPSG(32633);
+  wgs84.importFromEPSG(4326);
+  utm.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  OGRCoordinateTransformation* to_ll = OGRCreateCoordinateTransformation(&utm, &wgs84);
+  ASSERT_NE(to_ll, nullptr);
+  double lon = 500123.4, lat = 4999871.2;
+  ASSERT_TRUE(to_ll->Transform(1, &lon, &lat));
+  OGRCoordinateTransformation::DestroyCT(to_ll);
+  v1::SurfacePoint map;
+  map.mutable_map_point()->set_x(500061.7);
+  map.mutable_map_point()->set_y(4999822.9);
+  v1::SurfacePoint ll;
+  ll.mutable_lon_lat()->set_lon(lon);
+  ll.mutable_lon_lat()->set_lat(lat);
+  absl::StatusOr<SurfacePoint> map_here = local->DropMapPoint(500061.7, 4999822.9);
+  absl::StatusOr<SurfacePoint> ll_here = local->DropLonLat(lon, lat);
+  ASSERT_TRUE(map_here.ok() && ll_here.ok());
+  for (const auto& [remote, here] : {std::pair{map, *map_here}, std::pair{ll, *ll_here}}) {
+    testing::FieldResult by_map = FieldFrom("meshes/slot", remote);
+    ASSERT_TRUE(by_map.status.ok()) << by_map.status.error_message();
+    testing::FieldResult by_face = FieldFrom("meshes/slot", FacePointOf(here));
+    ASSERT_TRUE(by_face.status.ok()) << by_face.status.error_message();
+    ASSERT_EQ(by_map.distances.size(), local->mesh().vertex_count());
+    EXPECT_EQ(by_map.distances, by_face.distances);
+    EXPECT_GT(*std::max_element(by_map.distances.begin(), by_map.distances.end()), 200);
+  }
+
+  // A point in the hole, or off the DEM, names itself and its field.
+  v1::SurfacePoint hole;
+  hole.mutable_map_point()->set_x(500150);
+  hole.mutable_map_point()->set_y(4999800);
+  testing::FieldResult in_hole = FieldFrom("meshes/slot", hole);
+  EXPECT_EQ(in_hole.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_EQ(BadField(in_hole.status), "sources[0].map_point");
+  EXPECT_TRUE(Contains(in_hole.status.error_message(), "in a hole of the DEM")) << in_hole.status.error_message();
+  v1::SurfacePoint far;
+  far.mutable_lon_lat()->set_lon(-70);
+  far.mutable_lon_lat()->set_lat(10);
+  testing::FieldResult off = FieldFrom("meshes/slot", far);
+  EXPECT_EQ(off.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_EQ(BadField(off.status), "sources[0].lon_lat");
+
+  // On a mesh that is not a DEM's, map points are refused, naming why.
+  ASSERT_TRUE(testing::Upload(*stub_, testing::GridOff(4, 4, false), "grid").status.ok());
+  testing::FieldResult not_dem = FieldFrom("meshes/grid", map);
+  EXPECT_EQ(not_dem.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_TRUE(Contains(not_dem.status.error_message(), "not a DEM's")) << not_dem.status.error_message();
+}
+
+TEST_F(TerrainServiceTest, UploadsAreCheckedAndLimited) {
+  ServerOptions options;
+  options.limits.max_dem_cells = 899;  // the raster has 900
+  StartServer(options);
+  testing::UploadResult big = UploadDem(bytes_, "big");
+  EXPECT_EQ(big.status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_TRUE(Contains(big.status.error_message(), "--max_dem_cells=899")) << big.status.error_message();
+
+  StartServer();
+  // Not a GeoTIFF, a cut one, DEM options on a mesh file: INVALID_ARGUMENT naming the field.
+  testing::UploadResult junk = UploadDem("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "junk");
+  EXPECT_EQ(junk.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_EQ(BadField(junk.status), "chunk");
+  EXPECT_TRUE(Contains(junk.status.error_message(), "not a GeoTIFF")) << junk.status.error_message();
+  testing::UploadResult cut = UploadDem(bytes_.substr(0, bytes_.size() / 2), "cut");
+  EXPECT_EQ(cut.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  testing::UploadResult options_on_off =
+      UploadDem(testing::GridOff(3, 3, false), "off", v1::MESH_FORMAT_OFF, "grid.off", 2);
+  EXPECT_EQ(options_on_off.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_EQ(BadField(options_on_off.status), "metadata.dem");
+
+  // The format is guessed from the name, or else from the bytes; the step is the CLI's --dem-step.
+  testing::UploadResult named = UploadDem(bytes_, "", v1::MESH_FORMAT_UNSPECIFIED, "x.TIF", 2);
+  ASSERT_TRUE(named.status.ok()) << named.status.error_message();
+  EXPECT_EQ(named.mesh.terrain().grid_width(), 15u);
+  // Used column 7 is file column 14: no data from used row 3 (file row 6) down.
+  EXPECT_EQ(named.mesh.vertex_count(), 15u * 15u - 12u);
+  testing::UploadResult sniffed = UploadDem(bytes_, "", v1::MESH_FORMAT_UNSPECIFIED, "upload");
+  ASSERT_TRUE(sniffed.status.ok()) << sniffed.status.error_message();
+  EXPECT_EQ(sniffed.mesh.terrain().grid_width(), 30u);
+}
+
+// The map survives a restart (the stored header, version 3), and the grid is rebuilt from the
+// stored mesh: map points still drop. A DEM's mesh first stored as a mesh file gains its map.
+TEST_F(TerrainServiceTest, TheMapIsStoredAndGained) {
+  Restart();
+  absl::StatusOr<terrain::Dem> local = terrain::Dem::Read(tif_);
+  ASSERT_TRUE(local.ok());
+  const std::string off = (dir_ / "in" / "slot.off").string();
+  ASSERT_TRUE(WriteMeshOff(off, local->mesh()).ok());
+  std::ifstream in(off, std::ios::binary);
+  const std::string off_bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  testing::UploadResult plain = testing::Upload(*stub_, off_bytes, "plain");
+  ASSERT_TRUE(plain.status.ok()) << plain.status.error_message();
+  EXPECT_FALSE(plain.mesh.has_terrain());
+  v1::SurfacePoint map;
+  map.mutable_map_point()->set_x(500230.5);
+  map.mutable_map_point()->set_y(4999905.5);
+  EXPECT_EQ(FieldFrom("meshes/plain", map).status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+
+  testing::UploadResult dem = UploadDem(bytes_, "slot");
+  ASSERT_TRUE(dem.status.ok()) << dem.status.error_message();
+  EXPECT_EQ(dem.mesh.name(), plain.mesh.name());
+  ASSERT_TRUE(dem.mesh.has_terrain());
+  testing::FieldResult before = FieldFrom("meshes/plain", map);
+  ASSERT_TRUE(before.status.ok()) << before.status.error_message();
+
+  Restart();
+  v1::Mesh got;
+  {
+    grpc::ClientContext context;
+    context.set_deadline(testing::In(30));
+    v1::GetMeshRequest request;
+    request.set_name("meshes/slot");
+    ASSERT_TRUE(stub_->GetMesh(&context, request, &got).ok());
+  }
+  ASSERT_TRUE(got.has_terrain());
+  EXPECT_EQ(got.terrain().crs_wkt(), dem.mesh.terrain().crs_wkt());
+  EXPECT_EQ(got.terrain().nodata_cells(), 50u);
+  testing::FieldResult after = FieldFrom("meshes/slot", map);
+  ASSERT_TRUE(after.status.ok()) << after.status.error_message();
+  EXPECT_EQ(after.distances, before.distances);
+}
+
+}  // namespace
+}  // namespace geodex::server
