@@ -85,14 +85,21 @@ absl::StatusOr<T> Flagged(absl::StatusOr<T> result,
   return result;
 }
 
-// geodexd reads meshes, not rasters, and applies no barrier: a DEM, or a mesh with
-// --barrier-below, is turned into its mesh here, and that mesh is what the server gets.
+// A DEM, or a mesh with --barrier-below, is read here too (its map, its barrier): what the server
+// gets is then either the GeoTIFF itself (geodexd reads it the same way and keeps its map) or,
+// for other rasters, a barrier file or a mesh file, the mesh made here.
 bool DerivedHere(const std::string& mesh, const terrain::DemOptions& options) {
   return terrain::IsDemPath(mesh) || std::isfinite(options.barrier_below);
 }
 absl::StatusOr<MeshRef> UploadDerived(GeodexClient& client, const std::string& mesh,
-                                      const MeshData& data) {
+                                      const terrain::DemOptions& options, const MeshData& data) {
   // By its content's id, uploaded only if the server lacks it.
+  if (terrain::IsGeoTiffPath(mesh) && options.barrier_file.empty()) {
+    v1::DemOptions dem;
+    dem.set_step(options.step);
+    if (std::isfinite(options.barrier_below)) dem.set_barrier_below(options.barrier_below);
+    return client.ResolveDem(mesh, data, dem);
+  }
   return client.ResolveMeshData(std::filesystem::path(mesh).stem().string() + ".off", data);
 }
 
@@ -118,7 +125,7 @@ class RemoteBackend final : public Backend {
       if (!data.ok()) return data.status();
       // The mesh the server gets is this one (the barrier applied): draw and place sites on it.
       if (dem_ == nullptr) data_ = std::make_unique<MeshData>(*data);
-      ref = UploadDerived(*client_, mesh, *data);
+      ref = UploadDerived(*client_, mesh, dem_options, *data);
     } else {
       ref = client_->ResolveMesh(mesh);
     }
@@ -164,7 +171,20 @@ class RemoteBackend final : public Backend {
     return absl::OkStatus();  // the server checks them with the query, naming the field
   }
 
-  const terrain::Dem* Terrain() const override { return dem_.get(); }
+  // A DEM read here, or a DEM's mesh named on the server: its grid again from the stored map
+  // and geometry (Dem::FromMesh), fetched once, when a command first needs it.
+  const terrain::Dem* Terrain() const override {
+    if (dem_ != nullptr || !mesh_.file_bytes.empty() || dem_fetched_) return dem_.get();
+    dem_fetched_ = true;
+    absl::StatusOr<v1::Mesh> m = client_->GetMesh(mesh_.name);
+    if (!m.ok() || !m->has_terrain()) return nullptr;
+    absl::StatusOr<MeshData> data = client_->GetMeshGeometry(mesh_);
+    if (!data.ok()) return nullptr;
+    absl::StatusOr<terrain::Dem> dem =
+        terrain::Dem::FromMesh(*std::move(data), api::TerrainFromProto(m->terrain()));
+    if (dem.ok()) dem_ = std::make_shared<const terrain::Dem>(*std::move(dem));
+    return dem_.get();
+  }
 
   absl::StatusOr<const MeshData*> Geometry() override {
     if (dem_ != nullptr) return &dem_->mesh();
@@ -186,7 +206,8 @@ class RemoteBackend final : public Backend {
     InfoValues v;
     static_cast<MeshSummary&>(v) = api::MeshSummaryFromProto(*m);
     v.load_ms = MsSince(t0);  // remote: the time to describe the mesh
-    v.dem = dem_ ? &dem_->info() : nullptr;
+    if (dem_ == nullptr && m->has_terrain()) terrain_info_ = api::TerrainFromProto(m->terrain());
+    v.dem = dem_ ? &dem_->info() : terrain_info_ ? &*terrain_info_ : nullptr;
     return v;
   }
 
@@ -255,9 +276,12 @@ class RemoteBackend final : public Backend {
  private:
   std::unique_ptr<GeodexClient> client_;
   std::string mesh_arg_;
-  MeshRef mesh_;
+  mutable MeshRef mesh_;            // (GetMeshGeometry may re-upload, updating it)
   std::unique_ptr<MeshData> data_;  // read from mesh_arg_ on first need
-  std::shared_ptr<const terrain::Dem> dem_;  // when MESH is a DEM (read here)
+  // When MESH is a DEM: read here, or rebuilt from the server's copy (Terrain()).
+  mutable std::shared_ptr<const terrain::Dem> dem_;
+  mutable bool dem_fetched_ = false;
+  std::optional<terrain::DemInfo> terrain_info_;  // a server DEM's map, for info
   DistanceField field_;             // the last Field answer (Backend::Field hands out a pointer)
   bool cached_ = false;             // the last field came from the server's result cache
 };
@@ -315,11 +339,12 @@ int RemoteMesh(GeodexClient& client, const Args& args) {
     absl::StatusOr<MeshData> data = LoadMeshData(p[1], *dem);
     if (!data.ok()) return Fail(kExitInput, std::string(data.status().message()));
     absl::StatusOr<MeshRef> ref =  // uploads only if missing
-        DerivedHere(p[1], *dem) ? UploadDerived(client, p[1], *data) : client.ResolveMesh(p[1]);
+        DerivedHere(p[1], *dem) ? UploadDerived(client, p[1], *dem, *data) : client.ResolveMesh(p[1]);
     if (!ref.ok()) return FailQuery(ref.status());
     absl::StatusOr<v1::Mesh> m =
         args.options.count("name")
-            ? client.Upload(ref->file_name, ref->file_bytes, args.options.at("name"), ref->id)
+            ? client.Upload(ref->file_name, ref->file_bytes, args.options.at("name"), ref->id,
+                            ref->dem)
             : client.GetMesh(ref->name);
     if (!m.ok()) return FailQuery(m.status());
     std::fputs((json ? MeshJson(*m) + "\n" : MeshLine(*m)).c_str(), stdout);

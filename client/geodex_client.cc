@@ -146,7 +146,7 @@ grpc::Status GeodexClient::MeshCall(MeshRef& mesh,
   if (status.error_code() == grpc::StatusCode::NOT_FOUND && !mesh.file_bytes.empty() &&
       ErrorReason(status) == "MESH_NOT_FOUND") {
     // The server lost (or never had) the mesh: upload it again and retry once.
-    absl::StatusOr<v1::Mesh> uploaded = Upload(mesh.file_name, mesh.file_bytes, "", mesh.id);
+    absl::StatusOr<v1::Mesh> uploaded = Upload(mesh.file_name, mesh.file_bytes, "", mesh.id, mesh.dem);
     if (!uploaded.ok()) {
       return grpc::Status(static_cast<grpc::StatusCode>(uploaded.status().code()),
                           std::string(uploaded.status().message()));
@@ -188,7 +188,8 @@ absl::StatusOr<bool> GeodexClient::Health(const std::string& service) {
 
 absl::StatusOr<v1::Mesh> GeodexClient::Upload(const std::string& file_name,
                                               const std::string& bytes, const std::string& alias,
-                                              const std::string& expected_id) {
+                                              const std::string& expected_id,
+                                              const std::optional<v1::DemOptions>& dem) {
   v1::Mesh mesh;
   grpc::Status status = Call(expected_id, [&](grpc::ClientContext* context) {
     auto writer = stub_->CreateMesh(context, &mesh);
@@ -198,6 +199,10 @@ absl::StatusOr<v1::Mesh> GeodexClient::Upload(const std::string& file_name,
     metadata->set_display_name(alias);
     metadata->set_expected_mesh_id(expected_id);
     metadata->set_total_bytes(bytes.size());
+    if (dem.has_value()) {
+      metadata->set_format(v1::MESH_FORMAT_GEOTIFF);
+      *metadata->mutable_dem() = *dem;
+    }
     bool ok = writer->Write(request);
     for (size_t offset = 0; ok && offset < bytes.size(); offset += options_.upload_chunk_bytes) {
       request.Clear();
@@ -259,7 +264,7 @@ absl::StatusOr<MeshRef> GeodexClient::UploadIfAbsent(MeshRef ref) {
   absl::StatusOr<v1::Mesh> existing = GetMesh(ref.name);
   if (existing.ok()) return ref;
   if (!absl::IsNotFound(existing.status())) return existing.status();
-  absl::StatusOr<v1::Mesh> uploaded = Upload(ref.file_name, ref.file_bytes, "", ref.id);
+  absl::StatusOr<v1::Mesh> uploaded = Upload(ref.file_name, ref.file_bytes, "", ref.id, ref.dem);
   if (!uploaded.ok()) return uploaded.status();
   ref.uploaded = true;
   return ref;
@@ -273,6 +278,25 @@ absl::StatusOr<MeshRef> GeodexClient::ResolveMeshData(const std::string& file_na
   ref.file_bytes = MeshToOffText(data);
   ref.file_name = file_name;
   return UploadIfAbsent(std::move(ref));
+}
+
+absl::StatusOr<MeshRef> GeodexClient::ResolveDem(const std::string& path, const MeshData& mesh,
+                                                 const v1::DemOptions& options) {
+  MeshRef ref;
+  ref.id = ComputeMeshId(mesh);
+  ref.name = absl::StrCat("meshes/", ref.id);
+  std::ifstream in(path, std::ios::binary);
+  ref.file_bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  ref.file_name = std::filesystem::path(path).filename().string();
+  ref.dem = options;
+  absl::StatusOr<v1::Mesh> existing = GetMesh(ref.name);
+  if (existing.ok() && existing->has_terrain()) return ref;
+  if (!existing.ok() && !absl::IsNotFound(existing.status())) return existing.status();
+  // Absent, or stored without its map (uploaded as a mesh file): the raster gives it.
+  absl::StatusOr<v1::Mesh> uploaded = Upload(ref.file_name, ref.file_bytes, "", ref.id, ref.dem);
+  if (!uploaded.ok()) return uploaded.status();
+  ref.uploaded = true;
+  return ref;
 }
 
 absl::StatusOr<MeshRef> GeodexClient::ResolveMesh(const std::string& mesh) {

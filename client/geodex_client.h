@@ -68,6 +68,8 @@ struct MeshRef {
   std::string file_bytes;
   std::string file_name;
   bool uploaded = false;  // this client uploaded it
+  // Set when file_bytes are a GeoTIFF DEM: uploaded as MESH_FORMAT_GEOTIFF with these options.
+  std::optional<v1::DemOptions> dem;
 };
 
 class GeodexClient {
@@ -83,9 +85,15 @@ class GeodexClient {
   // A mesh read here (a sample, a DEM triangulated by the CLI): uploaded as OFF text named
   // `file_name` unless the server has its id already.
   absl::StatusOr<MeshRef> ResolveMeshData(const std::string& file_name, const MeshData& data);
-  // Uploads file bytes (idempotent). `expected_id` is checked by the server when set.
+  // A GeoTIFF DEM at `path`, read here into `mesh` (whose id names it): the raster's bytes are
+  // uploaded (MESH_FORMAT_GEOTIFF with `options`) unless the server has that mesh with its map.
+  absl::StatusOr<MeshRef> ResolveDem(const std::string& path, const MeshData& mesh,
+                                     const v1::DemOptions& options);
+  // Uploads file bytes (idempotent). `expected_id` is checked by the server when set. With
+  // `dem`, the bytes are a GeoTIFF DEM made a mesh with those options.
   absl::StatusOr<v1::Mesh> Upload(const std::string& file_name, const std::string& bytes,
-                                  const std::string& alias, const std::string& expected_id);
+                                  const std::string& alias, const std::string& expected_id,
+                                  const std::optional<v1::DemOptions>& dem = std::nullopt);
   absl::StatusOr<v1::Mesh> GetMesh(const std::string& name);
   // The mesh's positions and faces, as geodexd holds them (for drawing without the file).
   absl::StatusOr<MeshData> GetMeshGeometry(MeshRef& mesh);

@@ -211,6 +211,16 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
   double gt[6];
   if (ds->GetGeoTransform(gt) != CE_None) return bad("no geotransform (not georeferenced)");
   if (gt[2] != 0 || gt[4] != 0) return bad("a rotated grid (geotransform terms 2 and 4 not 0)");
+  if (!std::all_of(gt, gt + 6, [](double v) { return std::isfinite(v); }) || gt[1] == 0 || gt[5] == 0) {
+    return bad("its geotransform is not a grid (a cell size of 0, or not finite)");
+  }
+  // Cells that doubles cannot tell apart at these coordinates (or, geographic, finer than a
+  // centimetre, below what a projection's round trip resolves) make no surface.
+  const double reach = std::max({std::abs(gt[0]), std::abs(gt[3]), 1.0});
+  if (std::min(std::abs(gt[1]), std::abs(gt[5])) < 1e-9 * reach) {
+    return bad(absl::StrFormat("cells of %.3g by %.3g are too small at coordinates near %.6g",
+                               std::abs(gt[1]), std::abs(gt[5]), reach));
+  }
   const OGRSpatialReference* file_srs = ds->GetSpatialRef();
   if (file_srs == nullptr || file_srs->IsEmpty()) return bad("no coordinate reference system");
   OGRSpatialReference file_crs(*file_srs);
@@ -226,6 +236,9 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
   // Mesh coordinates: metres, in the file's CRS or (geographic) the UTM zone of the centre.
   TransformPtr to_mesh(nullptr, &OGRCoordinateTransformation::DestroyCT);
   if (file_crs.IsGeographic()) {
+    if (std::min(std::abs(gt[1]), std::abs(gt[5])) < 1e-7) {
+      return bad("cells finer than 1e-7 degrees (about a centimetre)");
+    }
     double lon = gt[0] + gt[1] * info.raster_width / 2.0, lat = gt[3] + gt[5] * info.raster_height / 2.0;
     OGRSpatialReference wgs84;
     wgs84.SetWellKnownGeogCS("WGS84");
@@ -233,6 +246,9 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
     TransformPtr to_wgs84 = MakeTransform(file_crs, wgs84);
     if (to_wgs84 == nullptr || !to_wgs84->Transform(1, &lon, &lat)) {
       return bad(absl::StrCat("cannot find the DEM's centre in WGS 84 (", QuietGdal::LastMessage(), ")"));
+    }
+    if (!(std::abs(lon) <= 180 && std::abs(lat) <= 90)) {
+      return bad(absl::StrFormat("its centre (%.9g, %.9g) is not a longitude and latitude", lon, lat));
     }
     const int zone = std::clamp(static_cast<int>(std::floor((lon + 180) / 6)) + 1, 1, 60);
     OGRSpatialReference utm;

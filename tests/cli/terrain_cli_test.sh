@@ -2,7 +2,7 @@
 # geodex on DEMs, as a GIS user runs it: fixtures are GeoTIFFs made here with GDAL's Python
 # bindings (a tilted plane in UTM 33N, the same area on a longitude/latitude grid, a flat DEM
 # with a nodata slot); answers are analytic; rasters written are read back with GDAL.
-# Also run in remote mode (remote_mode.sh): the DEM is then triangulated here and uploaded.
+# Also run in remote mode (remote_mode.sh): a GeoTIFF is then uploaded as it is and read by geodexd.
 # Env: GEODEX (the binary).
 set -u
 pass=0
@@ -226,8 +226,8 @@ check "geojson from a mesh: says why" grep -q "GeoJSON needs a DEM" "$tmp/err.tx
   --output "$tmp/d2.txt"
 check "labels raster beside text distances" test "$(wc -l <"$tmp/d2.txt")" -eq 850
 
-# Remotely, `mesh upload DEM` stores the DEM's mesh (triangulated here) under a name that queries
-# then use; it is the same mesh the DEM's path gives.
+# Remotely, `mesh upload DEM` sends the GeoTIFF itself: geodexd makes the same mesh and keeps its
+# map, so a query by the mesh's name needs no file here, map points, rasters and GeoJSON included.
 if [ "${GEODEX_MODE:-local}" = remote ]; then
   "$GEODEX" mesh upload "$tmp/slot.tif" --name slot >"$tmp/up.txt"
   check "mesh upload DEM: exit 0" test $? -eq 0
@@ -235,6 +235,22 @@ if [ "${GEODEX_MODE:-local}" = remote ]; then
   "$GEODEX" distances slot --sources 0 >"$tmp/byname.txt"
   "$GEODEX" distances "$tmp/slot.tif" --sources 0 >"$tmp/bypath.txt"
   check "mesh upload DEM: by name = by path" cmp -s "$tmp/byname.txt" "$tmp/bypath.txt"
+  "$GEODEX" info slot >"$tmp/info-name.txt"
+  check "info by name: the raster's CRS" grep -q "^crs: .*UTM zone 33N" "$tmp/info-name.txt"
+  check "info by name: the nodata count" grep -q "^nodata_cells: 50$" "$tmp/info-name.txt"
+  "$GEODEX" distances slot --sources g:500105:4999845 --at ll:15.0026:45.1522,g:500205:4999845 \
+    >"$tmp/at-name.txt"
+  "$GEODEX" distances "$tmp/slot.tif" --sources g:500105:4999845 \
+    --at ll:15.0026:45.1522,g:500205:4999845 >"$tmp/at-path.txt"
+  check "map points by name = by path" cmp -s "$tmp/at-name.txt" "$tmp/at-path.txt"
+  check "map points by name: answered" test "$(wc -l <"$tmp/at-name.txt")" -ge 2
+  "$GEODEX" distances slot --sources g:500105:4999845 --output "$tmp/byname.tif"
+  check "raster by name: exit 0" test $? -eq 0
+  "$GEODEX" isolines slot --sources g:500105:4999845 --levels 100,200 --output "$tmp/byname.geojson"
+  check "geojson by name: exit 0" test $? -eq 0
+  check "geojson by name: two isochrones" test "$($PY -c "import json,sys; print(len(json.load(open(sys.argv[1]))['features']))" "$tmp/byname.geojson")" -eq 2
+  "$GEODEX" distances slot --sources g:500148:4999800 2>"$tmp/err.txt" >/dev/null
+  check "by name, in the slot: named" grep -q -- "--sources: point g:500148:4999800: in a hole of the DEM" "$tmp/err.txt"
 fi
 
 # Errors: map points need a DEM, a point outside or in the slot is named, --dem-step needs a DEM.

@@ -431,6 +431,19 @@ TEST_F(DemTest, BadRastersAreClearErrors) {
   absl::StatusOr<Dem> feet = Dem::Read(Write("feet.tif", g));
   ASSERT_TRUE(feet.ok()) << feet.status();
   EXPECT_DOUBLE_EQ(feet->mesh().positions[2], 0.3048);
+  // A geographic grid whose centre is not on the Earth (found by tests/fuzz/dem_fuzzer: a UTM
+  // zone computed from 1e20 degrees overflowed; such cells are now refused as too small, and a
+  // centre at 1000 degrees as not on the Earth).
+  Grid off_earth = g;
+  off_earth.unit.clear();
+  off_earth.epsg = 4326;
+  off_earth.x0 = 1000;
+  off_earth.y0 = 45;
+  off_earth.dx = off_earth.dy = 0.001;
+  absl::StatusOr<Dem> far = Dem::Read(Write("far.tif", off_earth));
+  EXPECT_EQ(far.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(far.status().message().find("not a longitude and latitude"), std::string::npos)
+      << far.status();
 }
 
 }  // namespace
