@@ -196,6 +196,47 @@ class PythonClientTest(unittest.TestCase):
         with self.assertRaises(geodex.NotFoundError):
             self.client.get_mesh("meshes/knight")
 
+    def test_geotiff_dem_with_map_points_equals_the_cli(self):
+        import numpy
+        from osgeo import gdal, osr  # Debian's python3-gdal (scripts/install-deps.sh)
+        gdal.UseExceptions()
+        tif = os.path.join(self.tmp.name, "slope.tif")
+        ds = gdal.GetDriverByName("GTiff").Create(tif, 30, 20, 1, gdal.GDT_Float32)
+        ds.SetGeoTransform((500000, 10, 0, 5000000, 0, -10))
+        srs = osr.SpatialReference()
+        srs.ImportFromEPSG(32633)
+        ds.SetProjection(srs.ExportToWkt())
+        band = ds.GetRasterBand(1)
+        band.SetNoDataValue(-9999)
+        # A slope with a nodata slot in column 12 from row 5 down.
+        band.WriteArray(numpy.fromfunction(
+            lambda j, i: numpy.where((i == 12) & (j > 4), -9999, 0.3 * i + 0.1 * j), (20, 30)))
+        ds = None
+        mesh = self.client.upload(tif, name="slope")
+        self.assertEqual(mesh.terrain.crs_name, "WGS 84 / UTM zone 33N")
+        self.assertEqual((mesh.terrain.grid_width, mesh.terrain.nodata_cells), (30, 15))
+        wgs84 = osr.SpatialReference()
+        wgs84.ImportFromEPSG(4326)
+        wgs84.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
+        to_ll = osr.CoordinateTransformation(srs, wgs84)
+        lon, lat, _ = to_ll.TransformPoint(500232.5, 4999871.5)
+        field = self.client.distance_field("meshes/slope", [geodex.map_point(500031.5, 4999903.5),
+                                                            geodex.lon_lat(lon, lat)])
+        expected = [float(x) for x in self.local(
+            "distances", tif, "--sources",
+            "g:500031.5:4999903.5,ll:%.17g:%.17g" % (lon, lat)).split()]
+        self.assertEqual(field.distances, expected)  # dropped where the CLI drops them
+        self.assertEqual(set(field.labels), {0, 1})
+        with self.assertRaises(geodex.InvalidArgumentError) as error:  # in the nodata slot
+            self.client.distance_field("meshes/slope", [geodex.map_point(500125, 4999850)])
+        self.assertEqual(error.exception.field, "sources[0].map_point")
+        with self.assertRaises(geodex.InvalidArgumentError) as error:  # not a DEM's mesh
+            self.client.distance_field(self.mesh.name, [geodex.lon_lat(lon, lat)])
+        self.assertEqual(error.exception.field, "sources[0].lon_lat")
+        coarse = self.client.upload(tif, dem_step=2)
+        self.assertEqual(coarse.terrain.grid_width, 15)
+        self.assertNotEqual(coarse.name, mesh.name)
+
     def test_errors_are_typed_and_carry_the_details(self):
         with self.assertRaises(geodex.InvalidArgumentError) as error:
             self.client.distance_field(self.mesh.name, [vertex(99999)])

@@ -16,14 +16,16 @@ import pkgutil
 __path__ = pkgutil.extend_path(__path__, __name__)
 
 from .client import (Delaunay, Field, GeodexClient, Isolines, Located, Path, PathPoint,  # noqa: E402
-                     PointDistances, Voronoi, edge_point, face_point, position, vertex)
+                     PointDistances, Voronoi, edge_point, face_point, lon_lat, map_point,
+                     position, vertex)
 from .errors import (CancelledError, DataLossError, DeadlineExceededError,  # noqa: E402
                      GeodexError, InvalidArgumentError, NotFoundError, ResourceExhaustedError,
                      UnauthenticatedError, UnavailableError, UnreachableError)
 
 __version__ = "0.1.0"
 __all__ = [
-    "GeodexClient", "vertex", "edge_point", "face_point", "position", "Field", "Path", "PathPoint",
+    "GeodexClient", "vertex", "edge_point", "face_point", "position", "map_point", "lon_lat",
+    "Field", "Path", "PathPoint",
     "Located", "PointDistances", "Isolines", "Voronoi", "Delaunay", "GeodexError",
     "InvalidArgumentError", "NotFoundError", "UnreachableError", "ResourceExhaustedError",
     "UnauthenticatedError", "UnavailableError", "DeadlineExceededError", "CancelledError",

@@ -2,7 +2,7 @@
 
 Every method of the API is here; streamed answers are reassembled; failures raise the typed
 exceptions of geodex.errors. Points are geodex.v1 SurfacePoint messages (see vertex(), edge_point(),
-face_point(), position()).
+face_point(), position(), and on a DEM's mesh map_point(), lon_lat()).
 """
 import collections
 import functools
@@ -35,6 +35,17 @@ def face_point(face, b0, b1, b2):
 def position(x, y, z):
     """A 3D position, snapped to the surface by the server."""
     return pb.SurfacePoint(position=pb.Position(x=x, y=y, z=z))
+
+
+def map_point(x, y):
+    """On a DEM's mesh (uploaded as a GeoTIFF): a map point in the raster's CRS, dropped
+    vertically onto the surface by the server (the CLI's g:X:Y)."""
+    return pb.SurfacePoint(map_point=pb.MapPoint(x=x, y=y))
+
+
+def lon_lat(lon, lat):
+    """On a DEM's mesh: a WGS 84 longitude/latitude in degrees, dropped likewise (ll:LON:LAT)."""
+    return pb.SurfacePoint(lon_lat=pb.LonLat(lon=lon, lat=lat))
 
 
 # A point of a path or polyline: its position (x, y, z) and the simplex it lies on,
@@ -157,12 +168,26 @@ class GeodexClient:
         return self._health(b"", timeout=self.timeout) == b"\x08\x01"
 
     @_typed_errors
-    def upload(self, path, name="", pin=False):
-        """Uploads a mesh file in 1 MiB chunks (idempotent); returns the Mesh resource."""
+    def upload(self, path, name="", pin=False, dem_step=None, barrier_below=None):
+        """Uploads a mesh file in 1 MiB chunks (idempotent); returns the Mesh resource.
+
+        A GeoTIFF (.tif, .tiff) is a DEM: geodexd makes it a mesh in metres and keeps its map
+        (Mesh.terrain), so map_point() and lon_lat() work on it. `dem_step` uses every Nth cell;
+        `barrier_below` leaves out cells lower than that many metres (the sea at 0)."""
+        dem = None
+        if path.lower().endswith((".tif", ".tiff")) or dem_step or barrier_below is not None:
+            dem = pb.DemOptions(step=dem_step or 0)
+            if barrier_below is not None:
+                dem.barrier_below = barrier_below
+
         def requests():
-            yield pb.CreateMeshRequest(metadata=pb.CreateMeshMetadata(
+            metadata = pb.CreateMeshMetadata(
                 file_name=os.path.basename(path), display_name=name, pin=pin,
-                total_bytes=os.path.getsize(path)))
+                total_bytes=os.path.getsize(path))
+            if dem is not None:
+                metadata.format = pb.MESH_FORMAT_GEOTIFF
+                metadata.dem.CopyFrom(dem)
+            yield pb.CreateMeshRequest(metadata=metadata)
             with open(path, "rb") as f:
                 while True:
                     chunk = f.read(CHUNK_BYTES)
