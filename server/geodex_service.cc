@@ -23,19 +23,6 @@
 namespace geodex::server {
 namespace {
 
-absl::Status ValidateDisplayName(const std::string& name) {
-  if (name.empty()) return absl::OkStatus();
-  bool ok = name.size() <= 63 && !IsMeshId(name);
-  for (char c : name) {
-    ok = ok && ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
-                c == '.' || c == '_' || c == '-');
-  }
-  if (!ok) {
-    return FieldError("metadata.display_name", absl::StrCat(QuoteInput(name), " must be 1-63 characters of [A-Za-z0-9._-] and not a 64-digit hex id"));
-  }
-  return absl::OkStatus();
-}
-
 // MESH_FORMAT_GEOTIFF is not a mesh file format: a DEM (the reactor reads it through terrain/).
 absl::StatusOr<MeshFormat> FormatFromProto(int format) {
   switch (format) {
@@ -125,7 +112,7 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
       if (env_.descriptions != nullptr) {
         env_.descriptions->SetMesh(context_, metadata_.display_name());
       }
-      if (absl::Status valid = ValidateDisplayName(metadata_.display_name()); !valid.ok()) {
+      if (absl::Status valid = ValidateDisplayName(metadata_.display_name(), "metadata.display_name"); !valid.ok()) {
         return valid;
       }
       absl::StatusOr<MeshFormat> format = FormatFromProto(metadata_.format());
@@ -365,6 +352,7 @@ const std::vector<MethodRow>& MethodTable() {
        &Unary<v1::ListMeshesRequest, v1::ListMeshesResponse, &RunListMeshes>},
       {{"DeleteMesh", Lane::kInline},
        &Unary<v1::DeleteMeshRequest, v1::DeleteMeshResponse, &RunDeleteMesh>},
+      {{"DeriveMesh", Lane::kSolve}, &Unary<v1::DeriveMeshRequest, v1::Mesh, &RunDeriveMesh>},
       {{"ComputeDistanceField", Lane::kQuick},
        &Stream<v1::ComputeDistanceFieldRequest, v1::ComputeDistanceFieldResponse,
                &RunComputeDistanceField>},

@@ -4,6 +4,7 @@
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "geodex/mesh_id.h"
 #include "status_convert.h"
 #include "google/protobuf/util/time_util.h"
 
@@ -35,6 +36,19 @@ absl::StatusOr<std::string> ParseMeshName(const std::string& name, const std::st
     return FieldError(field, absl::StrCat("expected \"meshes/{mesh_id}\" or \"meshes/{display_name}\", got ", QuoteInput(name)));
   }
   return name.substr(kPrefix.size());
+}
+
+absl::Status ValidateDisplayName(const std::string& name, const std::string& field) {
+  if (name.empty()) return absl::OkStatus();
+  bool ok = name.size() <= 63 && !IsMeshId(name);
+  for (char c : name) {
+    ok = ok && ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                c == '.' || c == '_' || c == '-');
+  }
+  if (!ok) {
+    return FieldError(field, absl::StrCat(QuoteInput(name), " must be 1-63 characters of [A-Za-z0-9._-] and not a 64-digit hex id"));
+  }
+  return absl::OkStatus();
 }
 
 void MeshToProto(const StoredMesh& mesh, v1::Mesh* out) {

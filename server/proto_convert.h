@@ -20,6 +20,10 @@ namespace geodex::server {
 // "meshes/{key}" -> key (an id or an alias). `field` names the request field in errors.
 absl::StatusOr<std::string> ParseMeshName(const std::string& name, const std::string& field);
 
+// An alias given at upload or derivation: 1-63 characters of [A-Za-z0-9._-], not a 64-digit hex
+// id ("" is none). InvalidArgument naming `field`.
+absl::Status ValidateDisplayName(const std::string& name, const std::string& field);
+
 // Fills a Mesh resource.
 void MeshToProto(const StoredMesh& mesh, v1::Mesh* out);
 

@@ -55,6 +55,9 @@ absl::Status RunListMeshes(const QueryEnv& env, const v1::ListMeshesRequest& req
                            v1::ListMeshesResponse* response);
 absl::Status RunDeleteMesh(const QueryEnv& env, const v1::DeleteMeshRequest& request,
                            v1::DeleteMeshResponse* response);
+// A mesh derived by a barrier, built and stored like an upload (on the pool).
+absl::Status RunDeriveMesh(const QueryEnv& env, const v1::DeriveMeshRequest& request,
+                           v1::Mesh* response);
 
 // Unary queries.
 absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPathRequest& request,

@@ -1,4 +1,5 @@
-// Mesh resources: GetMesh, ListMeshes, DeleteMesh (answered inline: map look-ups).
+// Mesh resources: GetMesh, ListMeshes, DeleteMesh (answered inline: map look-ups), GetMeshGeometry
+// and DeriveMesh (on the pool: a derived mesh is built like an upload).
 
 #include <algorithm>
 #include <cmath>
@@ -11,6 +12,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "geodex/mesh_id.h"
+#include "geodex/terrain.h"
 #include "geometry_convert.h"
 #include "proto_convert.h"
 #include "queries.h"
@@ -75,6 +77,67 @@ absl::StatusOr<MessageStream<v1::MeshGeometry>> RunGetMeshGeometry(
   if (!mesh.ok()) return mesh.status();
   return ProducerOf(
       api::MeshGeometryToProto((*mesh)->mesh->ToMeshData(), env.limits->stream_chunk_bytes));
+}
+
+
+absl::Status RunDeriveMesh(const QueryEnv& env, const v1::DeriveMeshRequest& request,
+                           v1::Mesh* response) {
+  const v1::Barrier& barrier = request.barrier();
+  if (!barrier.has_below() && barrier.polygons_geojson().empty()) {
+    return FieldError("barrier", "empty: set below, polygons_geojson or both");
+  }
+  if (barrier.has_below() && !std::isfinite(barrier.below())) {
+    return FieldError("barrier.below", "must be finite");
+  }
+  if (absl::Status valid = ValidateDisplayName(request.display_name(), "display_name"); !valid.ok()) {
+    return valid;
+  }
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> base = LookupMesh(env, request.mesh(), "mesh");
+  if (!base.ok()) return base.status();
+  const StoredMesh& from = **base;
+  // A DEM's mesh keeps its exact file positions in its grid; any other comes from the built mesh.
+  MeshData derived = from.dem != nullptr ? from.dem->mesh() : from.mesh->ToMeshData();
+  const size_t faces_before = derived.face_count();
+  if (barrier.has_below()) derived = terrain::RemoveFacesBelow(derived, barrier.below());
+  if (!barrier.polygons_geojson().empty()) {
+    uint64_t inside = 0;
+    absl::StatusOr<MeshData> cut = terrain::RemoveFacesInPolygons(
+        derived, barrier.polygons_geojson(), from.terrain ? &*from.terrain : nullptr,
+        "barrier.polygons_geojson", &inside);
+    if (!cut.ok()) return FieldError("barrier.polygons_geojson", cut.status().message());
+    derived = *std::move(cut);
+  }
+  if (derived.faces.empty()) return FieldError("barrier", "covers every face of the mesh");
+  if (env.cancel->IsCancelled()) return absl::CancelledError("derivation cancelled");
+  const std::string id = ComputeMeshId(derived);
+  auto candidate = std::make_shared<StoredMesh>();
+  candidate->id = id;
+  if (!env.store->Contains(id)) {
+    absl::StatusOr<TriangleMesh> built = TriangleMesh::Build(derived);
+    if (!built.ok()) return FieldError("barrier", built.status().message());
+    std::shared_ptr<const terrain::Dem> dem;
+    if (from.terrain) {
+      terrain::DemInfo info = *from.terrain;
+      info.barrier_faces += faces_before - derived.face_count();
+      absl::StatusOr<terrain::Dem> grid = terrain::Dem::FromMesh(derived, std::move(info));
+      if (!grid.ok()) return absl::InternalError(grid.status().message());
+      dem = std::make_shared<const terrain::Dem>(*std::move(grid));
+    }
+    if (env.cancel->IsCancelled()) return absl::CancelledError("derivation cancelled");
+    candidate = MakeStoredMesh(id, *std::move(built), std::move(dem));
+    candidate->pinned = request.pin();
+  }
+  candidate->display_name = request.display_name();
+  const std::string canonical =
+      env.store->has_disk() && candidate->mesh != nullptr ? CanonicalMeshEncoding(derived) : "";
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> stored =
+      env.store->Insert(std::move(candidate), canonical, env.limits->max_names_per_mesh);
+  if (absl::IsInvalidArgument(stored.status())) {  // the store names the upload's field
+    return FieldError("display_name", stored.status().message());
+  }
+  if (!stored.ok()) return stored.status();
+  MeshToProto(**stored, response);
+  return absl::OkStatus();
 }
 
 }  // namespace geodex::server

@@ -53,13 +53,14 @@ double MetresPerHeightUnit(std::string unit) {
   return 0;
 }
 
-// Every polygon of a vector file, in `crs`, unioned. Errors name the file.
-absl::StatusOr<std::unique_ptr<OGRGeometry>> ReadBarrierPolygons(const std::string& path,
-                                                                 const OGRSpatialReference& crs) {
+// Every polygon of a vector dataset, in `crs` (null: as they are, no CRS), unioned. Errors start
+// with `name`.
+absl::StatusOr<std::unique_ptr<OGRGeometry>> BarrierPolygonsOf(GDALDataset* ds,
+                                                               const std::string& name,
+                                                               const OGRSpatialReference* crs) {
   auto bad = [&](const std::string& why) {
-    return absl::InvalidArgumentError(absl::StrCat("--barrier ", path, ": ", why));
+    return absl::InvalidArgumentError(absl::StrCat(name, ": ", why));
   };
-  GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY));
   if (ds == nullptr) return bad(absl::StrCat("not a vector file GDAL reads (", QuietGdal::LastMessage(), ")"));
   OGRSpatialReference wgs84;
   wgs84.SetWellKnownGeogCS("WGS84");
@@ -69,13 +70,16 @@ absl::StatusOr<std::unique_ptr<OGRGeometry>> ReadBarrierPolygons(const std::stri
     const OGRSpatialReference* layer_crs = layer->GetSpatialRef();
     OGRSpatialReference from(layer_crs != nullptr ? *layer_crs : wgs84);
     from.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-    TransformPtr to_dem = MakeTransform(from, crs);
-    if (to_dem == nullptr) return bad(absl::StrCat("cannot project it to the DEM's CRS (", QuietGdal::LastMessage(), ")"));
+    TransformPtr to_dem(nullptr, &OGRCoordinateTransformation::DestroyCT);
+    if (crs != nullptr) {
+      to_dem = MakeTransform(from, *crs);
+      if (to_dem == nullptr) return bad(absl::StrCat("cannot project it to the DEM's CRS (", QuietGdal::LastMessage(), ")"));
+    }
     for (const auto& feature : *layer) {
       const OGRGeometry* g = feature->GetGeometryRef();
       if (g == nullptr) continue;
       std::unique_ptr<OGRGeometry> copy(g->clone());
-      if (copy->transform(to_dem.get()) != OGRERR_NONE) {
+      if (to_dem != nullptr && copy->transform(to_dem.get()) != OGRERR_NONE) {
         return bad(absl::StrCat("cannot project a feature to the DEM's CRS (", QuietGdal::LastMessage(), ")"));
       }
       const OGRwkbGeometryType type = wkbFlatten(copy->getGeometryType());
@@ -122,6 +126,67 @@ bool IsDemPath(const std::string& path) {
     if (ext == known) return true;
   }
   return false;
+}
+
+absl::StatusOr<MeshData> RemoveFacesInPolygons(const MeshData& mesh, const std::string& geojson,
+                                               const DemInfo* dem, const std::string& name,
+                                               uint64_t* removed) {
+  QuietGdal quiet;
+  auto bad = [&](const std::string& why) {
+    return absl::InvalidArgumentError(absl::StrCat(name, ": ", why));
+  };
+  OGRSpatialReference file_crs;
+  if (dem != nullptr) {
+    if (file_crs.importFromWkt(dem->file_crs_wkt.c_str()) != OGRERR_NONE) return bad("the DEM's CRS does not parse");
+    file_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  }
+  // The text itself is the dataset (GDAL's GeoJSON driver only: it reads no other file).
+  const char* const drivers[] = {"GeoJSON", nullptr};
+  GDALDatasetUniquePtr ds(GDALDataset::FromHandle(
+      GDALOpenEx(geojson.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, drivers, nullptr, nullptr)));
+  absl::StatusOr<std::unique_ptr<OGRGeometry>> polygons =
+      ds == nullptr ? bad(absl::StrCat("not GeoJSON polygons (", QuietGdal::LastMessage(), ")"))
+                    : BarrierPolygonsOf(ds.get(), name, dem != nullptr ? &file_crs : nullptr);
+  if (!polygons.ok()) return polygons.status();
+  OGRPreparedGeometryUniquePtr inside(OGRCreatePreparedGeometry(OGRGeometry::ToHandle(polygons->get())));
+  if (inside == nullptr) return absl::InternalError("GDAL cannot prepare polygons (built without GEOS?)");
+  // Face centres in the polygons' frame: the mesh's x y, or the DEM file's CRS.
+  const size_t faces = mesh.face_count();
+  std::vector<double> cx(faces), cy(faces);
+  for (size_t f = 0; f < faces; ++f) {
+    for (int c = 0; c < 3; ++c) {
+      const size_t v = mesh.faces[3 * f + c];
+      cx[f] += mesh.positions[3 * v] / 3;
+      cy[f] += mesh.positions[3 * v + 1] / 3;
+    }
+  }
+  if (dem != nullptr && dem->reprojected) {
+    OGRSpatialReference mesh_crs;
+    mesh_crs.importFromWkt(dem->mesh_crs_wkt.c_str());
+    mesh_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    TransformPtr back = MakeTransform(mesh_crs, file_crs);
+    std::vector<int> ok(faces);
+    if (back == nullptr || (faces > 0 && !back->Transform(static_cast<int>(faces), cx.data(), cy.data(), nullptr, ok.data()))) {
+      return bad("the mesh's faces do not project to the DEM's CRS");
+    }
+  } else if (dem != nullptr) {
+    for (size_t f = 0; f < faces; ++f) {
+      cx[f] /= dem->horizontal_scale;
+      cy[f] /= dem->horizontal_scale;
+    }
+  }
+  MeshData out;
+  out.positions = mesh.positions;
+  *removed = 0;
+  for (size_t f = 0; f < faces; ++f) {
+    OGRPoint p(cx[f], cy[f]);
+    if (OGRPreparedGeometryContains(inside.get(), OGRGeometry::ToHandle(&p)) != 0) {
+      ++*removed;
+      continue;
+    }
+    out.faces.insert(out.faces.end(), mesh.faces.begin() + 3 * f, mesh.faces.begin() + 3 * f + 3);
+  }
+  return out;
 }
 
 bool IsGeoTiffPath(const std::string& path) {
@@ -345,7 +410,10 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
   std::unique_ptr<OGRGeometry> barrier_union;
   if (!options.barrier_file.empty()) {
     absl::StatusOr<std::unique_ptr<OGRGeometry>> polygons =
-        ReadBarrierPolygons(options.barrier_file, file_crs);
+        BarrierPolygonsOf(GDALDatasetUniquePtr(GDALDataset::Open(options.barrier_file.c_str(),
+                                                                 GDAL_OF_VECTOR | GDAL_OF_READONLY))
+                              .get(),
+                          absl::StrCat("--barrier ", options.barrier_file), &file_crs);
     if (!polygons.ok()) return polygons.status();
     barrier_union = *std::move(polygons);
     barrier.reset(OGRCreatePreparedGeometry(OGRGeometry::ToHandle(barrier_union.get())));

@@ -10,6 +10,10 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "geodex/distance_field.h"
+#include "geodex/geodesic_solver.h"
+#include "geodex/triangle_mesh.h"
 #include "gdal_priv.h"
 #include "geodex/mesh_id.h"
 #include "geodex/mesh_io.h"
@@ -265,6 +269,119 @@ TEST_F(TerrainServiceTest, TheMapIsStoredAndGained) {
   testing::FieldResult after = FieldFrom("meshes/slot", map);
   ASSERT_TRUE(after.status.ok()) << after.status.error_message();
   EXPECT_EQ(after.distances, before.distances);
+}
+
+
+// Barriers as a request: DeriveMesh leaves out the faces a barrier covers and stores the result by
+// its content. On a DEM's mesh a GeoJSON wall (in longitude/latitude) gives exactly the mesh the
+// CLI makes with --barrier (the same id), map points still drop, and paths go around the wall.
+TEST_F(TerrainServiceTest, DeriveMeshByABarrier) {
+  StartServer();
+  testing::UploadResult slot = UploadDem(bytes_, "slot");
+  ASSERT_TRUE(slot.status.ok());
+  auto derive = [&](const std::string& mesh, const v1::Barrier& barrier, const std::string& name,
+                    v1::Mesh* out) {
+    grpc::ClientContext context;
+    context.set_deadline(testing::In(120));
+    v1::DeriveMeshRequest request;
+    request.set_mesh(mesh);
+    *request.mutable_barrier() = barrier;
+    request.set_display_name(name);
+    return stub_->DeriveMesh(&context, request, out);
+  };
+  // A wall of columns 5-6 from the top edge down to row 20, as a WGS 84 polygon.
+  OGRSpatialReference utm, wgs84;
+  utm.importFromEPSG(32633);
+  wgs84.importFromEPSG(4326);
+  utm.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  OGRCoordinateTransformation* to_ll = OGRCreateCoordinateTransformation(&utm, &wgs84);
+  ASSERT_NE(to_ll, nullptr);
+  std::string ring;
+  for (auto [x, y] : std::vector<std::pair<double, double>>{
+           {500052, 5000010}, {500052, 4999795}, {500068, 4999795}, {500068, 5000010}, {500052, 5000010}}) {
+    ASSERT_TRUE(to_ll->Transform(1, &x, &y));
+    absl::StrAppendFormat(&ring, "%s[%.15f, %.15f]", ring.empty() ? "" : ", ", x, y);
+  }
+  OGRCoordinateTransformation::DestroyCT(to_ll);
+  const std::string geojson = absl::StrCat(
+      R"({"type": "FeatureCollection", "features": [{"type": "Feature", "properties": {}, )",
+      R"("geometry": {"type": "Polygon", "coordinates": [[)", ring, "]]}}]}");
+  const std::string wall_file = (dir_ / "in" / "wall.geojson").string();
+  std::ofstream(wall_file) << geojson;
+  terrain::DemOptions with_wall;
+  with_wall.barrier_file = wall_file;
+  absl::StatusOr<terrain::Dem> local = terrain::Dem::Read(tif_, with_wall);
+  ASSERT_TRUE(local.ok()) << local.status();
+  ASSERT_EQ(local->info().barrier_faces, 40u);  // block column 5, rows 0-19: a wall
+
+  v1::Barrier wall;
+  wall.set_polygons_geojson(geojson);
+  v1::Mesh walled;
+  grpc::Status status = derive("meshes/slot", wall, "walled", &walled);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(walled.name(), absl::StrCat("meshes/", ComputeMeshId(local->mesh())));
+  EXPECT_EQ(walled.vertex_count(), local->mesh().vertex_count());
+  ASSERT_TRUE(walled.has_terrain());
+  EXPECT_EQ(walled.terrain().barrier_faces(), local->info().barrier_faces);
+  v1::Mesh again;
+  ASSERT_TRUE(derive("meshes/slot", wall, "", &again).ok());
+  EXPECT_EQ(again.name(), walled.name());  // by content: the same mesh
+
+  // A map point west of the wall to one east of it: the path goes around the wall's foot.
+  v1::SurfacePoint west;
+  west.mutable_map_point()->set_x(500025);
+  west.mutable_map_point()->set_y(4999945);
+  testing::FieldResult open = FieldFrom("meshes/slot", west);
+  testing::FieldResult around = FieldFrom("meshes/walled", west);
+  ASSERT_TRUE(open.status.ok() && around.status.ok()) << around.status.error_message();
+  const uint32_t east = local->VertexAt(10, 4);
+  EXPECT_GT(around.distances[east], open.distances[east] + 100);
+  // The CLI's local mesh gives the same field to the bit.
+  absl::StatusOr<TriangleMesh> built = TriangleMesh::Build(local->mesh());
+  ASSERT_TRUE(built.ok());
+  absl::StatusOr<SurfacePoint> west_here = local->DropMapPoint(500025, 4999945);
+  ASSERT_TRUE(west_here.ok());
+  absl::StatusOr<DistanceField> here = ComputeDistanceField(*built, {*west_here}, GeodesicOptions{});
+  ASSERT_TRUE(here.ok());
+  EXPECT_EQ(around.distances, here->distance);
+
+  // Below a height: faces with a corner lower than 2.6 m go (the top-left corner: 0.5 col +
+  // 0.25 row), and vertex 0 (height 0) is unreachable from the far corner.
+  v1::Barrier low;
+  low.set_below(2.6);
+  v1::Mesh dry;
+  ASSERT_TRUE(derive("meshes/slot", low, "dry", &dry).ok());
+  EXPECT_LT(dry.face_count(), slot.mesh.face_count());
+  testing::FieldResult from_far = testing::ReadField(*stub_, testing::FieldRequest("meshes/dry", {849}));
+  ASSERT_TRUE(from_far.status.ok()) << from_far.status.error_message();
+  EXPECT_TRUE(std::isinf(from_far.distances[0]));
+  EXPECT_TRUE(std::isfinite(from_far.distances[849 - 1]));
+
+  // On a mesh without a map, polygons are in its own x y.
+  ASSERT_TRUE(testing::Upload(*stub_, testing::GridOff(6, 6, false), "grid").status.ok());
+  v1::Barrier square;
+  square.set_polygons_geojson(R"({"type": "Polygon", "coordinates": [[[2, -1], [4, -1], [4, 7], [2, 7], [2, -1]]]})");
+  v1::Mesh cut;
+  ASSERT_TRUE(derive("meshes/grid", square, "", &cut).ok());
+  EXPECT_EQ(cut.face_count(), 72u - 24u);  // columns 2 and 3: 2 cells x 6 rows x 2 triangles
+  EXPECT_FALSE(cut.has_terrain());
+
+  // Errors name the field.
+  v1::Mesh none;
+  grpc::Status empty = derive("meshes/slot", v1::Barrier(), "", &none);
+  EXPECT_EQ(empty.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_EQ(BadField(empty), "barrier");
+  v1::Barrier junk;
+  junk.set_polygons_geojson("{not json");
+  grpc::Status bad_json = derive("meshes/slot", junk, "", &none);
+  EXPECT_EQ(BadField(bad_json), "barrier.polygons_geojson") << bad_json.error_message();
+  v1::Barrier everything;
+  everything.set_below(1e9);
+  grpc::Status all = derive("meshes/slot", everything, "", &none);
+  EXPECT_TRUE(Contains(all.error_message(), "covers every face")) << all.error_message();
+  grpc::Status taken = derive("meshes/slot", low, "walled", &none);  // another mesh's alias
+  EXPECT_EQ(BadField(taken), "display_name") << taken.error_message();
 }
 
 }  // namespace

@@ -69,6 +69,15 @@ struct DemInfo {
   bool operator==(const DemInfo&) const = default;
 };
 
+// A barrier drawn as polygons, on any mesh: `geojson` is the text of a GeoJSON FeatureCollection,
+// Feature or geometry (RFC 7946 WGS 84 unless it names its CRS) on a DEM's mesh (`dem`: its map),
+// or, with `dem` null, polygons in the mesh's own x y (no CRS). The faces whose centre lies inside
+// one are removed (vertices keep their ids); `*removed` counts them. InvalidArgument starting
+// with `name` when the text is not GeoJSON polygons. Only GDAL's GeoJSON driver reads it.
+absl::StatusOr<MeshData> RemoveFacesInPolygons(const MeshData& mesh, const std::string& geojson,
+                                               const DemInfo* dem, const std::string& name,
+                                               uint64_t* removed);
+
 inline constexpr uint32_t kNoVertex = 0xffffffffu;
 
 class Dem {
