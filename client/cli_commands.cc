@@ -231,11 +231,9 @@ absl::StatusOr<terrain::DemOptions> MeshReadOptions(const Args& args, const std:
     return absl::InvalidArgumentError("--barrier-below must be a number");
   }
   if (args.options.count("barrier")) dem.barrier_file = args.options.at("barrier");
-  for (const char* flag : {"dem-step", "barrier"}) {
-    if (args.options.count(flag) && !terrain::IsDemPath(mesh)) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("--", flag, ": ", mesh, " is not a DEM (a raster such as .tif)"));
-    }
+  if (args.options.count("dem-step") && !terrain::IsDemPath(mesh)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--dem-step: ", mesh, " is not a DEM (a raster such as .tif)"));
   }
   if (args.options.count("crs") && args.options.at("crs") != "wgs84" &&
       args.options.at("crs") != "native") {

@@ -4,7 +4,9 @@
 
 #include <unistd.h>
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <condition_variable>
 #include <cstdio>
 #include <mutex>
@@ -50,6 +52,15 @@ int Fail(int code, const std::string& message) {
   return code;
 }
 
+absl::StatusOr<std::string> ReadBarrierText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--barrier ", path, ": cannot open: ", std::strerror(errno)));
+  }
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
 // Reads a mesh file, or a built-in sample ("sample:terrain").
 absl::StatusOr<MeshData> LoadMeshData(const std::string& path,
                                       const terrain::DemOptions& dem_options,
@@ -66,7 +77,14 @@ absl::StatusOr<MeshData> LoadMeshData(const std::string& path,
       path.rfind("sample:", 0) == 0 ? MakeSampleMesh(path) : ReadMeshFile(path);
   if (!data.ok()) return data.status();
   if (std::isfinite(dem_options.barrier_below)) {
-    return terrain::RemoveFacesBelow(*data, dem_options.barrier_below);
+    data = terrain::RemoveFacesBelow(*data, dem_options.barrier_below);
+  }
+  if (!dem_options.barrier_file.empty()) {  // polygons in the mesh's own x y
+    absl::StatusOr<std::string> text = ReadBarrierText(dem_options.barrier_file);
+    if (!text.ok()) return text.status();
+    uint64_t removed = 0;
+    data = terrain::RemoveFacesInPolygons(*data, *text, nullptr,
+                                          "--barrier " + dem_options.barrier_file, &removed);
   }
   return data;
 }

@@ -27,8 +27,13 @@ double MsSince(std::chrono::steady_clock::time_point t);
 // Prints "geodex: MESSAGE" on stderr and returns `code`.
 int Fail(int code, const std::string& message);
 
+// The text of a --barrier file (GeoJSON polygons); InvalidArgument naming it with the OS's reason.
+absl::StatusOr<std::string> ReadBarrierText(const std::string& path);
+
 // Reads a mesh file, or a built-in sample ("sample:terrain"); a DEM (terrain::IsDemPath) is read
-// with GDAL and triangulated, and kept in *dem when given.
+// with GDAL and triangulated, and kept in *dem when given. A mesh file or sample takes the
+// barriers too: --barrier-below (faces with a corner lower) and --barrier (GeoJSON polygons in
+// its own x y), vertices keeping their ids.
 absl::StatusOr<MeshData> LoadMeshData(const std::string& path,
                                       const terrain::DemOptions& dem_options = {},
                                       std::shared_ptr<const terrain::Dem>* dem = nullptr);

@@ -89,7 +89,8 @@ absl::StatusOr<T> Flagged(absl::StatusOr<T> result,
 // gets is then either the GeoTIFF itself (geodexd reads it the same way and keeps its map) or,
 // for other rasters, a barrier file or a mesh file, the mesh made here.
 bool DerivedHere(const std::string& mesh, const terrain::DemOptions& options) {
-  return terrain::IsDemPath(mesh) || std::isfinite(options.barrier_below);
+  return terrain::IsDemPath(mesh) || std::isfinite(options.barrier_below) ||
+         !options.barrier_file.empty();
 }
 absl::StatusOr<MeshRef> UploadDerived(GeodexClient& client, const std::string& mesh,
                                       const terrain::DemOptions& options, const MeshData& data) {
@@ -114,12 +115,11 @@ class RemoteBackend final : public Backend {
     mesh_arg_ = mesh;
     std::error_code ec;
     absl::StatusOr<MeshRef> ref;
-    const bool barrier = std::isfinite(dem_options.barrier_below);
-    const bool here = std::filesystem::exists(mesh, ec) || mesh.rfind("sample:", 0) == 0;
-    if (barrier && !here) {
-      return absl::InvalidArgumentError(absl::StrCat(
-          "--barrier-below: ", mesh, " must be a file or a sample (the barrier is applied here)"));
-    }
+    const bool barrier =
+        std::isfinite(dem_options.barrier_below) || !dem_options.barrier_file.empty();
+    const bool here = (std::filesystem::exists(mesh, ec) && !std::filesystem::is_directory(mesh, ec)) ||
+                      mesh.rfind("sample:", 0) == 0;
+    if (barrier && !here) return OpenDerivedOnServer(mesh, dem_options);
     if (DerivedHere(mesh, dem_options) && here) {
       absl::StatusOr<MeshData> data = LoadMeshData(mesh, dem_options, &dem_);
       if (!data.ok()) return data.status();
@@ -131,6 +131,35 @@ class RemoteBackend final : public Backend {
     }
     if (!ref.ok()) return ref.status();
     mesh_ = *std::move(ref);
+    return absl::OkStatus();
+  }
+
+  // A mesh named on the server with a barrier: the server derives it (DeriveMesh). There faces
+  // with a corner below --barrier-below go, as on a mesh file (vertices keep their ids, also on a
+  // DEM's mesh), and --barrier's GeoJSON is read as on the server's mesh (WGS 84 on a DEM's).
+  absl::Status OpenDerivedOnServer(const std::string& mesh, const terrain::DemOptions& options) {
+    absl::StatusOr<MeshRef> base = client_->ResolveMesh(mesh);
+    if (!base.ok()) return base.status();
+    v1::Barrier barrier;
+    if (std::isfinite(options.barrier_below)) barrier.set_below(options.barrier_below);
+    if (!options.barrier_file.empty()) {
+      absl::StatusOr<std::string> text = ReadBarrierText(options.barrier_file);
+      if (!text.ok()) return text.status();
+      barrier.set_polygons_geojson(*std::move(text));
+    }
+    absl::StatusOr<v1::Mesh> derived = client_->DeriveMesh(base->name, barrier);
+    if (!derived.ok()) {
+      std::optional<FieldViolation> violation = FieldViolationOf(derived.status());
+      if (violation.has_value() && violation->field.rfind("barrier", 0) == 0) {
+        const bool polygons = violation->field == "barrier.polygons_geojson";
+        return absl::InvalidArgumentError(absl::StrCat(
+            polygons ? "--barrier " + options.barrier_file : std::string("--barrier-below"), ": ",
+            violation->description));
+      }
+      return derived.status();
+    }
+    mesh_.name = derived->name();
+    mesh_.id = derived->name().substr(7);
     return absl::OkStatus();
   }
 

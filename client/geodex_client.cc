@@ -260,6 +260,21 @@ absl::Status GeodexClient::DeleteMesh(const std::string& name) {
   }));
 }
 
+absl::StatusOr<v1::Mesh> GeodexClient::DeriveMesh(const std::string& name,
+                                                  const v1::Barrier& barrier,
+                                                  const std::string& alias) {
+  v1::DeriveMeshRequest request;
+  request.set_mesh(name);
+  *request.mutable_barrier() = barrier;
+  request.set_display_name(alias);
+  v1::Mesh mesh;
+  grpc::Status status = Call(IdOfName(name), [&](grpc::ClientContext* context) {
+    return stub_->DeriveMesh(context, request, &mesh);
+  });
+  if (!status.ok()) return ToAbsl(status);
+  return mesh;
+}
+
 absl::StatusOr<MeshRef> GeodexClient::UploadIfAbsent(MeshRef ref) {
   absl::StatusOr<v1::Mesh> existing = GetMesh(ref.name);
   if (existing.ok()) return ref;

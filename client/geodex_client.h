@@ -99,6 +99,9 @@ class GeodexClient {
   absl::StatusOr<MeshData> GetMeshGeometry(MeshRef& mesh);
   absl::StatusOr<std::vector<v1::Mesh>> ListMeshes();  // every page
   absl::Status DeleteMesh(const std::string& name);
+  // The mesh `name` without what `barrier` covers, stored by the server (DeriveMesh).
+  absl::StatusOr<v1::Mesh> DeriveMesh(const std::string& name, const v1::Barrier& barrier,
+                                      const std::string& alias = "");
 
   // Queries (options: the proto's SolverOptions). Results in core's types.
   // With `directions`, the field's direction field too (DistanceField::direction).

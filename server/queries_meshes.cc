@@ -112,7 +112,10 @@ absl::Status RunDeriveMesh(const QueryEnv& env, const v1::DeriveMeshRequest& req
   const std::string id = ComputeMeshId(derived);
   auto candidate = std::make_shared<StoredMesh>();
   candidate->id = id;
-  if (!env.store->Contains(id)) {
+  // Built unless stored already; a copy stored without the map (uploaded as a mesh file by a
+  // client that derived it) gains it.
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> known = env.store->GetRecord(id);
+  if (!known.ok() || (from.terrain && !(*known)->terrain)) {
     absl::StatusOr<TriangleMesh> built = TriangleMesh::Build(derived);
     if (!built.ok()) return FieldError("barrier", built.status().message());
     std::shared_ptr<const terrain::Dem> dem;

@@ -141,8 +141,16 @@ import json; d = json.load(open('$tmp/bw.json')); assert d['barrier_faces'] == 3
 check "barrier polygons: beyond is inf" $PY -c "
 import math; d = [float(x) for x in open('$tmp/bw.txt')]
 assert len(d) == 200 and math.isinf(d[15]) and math.isfinite(d[5]), (d[5], d[15])"
-"$GEODEX" distances "$tmp/tri.off" --sources 0 --barrier "$tmp/wall.geojson" 2>"$tmp/err.txt" >/dev/null
-check "barrier polygons on a mesh: exit 2" test $? -eq 2
+# On a mesh file, --barrier's polygons are in the mesh's own x y: the unit square's upper-left
+# triangle (centre (1/3, 2/3)) goes, and its corner vertex 3 is unreachable.
+printf 'OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n' >"$tmp/sq.off"
+echo '{"type": "Polygon", "coordinates": [[[0, 0.5], [0.5, 0.5], [0.5, 1], [0, 1], [0, 0.5]]]}' \
+  >"$tmp/corner.geojson"
+"$GEODEX" distances "$tmp/sq.off" --sources 0 --barrier "$tmp/corner.geojson" >"$tmp/sq.txt"
+check "barrier polygons on a mesh: exit 0" test $? -eq 0
+check "barrier polygons on a mesh: the corner is cut off" $PY -c "
+import math; d = [float(x) for x in open('$tmp/sq.txt')]
+assert d[:3] == [0, 1, math.sqrt(2)] and math.isinf(d[3]), d"
 "$GEODEX" distances "$tmp/strait.tif" --sources g:500005:4999995 >"$tmp/nb.txt"
 check "no barrier: the sea is crossed" $PY -c "
 import math; d = [float(x) for x in open('$tmp/nb.txt')]; assert len(d) == 200 and all(map(math.isfinite, d))"
@@ -251,6 +259,25 @@ if [ "${GEODEX_MODE:-local}" = remote ]; then
   check "geojson by name: two isochrones" test "$($PY -c "import json,sys; print(len(json.load(open(sys.argv[1]))['features']))" "$tmp/byname.geojson")" -eq 2
   "$GEODEX" distances slot --sources g:500148:4999800 2>"$tmp/err.txt" >/dev/null
   check "by name, in the slot: named" grep -q -- "--sources: point g:500148:4999800: in a hole of the DEM" "$tmp/err.txt"
+  # Barriers on a mesh named on the server: geodexd derives the mesh (DeriveMesh). The strait's
+  # wall gives the mesh --barrier gives by path (the same answers); below a height, faces go.
+  "$GEODEX" mesh upload "$tmp/strait.tif" --name strait >/dev/null
+  "$GEODEX" distances strait --sources g:500005:4999995 --barrier "$tmp/wall.geojson" >"$tmp/bw-name.txt"
+  check "barrier by name: exit 0" test $? -eq 0
+  check "barrier by name = by path" cmp -s "$tmp/bw-name.txt" "$tmp/bw.txt"
+  "$GEODEX" mesh upload "$tmp/sq.off" --name sq >/dev/null
+  "$GEODEX" distances sq --sources 0 --barrier "$tmp/corner.geojson" >"$tmp/sq-name.txt"
+  check "barrier polygons on a mesh by name = by path" cmp -s "$tmp/sq-name.txt" "$tmp/sq.txt"
+  "$GEODEX" distances strait --sources g:500005:4999995 --barrier-below 0 >"$tmp/b-name.txt"
+  check "barrier below by name: the far shore inf" $PY - "$tmp/b-name.txt" <<'PY'
+import math, sys
+d = [float(x) for x in open(sys.argv[1])]
+assert len(d) == 200 and math.isfinite(d[0]) and math.isinf(d[19]), (len(d), d[0], d[19])
+PY
+  echo '{"type": "Point", "coordinates": [15, 45]}' >"$tmp/point.geojson"
+  "$GEODEX" distances strait --sources 0 --barrier "$tmp/point.geojson" 2>"$tmp/err.txt" >/dev/null
+  check "bad barrier by name: exit 3" test $? -eq 3
+  check "bad barrier by name: names the flag" grep -q -- "--barrier $tmp/point.geojson: .*a barrier is polygons" "$tmp/err.txt"
 fi
 
 # Errors: map points need a DEM, a point outside or in the slot is named, --dem-step needs a DEM.

@@ -233,6 +233,25 @@ class PythonClientTest(unittest.TestCase):
         with self.assertRaises(geodex.InvalidArgumentError) as error:  # not a DEM's mesh
             self.client.distance_field(self.mesh.name, [geodex.lon_lat(lon, lat)])
         self.assertEqual(error.exception.field, "sources[0].lon_lat")
+        # A barrier: a wall across the DEM (WGS 84 polygon) derives a mesh the server stores; the
+        # CLI makes the same one with --barrier (the same answers).
+        ring = [to_ll.TransformPoint(x, y)[:2] for x, y in
+                [(500052, 5000010), (500068, 5000010), (500068, 4999815), (500052, 4999815),
+                 (500052, 5000010)]]
+        wall = {"type": "Polygon", "coordinates": [ring]}
+        walled = self.client.derive_mesh("meshes/slope", polygons_geojson=wall, name="walled")
+        self.assertEqual(walled.terrain.barrier_faces, 2 * 18)
+        wall_file = os.path.join(self.tmp.name, "wall.geojson")
+        with open(wall_file, "w") as f:
+            json.dump(wall, f)
+        around = self.client.distance_field("meshes/walled", [geodex.map_point(500031.5, 4999903.5)])
+        expected = [float(x) for x in self.local(
+            "distances", tif, "--sources", "g:500031.5:4999903.5", "--barrier", wall_file).split()]
+        self.assertEqual(around.distances, expected)
+        self.assertGreater(around.distances[7], field.distances[7])
+        with self.assertRaises(geodex.InvalidArgumentError) as error:
+            self.client.derive_mesh("meshes/slope")
+        self.assertEqual(error.exception.field, "barrier")
         coarse = self.client.upload(tif, dem_step=2)
         self.assertEqual(coarse.terrain.grid_width, 15)
         self.assertNotEqual(coarse.name, mesh.name)
