@@ -434,19 +434,16 @@ int RunDistances(Backend& backend, const Args& args) {
       if (!data.ok()) return FailQuery(data.status());
       // Each feature names its point as the user wrote it (g:, ll:, a vertex...), and where it is.
       const std::vector<std::string> written = absl::StrSplit(args.options.at("at"), ',');
-      std::vector<terrain::GeoFeature> features;
+      std::vector<terrain::PointValue> points;
       for (size_t i = 0; i < at.size(); ++i) {
-        terrain::GeoFeature f;
-        f.points = {PositionOf(**data, at[i])};
-        f.properties = {{"point", written.size() == at.size() ? written[i] : SurfacePointToString(at[i])},
-                        {"surface_point", SurfacePointToString(at[i])}};
-        if (std::isfinite(exact[i])) {  // unreachable: distance and source stay null
-          f.properties.push_back({"distance", exact[i]});
-          f.properties.push_back({"source", source[i]});
-        }
-        features.push_back(std::move(f));
+        points.push_back({PositionOf(**data, at[i]),
+                          written.size() == at.size() ? written[i] : SurfacePointToString(at[i]),
+                          SurfacePointToString(at[i]), exact[i], source[i]});
       }
-      if (int code = WriteGeoJsonOutput(backend, args, features); code != kExitOk) return code;
+      if (int code = WriteGeoJsonOutput(backend, args, terrain::PointFeatures(points));
+          code != kExitOk) {
+        return code;
+      }
       text.clear();
     }
   } else {
@@ -510,11 +507,11 @@ int RunPath(Backend& backend, const Args& args) {
   absl::StatusOr<PathQueryResult> result = backend.Path(from, to, options);
   if (!result.ok()) return FailQuery(result.status());
   if (IsGeoJsonPath(args)) {  // a 3D LineString with its length
-    terrain::GeoFeature f;
-    f.kind = terrain::GeoFeature::Kind::kLine;
-    for (const PathPoint& q : result->path.points) f.points.push_back(q.position);
-    f.properties = {{"length", result->distance}, {"units", std::string("m")}};
-    if (int code = WriteGeoJsonOutput(backend, args, {f}); code != kExitOk) return code;
+    if (int code = WriteGeoJsonOutput(
+            backend, args, {terrain::PathFeature(result->path.points, result->distance)});
+        code != kExitOk) {
+      return code;
+    }
   } else {
     const std::string text = json ? FormatPathJson(*result) : FormatPath(*result);
     if (int code = WriteOutput(args, text); code != kExitOk) return code;

@@ -279,16 +279,8 @@ int RunIsolines(Backend& backend, const Args& args) {
     // Isochrones: per level, the area within that distance (union of each face's part below it).
     absl::StatusOr<const DistanceField*> field = backend.Field(s.points, FieldOptions{});
     if (!field.ok()) return FailQuery(field.status());
-    std::vector<terrain::GeoFeature> features;
-    for (double level : iso->levels) {
-      terrain::GeoFeature f;
-      f.kind = terrain::GeoFeature::Kind::kArea;
-      f.pieces = terrain::SublevelPieces(*s.data, (*field)->distance, level);
-      f.exact_tiling = true;
-      f.properties = {{"level", level}, {"units", std::string("m")}};
-      features.push_back(std::move(f));
-    }
-    return WriteGeoJsonOutput(backend, args, features);
+    return WriteGeoJsonOutput(backend, args,
+                              terrain::IsochroneFeatures(*s.data, (*field)->distance, iso->levels));
   }
   if (format == Format::kObj) return WriteOutput(args, Obj("isolines", lines));
   if (format == Format::kSvg) return WriteOutput(args, Svg("isolines", *s.data, lines, SitePositions(s)));
@@ -345,27 +337,7 @@ int RunVoronoi(Backend& backend, const Args& args) {
   json += "]}\n";
   if (format == Format::kGeoJson) {
     // One (Multi)Polygon per site: its whole faces and its fragments, unioned.
-    std::vector<terrain::GeoFeature> features;
-    for (const VoronoiCell& c : vd->cells) {
-      terrain::GeoFeature f;
-      f.kind = terrain::GeoFeature::Kind::kArea;
-      for (uint32_t face : c.whole_faces) {
-        terrain::Polygon2 tri;
-        for (int k = 0; k < 3; ++k) {
-          const size_t v = s.data->faces[3 * size_t{face} + k];
-          tri.push_back({s.data->positions[3 * v], s.data->positions[3 * v + 1]});
-        }
-        f.pieces.push_back(std::move(tri));
-      }
-      for (const VoronoiFragment& fr : c.fragments) {
-        terrain::Polygon2 piece;
-        for (const PathPoint& q : fr.polygon) piece.push_back({q.position[0], q.position[1]});
-        f.pieces.push_back(std::move(piece));
-      }
-      f.properties = {{"site", int64_t{c.site}}, {"area", c.area}};
-      features.push_back(std::move(f));
-    }
-    return WriteGeoJsonOutput(backend, args, features);
+    return WriteGeoJsonOutput(backend, args, terrain::VoronoiFeatures(*s.data, *vd));
   }
   if (format == Format::kObj) return WriteOutput(args, Obj("voronoi", lines));
   if (format == Format::kSvg) return WriteOutput(args, Svg("voronoi", *s.data, lines, SitePositions(s)));
@@ -435,16 +407,7 @@ int RunDelaunay(Backend& backend, const Args& args) {
   json += "]}\n";
   if (format == Format::kGeoJson) {
     // One 3D LineString per Delaunay edge: the geodesic between its two sites.
-    std::vector<terrain::GeoFeature> features;
-    for (const DelaunayEdge& e : dt->edges) {
-      terrain::GeoFeature f;
-      f.kind = terrain::GeoFeature::Kind::kLine;
-      for (const PathPoint& q : e.points) f.points.push_back(q.position);
-      f.properties = {{"site_a", int64_t{e.site_a}}, {"site_b", int64_t{e.site_b}},
-                      {"length", e.length}};
-      features.push_back(std::move(f));
-    }
-    return WriteGeoJsonOutput(backend, args, features);
+    return WriteGeoJsonOutput(backend, args, terrain::DelaunayFeatures(*dt));
   }
   if (format == Format::kObj) return WriteOutput(args, Obj("delaunay", lines));
   if (format == Format::kSvg) return WriteOutput(args, Svg("delaunay", *s.data, lines, SitePositions(s)));

@@ -696,4 +696,29 @@ absl::Status Dem::WriteIndexRaster(const std::string& path, const std::vector<ui
   });
 }
 
+
+namespace {
+// An in-memory GeoTIFF's bytes, the file removed.
+absl::StatusOr<std::string> RasterBytes(const std::function<absl::Status(const std::string&)>& write) {
+  static std::atomic<uint64_t> serial{0};
+  const std::string path = absl::StrCat("/vsimem/geodex-raster-", serial.fetch_add(1), ".tif");
+  absl::Status written = write(path);
+  vsi_l_offset length = 0;
+  GByte* data = VSIGetMemFileBuffer(path.c_str(), &length, TRUE);
+  std::string out = data != nullptr ? std::string(reinterpret_cast<const char*>(data), length) : "";
+  CPLFree(data);
+  VSIUnlink(path.c_str());
+  if (!written.ok()) return absl::InternalError(written.message());
+  return out;
+}
+}  // namespace
+
+absl::StatusOr<std::string> Dem::FloatRasterBytes(const std::vector<double>& values) const {
+  return RasterBytes([&](const std::string& path) { return WriteFloatRaster(path, values); });
+}
+
+absl::StatusOr<std::string> Dem::IndexRasterBytes(const std::vector<uint32_t>& values) const {
+  return RasterBytes([&](const std::string& path) { return WriteIndexRaster(path, values); });
+}
+
 }  // namespace geodex::terrain

@@ -1,6 +1,7 @@
 #include "geodex/geojson.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -8,6 +9,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "cpl_error.h"
+#include "cpl_vsi.h"
 #include "gdal_priv.h"
 #include "gdal_quiet.h"
 #include "ogr_geometry.h"
@@ -238,6 +240,104 @@ absl::Status WriteGeoJson(const DemInfo& dem, const std::vector<GeoFeature>& fea
   ds.reset();
   if (CPLGetLastErrorType() >= CE_Failure) return failed(QuietGdal::LastMessage());
   return absl::OkStatus();
+}
+
+
+// An in-memory file's bytes, taken and the file removed; "" when there is none.
+std::string TakeMemFile(const std::string& path) {
+  vsi_l_offset length = 0;
+  GByte* data = VSIGetMemFileBuffer(path.c_str(), &length, TRUE);
+  std::string out = data != nullptr ? std::string(reinterpret_cast<const char*>(data), length) : "";
+  CPLFree(data);
+  VSIUnlink(path.c_str());
+  return out;
+}
+
+std::string MemPath(const char* extension) {
+  static std::atomic<uint64_t> serial{0};
+  return absl::StrCat("/vsimem/geodex-out-", serial.fetch_add(1), extension);
+}
+
+absl::StatusOr<std::string> GeoJsonText(const DemInfo& dem, const std::vector<GeoFeature>& features,
+                                        bool native_crs) {
+  const std::string path = MemPath(".geojson");
+  absl::Status written = WriteGeoJson(dem, features, path, native_crs);
+  std::string text = TakeMemFile(path);
+  if (!written.ok()) return absl::InternalError(written.message());
+  return text;
+}
+
+std::vector<GeoFeature> IsochroneFeatures(const MeshData& mesh, const std::vector<double>& distance,
+                                          const std::vector<double>& levels) {
+  std::vector<GeoFeature> features;
+  for (double level : levels) {
+    GeoFeature f;
+    f.kind = GeoFeature::Kind::kArea;
+    f.pieces = SublevelPieces(mesh, distance, level);
+    f.exact_tiling = true;
+    f.properties = {{"level", level}, {"units", std::string("m")}};
+    features.push_back(std::move(f));
+  }
+  return features;
+}
+
+std::vector<GeoFeature> VoronoiFeatures(const MeshData& mesh, const VoronoiDiagram& diagram) {
+  std::vector<GeoFeature> features;
+  for (const VoronoiCell& c : diagram.cells) {
+    GeoFeature f;
+    f.kind = GeoFeature::Kind::kArea;
+    for (uint32_t face : c.whole_faces) {
+      Polygon2 tri;
+      for (int k = 0; k < 3; ++k) {
+        const size_t v = mesh.faces[3 * size_t{face} + k];
+        tri.push_back({mesh.positions[3 * v], mesh.positions[3 * v + 1]});
+      }
+      f.pieces.push_back(std::move(tri));
+    }
+    for (const VoronoiFragment& fr : c.fragments) {
+      Polygon2 piece;
+      for (const PathPoint& q : fr.polygon) piece.push_back({q.position[0], q.position[1]});
+      f.pieces.push_back(std::move(piece));
+    }
+    f.properties = {{"site", int64_t{c.site}}, {"area", c.area}};
+    features.push_back(std::move(f));
+  }
+  return features;
+}
+
+std::vector<GeoFeature> DelaunayFeatures(const DelaunayTriangulation& delaunay) {
+  std::vector<GeoFeature> features;
+  for (const DelaunayEdge& e : delaunay.edges) {
+    GeoFeature f;
+    f.kind = GeoFeature::Kind::kLine;
+    for (const PathPoint& q : e.points) f.points.push_back(q.position);
+    f.properties = {{"site_a", int64_t{e.site_a}}, {"site_b", int64_t{e.site_b}}, {"length", e.length}};
+    features.push_back(std::move(f));
+  }
+  return features;
+}
+
+GeoFeature PathFeature(const std::vector<PathPoint>& points, double length) {
+  GeoFeature f;
+  f.kind = GeoFeature::Kind::kLine;
+  for (const PathPoint& q : points) f.points.push_back(q.position);
+  f.properties = {{"length", length}, {"units", std::string("m")}};
+  return f;
+}
+
+std::vector<GeoFeature> PointFeatures(const std::vector<PointValue>& points) {
+  std::vector<GeoFeature> features;
+  for (const PointValue& p : points) {
+    GeoFeature f;
+    f.points = {p.position};
+    f.properties = {{"point", p.point}, {"surface_point", p.surface_point}};
+    if (std::isfinite(p.distance)) {  // unreachable: distance and source stay null
+      f.properties.push_back({"distance", p.distance});
+      f.properties.push_back({"source", p.source});
+    }
+    features.push_back(std::move(f));
+  }
+  return features;
 }
 
 }  // namespace geodex::terrain

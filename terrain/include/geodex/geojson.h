@@ -13,8 +13,12 @@
 #include <vector>
 
 #include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "geodex/delaunay.h"
 #include "geodex/mesh_data.h"
+#include "geodex/shortest_path.h"
 #include "geodex/terrain.h"
+#include "geodex/voronoi.h"
 
 namespace geodex::terrain {
 
@@ -36,6 +40,30 @@ struct GeoFeature {
 // Writes `features` as one FeatureCollection. Errors name the path (with GDAL's reason).
 absl::Status WriteGeoJson(const DemInfo& dem, const std::vector<GeoFeature>& features,
                           const std::string& path, bool native_crs);
+// The same file's text (what geodexd's ExportGis sends).
+absl::StatusOr<std::string> GeoJsonText(const DemInfo& dem, const std::vector<GeoFeature>& features,
+                                        bool native_crs);
+
+// The features of each product, as the CLI and geodexd write them; x y z in the DEM's mesh.
+// Isochrones: per level, the area within that distance (`level`, `units` "m"), from the field's
+// vertex values on `mesh`.
+std::vector<GeoFeature> IsochroneFeatures(const MeshData& mesh, const std::vector<double>& distance,
+                                          const std::vector<double>& levels);
+// Voronoi cells: one (Multi)Polygon per site (`site`, `area`), its whole faces and fragments.
+std::vector<GeoFeature> VoronoiFeatures(const MeshData& mesh, const VoronoiDiagram& diagram);
+// Delaunay edges: one 3D LineString per edge (`site_a`, `site_b`, `length`).
+std::vector<GeoFeature> DelaunayFeatures(const DelaunayTriangulation& delaunay);
+// A path: one 3D LineString (`length`, `units` "m").
+GeoFeature PathFeature(const std::vector<PathPoint>& points, double length);
+// Points with their distance: `point` as the user wrote it, `surface_point` where it landed, and
+// (when reachable) `distance` and `source`.
+struct PointValue {
+  std::array<double, 3> position{};
+  std::string point, surface_point;
+  double distance = 0;
+  int64_t source = -1;
+};
+std::vector<GeoFeature> PointFeatures(const std::vector<PointValue>& points);
 
 // The part of each face where the field, linear on the face between its vertices' values, is at
 // most `level`: a convex polygon per face (an edge to a vertex at +inf contributes only its finite

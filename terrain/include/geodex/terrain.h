@@ -125,6 +125,9 @@ class Dem {
   absl::Status WriteFloatRaster(const std::string& path, const std::vector<double>& values) const;
   // The same for indices (int32, nodata -1; kNoVertex-like values >= 2^31 are nodata).
   absl::Status WriteIndexRaster(const std::string& path, const std::vector<uint32_t>& values) const;
+  // The same files' bytes (what geodexd's ExportGis sends).
+  absl::StatusOr<std::string> FloatRasterBytes(const std::vector<double>& values) const;
+  absl::StatusOr<std::string> IndexRasterBytes(const std::vector<uint32_t>& values) const;
 
  private:
   Dem() = default;
