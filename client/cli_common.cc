@@ -201,25 +201,6 @@ void RowProgress::Update(size_t done, size_t total) {
   std::fflush(stderr);
 }
 
-std::array<double, 3> PositionOf(const MeshData& m, const SurfacePoint& p) {
-  using Point3 = std::array<double, 3>;
-  auto vertex = [&](uint32_t v) {
-    return Point3{m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]};
-  };
-  Point3 out{0, 0, 0};
-  if (p.kind == SurfacePoint::Kind::kVertex) return vertex(p.vertex);
-  if (p.kind == SurfacePoint::Kind::kEdge) {
-    const Point3 a = vertex(p.edge_from), b = vertex(p.edge_to);
-    for (int k = 0; k < 3; ++k) out[k] = a[k] + p.t * (b[k] - a[k]);
-  } else if (p.kind == SurfacePoint::Kind::kFace) {
-    for (int c = 0; c < 3; ++c) {
-      const Point3 v = vertex(m.faces[3 * p.face + c]);
-      for (int k = 0; k < 3; ++k) out[k] += p.bary[c] * v[k];
-    }
-  }
-  return out;
-}
-
 std::string FormatInfo(const InfoValues& v, bool json) {
   const MeshReport& r = v.report;
   const std::vector<std::pair<std::string, std::string>> rows = {

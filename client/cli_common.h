@@ -92,9 +92,6 @@ class RowProgress {
   Clock::time_point start_, last_;
 };
 
-// The position (file coordinates) of a vertex, edge or face point of `mesh`.
-std::array<double, 3> PositionOf(const MeshData& mesh, const SurfacePoint& p);
-
 // --- Output, shared by local and remote mode (so both print the same bytes) ---
 
 // What `geodex info` prints.

@@ -375,6 +375,8 @@ const std::vector<MethodRow>& MethodTable() {
        &Stream<v1::ComputeVoronoiRequest, v1::ComputeVoronoiResponse, &RunComputeVoronoi>},
       {{"ComputeDelaunay", Lane::kQuick},
        &Stream<v1::ComputeDelaunayRequest, v1::ComputeDelaunayResponse, &RunComputeDelaunay>},
+      {{"ExportGis", Lane::kQuick},  // a cached field's raster or isochrones need no solve
+       &Stream<v1::ExportGisRequest, v1::ExportGisResponse, &RunExportGis>},
   };
   return *table;
 }

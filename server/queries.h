@@ -80,6 +80,9 @@ absl::StatusOr<MessageStream<v1::ComputeVoronoiResponse>> RunComputeVoronoi(
     const QueryEnv& env, const v1::ComputeVoronoiRequest& request);
 absl::StatusOr<MessageStream<v1::ComputeDelaunayResponse>> RunComputeDelaunay(
     const QueryEnv& env, const v1::ComputeDelaunayRequest& request);
+// A DEM mesh's GIS file (GeoJSON or GeoTIFF bytes, queries_gis.cc).
+absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
+    const QueryEnv& env, const v1::ExportGisRequest& request);
 
 // "meshes/{key}" looked up in the store: InvalidArgument for a malformed name, NotFound for an
 // unknown one. `field` names the request field.

@@ -36,35 +36,12 @@ MessageProducer<Response> Streamed(std::vector<Response> messages, const SolvedF
 
 absl::StatusOr<MessageStream<v1::ComputeIsolinesResponse>> RunComputeIsolines(
     const QueryEnv& env, const v1::ComputeIsolinesRequest& request) {
-  const uint32_t max_levels = env.limits->max_levels;
-  if (static_cast<uint64_t>(request.levels_size()) > max_levels) {
-    return ServerLimitError("max_levels", absl::StrCat("levels: ", request.levels_size(),
-                                                       " levels, over --max_levels=", max_levels));
-  }
-  IsolineOptions options;
-  for (int i = 0; i < request.levels_size(); ++i) {
-    if (!std::isfinite(request.levels(i))) {
-      return FieldError(absl::StrCat("levels[", i, "]"),
-                        absl::StrCat("must be finite, got ", request.levels(i)));
-    }
-    options.levels.push_back(request.levels(i));
-  }
-  if (options.levels.empty()) {
-    if (request.count() < 2) {
-      return FieldError("count",
-                        absl::StrCat("give levels, or a count >= 2 (got ", request.count(), ")"));
-    }
-    if (static_cast<uint64_t>(request.count()) > uint64_t{max_levels} + 1) {
-      return ServerLimitError(
-          "max_levels", absl::StrCat("count: ", request.count(), " gives ", request.count() - 1,
-                                     " levels, over --max_levels=", max_levels));
-    }
-    options.count = request.count();
-  }
+  absl::StatusOr<IsolineOptions> options = IsolineLevels(env, request.levels(), request.count());
+  if (!options.ok()) return options.status();
   absl::StatusOr<SolvedField> solved =
       SolveField(env, request.mesh(), request.sources(), request.options());
   if (!solved.ok()) return solved.status();
-  absl::StatusOr<Isolines> isolines = ExtractIsolines(*solved->mesh->mesh, *solved->field, options);
+  absl::StatusOr<Isolines> isolines = ExtractIsolines(*solved->mesh->mesh, *solved->field, *options);
   if (!isolines.ok()) return isolines.status();
 
   std::vector<v1::ComputeIsolinesResponse> messages =

@@ -164,4 +164,36 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> LookupMesh(const QueryEnv& env
   return mesh;  // or DataLoss (a corrupt file), ResourceExhausted (cannot be loaded back)
 }
 
+
+absl::StatusOr<IsolineOptions> IsolineLevels(const QueryEnv& env,
+                                             const google::protobuf::RepeatedField<double>& levels,
+                                             int32_t count) {
+  const uint32_t max_levels = env.limits->max_levels;
+  if (static_cast<uint64_t>(levels.size()) > max_levels) {
+    return ServerLimitError("max_levels", absl::StrCat("levels: ", levels.size(),
+                                                       " levels, over --max_levels=", max_levels));
+  }
+  IsolineOptions options;
+  for (int i = 0; i < levels.size(); ++i) {
+    if (!std::isfinite(levels[i])) {
+      return FieldError(absl::StrCat("levels[", i, "]"),
+                        absl::StrCat("must be finite, got ", levels[i]));
+    }
+    options.levels.push_back(levels[i]);
+  }
+  if (options.levels.empty()) {
+    if (count < 2) {
+      return FieldError("count",
+                        absl::StrCat("give levels, or a count >= 2 (got ", count, ")"));
+    }
+    if (static_cast<uint64_t>(count) > uint64_t{max_levels} + 1) {
+      return ServerLimitError(
+          "max_levels", absl::StrCat("count: ", count, " gives ", count - 1,
+                                     " levels, over --max_levels=", max_levels));
+    }
+    options.count = count;
+  }
+  return options;
+}
+
 }  // namespace geodex::server

@@ -11,6 +11,7 @@
 #include "absl/status/statusor.h"
 #include "geodex/distance_field.h"
 #include "geodex/geodesic_solver.h"
+#include "geodex/isolines.h"
 #include "geodex/surface_point.h"
 #include "geodex/v1/geodex.pb.h"
 #include "mesh_store.h"
@@ -40,6 +41,12 @@ absl::StatusOr<std::shared_ptr<const DistanceField>> CachedField(
     const QueryEnv& env, const StoredMesh& mesh, const std::vector<SurfacePoint>& sources,
     const GeodesicOptions& options, bool* cached);
 void FieldStatsToProto(const DistanceField& field, bool cached, v1::SolveStats* out);
+
+// Isoline levels from a request: explicit `levels` (finite, at most --max_levels) or a `count`
+// (ComputeIsolines' family). Errors name the field or the flag.
+absl::StatusOr<IsolineOptions> IsolineLevels(const QueryEnv& env,
+                                             const google::protobuf::RepeatedField<double>& levels,
+                                             int32_t count);
 
 // The field behind distance fields, isolines, Voronoi and Delaunay.
 struct SolvedField {

@@ -122,6 +122,33 @@ absl::Status ValidateSurfacePoint(const TriangleMesh& mesh, const SurfacePoint& 
   return absl::InvalidArgumentError("unknown point kind");
 }
 
+std::array<double, 3> PositionOf(const MeshData& m, const SurfacePoint& p) {
+  using Point3 = std::array<double, 3>;
+  auto vertex = [&](uint32_t v) {
+    return Point3{m.positions[3 * size_t{v}], m.positions[3 * size_t{v} + 1],
+                  m.positions[3 * size_t{v} + 2]};
+  };
+  Point3 out{0, 0, 0};
+  switch (p.kind) {
+    case SurfacePoint::Kind::kVertex:
+      return vertex(p.vertex);
+    case SurfacePoint::Kind::kEdge: {
+      const Point3 a = vertex(p.edge_from), b = vertex(p.edge_to);
+      for (int k = 0; k < 3; ++k) out[k] = a[k] + p.t * (b[k] - a[k]);
+      break;
+    }
+    case SurfacePoint::Kind::kFace:
+      for (int c = 0; c < 3; ++c) {
+        const Point3 v = vertex(m.faces[3 * size_t{p.face} + c]);
+        for (int k = 0; k < 3; ++k) out[k] += p.bary[c] * v[k];
+      }
+      break;
+    case SurfacePoint::Kind::kPosition:
+      return p.position;
+  }
+  return out;
+}
+
 std::string SurfacePointToString(const SurfacePoint& p) {
   switch (p.kind) {
     case SurfacePoint::Kind::kVertex:

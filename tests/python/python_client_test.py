@@ -252,6 +252,27 @@ class PythonClientTest(unittest.TestCase):
         with self.assertRaises(geodex.InvalidArgumentError) as error:
             self.client.derive_mesh("meshes/slope")
         self.assertEqual(error.exception.field, "barrier")
+        # GIS files from the server are the CLI's files, byte for byte.
+        source = geodex.map_point(500031.5, 4999903.5)
+        for product, args, ext in [("isochrones", ["isolines", "--levels", "40,90"], "geojson"),
+                                   ("voronoi", ["voronoi", "--sites", "g:500031.5:4999903.5,5"],
+                                    "geojson")]:
+            out = os.path.join(self.tmp.name, "cli." + ext)
+            flag = "--sites" if product == "voronoi" else "--sources"
+            cli_args = args if product == "voronoi" else args + [flag, "g:500031.5:4999903.5"]
+            self.local(cli_args[0], tif, *cli_args[1:], "--output", out)
+            sources = [source, vertex(5)] if product == "voronoi" else [source]
+            got = self.client.export_gis("meshes/slope", product, sources, levels=[40, 90])
+            with open(out, "rb") as f:
+                self.assertEqual(got, f.read(), product)
+        raster = self.client.export_gis("meshes/slope", "distance_raster", [source])
+        gdal.FileFromMemBuffer("/vsimem/py-export.tif", raster)
+        cells = gdal.Open("/vsimem/py-export.tif").ReadAsArray()
+        gdal.Unlink("/vsimem/py-export.tif")
+        self.assertEqual(cells.shape, (20, 30))
+        self.assertEqual(cells[10, 12], -1)  # the slot
+        alone = self.client.distance_field("meshes/slope", [source]).distances
+        self.assertEqual(float(cells[0, 0]), float(numpy.float32(alone[0])))  # float32 cells
         coarse = self.client.upload(tif, dem_step=2)
         self.assertEqual(coarse.terrain.grid_width, 15)
         self.assertNotEqual(coarse.name, mesh.name)

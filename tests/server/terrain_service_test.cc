@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
@@ -14,6 +15,7 @@
 #include "geodex/distance_field.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/triangle_mesh.h"
+#include "cpl_vsi.h"
 #include "gdal_priv.h"
 #include "geodex/mesh_id.h"
 #include "geodex/mesh_io.h"
@@ -382,6 +384,105 @@ TEST_F(TerrainServiceTest, DeriveMeshByABarrier) {
   EXPECT_TRUE(Contains(all.error_message(), "covers every face")) << all.error_message();
   grpc::Status taken = derive("meshes/slot", low, "walled", &none);  // another mesh's alias
   EXPECT_EQ(BadField(taken), "display_name") << taken.error_message();
+}
+
+
+// ExportGis: the files the CLI writes, made by geodexd from a stored DEM's mesh.
+TEST_F(TerrainServiceTest, ExportGisMakesTheCliFiles) {
+  ServerOptions options;
+  options.limits.stream_chunk_bytes = 1000;  // several messages per file
+  StartServer(options);
+  ASSERT_TRUE(UploadDem(bytes_, "slot").status.ok());
+  auto run = [&](const v1::ExportGisRequest& request, std::string* media) {
+    grpc::ClientContext context;
+    context.set_deadline(testing::In(120));
+    auto reader = stub_->ExportGis(&context, request);
+    v1::ExportGisResponse message;
+    std::string bytes;
+    int messages = 0;
+    while (reader->Read(&message)) {
+      if (messages++ == 0) *media = message.media_type();
+      EXPECT_LE(message.data().size(), 1000u);
+      bytes += message.data();
+    }
+    grpc::Status status = reader->Finish();
+    EXPECT_TRUE(status.ok()) << status.error_message();
+    return bytes;
+  };
+  v1::ExportGisRequest request;
+  request.set_mesh("meshes/slot");
+  request.add_sources()->mutable_map_point()->set_x(500105);
+  request.mutable_sources(0)->mutable_map_point()->set_y(4999845);
+  std::string media;
+
+  // The distance raster: aligned with the grid, the field's values, nodata in the slot.
+  request.set_product(v1::GIS_PRODUCT_DISTANCE_RASTER);
+  const std::string tiff = run(request, &media);
+  EXPECT_EQ(media, "image/tiff");
+  absl::StatusOr<terrain::Dem> local = terrain::Dem::Read(tif_);
+  ASSERT_TRUE(local.ok());
+  absl::StatusOr<SurfacePoint> source = local->DropMapPoint(500105, 4999845);
+  absl::StatusOr<TriangleMesh> built = TriangleMesh::Build(local->mesh());
+  ASSERT_TRUE(source.ok() && built.ok());
+  absl::StatusOr<DistanceField> field = ComputeDistanceField(*built, {*source}, GeodesicOptions{});
+  ASSERT_TRUE(field.ok());
+  const std::string path = "/vsimem/export-test.tif";
+  VSILFILE* file = VSIFileFromMemBuffer(path.c_str(), reinterpret_cast<GByte*>(const_cast<char*>(tiff.data())),
+                                        tiff.size(), FALSE);
+  ASSERT_NE(file, nullptr);
+  VSIFCloseL(file);
+  GDALDataset* ds = GDALDataset::Open(path.c_str(), GDAL_OF_RASTER);
+  ASSERT_NE(ds, nullptr);
+  std::vector<float> cells(30 * 30);
+  ASSERT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, 30, 30, cells.data(), 30, 30, GDT_Float32, 0, 0),
+            CE_None);
+  double gt[6];
+  ds->GetGeoTransform(gt);
+  EXPECT_EQ(gt[0], 500000);
+  GDALClose(ds);
+  VSIUnlink(path.c_str());
+  EXPECT_EQ(cells[15 * 30 + 14], -1);  // the slot
+  EXPECT_EQ(cells[20 * 30 + 3], static_cast<float>(field->distance[local->VertexAt(3, 20)]));
+
+  // Isochrones: one Feature per level, in WGS 84.
+  request.set_product(v1::GIS_PRODUCT_ISOCHRONES);
+  request.add_levels(50);
+  request.add_levels(120);
+  const std::string geojson = run(request, &media);
+  EXPECT_EQ(media, "application/geo+json");
+  EXPECT_TRUE(Contains(geojson, "\"level\": 120")) << geojson.substr(0, 300);
+  EXPECT_TRUE(Contains(geojson, "MultiPolygon") || Contains(geojson, "\"Polygon\""));
+  EXPECT_TRUE(Contains(geojson, "[ 15.")) << geojson.substr(0, 400);  // longitudes near 15 E
+
+  // Points name themselves as written and where they landed.
+  request.set_product(v1::GIS_PRODUCT_POINTS);
+  request.add_points()->mutable_map_point()->set_x(500205);
+  request.mutable_points(0)->mutable_map_point()->set_y(4999845);
+  request.add_points()->set_vertex(0);
+  const std::string points = run(request, &media);
+  EXPECT_TRUE(Contains(points, "\"point\": \"g:500205:4999845\"")) << points.substr(0, 600);
+  EXPECT_TRUE(Contains(points, "\"point\": \"0\""));
+
+  // Not a DEM's mesh, no product: INVALID_ARGUMENT naming the field.
+  ASSERT_TRUE(testing::Upload(*stub_, testing::GridOff(3, 3, false), "grid").status.ok());
+  for (auto [mesh, product, field_name] :
+       std::vector<std::tuple<std::string, v1::GisProduct, std::string>>{
+           {"meshes/grid", v1::GIS_PRODUCT_VORONOI, "mesh"},
+           {"meshes/slot", v1::GIS_PRODUCT_UNSPECIFIED, "product"}}) {
+    v1::ExportGisRequest bad;
+    bad.set_mesh(mesh);
+    bad.set_product(product);
+    bad.add_sources()->set_vertex(0);
+    grpc::ClientContext context;
+    context.set_deadline(testing::In(60));
+    auto reader = stub_->ExportGis(&context, bad);
+    v1::ExportGisResponse message;
+    while (reader->Read(&message)) {
+    }
+    grpc::Status status = reader->Finish();
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << mesh;
+    EXPECT_EQ(BadField(status), field_name) << status.error_message();
+  }
 }
 
 }  // namespace

@@ -78,15 +78,6 @@ class DemTest : public ::testing::Test {
 // The tilted plane z = 0.1 (x - 500000) + 0.2 (y - 4999700).
 double Plane(double x, double y) { return 0.1 * (x - 500000) + 0.2 * (y - 4999700); }
 
-std::array<double, 3> PositionOf(const MeshData& mesh, const SurfacePoint& p) {
-  std::array<double, 3> out{};
-  for (int c = 0; c < 3; ++c) {
-    const uint32_t v = mesh.faces[3 * size_t{p.face} + c];
-    for (int k = 0; k < 3; ++k) out[k] += p.bary[c] * mesh.positions[3 * size_t{v} + k];
-  }
-  return out;
-}
-
 DemOptions Step(uint32_t step) {
   DemOptions options;
   options.step = step;

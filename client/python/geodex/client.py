@@ -228,6 +228,21 @@ class GeodexClient:
             mesh=mesh, barrier=barrier, display_name=name, pin=pin), mesh)
 
     @_typed_errors
+    def export_gis(self, mesh, product, sources, points=(), levels=(), count=0, native_crs=False,
+                   **options):
+        """A GIS file of a DEM's mesh, as the CLI writes it with --output FILE.geojson / FILE.tif:
+        its bytes. `product`: "isochrones" (levels or count), "voronoi", "delaunay", "path"
+        (sources[0] to points[0]), "points" (distances at `points`), "distance_raster",
+        "label_raster"; GeoJSON is RFC 7946 unless `native_crs`."""
+        request = pb.ExportGisRequest(
+            mesh=mesh, product=pb.GisProduct.Value("GIS_PRODUCT_" + product.upper()),
+            sources=sources, points=points, levels=levels, count=count, native_crs=native_crs,
+            options=_solver_options(options))
+        metadata = self._metadata(mesh)
+        return b"".join(m.data for m in self.stub.ExportGis(request, timeout=self.timeout,
+                                                             metadata=metadata))
+
+    @_typed_errors
     def delete_mesh(self, mesh):
         self._call(self.stub.DeleteMesh, pb.DeleteMeshRequest(name=mesh), mesh)
 

@@ -7,6 +7,7 @@
 
 #include "absl/status/statusor.h"
 #include "absl/strings/string_view.h"
+#include "geodex/mesh_data.h"
 
 namespace geodex {
 
@@ -67,5 +68,9 @@ absl::Status ValidateSurfacePoint(const TriangleMesh& mesh, const SurfacePoint& 
 absl::Status VertexOutOfRange(const SurfacePoint& p, uint32_t vertex, uint32_t vertex_count);
 
 std::string SurfacePointToString(const SurfacePoint& p);
+
+// The position (file coordinates) of a vertex, edge or face point of `mesh` (a position point is
+// its own position).
+std::array<double, 3> PositionOf(const MeshData& mesh, const SurfacePoint& p);
 
 }  // namespace geodex

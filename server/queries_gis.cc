@@ -1,0 +1,168 @@
+// GIS files of a DEM's mesh streamed: ExportGis. The products are built by terrain/ (geojson.h,
+// Dem's rasters), the same code the CLI writes its --output FILE.geojson / FILE.tif with, so a
+// file from geodexd is the file the CLI makes locally.
+
+#include <cmath>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "geodex/delaunay.h"
+#include "geodex/distance_matrix.h"
+#include "geodex/geojson.h"
+#include "geodex/isolines.h"
+#include "geodex/shortest_path.h"
+#include "geodex/terrain.h"
+#include "geodex/voronoi.h"
+#include "proto_convert.h"
+#include "queries.h"
+#include "query_support.h"
+#include "service_limits.h"
+#include "status_convert.h"
+
+namespace geodex::server {
+namespace {
+
+// A request point as a user of the CLI writes it (the GeoJSON `point` property).
+std::string SpecOf(const v1::SurfacePoint& p) {
+  switch (p.point_case()) {
+    case v1::SurfacePoint::kVertex:
+      return absl::StrCat(p.vertex());
+    case v1::SurfacePoint::kEdge:
+      return absl::StrFormat("e:%d:%d:%.17g", p.edge().from(), p.edge().to(), p.edge().t());
+    case v1::SurfacePoint::kFace:
+      return absl::StrFormat("f:%d:%.17g:%.17g:%.17g", p.face().face(), p.face().b0(),
+                             p.face().b1(), p.face().b2());
+    case v1::SurfacePoint::kPosition:
+      return absl::StrFormat("p:%.17g:%.17g:%.17g", p.position().x(), p.position().y(),
+                             p.position().z());
+    case v1::SurfacePoint::kMapPoint:
+      return absl::StrFormat("g:%.17g:%.17g", p.map_point().x(), p.map_point().y());
+    case v1::SurfacePoint::kLonLat:
+      return absl::StrFormat("ll:%.17g:%.17g", p.lon_lat().lon(), p.lon_lat().lat());
+    case v1::SurfacePoint::POINT_NOT_SET:
+      break;
+  }
+  return "";
+}
+
+// The file, cut into messages of at most --stream_chunk_bytes.
+MessageStream<v1::ExportGisResponse> FileStream(const std::string& bytes, const char* media_type,
+                                                uint32_t chunk_bytes) {
+  std::vector<v1::ExportGisResponse> messages;
+  for (size_t offset = 0; offset < bytes.size() || messages.empty(); offset += chunk_bytes) {
+    v1::ExportGisResponse& m = messages.emplace_back();
+    if (offset == 0) m.set_media_type(media_type);
+    m.set_data(bytes.substr(offset, chunk_bytes));
+  }
+  return ProducerOf(std::move(messages));
+}
+
+}  // namespace
+
+absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
+    const QueryEnv& env, const v1::ExportGisRequest& request) {
+  const v1::GisProduct product = request.product();
+  if (product == v1::GIS_PRODUCT_UNSPECIFIED || !v1::GisProduct_IsValid(product)) {
+    return FieldError("product", absl::StrCat("unknown value ", static_cast<int>(product)));
+  }
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> found = LookupMesh(env, request.mesh(), "mesh");
+  if (!found.ok()) return found.status();
+  if ((*found)->terrain && (*found)->dem == nullptr && env.quick) return SolveLaneNeeded();
+  if ((*found)->dem == nullptr) {
+    return FieldError("mesh", "not a DEM's mesh (upload a GeoTIFF): GIS files need its map");
+  }
+  const terrain::Dem& dem = *(*found)->dem;
+  const uint32_t chunk = env.limits->stream_chunk_bytes;
+  const char* kGeoJson = "application/geo+json";
+  auto geojson = [&](const std::vector<terrain::GeoFeature>& features)
+      -> absl::StatusOr<MessageStream<v1::ExportGisResponse>> {
+    absl::StatusOr<std::string> text = terrain::GeoJsonText(dem.info(), features, request.native_crs());
+    if (!text.ok()) return text.status();
+    return FileStream(*text, kGeoJson, chunk);
+  };
+
+  if (product == v1::GIS_PRODUCT_PATH || product == v1::GIS_PRODUCT_POINTS) {
+    if (env.quick) return SolveLaneNeeded();
+    const StoredMesh& mesh = **found;
+    absl::StatusOr<GeodesicOptions> solver = Options(env, request.options());
+    if (!solver.ok()) return solver.status();
+    if (product == v1::GIS_PRODUCT_PATH) {
+      if (request.sources_size() != 1 || request.points_size() != 1) {
+        return FieldError(request.sources_size() != 1 ? "sources" : "points",
+                          "a path needs exactly one source (its start) and one point (its end)");
+      }
+      absl::StatusOr<SurfacePoint> from = ResolvePoint(mesh, request.sources(0), "sources[0]");
+      if (!from.ok()) return from.status();
+      absl::StatusOr<SurfacePoint> to = ResolvePoint(mesh, request.points(0), "points[0]");
+      if (!to.ok()) return to.status();
+      PathQueryOptions options;
+      options.solver = *solver;
+      absl::StatusOr<PathQueryResult> path = ComputeShortestPath(*mesh.mesh, *from, *to, options);
+      if (absl::IsNotFound(path.status())) return UnreachableError("points[0]: unreachable from sources[0]");
+      if (!path.ok()) return NameSolveError(path.status(), "sources");
+      return geojson({terrain::PathFeature(path->path.points, path->distance)});
+    }
+    absl::StatusOr<std::vector<SurfacePoint>> sources = ResolveSources(env, mesh, request.sources());
+    if (!sources.ok()) return sources.status();
+    absl::StatusOr<std::vector<SurfacePoint>> points =
+        ResolvePoints(mesh, request.points(), "points", env.limits->max_targets, "max_targets");
+    if (!points.ok()) return points.status();
+    absl::StatusOr<std::vector<std::pair<double, uint32_t>>> exact =
+        ComputeExactDistancesAt(*mesh.mesh, *sources, *points, *solver);
+    if (!exact.ok()) return NameSolveError(exact.status(), "sources");
+    std::vector<terrain::PointValue> values;
+    for (size_t i = 0; i < points->size(); ++i) {
+      const auto& [distance, label] = (*exact)[i];
+      values.push_back({PositionOf(dem.mesh(), (*points)[i]), SpecOf(request.points(static_cast<int>(i))),
+                        SurfacePointToString((*points)[i]), distance,
+                        std::isfinite(distance) ? int64_t{label} : -1});
+    }
+    return geojson(terrain::PointFeatures(values));
+  }
+
+  // The rest is made from the field of `sources` (cached like any field).
+  absl::StatusOr<IsolineOptions> levels;
+  if (product == v1::GIS_PRODUCT_ISOCHRONES) {
+    levels = IsolineLevels(env, request.levels(), request.count());
+    if (!levels.ok()) return levels.status();
+  }
+  absl::StatusOr<SolvedField> solved =
+      SolveField(env, request.mesh(), request.sources(), request.options());
+  if (!solved.ok()) return solved.status();
+  const TriangleMesh& mesh = *solved->mesh->mesh;
+  const DistanceField& field = *solved->field;
+  switch (product) {
+    case v1::GIS_PRODUCT_ISOCHRONES: {
+      absl::StatusOr<Isolines> iso = ExtractIsolines(mesh, field, *levels);  // its levels
+      if (!iso.ok()) return iso.status();
+      return geojson(terrain::IsochroneFeatures(dem.mesh(), field.distance, iso->levels));
+    }
+    case v1::GIS_PRODUCT_VORONOI: {
+      absl::StatusOr<VoronoiDiagram> diagram = BuildVoronoi(mesh, field);
+      if (!diagram.ok()) return diagram.status();
+      return geojson(terrain::VoronoiFeatures(dem.mesh(), *diagram));
+    }
+    case v1::GIS_PRODUCT_DELAUNAY: {
+      absl::StatusOr<DelaunayTriangulation> delaunay = BuildDelaunay(mesh, field);
+      if (!delaunay.ok()) return delaunay.status();
+      return geojson(terrain::DelaunayFeatures(*delaunay));
+    }
+    case v1::GIS_PRODUCT_DISTANCE_RASTER:
+    case v1::GIS_PRODUCT_LABEL_RASTER: {
+      absl::StatusOr<std::string> tiff = product == v1::GIS_PRODUCT_DISTANCE_RASTER
+                                             ? dem.FloatRasterBytes(field.distance)
+                                             : dem.IndexRasterBytes(field.source);
+      if (!tiff.ok()) return tiff.status();
+      return FileStream(*tiff, "image/tiff", chunk);
+    }
+    default:
+      break;
+  }
+  return absl::InternalError("unhandled GIS product");
+}
+
+}  // namespace geodex::server
