@@ -1,5 +1,6 @@
 // libFuzzer target: the query handlers of geodexd (server/queries.h) on arbitrary requests, against
-// an in-process mesh store with two small meshes ("meshes/hills" and its id). Byte 0 picks the
+// an in-process mesh store with two small meshes ("meshes/hills" and its id) and a DEM's mesh
+// ("meshes/dem", with its map: map points, DeriveMesh's GeoJSON polygons, ExportGis). Byte 0 picks the
 // method; the rest is parsed as that method's request message. Every outcome must be an answer or
 // a status, never a crash; streamed results are drained. Solves are bounded by a window budget.
 
@@ -13,7 +14,9 @@
 #include "geodex/cancel.h"
 #include "geodex/mesh_io.h"
 #include "geodex/mesh_id.h"
+#include "geodex/terrain.h"
 #include "mesh_store.h"
+#include "ogr_spatialref.h"
 #include "queries.h"
 #include "service_limits.h"
 
@@ -55,6 +58,32 @@ struct World {
       if (n == 6) mesh->display_name = "hills";
       (void)store.Insert(std::move(mesh));
     }
+    // A 6 x 6 DEM of 10 m cells in UTM 33N: its cell centres, two triangles per block.
+    MeshData grid;
+    for (int j = 0; j < 6; ++j) {
+      for (int i = 0; i < 6; ++i) {
+        grid.positions.insert(grid.positions.end(), {500005.0 + 10 * i, 4999995.0 - 10 * j, 0.5 * i * j});
+      }
+    }
+    for (uint32_t j = 0; j < 5; ++j) {
+      for (uint32_t i = 0; i < 5; ++i) {
+        const uint32_t a = j * 6 + i, b = a + 1, c = a + 6, d = a + 7;
+        grid.faces.insert(grid.faces.end(), {a, c, d, a, d, b});
+      }
+    }
+    terrain::DemInfo info;
+    info.raster_width = info.raster_height = info.grid_width = info.grid_height = 6;
+    info.geotransform = {500000, 10, 0, 5000000, 0, -10};
+    OGRSpatialReference utm;
+    utm.importFromEPSG(32633);
+    char* wkt = nullptr;
+    utm.exportToWkt(&wkt);
+    info.file_crs_wkt = info.mesh_crs_wkt = wkt;
+    CPLFree(wkt);
+    auto dem = std::make_shared<const terrain::Dem>(*terrain::Dem::FromMesh(grid, info));
+    auto mesh = MakeStoredMesh(ComputeMeshId(grid), *TriangleMesh::Build(grid), dem);
+    mesh->display_name = "dem";
+    (void)store.Insert(std::move(mesh));
   }
 };
 
@@ -88,7 +117,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const QueryEnv env{&world->store, &world->limits, &cancel, &world->cache, &world->counters};
   const uint8_t* body = data + 1;
   const size_t n = size - 1;
-  switch (data[0] % 9) {
+  switch (data[0] % 11) {
     case 0: RunStream(body, n, env, &RunComputeDistanceField); break;
     case 1: RunUnary(body, n, env, &RunFindShortestPath); break;
     case 2: RunStream(body, n, env, &RunComputeDistanceMatrix); break;
@@ -98,6 +127,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     case 6: RunStream(body, n, env, &RunComputeVoronoi); break;
     case 7: RunStream(body, n, env, &RunComputeDelaunay); break;
     case 8: RunStream(body, n, env, &RunGetMeshGeometry); break;
+    case 9: RunUnary(body, n, env, &RunDeriveMesh); break;
+    case 10: RunStream(body, n, env, &RunExportGis); break;
   }
   return 0;
 }
