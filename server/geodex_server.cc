@@ -62,6 +62,7 @@ absl::Status ValidateServerOptions(const ServerOptions& options) {
            at_least("max_upload_bytes", l.max_upload_bytes, 1, ""),
            at_least("max_vertices", l.max_vertices, 1, ""),
            at_least("max_faces", l.max_faces, 1, ""),
+           at_least("max_dem_cells", l.max_dem_cells, 4, " (a DEM has at least 2x2 cells)"),
            at_least("max_sources", l.max_sources, 1, ""),
            at_least("max_names_per_mesh", l.max_names_per_mesh, 1, ""),
            at_least("max_targets", l.max_targets, 1, ""),

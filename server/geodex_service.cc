@@ -10,6 +10,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "geodex/cancel.h"
+#include "geodex/limits.h"
 #include "geodex/mesh_io.h"
 #include "geodex/terrain.h"
 #include "google/protobuf/descriptor.h"
@@ -213,12 +214,15 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
     options.step = std::max<uint32_t>(1, metadata_.dem().step());
     if (metadata_.dem().has_barrier_below()) options.barrier_below = metadata_.dem().barrier_below();
     options.max_cells = env_.limits->max_dem_cells;
+    options.max_vertices = env_.limits->max_vertices;
+    options.max_faces = env_.limits->max_faces;
     absl::StatusOr<terrain::Dem> dem = terrain::Dem::ReadGeoTiffBytes(bytes_, file_name, options);
-    if (absl::IsResourceExhausted(dem.status())) {
-      return ServerLimitError("max_dem_cells", absl::StrCat(dem.status().message(), " (--max_dem_cells=",
-                                                            env_.limits->max_dem_cells, ")"));
-    }
+    if (ExceededLimit(dem.status())) return dem.status();  // names its flag on the way out
     if (!dem.ok()) return FieldError("chunk", dem.status().message());
+    // What is stored must load again: the grid is rebuilt from the stored mesh then.
+    if (absl::Status back = terrain::Dem::FromMesh(dem->mesh(), dem->info()).status(); !back.ok()) {
+      return FieldError("chunk", absl::StrCat(file_name, ": ", back.message()));
+    }
     return dem;
   }
 
@@ -375,7 +379,7 @@ const std::vector<MethodRow>& MethodTable() {
        &Stream<v1::ComputeVoronoiRequest, v1::ComputeVoronoiResponse, &RunComputeVoronoi>},
       {{"ComputeDelaunay", Lane::kQuick},
        &Stream<v1::ComputeDelaunayRequest, v1::ComputeDelaunayResponse, &RunComputeDelaunay>},
-      {{"ExportGis", Lane::kQuick},  // a cached field's raster or isochrones need no solve
+      {{"ExportGis", Lane::kSolve},  // GEOS unions and GDAL writing: never on the quick lane
        &Stream<v1::ExportGisRequest, v1::ExportGisResponse, &RunExportGis>},
   };
   return *table;

@@ -103,13 +103,14 @@ std::shared_ptr<const StoredMesh> MeshStore::AdmitLocked(std::shared_ptr<const S
 }
 
 absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::Insert(
-    std::shared_ptr<StoredMesh> mesh, const std::string& canonical, uint32_t max_names) {
+    std::shared_ptr<StoredMesh> mesh, const std::string& canonical, uint32_t max_names,
+    const std::string& name_field) {
   {
     std::lock_guard<std::mutex> lock(mu_);
     if (!mesh->display_name.empty()) {
       auto alias = aliases_.find(mesh->display_name);
       if (alias != aliases_.end() && alias->second != mesh->id) {
-        return FieldError("metadata.display_name", absl::StrCat("\"", mesh->display_name, "\" already names mesh ", alias->second));
+        return FieldError(name_field, absl::StrCat("\"", mesh->display_name, "\" already names mesh ", alias->second));
       }
     }
     auto existing = meshes_.find(mesh->id);
@@ -125,14 +126,24 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::Insert(
       if (gains_terrain) {
         auto updated = std::make_shared<StoredMesh>(old);
         updated->terrain = mesh->terrain;
-        if (slot.resident) {
+        // Resident, it holds the grid too: room is made for it as for any mesh (not by evicting
+        // this one, just used), before anything is written.
+        const uint64_t extra = slot.resident ? mesh->dem->MemoryBytes() : 0;
+        std::vector<std::string> victims;
+        if (extra > 0) {
+          absl::StatusOr<std::vector<std::string>> room = VictimsLocked(extra);
+          if (!room.ok()) return room.status();
+          for (std::string& id : *room) {
+            if (id != mesh->id) victims.push_back(std::move(id));
+          }
           updated->dem = mesh->dem;
-          updated->memory_bytes += mesh->dem->MemoryBytes();
-          used_bytes_ += mesh->dem->MemoryBytes();
+          updated->memory_bytes += extra;
         }
         if (disk_) {
           if (absl::Status s = disk_->UpdateHeader(*updated); !s.ok()) return s;
         }
+        for (const std::string& id : victims) EvictLocked(id);
+        used_bytes_ += extra;
         slot.mesh = std::move(updated);
       }
       const StoredMesh& current = *slot.mesh;
@@ -140,7 +151,7 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::Insert(
         const size_t names = (current.display_name.empty() ? 0 : 1) + current.aliases.size();
         if (names >= max_names) {
           return ServerLimitError("max_names_per_mesh", absl::StrCat(
-              "metadata.display_name: mesh ", mesh->id, " already has ", names,
+              name_field, ": mesh ", mesh->id, " already has ", names,
               " names, the most a mesh may have (--max_names_per_mesh=", max_names, ")"));
         }
         auto updated = std::make_shared<StoredMesh>(current);
@@ -265,10 +276,15 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::Get(const std::stri
   loaded->upload_bytes = record->upload_bytes;
   loaded->create_time = record->create_time;
 
-  std::lock_guard<std::mutex> lock(mu_);
+  std::unique_lock<std::mutex> lock(mu_);
   auto it = meshes_.find(record->id);
   if (it == meshes_.end()) {
     return absl::NotFoundError(absl::StrCat("mesh \"", id_or_alias, "\" was deleted"));
+  }
+  if (!it->second.resident && it->second.mesh->terrain && !loaded->terrain) {
+    // The record gained its map while this load read the older header: read it again.
+    lock.unlock();
+    return Get(id_or_alias);
   }
   if (it->second.resident) {
     lru_.splice(lru_.begin(), lru_, it->second.lru);

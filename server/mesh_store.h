@@ -57,9 +57,10 @@ class MeshStore {
   // new alias is added to its names). Errors: ResourceExhausted when the mesh is larger than the
   // budget, cannot fit beside the pinned meshes, already has `max_names` names, or the disk is
   // full; InvalidArgument when the alias belongs to another mesh; Internal for other I/O errors.
-  absl::StatusOr<std::shared_ptr<const StoredMesh>> Insert(std::shared_ptr<StoredMesh> mesh,
-                                                           const std::string& canonical = "",
-                                                           uint32_t max_names = 16);
+  // `name_field` names the request field of the alias in errors.
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> Insert(
+      std::shared_ptr<StoredMesh> mesh, const std::string& canonical = "", uint32_t max_names = 16,
+      const std::string& name_field = "metadata.display_name");
 
   // The mesh with this id or alias, loaded (from disk if needed; that can take a while: call it on
   // a compute thread). Marks it recently used. NotFound when unknown, DataLoss when its file does

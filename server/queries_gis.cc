@@ -49,9 +49,17 @@ std::string SpecOf(const v1::SurfacePoint& p) {
   return "";
 }
 
-// The file, cut into messages of at most --stream_chunk_bytes.
-MessageStream<v1::ExportGisResponse> FileStream(const std::string& bytes, const char* media_type,
-                                                uint32_t chunk_bytes) {
+// The file, cut into messages of at most --stream_chunk_bytes; a file over 8 bytes per
+// --max_output_values is refused.
+absl::StatusOr<MessageStream<v1::ExportGisResponse>> FileStream(const std::string& bytes,
+                                                                const char* media_type,
+                                                                uint32_t chunk_bytes,
+                                                                uint64_t max_output_values) {
+  if (bytes.size() / 8 > max_output_values) {
+    return ServerLimitError("max_output_values",
+                            absl::StrCat("the file would be ", bytes.size(), " bytes, over 8 per value of --max_output_values=",
+                                         max_output_values));
+  }
   std::vector<v1::ExportGisResponse> messages;
   for (size_t offset = 0; offset < bytes.size() || messages.empty(); offset += chunk_bytes) {
     v1::ExportGisResponse& m = messages.emplace_back();
@@ -71,22 +79,24 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
   }
   absl::StatusOr<std::shared_ptr<const StoredMesh>> found = LookupMesh(env, request.mesh(), "mesh");
   if (!found.ok()) return found.status();
-  if ((*found)->terrain && (*found)->dem == nullptr && env.quick) return SolveLaneNeeded();
   if ((*found)->dem == nullptr) {
     return FieldError("mesh", "not a DEM's mesh (upload a GeoTIFF): GIS files need its map");
   }
   const terrain::Dem& dem = *(*found)->dem;
   const uint32_t chunk = env.limits->stream_chunk_bytes;
   const char* kGeoJson = "application/geo+json";
-  auto geojson = [&](const std::vector<terrain::GeoFeature>& features)
+  auto geojson_of = [&](const terrain::Dem& on, const std::vector<terrain::GeoFeature>& features)
       -> absl::StatusOr<MessageStream<v1::ExportGisResponse>> {
-    absl::StatusOr<std::string> text = terrain::GeoJsonText(dem.info(), features, request.native_crs());
+    if (env.cancel->IsCancelled()) return absl::CancelledError("export cancelled");
+    absl::StatusOr<std::string> text = terrain::GeoJsonText(on.info(), features, request.native_crs());
     if (!text.ok()) return text.status();
-    return FileStream(*text, kGeoJson, chunk);
+    return FileStream(*text, kGeoJson, chunk, env.limits->max_output_values);
+  };
+  auto geojson = [&](const std::vector<terrain::GeoFeature>& features) {
+    return geojson_of(dem, features);
   };
 
   if (product == v1::GIS_PRODUCT_PATH || product == v1::GIS_PRODUCT_POINTS) {
-    if (env.quick) return SolveLaneNeeded();
     const StoredMesh& mesh = **found;
     absl::StatusOr<GeodesicOptions> solver = Options(env, request.options());
     if (!solver.ok()) return solver.status();
@@ -135,29 +145,34 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
   if (!solved.ok()) return solved.status();
   const TriangleMesh& mesh = *solved->mesh->mesh;
   const DistanceField& field = *solved->field;
+  // The mesh the field was solved on (the name was looked up again: it may name another mesh now).
+  if (solved->mesh->dem == nullptr) {
+    return FieldError("mesh", "not a DEM's mesh (upload a GeoTIFF): GIS files need its map");
+  }
+  const terrain::Dem& grid = *solved->mesh->dem;
   switch (product) {
     case v1::GIS_PRODUCT_ISOCHRONES: {
       absl::StatusOr<Isolines> iso = ExtractIsolines(mesh, field, *levels);  // its levels
       if (!iso.ok()) return iso.status();
-      return geojson(terrain::IsochroneFeatures(dem.mesh(), field.distance, iso->levels));
+      return geojson_of(grid, terrain::IsochroneFeatures(grid.mesh(), field.distance, iso->levels));
     }
     case v1::GIS_PRODUCT_VORONOI: {
       absl::StatusOr<VoronoiDiagram> diagram = BuildVoronoi(mesh, field);
       if (!diagram.ok()) return diagram.status();
-      return geojson(terrain::VoronoiFeatures(dem.mesh(), *diagram));
+      return geojson_of(grid, terrain::VoronoiFeatures(grid.mesh(), *diagram));
     }
     case v1::GIS_PRODUCT_DELAUNAY: {
       absl::StatusOr<DelaunayTriangulation> delaunay = BuildDelaunay(mesh, field);
       if (!delaunay.ok()) return delaunay.status();
-      return geojson(terrain::DelaunayFeatures(*delaunay));
+      return geojson_of(grid, terrain::DelaunayFeatures(*delaunay));
     }
     case v1::GIS_PRODUCT_DISTANCE_RASTER:
     case v1::GIS_PRODUCT_LABEL_RASTER: {
       absl::StatusOr<std::string> tiff = product == v1::GIS_PRODUCT_DISTANCE_RASTER
-                                             ? dem.FloatRasterBytes(field.distance)
-                                             : dem.IndexRasterBytes(field.source);
+                                             ? grid.FloatRasterBytes(field.distance)
+                                             : grid.IndexRasterBytes(field.source);
       if (!tiff.ok()) return tiff.status();
-      return FileStream(*tiff, "image/tiff", chunk);
+      return FileStream(*tiff, "image/tiff", chunk, env.limits->max_output_values);
     }
     default:
       break;

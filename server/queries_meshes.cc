@@ -133,11 +133,8 @@ absl::Status RunDeriveMesh(const QueryEnv& env, const v1::DeriveMeshRequest& req
   candidate->display_name = request.display_name();
   const std::string canonical =
       env.store->has_disk() && candidate->mesh != nullptr ? CanonicalMeshEncoding(derived) : "";
-  absl::StatusOr<std::shared_ptr<const StoredMesh>> stored =
-      env.store->Insert(std::move(candidate), canonical, env.limits->max_names_per_mesh);
-  if (absl::IsInvalidArgument(stored.status())) {  // the store names the upload's field
-    return FieldError("display_name", stored.status().message());
-  }
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> stored = env.store->Insert(
+      std::move(candidate), canonical, env.limits->max_names_per_mesh, "display_name");
   if (!stored.ok()) return stored.status();
   MeshToProto(**stored, response);
   return absl::OkStatus();

@@ -40,6 +40,8 @@ inline const char* FlagOfLimit(Limit limit) {
       return "max_upload_bytes";
     case Limit::kWindows:
       return "max_windows";
+    case Limit::kDemCells:
+      return "max_dem_cells";
   }
   return "unknown";
 }

@@ -1,5 +1,6 @@
 #include "geodex/limits.h"
 
+#include <iterator>
 #include <string>
 
 #include "absl/strings/cord.h"
@@ -9,7 +10,7 @@ namespace {
 
 constexpr absl::string_view kPayloadUrl = "geodex/limit";
 
-constexpr absl::string_view kNames[] = {"vertices", "faces", "input_bytes", "windows"};
+constexpr absl::string_view kNames[] = {"vertices", "faces", "input_bytes", "windows", "dem_cells"};
 
 }  // namespace
 
@@ -22,7 +23,7 @@ absl::Status LimitExceededError(Limit limit, absl::string_view message) {
 std::optional<Limit> ExceededLimit(const absl::Status& status) {
   auto payload = status.GetPayload(kPayloadUrl);
   if (!payload.has_value()) return std::nullopt;
-  for (int i = 0; i < 4; ++i) {
+  for (int i = 0; i < static_cast<int>(std::size(kNames)); ++i) {
     if (*payload == kNames[i]) return static_cast<Limit>(i);
   }
   return std::nullopt;

@@ -17,6 +17,7 @@
 #include "cpl_vsi.h"
 #include "gdal_priv.h"
 #include "gdal_quiet.h"
+#include "geodex/limits.h"
 #include "ogr_api.h"
 #include "ogr_geometry.h"
 #include "ogr_spatialref.h"
@@ -140,13 +141,27 @@ absl::StatusOr<MeshData> RemoveFacesInPolygons(const MeshData& mesh, const std::
     if (file_crs.importFromWkt(dem->file_crs_wkt.c_str()) != OGRERR_NONE) return bad("the DEM's CRS does not parse");
     file_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
   }
-  // The text itself is the dataset (GDAL's GeoJSON driver only: it reads no other file).
+  // The text goes into an in-memory file of its own that GDAL's GeoJSON driver alone opens. (Given
+  // to GDAL as the "file name", text not starting with '{' would be taken for a path or a URL: a
+  // client could make a server read its files or fetch addresses.)
+  const size_t first = geojson.find_first_not_of(" \t\r\n");
+  if (first == std::string::npos || geojson[first] != '{') {
+    return bad("not GeoJSON (a JSON object, starting with '{')");
+  }
+  static std::atomic<uint64_t> serial{0};
+  const std::string path = absl::StrCat("/vsimem/geodex-barrier-", serial.fetch_add(1), ".geojson");
+  VSILFILE* file = VSIFileFromMemBuffer(
+      path.c_str(), reinterpret_cast<GByte*>(const_cast<char*>(geojson.data())), geojson.size(), FALSE);
+  if (file == nullptr) return absl::InternalError("GDAL cannot make an in-memory file");
+  VSIFCloseL(file);
   const char* const drivers[] = {"GeoJSON", nullptr};
   GDALDatasetUniquePtr ds(GDALDataset::FromHandle(
-      GDALOpenEx(geojson.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, drivers, nullptr, nullptr)));
+      GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, drivers, nullptr, nullptr)));
   absl::StatusOr<std::unique_ptr<OGRGeometry>> polygons =
       ds == nullptr ? bad(absl::StrCat("not GeoJSON polygons (", QuietGdal::LastMessage(), ")"))
                     : BarrierPolygonsOf(ds.get(), name, dem != nullptr ? &file_crs : nullptr);
+  ds.reset();
+  VSIUnlink(path.c_str());
   if (!polygons.ok()) return polygons.status();
   OGRPreparedGeometryUniquePtr inside(OGRCreatePreparedGeometry(OGRGeometry::ToHandle(polygons->get())));
   if (inside == nullptr) return absl::InternalError("GDAL cannot prepare polygons (built without GEOS?)");
@@ -262,7 +277,7 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
   info.raster_height = static_cast<uint32_t>(ds->GetRasterYSize());
   if (options.max_cells != 0 &&
       uint64_t{info.raster_width} * info.raster_height > options.max_cells) {
-    return absl::ResourceExhaustedError(absl::StrFormat(
+    return LimitExceededError(Limit::kDemCells, absl::StrFormat(
         "%s: %ux%u cells, more than the %u a DEM may have here", path, info.raster_width,
         info.raster_height, options.max_cells));
   }
@@ -272,6 +287,18 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
   if (info.grid_width < 2 || info.grid_height < 2) {
     return bad(absl::StrFormat("%ux%u cells at --dem-step %u; a DEM needs at least 2x2",
                                info.grid_width, info.grid_height, options.step));
+  }
+  const uint64_t most_vertices = uint64_t{info.grid_width} * info.grid_height;
+  const uint64_t most_faces = 2 * uint64_t{info.grid_width - 1} * (info.grid_height - 1);
+  if (options.max_vertices != 0 && most_vertices > options.max_vertices) {
+    return LimitExceededError(Limit::kVertices, absl::StrFormat(
+        "%s: %ux%u used cells can make %d vertices, more than the %d a mesh may have here", path,
+        info.grid_width, info.grid_height, most_vertices, options.max_vertices));
+  }
+  if (options.max_faces != 0 && most_faces > options.max_faces) {
+    return LimitExceededError(Limit::kFaces, absl::StrFormat(
+        "%s: %ux%u used cells can make %d faces, more than the %d a mesh may have here", path,
+        info.grid_width, info.grid_height, most_faces, options.max_faces));
   }
   double gt[6];
   if (ds->GetGeoTransform(gt) != CE_None) return bad("no geotransform (not georeferenced)");
@@ -472,6 +499,11 @@ absl::StatusOr<Dem> Dem::FromMesh(MeshData mesh, DemInfo info) {
   }
   const size_t n = mesh.vertex_count();
   if (n > size_t{W} * H) return bad("more vertices than cells");
+  // The grid maps are W x H: bounded by the mesh (a DEM up to 255 of 256 cells without data),
+  // whatever a header says.
+  if (uint64_t{W} * H > 256 * (uint64_t{n} + 1) + (uint64_t{1} << 24)) {
+    return bad("its grid is far larger than its mesh");
+  }
   // Each vertex's map position in the file's CRS.
   std::vector<double> xs(n), ys(n);
   for (size_t v = 0; v < n; ++v) {

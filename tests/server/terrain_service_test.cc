@@ -205,7 +205,19 @@ TEST_F(TerrainServiceTest, UploadsAreCheckedAndLimited) {
   StartServer(options);
   testing::UploadResult big = UploadDem(bytes_, "big");
   EXPECT_EQ(big.status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
-  EXPECT_TRUE(Contains(big.status.error_message(), "--max_dem_cells=899")) << big.status.error_message();
+  EXPECT_TRUE(Contains(big.status.error_message(), "(server flag --max_dem_cells)")) << big.status.error_message();
+  // The mesh's limits hold before any row is read too.
+  options.limits.max_dem_cells = 900;
+  options.limits.max_vertices = 899;
+  StartServer(options);
+  testing::UploadResult many = UploadDem(bytes_, "many");
+  EXPECT_EQ(many.status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_TRUE(Contains(many.status.error_message(), "(server flag --max_vertices)")) << many.status.error_message();
+  options.limits.max_vertices = 900;
+  options.limits.max_faces = 2 * 29 * 29 - 1;
+  StartServer(options);
+  testing::UploadResult faces = UploadDem(bytes_, "faces");
+  EXPECT_TRUE(Contains(faces.status.error_message(), "(server flag --max_faces)")) << faces.status.error_message();
 
   StartServer();
   // Not a GeoTIFF, a cut one, DEM options on a mesh file: INVALID_ARGUMENT naming the field.
@@ -255,6 +267,9 @@ TEST_F(TerrainServiceTest, TheMapIsStoredAndGained) {
   ASSERT_TRUE(dem.mesh.has_terrain());
   testing::FieldResult before = FieldFrom("meshes/plain", map);
   ASSERT_TRUE(before.status.ok()) << before.status.error_message();
+  // The grid it gained is counted in the budget, once.
+  EXPECT_GT(dem.mesh.memory_bytes(), plain.mesh.memory_bytes());
+  EXPECT_EQ(server_->store().used_bytes(), dem.mesh.memory_bytes());
 
   Restart();
   v1::Mesh got;
@@ -384,6 +399,16 @@ TEST_F(TerrainServiceTest, DeriveMeshByABarrier) {
   EXPECT_TRUE(Contains(all.error_message(), "covers every face")) << all.error_message();
   grpc::Status taken = derive("meshes/slot", low, "walled", &none);  // another mesh's alias
   EXPECT_EQ(BadField(taken), "display_name") << taken.error_message();
+  EXPECT_EQ(taken.error_message().rfind("display_name: \"walled\" already names mesh", 0), 0u)
+      << taken.error_message();
+  // Text that is not a GeoJSON object is never taken for a path or a URL.
+  for (const char* text : {"/etc/passwd", "https://127.0.0.1:1/x.geojson", "/vsimem/geodex-dem-0.tif"}) {
+    v1::Barrier path;
+    path.set_polygons_geojson(text);
+    grpc::Status refused = derive("meshes/slot", path, "", &none);
+    EXPECT_EQ(BadField(refused), "barrier.polygons_geojson") << text;
+    EXPECT_TRUE(Contains(refused.error_message(), "not GeoJSON (a JSON object")) << refused.error_message();
+  }
 }
 
 

@@ -36,9 +36,13 @@ struct DemOptions {
   // A barrier drawn as polygons (any vector file GDAL reads, GeoJSON first; its own CRS, WGS 84
   // when it names none): the triangles whose centre lies inside one are left out. "": none.
   std::string barrier_file;
-  // The most cells (width x height of the file) a raster may have; 0: any. What a server sets
-  // before GDAL reads untrusted bytes (ResourceExhausted above it).
+  // The most cells (width x height of the file) a raster may have, and the most vertices and
+  // faces its mesh may have (every used cell with data, two triangles per block); 0: any. What a
+  // server sets before GDAL reads untrusted bytes: checked before any row is read, a
+  // LimitExceededError (geodex/limits.h: kDemCells, kVertices, kFaces) above it.
   uint64_t max_cells = 0;
+  uint64_t max_vertices = 0;
+  uint64_t max_faces = 0;
 };
 
 // The faces of `mesh` with no corner lower than `z` (the same barrier on a mesh file: a face
