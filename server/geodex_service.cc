@@ -245,13 +245,15 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
     } else if (metadata_.has_dem()) {
       return FieldError("metadata.dem", "DEM options are for a GeoTIFF upload, and this upload is not one");
     }
-    absl::StatusOr<MeshData> data = dem != nullptr ? absl::StatusOr<MeshData>(dem->mesh())
+    // A DEM's mesh is its grid's (not copied); a mesh file's is read here.
+    absl::StatusOr<MeshData> read = dem != nullptr ? MeshData()
                                                    : ReadMeshFromBuffer(absl::string_view(bytes_),
                                                                         format_, file_name, read_limits);
-    if (!data.ok()) {
-      if (data.status().code() == absl::StatusCode::kResourceExhausted) return data.status();
-      return FieldError("chunk", data.status().message());
+    if (!read.ok()) {
+      if (read.status().code() == absl::StatusCode::kResourceExhausted) return read.status();
+      return FieldError("chunk", read.status().message());
     }
+    const MeshData* data = dem != nullptr ? &dem->mesh() : &*read;
     if (data->vertex_count() > limits.max_vertices) {
       return ServerLimitError("max_vertices", absl::StrCat("mesh has ", data->vertex_count(),
                        " vertices, over --max_vertices=", limits.max_vertices));

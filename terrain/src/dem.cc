@@ -5,7 +5,6 @@
 #include <filesystem>
 #include <functional>
 #include <limits>
-#include <atomic>
 #include <mutex>
 #include <utility>
 
@@ -14,9 +13,9 @@
 #include "absl/strings/str_format.h"
 #include "cpl_conv.h"
 #include "cpl_error.h"
-#include "cpl_vsi.h"
 #include "gdal_priv.h"
 #include "gdal_quiet.h"
+#include "mem_file.h"
 #include "geodex/limits.h"
 #include "ogr_api.h"
 #include "ogr_geometry.h"
@@ -148,20 +147,14 @@ absl::StatusOr<MeshData> RemoveFacesInPolygons(const MeshData& mesh, const std::
   if (first == std::string::npos || geojson[first] != '{') {
     return bad("not GeoJSON (a JSON object, starting with '{')");
   }
-  static std::atomic<uint64_t> serial{0};
-  const std::string path = absl::StrCat("/vsimem/geodex-barrier-", serial.fetch_add(1), ".geojson");
-  VSILFILE* file = VSIFileFromMemBuffer(
-      path.c_str(), reinterpret_cast<GByte*>(const_cast<char*>(geojson.data())), geojson.size(), FALSE);
-  if (file == nullptr) return absl::InternalError("GDAL cannot make an in-memory file");
-  VSIFCloseL(file);
+  MemFile text(".geojson", geojson);
+  if (!text.ok()) return absl::InternalError("GDAL cannot make an in-memory file");
   const char* const drivers[] = {"GeoJSON", nullptr};
   GDALDatasetUniquePtr ds(GDALDataset::FromHandle(
-      GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, drivers, nullptr, nullptr)));
+      GDALOpenEx(text.path().c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, drivers, nullptr, nullptr)));
   absl::StatusOr<std::unique_ptr<OGRGeometry>> polygons =
       ds == nullptr ? bad(absl::StrCat("not GeoJSON polygons (", QuietGdal::LastMessage(), ")"))
                     : BarrierPolygonsOf(ds.get(), name, dem != nullptr ? &file_crs : nullptr);
-  ds.reset();
-  VSIUnlink(path.c_str());
   if (!polygons.ok()) return polygons.status();
   OGRPreparedGeometryUniquePtr inside(OGRCreatePreparedGeometry(OGRGeometry::ToHandle(polygons->get())));
   if (inside == nullptr) return absl::InternalError("GDAL cannot prepare polygons (built without GEOS?)");
@@ -239,26 +232,18 @@ absl::StatusOr<Dem> Dem::ReadGeoTiffBytes(const std::string& bytes, const std::s
     return absl::InvalidArgumentError(absl::StrCat(name, ": not a GeoTIFF (no TIFF header)"));
   }
   QuietGdal quiet;
-  // An in-memory file over the caller's bytes (not copied), unique per call: uploads run in
-  // parallel on the server's pool.
-  static std::atomic<uint64_t> serial{0};
-  const std::string path = absl::StrCat("/vsimem/geodex-dem-", serial.fetch_add(1), ".tif");
-  VSILFILE* file = VSIFileFromMemBuffer(
-      path.c_str(), reinterpret_cast<GByte*>(const_cast<char*>(bytes.data())), bytes.size(), FALSE);
-  if (file == nullptr) return absl::InternalError("GDAL cannot make an in-memory file");
-  VSIFCloseL(file);
+  MemFile tiff(".tif", bytes);
+  if (!tiff.ok()) return absl::InternalError("GDAL cannot make an in-memory file");
   // Only the GTiff driver parses untrusted bytes, and it looks for no side-car files.
   const char* const drivers[] = {"GTiff", nullptr};
   const char* const open_options[] = {nullptr};
-  GDALDatasetUniquePtr ds(GDALDataset::FromHandle(
-      GDALOpenEx(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, drivers, open_options, nullptr)));
-  absl::StatusOr<Dem> dem =
-      ds == nullptr ? absl::InvalidArgumentError(absl::StrCat(
-                          name, ": not a GeoTIFF GDAL reads (", QuietGdal::LastMessage(), ")"))
-                    : ReadDataset(*ds, name, options);
-  ds.reset();
-  VSIUnlink(path.c_str());
-  return dem;
+  GDALDatasetUniquePtr ds(GDALDataset::FromHandle(GDALOpenEx(
+      tiff.path().c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, drivers, open_options, nullptr)));
+  if (ds == nullptr) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(name, ": not a GeoTIFF GDAL reads (", QuietGdal::LastMessage(), ")"));
+  }
+  return ReadDataset(*ds, name, options);
 }
 
 absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& path,
@@ -730,18 +715,13 @@ absl::Status Dem::WriteIndexRaster(const std::string& path, const std::vector<ui
 
 
 namespace {
-// An in-memory GeoTIFF's bytes, the file removed.
+// What `write` writes to an in-memory GeoTIFF, as bytes.
 absl::StatusOr<std::string> RasterBytes(const std::function<absl::Status(const std::string&)>& write) {
-  static std::atomic<uint64_t> serial{0};
-  const std::string path = absl::StrCat("/vsimem/geodex-raster-", serial.fetch_add(1), ".tif");
-  absl::Status written = write(path);
-  vsi_l_offset length = 0;
-  GByte* data = VSIGetMemFileBuffer(path.c_str(), &length, TRUE);
-  std::string out = data != nullptr ? std::string(reinterpret_cast<const char*>(data), length) : "";
-  CPLFree(data);
-  VSIUnlink(path.c_str());
-  if (!written.ok()) return absl::InternalError(written.message());
-  return out;
+  MemFile tiff(".tif");
+  if (absl::Status written = write(tiff.path()); !written.ok()) {
+    return absl::InternalError(written.message());
+  }
+  return tiff.Take();
 }
 }  // namespace
 

@@ -1,7 +1,6 @@
 #include "geodex/geojson.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -9,9 +8,9 @@
 
 #include "absl/strings/str_cat.h"
 #include "cpl_error.h"
-#include "cpl_vsi.h"
 #include "gdal_priv.h"
 #include "gdal_quiet.h"
+#include "mem_file.h"
 #include "ogr_geometry.h"
 #include "ogrsf_frmts.h"
 
@@ -243,28 +242,13 @@ absl::Status WriteGeoJson(const DemInfo& dem, const std::vector<GeoFeature>& fea
 }
 
 
-// An in-memory file's bytes, taken and the file removed; "" when there is none.
-std::string TakeMemFile(const std::string& path) {
-  vsi_l_offset length = 0;
-  GByte* data = VSIGetMemFileBuffer(path.c_str(), &length, TRUE);
-  std::string out = data != nullptr ? std::string(reinterpret_cast<const char*>(data), length) : "";
-  CPLFree(data);
-  VSIUnlink(path.c_str());
-  return out;
-}
-
-std::string MemPath(const char* extension) {
-  static std::atomic<uint64_t> serial{0};
-  return absl::StrCat("/vsimem/geodex-out-", serial.fetch_add(1), extension);
-}
-
 absl::StatusOr<std::string> GeoJsonText(const DemInfo& dem, const std::vector<GeoFeature>& features,
                                         bool native_crs) {
-  const std::string path = MemPath(".geojson");
-  absl::Status written = WriteGeoJson(dem, features, path, native_crs);
-  std::string text = TakeMemFile(path);
-  if (!written.ok()) return absl::InternalError(written.message());
-  return text;
+  MemFile file(".geojson");
+  if (absl::Status written = WriteGeoJson(dem, features, file.path(), native_crs); !written.ok()) {
+    return absl::InternalError(written.message());
+  }
+  return file.Take();
 }
 
 std::vector<GeoFeature> IsochroneFeatures(const MeshData& mesh, const std::vector<double>& distance,

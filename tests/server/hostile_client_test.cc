@@ -60,21 +60,8 @@ google::rpc::ErrorInfo Info(const grpc::Status& status) {
   return info;
 }
 
-std::string BadField(const grpc::Status& status) {
-  google::rpc::Status details;
-  google::rpc::BadRequest bad;
-  EXPECT_TRUE(details.ParseFromString(status.error_details())) << status.error_message();
-  for (const auto& any : details.details()) {
-    if (any.UnpackTo(&bad) && bad.field_violations_size() > 0) {
-      return bad.field_violations(0).field();
-    }
-  }
-  return "";
-}
-
-bool Contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
+using testing::BadField;
+using testing::Contains;
 
 class HostileClientTest : public testing::ServerFixture {
  protected:

@@ -21,6 +21,8 @@
 #include "grpcpp/generic/generic_stub.h"
 #include "grpcpp/support/byte_buffer.h"
 #include "grpcpp/security/credentials.h"
+#include "google/rpc/error_details.pb.h"
+#include "google/rpc/status.pb.h"
 #include "gtest/gtest.h"
 
 namespace geodex::server::testing {
@@ -205,6 +207,23 @@ inline RawResult RawCall(const std::shared_ptr<grpc::Channel>& channel, const st
 }
 
 // An in-process server on 127.0.0.1:0 and a stub with default client limits.
+// The field a google.rpc.BadRequest in the status's details names ("" when there is none).
+inline std::string BadField(const grpc::Status& status) {
+  google::rpc::Status details;
+  google::rpc::BadRequest bad;
+  EXPECT_TRUE(details.ParseFromString(status.error_details())) << status.error_message();
+  for (const auto& any : details.details()) {
+    if (any.UnpackTo(&bad) && bad.field_violations_size() > 0) {
+      return bad.field_violations(0).field();
+    }
+  }
+  return "";
+}
+
+inline bool Contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
 class ServerFixture : public ::testing::Test {
  protected:
   void StartServer(ServerOptions options = {}) {

@@ -20,8 +20,6 @@
 #include "geodex/mesh_id.h"
 #include "geodex/mesh_io.h"
 #include "geodex/terrain.h"
-#include "google/rpc/error_details.pb.h"
-#include "google/rpc/status.pb.h"
 #include "gtest/gtest.h"
 #include "ogr_spatialref.h"
 #include "server_test_util.h"
@@ -31,19 +29,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string BadField(const grpc::Status& status) {
-  google::rpc::Status details;
-  google::rpc::BadRequest bad;
-  EXPECT_TRUE(details.ParseFromString(status.error_details())) << status.error_message();
-  for (const auto& any : details.details()) {
-    if (any.UnpackTo(&bad) && bad.field_violations_size() > 0) return bad.field_violations(0).field();
-  }
-  return "";
-}
-
-bool Contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
+using testing::BadField;
+using testing::Contains;
 
 class TerrainServiceTest : public testing::ServerFixture {
  protected:
