@@ -260,6 +260,86 @@ int OpenMesh(Backend& backend, const Args& args, const std::string& mesh,
   }
 }
 
+namespace {
+
+std::string FormatInfo(const InfoValues& v, bool json) {
+  const MeshReport& r = v.report;
+  const std::vector<std::pair<std::string, std::string>> rows = {
+      {"vertices", absl::StrFormat("%d", r.file_vertices)},
+      {"faces", absl::StrFormat("%d", r.file_faces)},
+      {"boundary_edges", absl::StrFormat("%d", r.boundary_edges)},
+      {"boundary_loops", absl::StrFormat("%d", r.boundary_loops)},
+      {"components", absl::StrFormat("%d", r.components)},
+      {"vertex_connected_components", absl::StrFormat("%d", r.vertex_connected_components)},
+      {"isolated_vertices", absl::StrFormat("%d", r.isolated_vertices)},
+      {"non_manifold_edges", absl::StrFormat("%d", r.non_manifold_edges)},
+      {"non_manifold_vertices", absl::StrFormat("%d", r.non_manifold_vertices)},
+      {"degenerate_faces", absl::StrFormat("%d", r.degenerate_faces)},
+      {"flipped_faces", absl::StrFormat("%d", r.flipped_faces)},
+      {"orientation_cuts", absl::StrFormat("%d", r.orientation_cuts)},
+      {"saddle_vertices", absl::StrFormat("%d", r.saddle_vertices)},
+      {"boundary_vertices", absl::StrFormat("%d", r.boundary_vertices)},
+      {"internal_vertices", absl::StrFormat("%d", v.internal_vertices)},
+      {"mean_edge_length", absl::StrFormat("%.17g", v.mean_edge_length)},
+      {"max_edge_length", absl::StrFormat("%.17g", v.max_edge_length)},
+      {"bbox_min", absl::StrFormat("%.17g %.17g %.17g", v.bbox_min[0], v.bbox_min[1], v.bbox_min[2])},
+      {"bbox_max", absl::StrFormat("%.17g %.17g %.17g", v.bbox_max[0], v.bbox_max[1], v.bbox_max[2])},
+      {"bytes", absl::StrFormat("%d", v.bytes)},
+      {"load_ms", absl::StrFormat("%.3f", v.load_ms)},
+      {"build_ms", absl::StrFormat("%.3f", v.build_ms)},
+  };
+  // A DEM's map (strings are quoted in JSON).
+  std::vector<std::pair<std::string, std::string>> dem_rows;
+  if (v.dem != nullptr) {
+    const terrain::DemInfo& d = *v.dem;
+    dem_rows = {
+        {"barrier_cells", absl::StrFormat("%d", d.barrier_cells)},
+        {"barrier_faces", absl::StrFormat("%d", d.barrier_faces)},
+        {"crs", d.file_crs_name},
+        {"mesh_crs", d.mesh_crs_name},
+        {"units", "m"},
+        {"raster", absl::StrFormat("%d %d", d.raster_width, d.raster_height)},
+        {"dem_step", absl::StrFormat("%d", d.step)},
+        {"grid", absl::StrFormat("%d %d", d.grid_width, d.grid_height)},
+        {"nodata_cells", absl::StrFormat("%d", d.nodata_cells)},
+        {"vertical_unit", d.vertical_unit.empty() ? "m (assumed)" : d.vertical_unit},
+        {"driver", d.driver},
+    };
+  }
+  std::string out;
+  if (!json) {
+    for (const auto& [k, value] : rows) absl::StrAppend(&out, k, ": ", value, "\n");
+    for (const auto& [k, value] : dem_rows) absl::StrAppend(&out, k, ": ", value, "\n");
+    return out;
+  }
+  out = "{";
+  for (size_t i = 0; i < rows.size(); ++i) {
+    // A bounding-box corner is an array of three numbers in JSON.
+    const bool triple = rows[i].first.rfind("bbox_", 0) == 0;
+    out += absl::StrFormat("%s\"%s\": %s%s%s", i ? ", " : "", rows[i].first, triple ? "[" : "",
+                           triple ? absl::StrJoin(absl::StrSplit(rows[i].second, ' '), ", ")
+                                  : rows[i].second,
+                           triple ? "]" : "");
+  }
+  for (const auto& [k, value] : dem_rows) {
+    const bool pair = k == "raster" || k == "grid";
+    const bool number =
+        k == "dem_step" || k == "nodata_cells" || k == "barrier_cells" || k == "barrier_faces";
+    out += absl::StrFormat(", \"%s\": %s", k,
+                           pair     ? absl::StrCat("[", absl::StrJoin(absl::StrSplit(value, ' '), ", "), "]")
+                           : number ? value
+                                    : JsonString(value));
+  }
+  return out + "}\n";
+}
+
+// geodex info: its entry of `geodex --help`.
+constexpr char kInfoHelp[] = R"(  info MESH [--format text|json] [--strict]
+      One 'key: value' line per property (vertices, faces, boundary_loops, components,
+      isolated_vertices, non_manifold_edges, non_manifold_vertices, degenerate_faces,
+      saddle_vertices, bytes, ...). Reports on any readable mesh, valid or messy.
+)";
+
 int RunInfo(Backend& backend, const Args& args) {
   std::string error;
   if (!CheckKnown(args, {"format", "strict"}, &error) || !backend.Supports(args, &error)) {
@@ -307,7 +387,6 @@ bool GetSolverFlags(const Args& args, GeodesicOptions* options, std::string* err
   return true;
 }
 
-namespace {
 
 // --stats members for the farthest snap of a p:X:Y:Z point (none without positions).
 std::string SnapJson(const SnapReport& snap) {
@@ -338,7 +417,75 @@ std::string StatsJson(const Backend& backend, const std::string& leading, const 
       trailing, s.solve_ms);
 }
 
-}  // namespace
+
+std::string FormatDistances(const std::vector<double>& distances,
+                            const std::vector<std::array<double, 3>>& directions) {
+  std::string text;
+  text.reserve(distances.size() * (directions.empty() ? 24 : 96));
+  char buf[160];
+  for (size_t i = 0; i < distances.size(); ++i) {
+    const int n = directions.empty()
+                      ? std::snprintf(buf, sizeof(buf), "%.17g\n", distances[i])
+                      : std::snprintf(buf, sizeof(buf), "%.17g\t%.17g %.17g %.17g\n", distances[i],
+                                      directions[i][0], directions[i][1], directions[i][2]);
+    text.append(buf, n);
+  }
+  return text;
+}
+
+std::string FormatAtLine(const SurfacePoint& point, double estimate, double exact,
+                         uint32_t source) {
+  return absl::StrFormat("%s\testimate %.17g\texact %.17g\tsource %d\n", SurfacePointToString(point),
+                         estimate, exact,
+                         static_cast<int64_t>(source == kNoIndex ? -1 : int64_t{source}));
+}
+
+std::string FormatDistancesJson(const std::vector<double>& distances,
+                                const std::vector<std::array<double, 3>>& directions) {
+  std::string text = "{\"distances\": [";
+  text.reserve(distances.size() * (directions.empty() ? 24 : 96));
+  for (size_t i = 0; i < distances.size(); ++i) {
+    if (i) text += ", ";
+    text += JsonNumber(distances[i]);
+  }
+  if (!directions.empty()) {
+    text += "], \"directions\": [";
+    for (size_t i = 0; i < directions.size(); ++i) {
+      if (i) text += ", ";
+      text += std::isnan(directions[i][0]) ? "null" : JsonXyz(directions[i]);
+    }
+  }
+  return text + "]}\n";
+}
+
+std::string FormatAtJson(const std::vector<SurfacePoint>& points, const std::vector<double>& estimate,
+                         const std::vector<double>& exact, const std::vector<int64_t>& source) {
+  std::string text = "{\"points\": [";
+  for (size_t i = 0; i < points.size(); ++i) {
+    text += absl::StrFormat(
+        "%s{\"point\": \"%s\", \"estimate\": %s, \"exact\": %s, \"source\": %s}",
+        i ? ", " : "", SurfacePointToString(points[i]), JsonNumber(estimate[i]),
+        JsonNumber(exact[i]), source[i] < 0 ? "null" : absl::StrCat(source[i]));
+  }
+  return text + "]}\n";
+}
+
+// geodex distances: its entry of `geodex --help`.
+constexpr char kDistancesHelp[] = R"(  distances MESH --sources SPEC [--method exact|ich|dijkstra] [--lambda L] [--lambda-scale max|mean]
+                 [--max-distance D] [--max-windows N] [--stats] [--output FILE] [--format json]
+                 [--directions] [--labels-output FILE.tif]
+      One distance per vertex in the file's vertex order (%.17g; 'inf' if unreachable).
+      On a DEM, --output FILE.tif writes a float32 GeoTIFF aligned with the DEM's grid (same
+      geotransform and CRS; nodata -1 where unreachable or no data) and --labels-output
+      FILE.tif the nearest source's index (int32, nodata -1).
+      --stats prints one JSON object with counters and times (*_ms) on stderr.
+      --no-filter / --no-one-split switch off Lemma 2 / Lemma 1 (slower; same answer).
+      --at SPEC: instead, one line per surface point: its unfolding estimate (paper section 4)
+      and its exact distance ('POINT<TAB>estimate D<TAB>exact D<TAB>source I').
+      --directions: also the geodesic direction field, 'D<TAB>X Y Z' per vertex: the unit
+      tangent of the vertex's shortest path towards its nearest source (0 0 0 at a source,
+      nan where unreachable), what a vector-field planner follows.
+)";
 
 int RunDistances(Backend& backend, const Args& args) {
   std::string error;
@@ -476,6 +623,47 @@ int RunDistances(Backend& backend, const Args& args) {
   return kExitOk;
 }
 
+std::string SimplexText(const SurfacePoint& p) {
+  switch (p.kind) {
+    case SurfacePoint::Kind::kVertex:
+      return absl::StrFormat("v %d", p.vertex);
+    case SurfacePoint::Kind::kEdge:
+      return absl::StrFormat("e %d %d %.17g", p.edge_from, p.edge_to, p.t);
+    case SurfacePoint::Kind::kFace:
+      return absl::StrFormat("f %d %.17g %.17g %.17g", p.face, p.bary[0], p.bary[1], p.bary[2]);
+    case SurfacePoint::Kind::kPosition:
+      break;
+  }
+  return "?";
+}
+
+std::string FormatPath(const PathQueryResult& result) {
+  std::string text = absl::StrFormat("%.17g\n", result.distance);
+  for (const PathPoint& p : result.path.points) {
+    text += absl::StrFormat("%.17g %.17g %.17g %s\n", p.position[0], p.position[1], p.position[2],
+                            SimplexText(p.where));
+  }
+  return text;
+}
+
+std::string FormatPathJson(const PathQueryResult& result) {
+  std::string text = "{\"length\": " + JsonNumber(result.distance) + ", \"points\": [";
+  for (size_t i = 0; i < result.path.points.size(); ++i) {
+    text += (i ? ", " : "") + PathPointJson(result.path.points[i]);
+  }
+  return text + "]}\n";
+}
+
+// geodex path: its entry of `geodex --help`.
+constexpr char kPathHelp[] = R"(  path MESH --from SPEC --to SPEC [--method astar|full] [--stats] [--lambda L]
+       [--max-distance D] [--format json]
+      The exact shortest path: line 1 its length; then one line per polyline point,
+      'x y z' and the simplex it lies on ('v ID', 'e V1 V2 T' or 'f FACE B0 B1 B2').
+      astar (default) uses the paper's section 5 heuristic and stops at the target.
+      --lambda L (as for distances) trades exactness for speed; --max-distance D: a target
+      farther than D is unreachable.
+)";
+
 int RunPath(Backend& backend, const Args& args) {
   std::string error;
   bool json = false;
@@ -523,6 +711,39 @@ int RunPath(Backend& backend, const Args& args) {
   }
   return kExitOk;
 }
+
+std::string FormatMatrix(const DistanceMatrix& m) {
+  std::string text;
+  for (size_t i = 0; i < m.rows; ++i) {
+    for (size_t j = 0; j < m.cols; ++j) {
+      text += absl::StrFormat(j ? "\t%.17g" : "%.17g", m.values[i * m.cols + j]);
+    }
+    text += "\n";
+  }
+  return text;
+}
+
+std::string FormatMatrixJson(const DistanceMatrix& m) {
+  std::string text = absl::StrFormat("{\"rows\": %d, \"cols\": %d, \"values\": [", m.rows, m.cols);
+  for (size_t i = 0; i < m.rows; ++i) {
+    text += i ? ", [" : "[";
+    for (size_t j = 0; j < m.cols; ++j) {
+      text += (j ? ", " : "") + JsonNumber(m.values[i * m.cols + j]);
+    }
+    text += "]";
+  }
+  return text + "]}\n";
+}
+
+// geodex matrix: its entry of `geodex --help`.
+constexpr char kMatrixHelp[] = R"(  matrix MESH --sources SPEC --targets SPEC [--stats] [--lambda L] [--max-distance D]
+         [--k-nearest K] [--threads N] [--format json]
+      Exact distances, one row per source, tab-separated. Rows run in parallel on every usable
+      core (--threads N to limit). The same points as sources and targets give a symmetric
+      matrix, each pair solved once. --max-distance D: entries beyond D are inf. --k-nearest K:
+      per source only its K nearest targets are filled in, the rest inf. A progress bar shows
+      on a terminal for calls longer than a second.
+)";
 
 int RunMatrix(Backend& backend, const Args& args) {
   std::string error;
@@ -574,6 +795,12 @@ int RunMatrix(Backend& backend, const Args& args) {
   return kExitOk;
 }
 
+// geodex locate: its entry of `geodex --help`.
+constexpr char kLocateHelp[] = R"(  locate MESH --points p:X:Y:Z,... [--max-snap D] [--format text|json]
+      The nearest surface point to each 3D position: 'QUERY<TAB>SPEC<TAB>x y z<TAB>snap D', D
+      the distance it moved. --max-snap D refuses a position farther than D from the surface.
+)";
+
 int RunLocate(Backend& backend, const Args& args) {
   std::string error;
   bool json = false;
@@ -621,6 +848,23 @@ int RunLocate(Backend& backend, const Args& args) {
   if (json) text += "]}\n";
   std::fwrite(text.data(), 1, text.size(), stdout);
   return kExitOk;
+}
+
+}  // namespace
+
+const std::vector<Command>& QueryCommands() {
+  static const std::vector<Command>* commands = new std::vector<Command>{
+      {"info", kInfoHelp, {"strict"}, RunInfo},
+      {"distances", kDistancesHelp, {"stats", "no-filter", "no-one-split", "directions"}, RunDistances},
+      {"path", kPathHelp, {"stats"}, RunPath},
+      {"matrix", kMatrixHelp, {"stats"}, RunMatrix},
+      {"locate", kLocateHelp, {}, RunLocate},
+      IsolinesCommand(),
+      VoronoiCommand(),
+      DelaunayCommand(),
+      RenderCommand(),
+  };
+  return *commands;
 }
 
 }  // namespace geodex::cli

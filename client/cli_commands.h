@@ -1,7 +1,8 @@
 #pragma once
 
 // The geodex command line: argument parsing and the query commands (info, distances, path,
-// matrix), each written once against a Backend (local or remote).
+// matrix, locate here; isolines, voronoi, delaunay, render in cli_geometry.cc and cli_render.cc),
+// each written once against a Backend (local or remote), with its help and formats beside it.
 
 #include <map>
 #include <string>
@@ -29,10 +30,21 @@ bool ParseArgs(int argc, char** argv, int first, const std::vector<std::string>&
 
 class Backend;  // cli_backend.h: where the command runs (this process or a geodexd)
 
-int RunInfo(Backend& backend, const Args& args);
-int RunDistances(Backend& backend, const Args& args);
-int RunPath(Backend& backend, const Args& args);
-int RunMatrix(Backend& backend, const Args& args);
-int RunLocate(Backend& backend, const Args& args);
+// A query command, described next to its code: main dispatches on `name`, parses with its
+// value-less `flags`, and prints `help` (its entry of `geodex --help`, from "  NAME MESH ..." to
+// the end of its description) for `geodex NAME --help`.
+struct Command {
+  const char* name;
+  const char* help;
+  std::vector<std::string> flags;  // options that take no value (--stats, --directions, ...)
+  int (*run)(Backend& backend, const Args& args);
+};
+// Every query command, in the order `geodex --help` lists them (cli_commands.cc).
+const std::vector<Command>& QueryCommands();
+// The commands of the other files, listed by QueryCommands.
+const Command& IsolinesCommand();   // cli_geometry.cc
+const Command& VoronoiCommand();    // cli_geometry.cc
+const Command& DelaunayCommand();   // cli_geometry.cc
+const Command& RenderCommand();     // cli_render.cc
 
 }  // namespace geodex::cli

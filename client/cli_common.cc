@@ -24,7 +24,9 @@
 namespace geodex::cli {
 namespace {
 Progress* g_active_progress = nullptr;  // the one main shows, for Fail()
-// A JSON string literal (RFC 8259 escapes).
+
+}  // namespace
+
 std::string JsonString(const std::string& s) {
   std::string out = "\"";
   for (unsigned char c : s) {
@@ -39,8 +41,6 @@ std::string JsonString(const std::string& s) {
   }
   return out + "\"";
 }
-
-}  // namespace
 
 double MsSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
@@ -201,136 +201,6 @@ void RowProgress::Update(size_t done, size_t total) {
   std::fflush(stderr);
 }
 
-std::string FormatInfo(const InfoValues& v, bool json) {
-  const MeshReport& r = v.report;
-  const std::vector<std::pair<std::string, std::string>> rows = {
-      {"vertices", absl::StrFormat("%d", r.file_vertices)},
-      {"faces", absl::StrFormat("%d", r.file_faces)},
-      {"boundary_edges", absl::StrFormat("%d", r.boundary_edges)},
-      {"boundary_loops", absl::StrFormat("%d", r.boundary_loops)},
-      {"components", absl::StrFormat("%d", r.components)},
-      {"vertex_connected_components", absl::StrFormat("%d", r.vertex_connected_components)},
-      {"isolated_vertices", absl::StrFormat("%d", r.isolated_vertices)},
-      {"non_manifold_edges", absl::StrFormat("%d", r.non_manifold_edges)},
-      {"non_manifold_vertices", absl::StrFormat("%d", r.non_manifold_vertices)},
-      {"degenerate_faces", absl::StrFormat("%d", r.degenerate_faces)},
-      {"flipped_faces", absl::StrFormat("%d", r.flipped_faces)},
-      {"orientation_cuts", absl::StrFormat("%d", r.orientation_cuts)},
-      {"saddle_vertices", absl::StrFormat("%d", r.saddle_vertices)},
-      {"boundary_vertices", absl::StrFormat("%d", r.boundary_vertices)},
-      {"internal_vertices", absl::StrFormat("%d", v.internal_vertices)},
-      {"mean_edge_length", absl::StrFormat("%.17g", v.mean_edge_length)},
-      {"max_edge_length", absl::StrFormat("%.17g", v.max_edge_length)},
-      {"bbox_min", absl::StrFormat("%.17g %.17g %.17g", v.bbox_min[0], v.bbox_min[1], v.bbox_min[2])},
-      {"bbox_max", absl::StrFormat("%.17g %.17g %.17g", v.bbox_max[0], v.bbox_max[1], v.bbox_max[2])},
-      {"bytes", absl::StrFormat("%d", v.bytes)},
-      {"load_ms", absl::StrFormat("%.3f", v.load_ms)},
-      {"build_ms", absl::StrFormat("%.3f", v.build_ms)},
-  };
-  // A DEM's map (strings are quoted in JSON).
-  std::vector<std::pair<std::string, std::string>> dem_rows;
-  if (v.dem != nullptr) {
-    const terrain::DemInfo& d = *v.dem;
-    dem_rows = {
-        {"barrier_cells", absl::StrFormat("%d", d.barrier_cells)},
-        {"barrier_faces", absl::StrFormat("%d", d.barrier_faces)},
-        {"crs", d.file_crs_name},
-        {"mesh_crs", d.mesh_crs_name},
-        {"units", "m"},
-        {"raster", absl::StrFormat("%d %d", d.raster_width, d.raster_height)},
-        {"dem_step", absl::StrFormat("%d", d.step)},
-        {"grid", absl::StrFormat("%d %d", d.grid_width, d.grid_height)},
-        {"nodata_cells", absl::StrFormat("%d", d.nodata_cells)},
-        {"vertical_unit", d.vertical_unit.empty() ? "m (assumed)" : d.vertical_unit},
-        {"driver", d.driver},
-    };
-  }
-  std::string out;
-  if (!json) {
-    for (const auto& [k, value] : rows) absl::StrAppend(&out, k, ": ", value, "\n");
-    for (const auto& [k, value] : dem_rows) absl::StrAppend(&out, k, ": ", value, "\n");
-    return out;
-  }
-  out = "{";
-  for (size_t i = 0; i < rows.size(); ++i) {
-    // A bounding-box corner is an array of three numbers in JSON.
-    const bool triple = rows[i].first.rfind("bbox_", 0) == 0;
-    out += absl::StrFormat("%s\"%s\": %s%s%s", i ? ", " : "", rows[i].first, triple ? "[" : "",
-                           triple ? absl::StrJoin(absl::StrSplit(rows[i].second, ' '), ", ")
-                                  : rows[i].second,
-                           triple ? "]" : "");
-  }
-  for (const auto& [k, value] : dem_rows) {
-    const bool pair = k == "raster" || k == "grid";
-    const bool number =
-        k == "dem_step" || k == "nodata_cells" || k == "barrier_cells" || k == "barrier_faces";
-    out += absl::StrFormat(", \"%s\": %s", k,
-                           pair     ? absl::StrCat("[", absl::StrJoin(absl::StrSplit(value, ' '), ", "), "]")
-                           : number ? value
-                                    : JsonString(value));
-  }
-  return out + "}\n";
-}
-
-std::string FormatDistances(const std::vector<double>& distances,
-                            const std::vector<std::array<double, 3>>& directions) {
-  std::string text;
-  text.reserve(distances.size() * (directions.empty() ? 24 : 96));
-  char buf[160];
-  for (size_t i = 0; i < distances.size(); ++i) {
-    const int n = directions.empty()
-                      ? std::snprintf(buf, sizeof(buf), "%.17g\n", distances[i])
-                      : std::snprintf(buf, sizeof(buf), "%.17g\t%.17g %.17g %.17g\n", distances[i],
-                                      directions[i][0], directions[i][1], directions[i][2]);
-    text.append(buf, n);
-  }
-  return text;
-}
-
-std::string FormatAtLine(const SurfacePoint& point, double estimate, double exact,
-                         uint32_t source) {
-  return absl::StrFormat("%s\testimate %.17g\texact %.17g\tsource %d\n", SurfacePointToString(point),
-                         estimate, exact,
-                         static_cast<int64_t>(source == kNoIndex ? -1 : int64_t{source}));
-}
-
-namespace {
-
-std::string SimplexText(const SurfacePoint& p) {
-  switch (p.kind) {
-    case SurfacePoint::Kind::kVertex:
-      return absl::StrFormat("v %d", p.vertex);
-    case SurfacePoint::Kind::kEdge:
-      return absl::StrFormat("e %d %d %.17g", p.edge_from, p.edge_to, p.t);
-    case SurfacePoint::Kind::kFace:
-      return absl::StrFormat("f %d %.17g %.17g %.17g", p.face, p.bary[0], p.bary[1], p.bary[2]);
-    case SurfacePoint::Kind::kPosition:
-      break;
-  }
-  return "?";
-}
-
-}  // namespace
-
-std::string FormatPath(const PathQueryResult& result) {
-  std::string text = absl::StrFormat("%.17g\n", result.distance);
-  for (const PathPoint& p : result.path.points) {
-    text += absl::StrFormat("%.17g %.17g %.17g %s\n", p.position[0], p.position[1], p.position[2],
-                            SimplexText(p.where));
-  }
-  return text;
-}
-
-std::string FormatMatrix(const DistanceMatrix& m) {
-  std::string text;
-  for (size_t i = 0; i < m.rows; ++i) {
-    for (size_t j = 0; j < m.cols; ++j) {
-      text += absl::StrFormat(j ? "\t%.17g" : "%.17g", m.values[i * m.cols + j]);
-    }
-    text += "\n";
-  }
-  return text;
-}
 
 std::string JsonNumber(double x) {
   return std::isfinite(x) ? absl::StrFormat("%.17g", x) : "null";
@@ -357,55 +227,6 @@ std::string PathPointJson(const PathPoint& p) {
   return s + "\"position\": true}";
 }
 
-std::string FormatDistancesJson(const std::vector<double>& distances,
-                                const std::vector<std::array<double, 3>>& directions) {
-  std::string text = "{\"distances\": [";
-  text.reserve(distances.size() * (directions.empty() ? 24 : 96));
-  for (size_t i = 0; i < distances.size(); ++i) {
-    if (i) text += ", ";
-    text += JsonNumber(distances[i]);
-  }
-  if (!directions.empty()) {
-    text += "], \"directions\": [";
-    for (size_t i = 0; i < directions.size(); ++i) {
-      if (i) text += ", ";
-      text += std::isnan(directions[i][0]) ? "null" : JsonXyz(directions[i]);
-    }
-  }
-  return text + "]}\n";
-}
-
-std::string FormatAtJson(const std::vector<SurfacePoint>& points, const std::vector<double>& estimate,
-                         const std::vector<double>& exact, const std::vector<int64_t>& source) {
-  std::string text = "{\"points\": [";
-  for (size_t i = 0; i < points.size(); ++i) {
-    text += absl::StrFormat(
-        "%s{\"point\": \"%s\", \"estimate\": %s, \"exact\": %s, \"source\": %s}",
-        i ? ", " : "", SurfacePointToString(points[i]), JsonNumber(estimate[i]),
-        JsonNumber(exact[i]), source[i] < 0 ? "null" : absl::StrCat(source[i]));
-  }
-  return text + "]}\n";
-}
-
-std::string FormatPathJson(const PathQueryResult& result) {
-  std::string text = "{\"length\": " + JsonNumber(result.distance) + ", \"points\": [";
-  for (size_t i = 0; i < result.path.points.size(); ++i) {
-    text += (i ? ", " : "") + PathPointJson(result.path.points[i]);
-  }
-  return text + "]}\n";
-}
-
-std::string FormatMatrixJson(const DistanceMatrix& m) {
-  std::string text = absl::StrFormat("{\"rows\": %d, \"cols\": %d, \"values\": [", m.rows, m.cols);
-  for (size_t i = 0; i < m.rows; ++i) {
-    text += i ? ", [" : "[";
-    for (size_t j = 0; j < m.cols; ++j) {
-      text += (j ? ", " : "") + JsonNumber(m.values[i * m.cols + j]);
-    }
-    text += "]";
-  }
-  return text + "]}\n";
-}
 
 bool GetFormat(const Args& args, bool* json, std::string* error) {
   const std::string format = args.options.count("format") ? args.options.at("format") : "text";

@@ -99,32 +99,13 @@ struct InfoValues : MeshSummary {
   double load_ms = 0, build_ms = 0;
   const terrain::DemInfo* dem = nullptr;  // a DEM's map: its CRS, grid, nodata and units
 };
-std::string FormatInfo(const InfoValues& v, bool json);
-// One distance per line, %.17g ("inf" if unreachable); with `directions` (one per vertex),
-// "D<TAB>X Y Z" ("nan nan nan" where undefined).
-std::string FormatDistances(const std::vector<double>& distances,
-                            const std::vector<std::array<double, 3>>& directions = {});
-// "POINT<TAB>estimate D<TAB>exact D<TAB>source I" (I = -1 when unreachable).
-std::string FormatAtLine(const SurfacePoint& point, double estimate, double exact, uint32_t source);
-// Line 1 the length, then "x y z SIMPLEX" per point.
-std::string FormatPath(const PathQueryResult& result);
-// One tab-separated row per source.
-std::string FormatMatrix(const DistanceMatrix& matrix);
-// --- JSON (--format json): %.17g numbers, null for an unreachable (infinite) distance ---
+// --- JSON (--format json): %.17g numbers, null for an unreachable (infinite) distance. Each
+// command's own text and JSON formats are next to the command (cli_commands.cc). ---
 std::string JsonNumber(double x);
+std::string JsonString(const std::string& s);  // a string literal, RFC 8259 escapes
 std::string JsonXyz(const std::array<double, 3>& p);
 // {"p": [x, y, z], "v": id} / "e": [from, to, t] / "f": [face, b0, b1, b2]
 std::string PathPointJson(const PathPoint& p);
-// {"distances": [...]}, and "directions": [[x, y, z] | null, ...] when given
-std::string FormatDistancesJson(const std::vector<double>& distances,
-                                const std::vector<std::array<double, 3>>& directions = {});
-// {"points": [{"point": SPEC, "estimate": e, "exact": d, "source": i}, ...]}
-std::string FormatAtJson(const std::vector<SurfacePoint>& points, const std::vector<double>& estimate,
-                         const std::vector<double>& exact, const std::vector<int64_t>& source);
-// {"length": L, "points": [PathPointJson, ...]}
-std::string FormatPathJson(const PathQueryResult& result);
-// {"rows": R, "cols": C, "values": [[...], ...]}
-std::string FormatMatrixJson(const DistanceMatrix& matrix);
 // --format text|json (absent: text). False with *error naming the flag.
 bool GetFormat(const Args& args, bool* json, std::string* error);
 

@@ -2,7 +2,6 @@
 // geometry (paper section 6) and write it as JSON (default, stdout), OBJ lines or an SVG top view.
 // With a server the geometry is computed there and written here exactly the same way.
 
-#include "cli_geometry.h"
 
 #include "cli_common.h"
 #include "cli_backend.h"
@@ -230,7 +229,11 @@ int Usage(const std::string& command, const std::string& key, const std::string&
                                           command, key, extra));
 }
 
-}  // namespace
+// geodex isolines: its entry of `geodex --help`.
+constexpr char kIsolinesHelp[] = R"(  isolines MESH --sources SPEC (--levels L1,L2,... | --count K) [--output FILE.json|.obj|.svg]
+      Approximate geodesic offsets (paper section 6.1; linear along edges): polylines of edge
+      points per level. --count K: the levels D*j/K, j = 1..K-1, D the largest distance.
+)";
 
 int RunIsolines(Backend& backend, const Args& args) {
   std::string error;
@@ -286,6 +289,12 @@ int RunIsolines(Backend& backend, const Args& args) {
   if (format == Format::kSvg) return WriteOutput(args, Svg("isolines", *s.data, lines, SitePositions(s)));
   return WriteOutput(args, json);
 }
+
+// geodex voronoi: its entry of `geodex --help`.
+constexpr char kVoronoiHelp[] = R"(  voronoi MESH --sites SPEC [--output FILE.json|.obj|.svg]
+      Approximate Voronoi diagram (section 6.2): boundaries, cells (faces, fragments, areas),
+      adjacency.
+)";
 
 int RunVoronoi(Backend& backend, const Args& args) {
   std::string error;
@@ -344,7 +353,6 @@ int RunVoronoi(Backend& backend, const Args& args) {
   return WriteOutput(args, json);
 }
 
-namespace {
 
 std::string EdgeJson(const DelaunayEdge& e) {
   return absl::StrFormat(
@@ -353,7 +361,14 @@ std::string EdgeJson(const DelaunayEdge& e) {
       e.site_a, e.site_b, e.vertex_a, e.vertex_b, e.length, e.edge_start, PointsJson(e.points));
 }
 
-}  // namespace
+
+// geodex delaunay: its entry of `geodex --help`.
+constexpr char kDelaunayHelp[] = R"(  delaunay MESH --sites SPEC [--output FILE.json|.obj|.svg]
+      Approximate Delaunay triangulation (sections 6.3-6.4): edges as polylines, triangles, XL
+      edges found and the Delaunay edges removed because of them.
+      These three print JSON ("approximate": true) unless --output names an .obj (lines) or
+      .svg (top view) file; see docs/geometry.md.
+)";
 
 int RunDelaunay(Backend& backend, const Args& args) {
   std::string error;
@@ -412,6 +427,21 @@ int RunDelaunay(Backend& backend, const Args& args) {
   if (format == Format::kObj) return WriteOutput(args, Obj("delaunay", lines));
   if (format == Format::kSvg) return WriteOutput(args, Svg("delaunay", *s.data, lines, SitePositions(s)));
   return WriteOutput(args, json);
+}
+
+}  // namespace
+
+const Command& IsolinesCommand() {
+  static const Command command{"isolines", kIsolinesHelp, {}, RunIsolines};
+  return command;
+}
+const Command& VoronoiCommand() {
+  static const Command command{"voronoi", kVoronoiHelp, {}, RunVoronoi};
+  return command;
+}
+const Command& DelaunayCommand() {
+  static const Command command{"delaunay", kDelaunayHelp, {}, RunDelaunay};
+  return command;
 }
 
 }  // namespace geodex::cli

@@ -12,7 +12,6 @@
 #include "absl/strings/str_split.h"
 #include "cli_common.h"
 #include "cli_backend.h"
-#include "cli_render.h"
 #include "geodex/delaunay.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/isolines.h"
@@ -44,7 +43,18 @@ struct Layers {
   PathQueryResult path;
 };
 
-}  // namespace
+// geodex render: its entry of `geodex --help`.
+constexpr char kRenderHelp[] = R"(  render MESH --sources SPEC [--isolines K] [--voronoi] [--delaunay] [--path A B]
+         --output out.png|.ply|.gltf [--view auto|iso|top|bottom|front|back|left|right]
+         [--size WxH]
+      A picture of the field: the shaded mesh coloured by distance (viridis; grey where
+      unreachable) with a colour bar (0 to the largest distance, labelled, at least 320 pixels
+      wide), isolines (dark), Voronoi boundaries (white), Delaunay edges (orange), the path (red)
+      and the sources (black dots), framed automatically (z up; 800x600). The default view, auto,
+      is the one of iso and the six axis views that shows the most sources, then the most of the
+      lines.
+      .ply and .gltf write the coloured mesh for 3D viewers instead.
+)";
 
 int RunRender(Backend& backend, const Args& args) {
   std::string error;
@@ -179,6 +189,13 @@ int RunRender(Backend& backend, const Args& args) {
                 std::string(written.message()));
   }
   return kExitOk;
+}
+
+}  // namespace
+
+const Command& RenderCommand() {
+  static const Command command{"render", kRenderHelp, {"voronoi", "delaunay"}, RunRender};
+  return command;
 }
 
 }  // namespace geodex::cli

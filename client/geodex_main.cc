@@ -12,13 +12,13 @@
 #include "cli_backend.h"
 #include "cli_commands.h"
 #include "cli_common.h"
-#include "cli_geometry.h"
 #include "cli_remote.h"
-#include "cli_render.h"
 
 namespace {
 
-constexpr char kUsage[] = R"(geodex - exact geodesic distances on triangle meshes (improved Chen-Han)
+// `geodex --help`: this header, each command's entry (kept with its code: QueryCommands), then
+// the point grammar, JSON and exit codes (kUsageTail).
+constexpr char kUsageHead[] = R"(geodex - exact geodesic distances on triangle meshes (improved Chen-Han)
 
 usage: geodex [--server HOST:PORT] COMMAND MESH [options]
 
@@ -42,64 +42,9 @@ isolines, voronoi, delaunay and render take the mesh's coordinates from the file
 else from the server (GetMeshGeometry).
 
 commands:
-  info MESH [--format text|json] [--strict]
-      One 'key: value' line per property (vertices, faces, boundary_loops, components,
-      isolated_vertices, non_manifold_edges, non_manifold_vertices, degenerate_faces,
-      saddle_vertices, bytes, ...). Reports on any readable mesh, valid or messy.
-  distances MESH --sources SPEC [--method exact|ich|dijkstra] [--lambda L] [--lambda-scale max|mean]
-                 [--max-distance D] [--max-windows N] [--stats] [--output FILE] [--format json]
-                 [--directions] [--labels-output FILE.tif]
-      One distance per vertex in the file's vertex order (%.17g; 'inf' if unreachable).
-      On a DEM, --output FILE.tif writes a float32 GeoTIFF aligned with the DEM's grid (same
-      geotransform and CRS; nodata -1 where unreachable or no data) and --labels-output
-      FILE.tif the nearest source's index (int32, nodata -1).
-      --stats prints one JSON object with counters and times (*_ms) on stderr.
-      --no-filter / --no-one-split switch off Lemma 2 / Lemma 1 (slower; same answer).
-      --at SPEC: instead, one line per surface point: its unfolding estimate (paper section 4)
-      and its exact distance ('POINT<TAB>estimate D<TAB>exact D<TAB>source I').
-      --directions: also the geodesic direction field, 'D<TAB>X Y Z' per vertex: the unit
-      tangent of the vertex's shortest path towards its nearest source (0 0 0 at a source,
-      nan where unreachable), what a vector-field planner follows.
-  path MESH --from SPEC --to SPEC [--method astar|full] [--stats] [--lambda L]
-       [--max-distance D] [--format json]
-      The exact shortest path: line 1 its length; then one line per polyline point,
-      'x y z' and the simplex it lies on ('v ID', 'e V1 V2 T' or 'f FACE B0 B1 B2').
-      astar (default) uses the paper's section 5 heuristic and stops at the target.
-      --lambda L (as for distances) trades exactness for speed; --max-distance D: a target
-      farther than D is unreachable.
-  matrix MESH --sources SPEC --targets SPEC [--stats] [--lambda L] [--max-distance D]
-         [--k-nearest K] [--threads N] [--format json]
-      Exact distances, one row per source, tab-separated. Rows run in parallel on every usable
-      core (--threads N to limit). The same points as sources and targets give a symmetric
-      matrix, each pair solved once. --max-distance D: entries beyond D are inf. --k-nearest K:
-      per source only its K nearest targets are filled in, the rest inf. A progress bar shows
-      on a terminal for calls longer than a second.
-  locate MESH --points p:X:Y:Z,... [--max-snap D] [--format text|json]
-      The nearest surface point to each 3D position: 'QUERY<TAB>SPEC<TAB>x y z<TAB>snap D', D
-      the distance it moved. --max-snap D refuses a position farther than D from the surface.
-  isolines MESH --sources SPEC (--levels L1,L2,... | --count K) [--output FILE.json|.obj|.svg]
-      Approximate geodesic offsets (paper section 6.1; linear along edges): polylines of edge
-      points per level. --count K: the levels D*j/K, j = 1..K-1, D the largest distance.
-  voronoi MESH --sites SPEC [--output FILE.json|.obj|.svg]
-      Approximate Voronoi diagram (section 6.2): boundaries, cells (faces, fragments, areas),
-      adjacency.
-  delaunay MESH --sites SPEC [--output FILE.json|.obj|.svg]
-      Approximate Delaunay triangulation (sections 6.3-6.4): edges as polylines, triangles, XL
-      edges found and the Delaunay edges removed because of them.
-      These three print JSON ("approximate": true) unless --output names an .obj (lines) or
-      .svg (top view) file; see docs/geometry.md.
+)";
 
-  render MESH --sources SPEC [--isolines K] [--voronoi] [--delaunay] [--path A B]
-         --output out.png|.ply|.gltf [--view auto|iso|top|bottom|front|back|left|right]
-         [--size WxH]
-      A picture of the field: the shaded mesh coloured by distance (viridis; grey where
-      unreachable) with a colour bar (0 to the largest distance, labelled, at least 320 pixels
-      wide), isolines (dark), Voronoi boundaries (white), Delaunay edges (orange), the path (red)
-      and the sources (black dots), framed automatically (z up; 800x600). The default view, auto,
-      is the one of iso and the six axis views that shows the most sources, then the most of the
-      lines.
-      .ply and .gltf write the coloured mesh for 3D viewers instead.
-
+constexpr char kUsageTail[] = R"(
 SPEC: comma-separated points: 17 (vertex), e:V1:V2:T (the point (1-T)*V1 + T*V2 on an edge),
       f:FACE:B0:B1:B2 (barycentric in the face's vertex order as in the file),
       g:X:Y and ll:LON:LAT (on a DEM: map coordinates in the DEM's CRS, or WGS 84 longitude and
@@ -121,23 +66,23 @@ exit codes: 0 ok; 1 the computation failed (cancelled, budget, target unreachabl
             3 the mesh could not be read or is invalid.
 )";
 
-// `command`'s entry in kUsage (from its line to the next command's), then SPEC and the exit
-// codes; the whole text for a command it does not list.
+std::string Usage() {
+  std::string usage = kUsageHead;
+  for (const geodex::cli::Command& c : geodex::cli::QueryCommands()) usage += c.help;
+  return usage + kUsageTail;
+}
+
+
+// `geodex COMMAND --help`: that command's entry, then the point grammar and the exit codes; the
+// whole text for a command it does not know.
 std::string CommandHelp(const std::string& command) {
-  const std::string usage = kUsage;
-  const size_t start = usage.find("\n  " + command + " ");
-  if (start == std::string::npos) return usage;
-  size_t end = start + 1;
-  for (;;) {  // the next line indented by exactly two spaces and a letter, or a blank line
-    end = usage.find('\n', end + 1);
-    if (end == std::string::npos || end + 1 >= usage.size() || usage[end + 1] == '\n' ||
-        (usage.compare(end + 1, 2, "  ") == 0 && std::isalpha(usage[end + 3]))) {
-      break;
+  for (const geodex::cli::Command& c : geodex::cli::QueryCommands()) {
+    if (command == c.name) {
+      return std::string("usage: geodex [--server HOST:PORT] COMMAND MESH [options]\n\n") + c.help +
+             kUsageTail;
     }
   }
-  const size_t spec = usage.find("\nSPEC:");
-  return "usage: geodex [--server HOST:PORT] COMMAND MESH [options]\n" +
-         usage.substr(start, end - start) + "\n" + usage.substr(spec);
+  return Usage();
 }
 
 }  // namespace
@@ -146,7 +91,7 @@ int main(int argc, char** argv) {
   using namespace geodex::cli;
   if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h") ||
       !std::strcmp(argv[1], "help")) {
-    std::fputs(kUsage, argc < 2 ? stderr : stdout);
+    std::fputs(Usage().c_str(), argc < 2 ? stderr : stdout);
     return argc < 2 ? kExitUsage : kExitOk;
   }
   if (!std::strcmp(argv[1], "--version")) {
@@ -200,34 +145,32 @@ int main(int argc, char** argv) {
       return kExitOk;
     }
   }
-  Args args;
-  std::string error;
-  if (!ParseArgs(argc, argv, first + 1,
-                 {"stats", "strict", "no-filter", "no-one-split", "voronoi", "delaunay", "directions"}, &args,
-                 &error)) {
-    std::fprintf(stderr, "geodex: %s\n", error.c_str());
-    return kExitUsage;
-  }
   // A terminal sees elapsed time for anything that takes more than a second.
   Progress progress(server.empty() ? command : command + " on " + server);
   if (command == "mesh" || command == "health") {
+    Args args;
+    std::string error;
+    if (!ParseArgs(argc, argv, first + 1, {}, &args, &error)) {
+      std::fprintf(stderr, "geodex: %s\n", error.c_str());
+      return kExitUsage;
+    }
     if (!server.empty()) return RunServerCommand(server, command, args);
     std::fprintf(stderr, "geodex: '%s' talks to a server: use --server HOST:PORT\n",
                  command.c_str());
     return kExitUsage;
   }
   // Every query command is written once against a backend: this process, or the server.
-  using Command = int (*)(Backend&, const Args&);
-  static const std::pair<const char*, Command> kCommands[] = {
-      {"info", RunInfo},         {"distances", RunDistances}, {"path", RunPath},
-      {"matrix", RunMatrix},     {"locate", RunLocate},       {"isolines", RunIsolines},
-      {"voronoi", RunVoronoi},   {"delaunay", RunDelaunay},   {"render", RunRender},
-  };
-  for (const auto& [name, run] : kCommands) {
-    if (command != name) continue;
+  for (const Command& c : QueryCommands()) {
+    if (command != c.name) continue;
+    Args args;
+    std::string error;
+    if (!ParseArgs(argc, argv, first + 1, c.flags, &args, &error)) {
+      std::fprintf(stderr, "geodex: %s\n", error.c_str());
+      return kExitUsage;
+    }
     std::unique_ptr<Backend> backend = server.empty() ? MakeLocalBackend() : MakeRemoteBackend(server);
     if (backend == nullptr) return RunServerCommand(server, command, args);  // built without gRPC
-    return run(*backend, args);
+    return c.run(*backend, args);
   }
   std::fprintf(stderr, "geodex: unknown command '%s' (see geodex --help)\n", command.c_str());
   return kExitUsage;
