@@ -37,10 +37,11 @@ struct FieldOptions {
   bool directions = false;       // also DistanceField::direction
 };
 
-// One point of `distances --at`: the unfolding estimate, the exact distance and its source.
-struct AtValue {
-  double estimate = 0, exact = 0;
-  uint32_t source = 0;
+// `distances --at`: the unfolding estimate at each point (paper section 4, from the sources'
+// field) beside core's exact answer, whatever members PointValues has.
+struct AtValues {
+  std::vector<double> estimate;
+  PointValues exact;
 };
 
 class Backend {
@@ -72,9 +73,8 @@ class Backend {
   // backend keeps its last solve, so render's layers on the same sources share one, uncopied.
   virtual absl::StatusOr<const DistanceField*> Field(const std::vector<SurfacePoint>& sources,
                                                      const FieldOptions& options) = 0;
-  virtual absl::StatusOr<std::vector<AtValue>> DistancesAt(const std::vector<SurfacePoint>& sources,
-                                                           const std::vector<SurfacePoint>& at,
-                                                           const GeodesicOptions& options) = 0;
+  // The query is forwarded whole: to core locally, through proto/convert remotely.
+  virtual absl::StatusOr<AtValues> DistancesAt(const PointQuery& query) = 0;
   virtual absl::StatusOr<PathQueryResult> Path(const SurfacePoint& from, const SurfacePoint& to,
                                                const PathQueryOptions& options) = 0;
   // options.on_row sees rows as they are solved (locally) or arrive (remotely).

@@ -433,11 +433,24 @@ std::string FormatDistances(const std::vector<double>& distances,
   return text;
 }
 
-std::string FormatAtLine(const SurfacePoint& point, double estimate, double exact,
-                         uint32_t source) {
-  return absl::StrFormat("%s\testimate %.17g\texact %.17g\tsource %d\n", SurfacePointToString(point),
-                         estimate, exact,
-                         static_cast<int64_t>(source == kNoIndex ? -1 : int64_t{source}));
+// `distances --at`: one line per point, "POINT<TAB>estimate D<TAB>exact D<TAB>source I" (I = -1
+// when unreachable), or {"points": [{"point": SPEC, "estimate": e, "exact": d, "source": i}, ...]}.
+std::string FormatAt(const std::vector<SurfacePoint>& points, const AtValues& v, bool json) {
+  std::string text = json ? "{\"points\": [" : "";
+  for (size_t i = 0; i < points.size(); ++i) {
+    const uint32_t source = v.exact.source[i];
+    if (json) {
+      text += absl::StrFormat("%s{\"point\": \"%s\", \"estimate\": %s, \"exact\": %s, \"source\": %s}",
+                              i ? ", " : "", SurfacePointToString(points[i]),
+                              JsonNumber(v.estimate[i]), JsonNumber(v.exact.distance[i]),
+                              source == kNoIndex ? "null" : absl::StrCat(source));
+    } else {
+      text += absl::StrFormat("%s\testimate %.17g\texact %.17g\tsource %d\n",
+                              SurfacePointToString(points[i]), v.estimate[i], v.exact.distance[i],
+                              source == kNoIndex ? int64_t{-1} : int64_t{source});
+    }
+  }
+  return json ? text + "]}\n" : text;
 }
 
 std::string FormatDistancesJson(const std::vector<double>& distances,
@@ -454,18 +467,6 @@ std::string FormatDistancesJson(const std::vector<double>& distances,
       if (i) text += ", ";
       text += std::isnan(directions[i][0]) ? "null" : JsonXyz(directions[i]);
     }
-  }
-  return text + "]}\n";
-}
-
-std::string FormatAtJson(const std::vector<SurfacePoint>& points, const std::vector<double>& estimate,
-                         const std::vector<double>& exact, const std::vector<int64_t>& source) {
-  std::string text = "{\"points\": [";
-  for (size_t i = 0; i < points.size(); ++i) {
-    text += absl::StrFormat(
-        "%s{\"point\": \"%s\", \"estimate\": %s, \"exact\": %s, \"source\": %s}",
-        i ? ", " : "", SurfacePointToString(points[i]), JsonNumber(estimate[i]),
-        JsonNumber(exact[i]), source[i] < 0 ? "null" : absl::StrCat(source[i]));
   }
   return text + "]}\n";
 }
@@ -564,18 +565,9 @@ int RunDistances(Backend& backend, const Args& args) {
   const auto t_solve = std::chrono::steady_clock::now();
   if (args.options.count("at")) {
     // Surface points: the unfolding estimate and the exact value, one line each.
-    absl::StatusOr<std::vector<AtValue>> values = backend.DistancesAt(sources, at, options.solver);
+    absl::StatusOr<AtValues> values = backend.DistancesAt({sources, at, options.solver});
     if (!values.ok()) return FailQuery(values.status());
-    std::vector<double> estimate, exact;
-    std::vector<int64_t> source;
-    for (size_t i = 0; i < at.size(); ++i) {
-      const AtValue& v = (*values)[i];
-      if (!json) text += FormatAtLine(at[i], v.estimate, v.exact, v.source);
-      estimate.push_back(v.estimate);
-      exact.push_back(v.exact);
-      source.push_back(v.source == kNoIndex ? -1 : int64_t{v.source});
-    }
-    if (json) text = FormatAtJson(at, estimate, exact, source);
+    text = FormatAt(at, *values, json);
     if (IsGeoJsonPath(args)) {  // Point features with the exact distance and the nearest source
       absl::StatusOr<const MeshData*> data = backend.Geometry();
       if (!data.ok()) return FailQuery(data.status());
@@ -585,7 +577,8 @@ int RunDistances(Backend& backend, const Args& args) {
       for (size_t i = 0; i < at.size(); ++i) {
         points.push_back({PositionOf(**data, at[i]),
                           written.size() == at.size() ? written[i] : SurfacePointToString(at[i]),
-                          SurfacePointToString(at[i]), exact[i], source[i]});
+                          SurfacePointToString(at[i]), values->exact.distance[i],
+                          values->exact.source[i] == kNoIndex ? -1 : int64_t{values->exact.source[i]}});
       }
       if (int code = WriteGeoJsonOutput(backend, args, terrain::PointFeatures(points));
           code != kExitOk) {

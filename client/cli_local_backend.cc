@@ -91,23 +91,21 @@ class LocalBackend final : public Backend {
     return field_.get();
   }
 
-  absl::StatusOr<std::vector<AtValue>> DistancesAt(const std::vector<SurfacePoint>& sources,
-                                                   const std::vector<SurfacePoint>& at,
-                                                   const GeodesicOptions& options) override {
+  absl::StatusOr<AtValues> DistancesAt(const PointQuery& query) override {
     FieldOptions field_options;
-    field_options.solver = options;
-    absl::StatusOr<const DistanceField*> field = CachedField(sources, field_options);
+    field_options.solver = query.options;
+    absl::StatusOr<const DistanceField*> field = CachedField(query.sources, field_options);
     if (!field.ok()) return field.status();
-    absl::StatusOr<std::vector<std::pair<double, uint32_t>>> exact =
-        Reachable(ComputeExactDistancesAt(loaded_->mesh, sources, at, options));
+    AtValues out;
+    absl::StatusOr<PointValues> exact = Reachable(ComputePointValues(loaded_->mesh, query));
     if (!exact.ok()) return exact.status();
-    std::vector<AtValue> out;
-    for (size_t i = 0; i < at.size(); ++i) {
-      absl::StatusOr<PointEstimate> est = EstimateDistanceAt(loaded_->mesh, **field, at[i]);
+    out.exact = *std::move(exact);
+    for (const SurfacePoint& p : query.points) {
+      absl::StatusOr<PointEstimate> est = EstimateDistanceAt(loaded_->mesh, **field, p);
       if (!est.ok()) {
         return absl::InvalidArgumentError(absl::StrCat("--at: ", est.status().message()));
       }
-      out.push_back({est->distance, (*exact)[i].first, (*exact)[i].second});
+      out.estimate.push_back(est->distance);
     }
     return out;
   }

@@ -250,18 +250,14 @@ class RemoteBackend final : public Backend {
     return &field_;
   }
 
-  absl::StatusOr<std::vector<AtValue>> DistancesAt(const std::vector<SurfacePoint>& sources,
-                                                   const std::vector<SurfacePoint>& at,
-                                                   const GeodesicOptions& options) override {
+  absl::StatusOr<AtValues> DistancesAt(const PointQuery& query) override {
     absl::StatusOr<v1::EstimateDistancesResponse> r =
-        Flagged(client_->PointDistances(mesh_, sources, at, v1::POINT_DISTANCE_MODE_BOTH,
-                                        ToProto(options)),
+        Flagged(client_->PointDistances(mesh_, query, v1::POINT_DISTANCE_MODE_BOTH),
                 {{"sources", "sources"}, {"points", "at"}});
     if (!r.ok()) return r.status();
-    std::vector<AtValue> out;
-    for (int i = 0; i < static_cast<int>(at.size()); ++i) {
-      out.push_back({r->estimates(i), r->exact(i), r->exact_labels(i)});
-    }
+    AtValues out;
+    out.estimate.assign(r->estimates().begin(), r->estimates().end());
+    out.exact = api::PointValuesFromProto(*r);
     return out;
   }
 

@@ -471,14 +471,11 @@ absl::StatusOr<DistanceMatrix> GeodexClient::Matrix(MeshRef& mesh,
 }
 
 absl::StatusOr<v1::EstimateDistancesResponse> GeodexClient::PointDistances(
-    MeshRef& mesh, const std::vector<SurfacePoint>& sources, const std::vector<SurfacePoint>& points,
-    v1::PointDistanceMode mode, const v1::SolverOptions& options) {
+    MeshRef& mesh, const PointQuery& query, v1::PointDistanceMode mode) {
   v1::EstimateDistancesRequest request;
   request.set_mesh(mesh.name);
-  for (const SurfacePoint& p : sources) api::SurfacePointToProto(p, request.add_sources());
-  for (const SurfacePoint& p : points) api::SurfacePointToProto(p, request.add_points());
+  api::PointQueryToProto(query, &request);
   request.set_mode(mode);
-  *request.mutable_options() = options;
   v1::EstimateDistancesResponse response;
   grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
     return stub_->EstimateDistances(context, request, &response);

@@ -117,10 +117,11 @@ class GeodexClient {
       MeshRef& mesh, const std::vector<SurfacePoint>& sources,
       const std::vector<SurfacePoint>& targets, const v1::SolverOptions& options,
       uint32_t k_nearest = 0, const std::function<void(size_t, size_t)>& on_rows = nullptr);
-  absl::StatusOr<v1::EstimateDistancesResponse> PointDistances(
-      MeshRef& mesh, const std::vector<SurfacePoint>& sources,
-      const std::vector<SurfacePoint>& points, v1::PointDistanceMode mode,
-      const v1::SolverOptions& options);
+  // EstimateDistances: the query sent whole (api::PointQueryToProto); read the exact part of the
+  // answer with api::PointValuesFromProto.
+  absl::StatusOr<v1::EstimateDistancesResponse> PointDistances(MeshRef& mesh,
+                                                               const PointQuery& query,
+                                                               v1::PointDistanceMode mode);
   // The approximate geometry of section 6, reassembled from the streamed pieces. `sources` get
   // the server's resolved points (positions snapped) when non-null.
   absl::StatusOr<Isolines> ComputeIsolines(MeshRef& mesh, const std::vector<SurfacePoint>& sources,

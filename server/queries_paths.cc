@@ -182,17 +182,14 @@ absl::Status RunEstimateDistances(const QueryEnv& env, const v1::EstimateDistanc
     }
   }
   if (exact) {
-    SolveStats stats;
-    absl::StatusOr<std::vector<std::pair<double, uint32_t>>> values =
-        ComputeExactDistancesAt(tm, *sources, *points, *solver, &stats);
+    PointQuery query{*std::move(sources), *std::move(points), *solver};
+    absl::StatusOr<PointValues> values = ComputePointValues(tm, query);
     if (!values.ok()) return NameSolveError(values.status(), "points");
     env.counters->solves.fetch_add(1, std::memory_order_relaxed);
-    env.counters->windows_processed.fetch_add(stats.windows_processed, std::memory_order_relaxed);
-    for (const auto& [distance, label] : *values) {
-      response->add_exact(distance);
-      response->add_exact_labels(label);
-    }
-    if (request.want_stats()) StatsToProto(stats, response->mutable_exact_stats());
+    env.counters->windows_processed.fetch_add(values->stats.windows_processed,
+                                              std::memory_order_relaxed);
+    api::PointValuesToProto(*values, response);
+    if (request.want_stats()) StatsToProto(values->stats, response->mutable_exact_stats());
   }
   return CheckUnaryResponseSize(env, *response, "points");
 }

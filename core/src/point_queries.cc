@@ -384,24 +384,37 @@ absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
   return m;
 }
 
+absl::StatusOr<PointValues> ComputePointValues(const TriangleMesh& mesh, const PointQuery& query) {
+  if (absl::Status s = CheckOptions(query.options); !s.ok()) return s;
+  absl::StatusOr<std::vector<ich::ResolvedSource>> src = ResolveSources(mesh, query.sources);
+  if (!src.ok()) return src.status();
+  absl::StatusOr<std::vector<ich::ResolvedTarget>> resolved = ResolveTargets(mesh, query.points);
+  if (!resolved.ok()) return resolved.status();
+  std::vector<ich::TargetResult> results;
+  PointValues out;
+  if (absl::Status s =
+          SolveUntilTargetsFinal(mesh, query.options, *src, *resolved, &results, &out.stats);
+      !s.ok()) {
+    return s;
+  }
+  for (const ich::TargetResult& r : results) {
+    out.distance.push_back(r.distance);
+    out.source.push_back(r.label);
+  }
+  return out;
+}
+
 absl::StatusOr<std::vector<std::pair<double, uint32_t>>> ComputeExactDistancesAt(
     const TriangleMesh& mesh, const std::vector<SurfacePoint>& sources,
     const std::vector<SurfacePoint>& points, const GeodesicOptions& options,
     SolveStats* stats_out) {
-  if (absl::Status s = CheckOptions(options); !s.ok()) return s;
-  absl::StatusOr<std::vector<ich::ResolvedSource>> src = ResolveSources(mesh, sources);
-  if (!src.ok()) return src.status();
-  absl::StatusOr<std::vector<ich::ResolvedTarget>> resolved = ResolveTargets(mesh, points);
-  if (!resolved.ok()) return resolved.status();
-  std::vector<ich::TargetResult> results;
-  SolveStats stats;
-  if (absl::Status s = SolveUntilTargetsFinal(mesh, options, *src, *resolved, &results, &stats);
-      !s.ok()) {
-    return s;
-  }
+  absl::StatusOr<PointValues> values = ComputePointValues(mesh, {sources, points, options});
+  if (!values.ok()) return values.status();
   std::vector<std::pair<double, uint32_t>> out;
-  for (const ich::TargetResult& r : results) out.push_back({r.distance, r.label});
-  if (stats_out != nullptr) *stats_out = stats;
+  for (size_t i = 0; i < values->distance.size(); ++i) {
+    out.push_back({values->distance[i], values->source[i]});
+  }
+  if (stats_out != nullptr) *stats_out = values->stats;
   return out;
 }
 

@@ -207,4 +207,25 @@ terrain::DemInfo TerrainFromProto(const v1::Terrain& t) {
   return info;
 }
 
+void PointQueryToProto(const PointQuery& query, v1::EstimateDistancesRequest* out) {
+  for (const SurfacePoint& p : query.sources) SurfacePointToProto(p, out->add_sources());
+  for (const SurfacePoint& p : query.points) SurfacePointToProto(p, out->add_points());
+  SolverOptionsToProto(query.options, out->mutable_options());
+}
+
+void PointValuesToProto(const PointValues& values, v1::EstimateDistancesResponse* out) {
+  for (size_t i = 0; i < values.distance.size(); ++i) {
+    out->add_exact(values.distance[i]);
+    out->add_exact_labels(values.source[i]);
+  }
+}
+
+PointValues PointValuesFromProto(const v1::EstimateDistancesResponse& response) {
+  PointValues out;
+  out.distance.assign(response.exact().begin(), response.exact().end());
+  out.source.assign(response.exact_labels().begin(), response.exact_labels().end());
+  if (response.has_exact_stats()) out.stats = StatsFromProto(response.exact_stats());
+  return out;
+}
+
 }  // namespace geodex::api

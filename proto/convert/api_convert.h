@@ -7,6 +7,7 @@
 #include <array>
 
 #include "geodex/distance_field.h"
+#include "geodex/distance_matrix.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/shortest_path.h"
 #include "geodex/surface_point.h"
@@ -42,5 +43,12 @@ terrain::DemInfo TerrainFromProto(const v1::Terrain& terrain);
 // The request's solver options: lambda, its scale and max_distance (the server's conversion back,
 // with validation and its window limit, is server/proto_convert.h's SolverOptionsFromProto).
 void SolverOptionsToProto(const GeodesicOptions& options, v1::SolverOptions* out);
+
+// EstimateDistances' exact part, carried whole: the query into the request (its sources, points
+// and options; the mode is the caller's), and the answer into the response and back. The server
+// places the request's points itself (map points, limits), so no PointQueryFromProto.
+void PointQueryToProto(const PointQuery& query, v1::EstimateDistancesRequest* out);
+void PointValuesToProto(const PointValues& values, v1::EstimateDistancesResponse* out);
+PointValues PointValuesFromProto(const v1::EstimateDistancesResponse& response);
 
 }  // namespace geodex::api

@@ -227,5 +227,44 @@ TEST(ApiConvertTest, MeshSummaryRoundTrips) {
   EXPECT_EQ(back.bytes, s.bytes);
 }
 
+// EstimateDistances' exact part: the query into the request, core's answer through the response
+// and back, every member (what `distances --at` prints remotely).
+TEST(ApiConvertTest, PointQueryAndValuesRoundTrip) {
+  absl::StatusOr<TriangleMesh> mesh = LoadTestMesh("three-peaks.off");
+  ASSERT_TRUE(mesh.ok());
+  PointQuery query;
+  query.sources = {SurfacePoint::AtVertex(0), SurfacePoint::InFace(5, 0.2, 0.3, 0.5)};
+  query.points = {SurfacePoint::AtVertex(40), SurfacePoint::OnEdge(1, 2, 0.25), SurfacePoint::AtVertex(0)};
+  query.options.lambda = 0.125;
+  query.options.max_distance = 1e9;
+  v1::EstimateDistancesRequest request;
+  api::PointQueryToProto(query, &request);
+  ASSERT_EQ(request.sources_size(), 2);
+  ASSERT_EQ(request.points_size(), 3);
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_EQ(SurfacePointToString(api::SurfacePointFromProto(request.sources(i))),
+              SurfacePointToString(query.sources[i]));
+  }
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(SurfacePointToString(api::SurfacePointFromProto(request.points(i))),
+              SurfacePointToString(query.points[i]));
+  }
+  EXPECT_EQ(request.options().lambda(), 0.125);
+  EXPECT_EQ(request.options().max_distance(), 1e9);
+
+  query.options = GeodesicOptions{};
+  absl::StatusOr<PointValues> values = ComputePointValues(*mesh, query);
+  ASSERT_TRUE(values.ok()) << values.status();
+  ASSERT_EQ(values->distance.size(), 3u);
+  EXPECT_EQ(values->distance[2], 0);  // a source
+  v1::EstimateDistancesResponse response;
+  api::PointValuesToProto(*values, &response);
+  api::StatsToProto(values->stats, response.mutable_exact_stats());
+  const PointValues back = api::PointValuesFromProto(response);
+  EXPECT_EQ(back.distance, values->distance);
+  EXPECT_EQ(back.source, values->source);
+  EXPECT_EQ(back.stats.windows_processed, values->stats.windows_processed);
+}
+
 }  // namespace
 }  // namespace geodex

@@ -69,9 +69,24 @@ absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
 // The number of cores this process may run on (at least 1).
 unsigned UsableCores();
 
-// Exact distances from the nearest of `sources` to each of `points`, with the nearest source's
-// index: one multi-source solve that stops once every point's distance is final. `stats`, when
-// given, receives the solve's counters.
+// A question about surface points, asked whole: the exact distance at each of `points` from the
+// nearest of `sources`. What `geodex distances --at` and EstimateDistances' exact mode ask; the CLI
+// hands it to either backend as it is, and proto/convert maps it to the wire and back, so a new
+// member here reaches every caller without touching the layers between.
+struct PointQuery {
+  std::vector<SurfacePoint> sources, points;
+  GeodesicOptions options;
+};
+// Its answer, one entry per point, in order.
+struct PointValues {
+  std::vector<double> distance;  // kUnreachable where no source reaches
+  std::vector<uint32_t> source;  // the nearest source's index, kNoIndex where unreachable
+  SolveStats stats;
+};
+// One multi-source solve that stops once every point's distance is final.
+absl::StatusOr<PointValues> ComputePointValues(const TriangleMesh& mesh, const PointQuery& query);
+
+// ComputePointValues as (distance, source) pairs; `stats`, when given, receives the counters.
 absl::StatusOr<std::vector<std::pair<double, uint32_t>>> ComputeExactDistancesAt(
     const TriangleMesh& mesh, const std::vector<SurfacePoint>& sources,
     const std::vector<SurfacePoint>& points, const GeodesicOptions& options = {},
