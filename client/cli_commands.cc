@@ -434,20 +434,32 @@ std::string FormatDistances(const std::vector<double>& distances,
 }
 
 // `distances --at`: one line per point, "POINT<TAB>estimate D<TAB>exact D<TAB>source I" (I = -1
-// when unreachable), or {"points": [{"point": SPEC, "estimate": e, "exact": d, "source": i}, ...]}.
+// when unreachable) and with --directions "<TAB>direction X Y Z", or {"points": [{"point": SPEC,
+// "estimate": e, "exact": d, "source": i, "direction": [x, y, z] | null}, ...]}.
 std::string FormatAt(const std::vector<SurfacePoint>& points, const AtValues& v, bool json) {
   std::string text = json ? "{\"points\": [" : "";
+  const std::vector<std::array<double, 3>>& direction = v.exact.direction;
   for (size_t i = 0; i < points.size(); ++i) {
     const uint32_t source = v.exact.source[i];
     if (json) {
-      text += absl::StrFormat("%s{\"point\": \"%s\", \"estimate\": %s, \"exact\": %s, \"source\": %s}",
+      text += absl::StrFormat("%s{\"point\": \"%s\", \"estimate\": %s, \"exact\": %s, \"source\": %s",
                               i ? ", " : "", SurfacePointToString(points[i]),
                               JsonNumber(v.estimate[i]), JsonNumber(v.exact.distance[i]),
                               source == kNoIndex ? "null" : absl::StrCat(source));
+      if (!direction.empty()) {
+        absl::StrAppend(&text, ", \"direction\": ",
+                        std::isnan(direction[i][0]) ? "null" : JsonXyz(direction[i]));
+      }
+      text += "}";
     } else {
-      text += absl::StrFormat("%s\testimate %.17g\texact %.17g\tsource %d\n",
+      text += absl::StrFormat("%s\testimate %.17g\texact %.17g\tsource %d",
                               SurfacePointToString(points[i]), v.estimate[i], v.exact.distance[i],
                               source == kNoIndex ? int64_t{-1} : int64_t{source});
+      if (!direction.empty()) {
+        absl::StrAppend(&text, absl::StrFormat("\tdirection %.17g %.17g %.17g", direction[i][0],
+                                               direction[i][1], direction[i][2]));
+      }
+      text += "\n";
     }
   }
   return json ? text + "]}\n" : text;
@@ -485,7 +497,9 @@ constexpr char kDistancesHelp[] = R"(  distances MESH --sources SPEC [--method e
       and its exact distance ('POINT<TAB>estimate D<TAB>exact D<TAB>source I').
       --directions: also the geodesic direction field, 'D<TAB>X Y Z' per vertex: the unit
       tangent of the vertex's shortest path towards its nearest source (0 0 0 at a source,
-      nan where unreachable), what a vector-field planner follows.
+      nan where unreachable), what a vector-field planner follows. With --at, each point's own
+      direction (exact, its path's first step), '<TAB>direction X Y Z' after its line: where a
+      robot standing there heads.
 )";
 
 int RunDistances(Backend& backend, const Args& args) {
@@ -516,8 +530,8 @@ int RunDistances(Backend& backend, const Args& args) {
   }
   if (!GetSolverFlags(args, &options.solver, &error)) return Fail(kExitUsage, error);
   options.directions = args.options.count("directions") > 0;
-  if (options.directions && args.options.count("at")) {
-    return Fail(kExitUsage, "--directions: per vertex only, not with --at");
+  if (options.directions && args.options.count("at") && IsGeoJsonPath(args)) {
+    return Fail(kExitUsage, "--directions: not in GeoJSON (print them, or --format json)");
   }
   options.solver.use_filter = !args.options.count("no-filter");
   options.solver.use_one_angle_one_split = !args.options.count("no-one-split");
@@ -565,7 +579,7 @@ int RunDistances(Backend& backend, const Args& args) {
   const auto t_solve = std::chrono::steady_clock::now();
   if (args.options.count("at")) {
     // Surface points: the unfolding estimate and the exact value, one line each.
-    absl::StatusOr<AtValues> values = backend.DistancesAt({sources, at, options.solver});
+    absl::StatusOr<AtValues> values = backend.DistancesAt({sources, at, options.solver, options.directions});
     if (!values.ok()) return FailQuery(values.status());
     text = FormatAt(at, *values, json);
     if (IsGeoJsonPath(args)) {  // Point features with the exact distance and the nearest source

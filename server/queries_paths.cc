@@ -163,6 +163,10 @@ absl::Status RunEstimateDistances(const QueryEnv& env, const v1::EstimateDistanc
   const bool estimate = request.mode() != v1::POINT_DISTANCE_MODE_EXACT;
   const bool exact = request.mode() == v1::POINT_DISTANCE_MODE_EXACT ||
                      request.mode() == v1::POINT_DISTANCE_MODE_BOTH;
+  if (request.want_directions() && !exact) {
+    return FieldError("want_directions",
+                      "needs mode EXACT or BOTH (directions come from the exact solve)");
+  }
   if (exact && env.quick) return SolveLaneNeeded();
   absl::StatusOr<GeodesicOptions> solver = Options(env, request.options());
   if (!solver.ok()) return solver.status();
@@ -182,7 +186,7 @@ absl::Status RunEstimateDistances(const QueryEnv& env, const v1::EstimateDistanc
     }
   }
   if (exact) {
-    PointQuery query{*std::move(sources), *std::move(points), *solver};
+    PointQuery query{*std::move(sources), *std::move(points), *solver, request.want_directions()};
     absl::StatusOr<PointValues> values = ComputePointValues(tm, query);
     if (!values.ok()) return NameSolveError(values.status(), "points");
     env.counters->solves.fetch_add(1, std::memory_order_relaxed);

@@ -211,6 +211,7 @@ void PointQueryToProto(const PointQuery& query, v1::EstimateDistancesRequest* ou
   for (const SurfacePoint& p : query.sources) SurfacePointToProto(p, out->add_sources());
   for (const SurfacePoint& p : query.points) SurfacePointToProto(p, out->add_points());
   SolverOptionsToProto(query.options, out->mutable_options());
+  out->set_want_directions(query.directions);
 }
 
 void PointValuesToProto(const PointValues& values, v1::EstimateDistancesResponse* out) {
@@ -218,12 +219,19 @@ void PointValuesToProto(const PointValues& values, v1::EstimateDistancesResponse
     out->add_exact(values.distance[i]);
     out->add_exact_labels(values.source[i]);
   }
+  for (const std::array<double, 3>& d : values.direction) {
+    for (double x : d) out->add_exact_directions(x);
+  }
 }
 
 PointValues PointValuesFromProto(const v1::EstimateDistancesResponse& response) {
   PointValues out;
   out.distance.assign(response.exact().begin(), response.exact().end());
   out.source.assign(response.exact_labels().begin(), response.exact_labels().end());
+  for (int i = 0; i + 2 < response.exact_directions_size(); i += 3) {
+    out.direction.push_back({response.exact_directions(i), response.exact_directions(i + 1),
+                             response.exact_directions(i + 2)});
+  }
   if (response.has_exact_stats()) out.stats = StatsFromProto(response.exact_stats());
   return out;
 }

@@ -228,7 +228,39 @@ d = json.load(open('$tmp/dir.json'))
 assert len(d['directions']) == 2500
 assert all((v is None) == (x is None) for v, x in zip(d['directions'], d['distances']))
 assert all(abs(math.hypot(*v) - 1) < 1e-12 for v in d['directions'][1:] if v is not None)"
-expect_usage "directions with --at" "--directions" distances "$K" --sources 0 --at 5 --directions
+# --directions with --at: each point's own direction; on the flat domain straight at the source,
+# from face points and vertices alike (0 0 0 at the source itself).
+"$GEODEX" distances "$DATA/bump-domain.off" --sources 0 --directions \
+  --at f:10:0.2:0.3:0.5,f:57:0.6:0.2:0.2,f:200:0.1:0.1:0.8,9,0 >"$tmp/dirat.txt"
+check "directions at points: flat domain, straight at the source" /usr/bin/python3 - "$DATA/bump-domain.off" "$tmp/dirat.txt" <<'PY'
+import math, sys
+lines = open(sys.argv[1]).read().split("\n")
+nv, nf = map(int, lines[1].split()[:2])
+p = [tuple(map(float, lines[2 + i].split())) for i in range(nv)]
+faces = [list(map(int, lines[2 + nv + f].split()[1:4])) for f in range(nf)]
+def position(spec):
+    if spec.startswith("f:"):
+        _, f, *b = spec.split(":")
+        return tuple(sum(float(b[k]) * p[faces[int(f)][k]][c] for k in range(3)) for c in range(3))
+    return p[int(spec)]
+rows = [l.split("\t") for l in open(sys.argv[2]).read().splitlines()]
+assert len(rows) == 5 and all(r[4].startswith("direction ") for r in rows), rows
+for r in rows[:4]:
+    q = position(r[0])
+    d = [float(c) for c in r[4].split()[1:]]
+    want = [(p[0][k] - q[k]) / math.dist(p[0], q) for k in range(3)]
+    assert max(abs(a - b) for a, b in zip(d, want)) < 1e-9, (r, want)
+assert rows[4][4] == "direction 0 0 0", rows[4]
+PY
+"$GEODEX" distances "$K" --sources 0 --at f:4989:0.2:0.3:0.5,5,2400 --directions --max-distance 20 \
+  --format json >"$tmp/dirat.json"
+check "directions at points json: null beyond max-distance, unit vectors elsewhere" /usr/bin/python3 -c "
+import json, math
+d = json.load(open('$tmp/dirat.json'))['points']
+assert [p['exact'] is None for p in d] == [False, False, True], d
+assert d[2]['direction'] is None and all(abs(math.hypot(*p['direction']) - 1) < 1e-12 for p in d[:2])"
+expect_usage "directions not in GeoJSON" "--directions" distances "$K" --sources 0 --at 5 --directions \
+  --output "$tmp/x.geojson"
 
 # Snapping is never silent: locate reports it, --stats carries it, a far point is warned about,
 # --max-snap refuses it naming the point.

@@ -90,6 +90,10 @@ same_error() {  # same_error NAME ARGS...: the same exit code and a one-line mes
 }
 same "directions" distances "$DATA/kitten.off" --sources 0,f:100:0.2:0.3:0.5 --directions
 same "directions json" distances "$DATA/knight.off" --sources 3 --directions --format json --max-distance 0.3
+same "directions at points" distances "$DATA/kitten.off" --sources 0,f:100:0.2:0.3:0.5 --directions \
+  --at f:7:0.1:0.2:0.7,40,e:0:1:0.25
+same "directions at points json" distances "$DATA/knight.off" --sources 3 --directions --format json \
+  --at f:7:0.1:0.2:0.7,40 --max-distance 0.3
 same "locate" locate "$DATA/kitten.off" --points p:0:0:0,p:0:100:0,p:3:40:2
 same "locate json" locate "$DATA/kitten.off" --points p:0:0:0 --format json
 same "distances json" distances "$DATA/kitten.off" --sources 0,p:1:50:2 --format json --max-distance 20

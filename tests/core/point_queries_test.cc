@@ -11,6 +11,7 @@
 #include "geodex/geodesic_solver.h"
 #include "geodex/shortest_path.h"
 #include "gtest/gtest.h"
+#include "util/mesh_factory.h"
 #include "util/test_meshes.h"
 
 namespace geodex {
@@ -162,6 +163,124 @@ TEST(PointQueryTest, UnreachableTargetsAndBadPointsAreErrors) {
                 .status()
                 .code(),
             absl::StatusCode::kNotFound);
+}
+
+// --- Directions at surface points (PointQuery::directions) ---
+
+Vec3 Unit(const Vec3& from, const Vec3& to) {
+  const double n = Distance3(from, to);
+  return {(to[0] - from[0]) / n, (to[1] - from[1]) / n, (to[2] - from[2]) / n};
+}
+
+// On a plane each point heads straight at its nearest source, from vertices, edge points and
+// face points alike; a source itself has no direction.
+TEST(PointDirectionTest, OnAPlaneEachPointHeadsStraightAtItsNearestSource) {
+  GridSpec spec;
+  spec.cells_x = spec.cells_y = 12;
+  spec.jitter = 0.15;
+  const MeshData data = MakeGrid(spec);
+  absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(data);
+  ASSERT_TRUE(mesh.ok());
+  std::mt19937_64 rng(21);
+  PointQuery query;
+  query.sources = {SurfacePoint::AtVertex(30), SurfacePoint::InFace(200, 0.2, 0.5, 0.3)};
+  for (int i = 0; i < 40; ++i) query.points.push_back(RandomPoint(data, rng));
+  query.points.push_back(query.sources[1]);
+  query.directions = true;
+  absl::StatusOr<PointValues> v = ComputePointValues(*mesh, query);
+  ASSERT_TRUE(v.ok()) << v.status();
+  ASSERT_EQ(v->direction.size(), query.points.size());
+  const Vec3 s0 = PositionOf(data, query.sources[0]), s1 = PositionOf(data, query.sources[1]);
+  for (size_t j = 0; j + 1 < query.points.size(); ++j) {
+    const Vec3 p = PositionOf(data, query.points[j]);
+    const double d0 = Distance3(p, s0), d1 = Distance3(p, s1);
+    if (std::abs(d0 - d1) < 1e-6 || std::min(d0, d1) < 1e-9) continue;  // a tie, or on a source
+    const Vec3 want = Unit(p, d0 < d1 ? s0 : s1);
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(v->direction[j][c], want[c], 1e-9) << SurfacePointToString(query.points[j]);
+    }
+    EXPECT_EQ(v->source[j], d0 < d1 ? 0u : 1u);
+  }
+  EXPECT_EQ(v->direction.back(), (std::array<double, 3>{0, 0, 0}));
+  // The distances are those of the query without directions.
+  query.directions = false;
+  absl::StatusOr<PointValues> plain = ComputePointValues(*mesh, query);
+  ASSERT_TRUE(plain.ok());
+  EXPECT_TRUE(plain->direction.empty());
+  EXPECT_EQ(plain->distance, v->distance);
+}
+
+// In an L, a point hidden from the source behind the reflex corner heads for the corner, not for
+// the source; one in sight heads for the source.
+TEST(PointDirectionTest, InAnLAPointBehindTheCornerHeadsForTheCorner) {
+  const double size = 2;
+  const MeshData data = MakeLShape(6, size, 0.1);
+  absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(data);
+  ASSERT_TRUE(mesh.ok());
+  std::mt19937_64 rng(5);
+  PointQuery query;
+  // A face point high in the left arm (x < size/2, y > size/2).
+  SurfacePoint source;
+  for (;;) {
+    source = RandomPoint(data, rng);
+    const Vec3 p = PositionOf(data, source);
+    if (p[0] < 0.3 * size && p[1] > 0.8 * size && source.kind == SurfacePoint::Kind::kFace) break;
+  }
+  query.sources = {source};
+  for (int i = 0; i < 400 && query.points.size() < 30; ++i) {
+    const SurfacePoint p = RandomPoint(data, rng);
+    if (PositionOf(data, p)[1] < 0.45 * size) query.points.push_back(p);  // the lower arm
+  }
+  query.directions = true;
+  absl::StatusOr<PointValues> v = ComputePointValues(*mesh, query);
+  ASSERT_TRUE(v.ok()) << v.status();
+  const Vec3 s = PositionOf(data, source);
+  const Vec2 corner = LShapeReflexCorner(size);
+  int hidden = 0, seen = 0;
+  for (size_t j = 0; j < query.points.size(); ++j) {
+    const Vec3 p = PositionOf(data, query.points[j]);
+    const double d = LShapeDistance(size, {s[0], s[1]}, {p[0], p[1]});
+    EXPECT_NEAR(v->distance[j], d, 1e-12 * d);
+    const bool bends = d > Distance3(s, p) + 1e-9;
+    const Vec3 want = bends ? Unit(p, {corner[0], corner[1], 0}) : Unit(p, s);
+    (bends ? hidden : seen)++;
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(v->direction[j][c], want[c], 1e-9) << SurfacePointToString(query.points[j]);
+    }
+  }
+  EXPECT_GT(hidden, 5);  // both cases are exercised
+  EXPECT_GT(seen, 0);
+}
+
+// At vertices the directions are the direction field's (ComputeDirectionField reads them off the
+// full field's origins; here they come from a targeted solve's trace); beyond max_distance NaN.
+TEST(PointDirectionTest, AtVerticesTheyAreTheDirectionFieldAndNaNWhereUnreachable) {
+  for (const char* name : {"knight.off", "kitten.off"}) {
+    absl::StatusOr<TriangleMesh> mesh = LoadTestMesh(name);
+    ASSERT_TRUE(mesh.ok());
+    const std::vector<SurfacePoint> sources = {SurfacePoint::AtVertex(3)};
+    absl::StatusOr<DistanceField> field = ComputeDistanceField(*mesh, sources);
+    ASSERT_TRUE(field.ok());
+    const std::vector<std::array<double, 3>> dir = ComputeDirectionField(*mesh, *field);
+    PointQuery query;
+    query.sources = sources;
+    for (uint32_t v = 0; v < mesh->file_vertex_count(); v += 97) {
+      query.points.push_back(SurfacePoint::AtVertex(v));
+    }
+    query.directions = true;
+    absl::StatusOr<PointValues> at = ComputePointValues(*mesh, query);
+    ASSERT_TRUE(at.ok()) << at.status();
+    for (size_t j = 0; j < query.points.size(); ++j) {
+      const uint32_t v = query.points[j].vertex;
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(at->direction[j][c], dir[v][c], 1e-9) << name << " " << v;
+    }
+    query.options.max_distance = 1e-9;  // only the source within reach
+    query.points = {SurfacePoint::AtVertex(3), SurfacePoint::AtVertex(200)};
+    at = ComputePointValues(*mesh, query);
+    ASSERT_TRUE(at.ok()) << at.status();
+    EXPECT_EQ(at->direction[0], (std::array<double, 3>{0, 0, 0}));
+    EXPECT_TRUE(std::isnan(at->direction[1][0]) && std::isnan(at->direction[1][2]));
+  }
 }
 
 }  // namespace

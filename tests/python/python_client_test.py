@@ -87,6 +87,20 @@ class PythonClientTest(unittest.TestCase):
         self.assertEqual(field.directions[0], (0.0, 0.0, 0.0))  # a source
         self.assertAlmostEqual(sum(c * c for c in field.directions[7]), 1.0, delta=1e-12)
 
+    def test_directions_at_points_equal_the_cli(self):
+        at = self.client.point_distances(self.mesh.name, [vertex(0), vertex(1250)],
+                                         [face_point(4989, 0.2, 0.3, 0.5), vertex(5), vertex(0)],
+                                         want_directions=True)
+        lines = self.local("distances", os.path.join(DATA, "kitten.off"), "--sources", "0,1250",
+                           "--at", "f:4989:0.2:0.3:0.5,5,0", "--directions").splitlines()
+        self.assertEqual(len(at.directions), 3)
+        for d, line in zip(at.directions, lines):  # bit for bit
+            self.assertEqual(list(d), [float(v) for v in line.split("\t")[4].split()[1:]])
+        self.assertEqual(at.directions[2], (0.0, 0.0, 0.0))  # a source
+        self.assertAlmostEqual(sum(c * c for c in at.directions[0]), 1.0, delta=1e-12)
+        plain = self.client.point_distances(self.mesh.name, [vertex(0)], [vertex(5)])
+        self.assertEqual(plain.directions, [])
+
     def test_shortest_path_equals_the_cli(self):
         length, points = self.client.shortest_path(self.mesh.name, vertex(0), vertex(1250))
         lines = self.local("path", os.path.join(DATA, "kitten.off"), "--from", "0", "--to",

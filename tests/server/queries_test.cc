@@ -304,6 +304,40 @@ TEST_F(QueriesTest, EstimateAndExactDistancesEqualCore) {
   }
 }
 
+// want_directions: each point's direction, bit-equal to core's; refused (naming the field) when
+// the mode has no exact solve.
+TEST_F(QueriesTest, DirectionsAtPointsEqualCoreAndNeedTheExactMode) {
+  PointQuery query;
+  query.sources = Sites();
+  query.points = {SurfacePoint::AtVertex(5), SurfacePoint::InFace(11, 0.1, 0.1, 0.8),
+                  SurfacePoint::OnEdge(200, 201, 0.5)};
+  query.directions = true;
+  v1::EstimateDistancesRequest request;
+  request.set_mesh("meshes/hills");
+  api::PointQueryToProto(query, &request);
+  request.set_mode(v1::POINT_DISTANCE_MODE_EXACT);
+  grpc::ClientContext context;
+  context.set_deadline(In(60));
+  v1::EstimateDistancesResponse response;
+  grpc::Status status = stub_->EstimateDistances(&context, request, &response);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  absl::StatusOr<PointValues> local = ComputePointValues(*local_, query);
+  ASSERT_TRUE(local.ok()) << local.status();
+  const PointValues remote = api::PointValuesFromProto(response);
+  ASSERT_EQ(remote.direction.size(), 3u);
+  for (size_t i = 0; i < 3; ++i) {
+    for (int c = 0; c < 3; ++c) EXPECT_TRUE(BitEqual(remote.direction[i][c], local->direction[i][c]));
+    EXPECT_NEAR(std::hypot(remote.direction[i][0], remote.direction[i][1], remote.direction[i][2]),
+                1, 1e-12);
+  }
+  request.set_mode(v1::POINT_DISTANCE_MODE_ESTIMATE);
+  grpc::ClientContext c;
+  c.set_deadline(In(60));
+  status = stub_->EstimateDistances(&c, request, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_EQ(testing::BadField(status), "want_directions");
+}
+
 TEST_F(QueriesTest, LocatePointsEqualsCore) {
   SurfaceLocator locator(*local_);
   v1::LocatePointsRequest request;

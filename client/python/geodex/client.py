@@ -60,9 +60,10 @@ Field = collections.namedtuple("Field", "distances labels stats directions")
 Path = collections.namedtuple("Path", "length points")
 # Where a 3D position lands: the surface point (a SurfacePoint), its position, how far it moved.
 Located = collections.namedtuple("Located", "point position distance")
-# distances at surface points: the unfolding estimate and the exact distance, each with its source.
+# distances at surface points: the unfolding estimate and the exact distance, each with its source;
+# with want_directions each point's geodesic direction (x, y, z) towards its nearest source.
 PointDistances = collections.namedtuple("PointDistances",
-                                        "estimates estimate_labels exact exact_labels")
+                                        "estimates estimate_labels exact exact_labels directions")
 # Approximate isolines (paper section 6.1): the levels and (level, closed, [PathPoint]) lines.
 Isolines = collections.namedtuple("Isolines", "levels lines")
 # Approximate Voronoi diagram: {site: area}, [(site_a, site_b, [PathPoint])], [(a, b)] adjacency.
@@ -303,15 +304,18 @@ class GeodexClient:
         return [values[r * cols:(r + 1) * cols] for r in range(rows)]
 
     @_typed_errors
-    def point_distances(self, mesh, sources, points, **options):
+    def point_distances(self, mesh, sources, points, want_directions=False, **options):
         """Distances at surface points: PointDistances(estimates, estimate_labels, exact,
-        exact_labels): the paper's section-4 estimate from the field, and the exact value."""
+        exact_labels, directions): the paper's section-4 estimate from the field, and the exact
+        value; with want_directions, each point's unit direction (x, y, z) along its shortest path
+        towards its nearest source ((0, 0, 0) at a source, NaN where unreachable), else []."""
         request = pb.EstimateDistancesRequest(
             mesh=mesh, sources=sources, points=points, mode=pb.POINT_DISTANCE_MODE_BOTH,
-            options=_solver_options(options))
+            options=_solver_options(options), want_directions=want_directions)
         r = self._call(self.stub.EstimateDistances, request, mesh)
+        d = list(r.exact_directions)
         return PointDistances(list(r.estimates), list(r.estimate_labels), list(r.exact),
-                              list(r.exact_labels))
+                              list(r.exact_labels), [tuple(d[i:i + 3]) for i in range(0, len(d), 3)])
 
     @_typed_errors
     def locate(self, mesh, positions, max_snap=None):

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -76,11 +77,18 @@ unsigned UsableCores();
 struct PointQuery {
   std::vector<SurfacePoint> sources, points;
   GeodesicOptions options;
+  // Also each point's geodesic direction: what a robot at the point follows towards the nearest
+  // source (the direction field of ComputeDirectionField, at any surface point).
+  bool directions = false;
 };
 // Its answer, one entry per point, in order.
 struct PointValues {
   std::vector<double> distance;  // kUnreachable where no source reaches
   std::vector<uint32_t> source;  // the nearest source's index, kNoIndex where unreachable
+  // With query.directions: the unit tangent (file coordinates) of the point's shortest path
+  // towards its nearest source, its first step as traced; 0 0 0 at a source, NaN where
+  // unreachable. Where several shortest paths meet (the cut locus), the traced one's.
+  std::vector<std::array<double, 3>> direction;
   SolveStats stats;
 };
 // One multi-source solve that stops once every point's distance is final.
