@@ -343,46 +343,92 @@ grpc::internal::MethodHandler* Upload(const ReactorEnv* env, Lane /*lane*/) {
       });
 }
 
+template <typename Request, typename Response,
+          absl::Status (*kRun)(const QueryEnv&, const Request&, Response*)>
+absl::Status RunUnarySerialized(const QueryEnv& env, absl::string_view bytes) {
+  Request request;
+  if (!request.ParseFromArray(bytes.data(), static_cast<int>(bytes.size()))) {
+    return absl::InvalidArgumentError("request does not parse");
+  }
+  Response response;
+  return kRun(env, request, &response);
+}
+
+// A stream's pieces are drained (at most 100000, a bound for fuzzing) and dropped.
+template <typename Request, typename Response,
+          absl::StatusOr<MessageStream<Response>> (*kRun)(const QueryEnv&, const Request&)>
+absl::Status RunStreamSerialized(const QueryEnv& env, absl::string_view bytes) {
+  Request request;
+  if (!request.ParseFromArray(bytes.data(), static_cast<int>(bytes.size()))) {
+    return absl::InvalidArgumentError("request does not parse");
+  }
+  absl::StatusOr<MessageStream<Response>> stream = kRun(env, request);
+  if (!stream.ok()) return stream.status();
+  if (stream->work) {
+    if (absl::Status s = stream->work([] {}); !s.ok()) return s;
+  }
+  Response message;
+  for (int i = 0; i < 100000; ++i) {
+    const Produced produced = stream->next(&message);
+    if (produced != Produced::kMessage) break;
+    message.Clear();
+  }
+  return absl::OkStatus();
+}
+
 struct MethodRow {
   GeodexService::MethodInfo info;
   Installer install;
 };
 
+template <typename Request, typename Response,
+          absl::Status (*kRun)(const QueryEnv&, const Request&, Response*)>
+MethodRow UnaryRow(const char* name, Lane lane) {
+  return {{name, lane, &RunUnarySerialized<Request, Response, kRun>},
+          &Unary<Request, Response, kRun>};
+}
+
+template <typename Request, typename Response,
+          absl::StatusOr<MessageStream<Response>> (*kRun)(const QueryEnv&, const Request&)>
+MethodRow StreamRow(const char* name, Lane lane) {
+  return {{name, lane, &RunStreamSerialized<Request, Response, kRun>},
+          &Stream<Request, Response, kRun>};
+}
+
 const std::vector<MethodRow>& MethodTable() {
   static const auto* table = new std::vector<MethodRow>{
       {{"CreateMesh", Lane::kSolve}, &Upload},
-      {{"GetMesh", Lane::kInline}, &Unary<v1::GetMeshRequest, v1::Mesh, &RunGetMesh>},
-      {{"GetMeshGeometry", Lane::kQuick},  // a resident mesh: no solve; one on disk loads
-       &Stream<v1::GetMeshGeometryRequest, v1::MeshGeometry, &RunGetMeshGeometry>},
-      {{"ListMeshes", Lane::kInline},
-       &Unary<v1::ListMeshesRequest, v1::ListMeshesResponse, &RunListMeshes>},
-      {{"DeleteMesh", Lane::kInline},
-       &Unary<v1::DeleteMeshRequest, v1::DeleteMeshResponse, &RunDeleteMesh>},
-      {{"DeriveMesh", Lane::kSolve}, &Unary<v1::DeriveMeshRequest, v1::Mesh, &RunDeriveMesh>},
-      {{"ComputeDistanceField", Lane::kQuick},
-       &Stream<v1::ComputeDistanceFieldRequest, v1::ComputeDistanceFieldResponse,
-               &RunComputeDistanceField>},
-      {{"FindShortestPath", Lane::kQuick},
-       &Unary<v1::FindShortestPathRequest, v1::FindShortestPathResponse, &RunFindShortestPath>},
-      {{"FindShortestPaths", Lane::kSolve},
-       &Unary<v1::FindShortestPathsRequest, v1::FindShortestPathsResponse,
-              &RunFindShortestPaths>},
-      {{"ComputeDistanceMatrix", Lane::kQuick},  // a repeated matrix is a cache hit
-       &Stream<v1::ComputeDistanceMatrixRequest, v1::ComputeDistanceMatrixResponse,
-               &RunComputeDistanceMatrix>},
-      {{"EstimateDistances", Lane::kQuick},
-       &Unary<v1::EstimateDistancesRequest, v1::EstimateDistancesResponse,
-              &RunEstimateDistances>},
-      {{"LocatePoints", Lane::kQuick},
-       &Unary<v1::LocatePointsRequest, v1::LocatePointsResponse, &RunLocatePoints>},
-      {{"ComputeIsolines", Lane::kQuick},
-       &Stream<v1::ComputeIsolinesRequest, v1::ComputeIsolinesResponse, &RunComputeIsolines>},
-      {{"ComputeVoronoi", Lane::kQuick},
-       &Stream<v1::ComputeVoronoiRequest, v1::ComputeVoronoiResponse, &RunComputeVoronoi>},
-      {{"ComputeDelaunay", Lane::kQuick},
-       &Stream<v1::ComputeDelaunayRequest, v1::ComputeDelaunayResponse, &RunComputeDelaunay>},
-      {{"ExportGis", Lane::kSolve},  // GEOS unions and GDAL writing: never on the quick lane
-       &Stream<v1::ExportGisRequest, v1::ExportGisResponse, &RunExportGis>},
+      UnaryRow<v1::GetMeshRequest, v1::Mesh, &RunGetMesh>("GetMesh", Lane::kInline),
+      // A resident mesh: no solve; one on disk loads.
+      StreamRow<v1::GetMeshGeometryRequest, v1::MeshGeometry, &RunGetMeshGeometry>(
+          "GetMeshGeometry", Lane::kQuick),
+      UnaryRow<v1::ListMeshesRequest, v1::ListMeshesResponse, &RunListMeshes>("ListMeshes",
+                                                                               Lane::kInline),
+      UnaryRow<v1::DeleteMeshRequest, v1::DeleteMeshResponse, &RunDeleteMesh>("DeleteMesh",
+                                                                               Lane::kInline),
+      UnaryRow<v1::DeriveMeshRequest, v1::Mesh, &RunDeriveMesh>("DeriveMesh", Lane::kSolve),
+      StreamRow<v1::ComputeDistanceFieldRequest, v1::ComputeDistanceFieldResponse,
+                &RunComputeDistanceField>("ComputeDistanceField", Lane::kQuick),
+      UnaryRow<v1::FindShortestPathRequest, v1::FindShortestPathResponse, &RunFindShortestPath>(
+          "FindShortestPath", Lane::kQuick),
+      UnaryRow<v1::FindShortestPathsRequest, v1::FindShortestPathsResponse,
+               &RunFindShortestPaths>("FindShortestPaths", Lane::kSolve),
+      // A repeated matrix is a cache hit.
+      StreamRow<v1::ComputeDistanceMatrixRequest, v1::ComputeDistanceMatrixResponse,
+                &RunComputeDistanceMatrix>("ComputeDistanceMatrix", Lane::kQuick),
+      UnaryRow<v1::EstimateDistancesRequest, v1::EstimateDistancesResponse,
+               &RunEstimateDistances>("EstimateDistances", Lane::kQuick),
+      UnaryRow<v1::LocatePointsRequest, v1::LocatePointsResponse, &RunLocatePoints>(
+          "LocatePoints", Lane::kQuick),
+      StreamRow<v1::ComputeIsolinesRequest, v1::ComputeIsolinesResponse, &RunComputeIsolines>(
+          "ComputeIsolines", Lane::kQuick),
+      StreamRow<v1::ComputeVoronoiRequest, v1::ComputeVoronoiResponse, &RunComputeVoronoi>(
+          "ComputeVoronoi", Lane::kQuick),
+      StreamRow<v1::ComputeDelaunayRequest, v1::ComputeDelaunayResponse, &RunComputeDelaunay>(
+          "ComputeDelaunay", Lane::kQuick),
+      // GEOS unions and GDAL writing: never on the quick lane.
+      StreamRow<v1::ExportGisRequest, v1::ExportGisResponse, &RunExportGis>("ExportGis",
+                                                                            Lane::kSolve),
   };
   return *table;
 }

@@ -31,6 +31,11 @@ class GeodexService final : public v1::Geodex::CallbackService {
   struct MethodInfo {
     std::string name;  // "FindShortestPath"
     Lane lane;
+    // The method's query function (queries.h) on a serialized request, in this thread, without
+    // gRPC: parses, runs, drains a stream, drops the answer and returns its status
+    // (InvalidArgument for bytes that do not parse). What the request fuzzer drives. Null for
+    // CreateMesh, a client stream (its readers have fuzzers of their own).
+    absl::Status (*run_serialized)(const QueryEnv& env, absl::string_view request) = nullptr;
   };
   static const std::vector<MethodInfo>& Methods();
 

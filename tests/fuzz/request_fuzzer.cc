@@ -1,7 +1,8 @@
 // libFuzzer target: the query handlers of geodexd (server/queries.h) on arbitrary requests, against
 // an in-process mesh store with two small meshes ("meshes/hills" and its id) and a DEM's mesh
 // ("meshes/dem", with its map: map points, DeriveMesh's GeoJSON polygons, ExportGis). Byte 0 picks the
-// method; the rest is parsed as that method's request message. Every outcome must be an answer or
+// method from the service's own table (GeodexService::Methods, so a new method is fuzzed without a
+// change here); the rest is parsed as that method's request message. Every outcome must be an answer or
 // a status, never a crash; streamed results are drained. Solves are bounded by a window budget.
 
 #include <cstddef>
@@ -11,6 +12,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "field_cache.h"
+#include "geodex_service.h"
 #include "geodex/cancel.h"
 #include "geodex/mesh_io.h"
 #include "geodex/mesh_id.h"
@@ -87,25 +89,17 @@ struct World {
   }
 };
 
-template <typename Request, typename Response>
-void RunUnary(const uint8_t* data, size_t size, const QueryEnv& env,
-              absl::Status (*run)(const QueryEnv&, const Request&, Response*)) {
-  Request request;
-  if (!request.ParseFromArray(data, static_cast<int>(size))) return;
-  Response response;
-  (void)run(env, request, &response);
-}
-
-template <typename Request, typename Response>
-void RunStream(const uint8_t* data, size_t size, const QueryEnv& env,
-               absl::StatusOr<MessageStream<Response>> (*run)(const QueryEnv&, const Request&)) {
-  Request request;
-  if (!request.ParseFromArray(data, static_cast<int>(size))) return;
-  absl::StatusOr<MessageStream<Response>> stream = run(env, request);
-  if (!stream.ok()) return;
-  if (stream->work && !stream->work([] {}).ok()) return;
-  Response message;
-  for (int i = 0; i < 100000 && stream->next(&message) == Produced::kMessage; ++i) message.Clear();
+// The methods driven: every one of the service's table (GeodexService::Methods) that runs on a
+// serialized request, but DeleteMesh, which would empty the world.
+const std::vector<const GeodexService::MethodInfo*>& Fuzzed() {
+  static const auto* methods = [] {
+    auto* out = new std::vector<const GeodexService::MethodInfo*>;
+    for (const GeodexService::MethodInfo& m : GeodexService::Methods()) {
+      if (m.run_serialized != nullptr && m.name != "DeleteMesh") out->push_back(&m);
+    }
+    return out;
+  }();
+  return *methods;
 }
 
 }  // namespace
@@ -115,20 +109,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size < 1) return 0;
   CancelToken cancel;
   const QueryEnv env{&world->store, &world->limits, &cancel, &world->cache, &world->counters};
-  const uint8_t* body = data + 1;
-  const size_t n = size - 1;
-  switch (data[0] % 11) {
-    case 0: RunStream(body, n, env, &RunComputeDistanceField); break;
-    case 1: RunUnary(body, n, env, &RunFindShortestPath); break;
-    case 2: RunStream(body, n, env, &RunComputeDistanceMatrix); break;
-    case 3: RunUnary(body, n, env, &RunEstimateDistances); break;
-    case 4: RunUnary(body, n, env, &RunLocatePoints); break;
-    case 5: RunStream(body, n, env, &RunComputeIsolines); break;
-    case 6: RunStream(body, n, env, &RunComputeVoronoi); break;
-    case 7: RunStream(body, n, env, &RunComputeDelaunay); break;
-    case 8: RunStream(body, n, env, &RunGetMeshGeometry); break;
-    case 9: RunUnary(body, n, env, &RunDeriveMesh); break;
-    case 10: RunStream(body, n, env, &RunExportGis); break;
-  }
+  const std::vector<const GeodexService::MethodInfo*>& methods = Fuzzed();
+  (void)methods[data[0] % methods.size()]->run_serialized(
+      env, absl::string_view(reinterpret_cast<const char*>(data + 1), size - 1));
   return 0;
 }
