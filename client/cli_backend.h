@@ -30,13 +30,6 @@
 
 namespace geodex::cli {
 
-// What a field-only option asks of the solver beyond GeodesicOptions' exact ICH defaults.
-struct FieldOptions {
-  GeodesicOptions solver;
-  std::string method = "exact";  // exact | ich | dijkstra (the name, for --stats)
-  bool directions = false;       // also DistanceField::direction
-};
-
 // `distances --at`: the unfolding estimate at each point (paper section 4, from the sources'
 // field) beside core's exact answer, whatever members PointValues has.
 struct AtValues {
@@ -69,10 +62,11 @@ class Backend {
   virtual absl::StatusOr<const MeshData*> Geometry() = 0;
 
   virtual absl::StatusOr<InfoValues> Info() = 0;
-  // The field is the backend's, valid until it solves for other sources or options: a local
-  // backend keeps its last solve, so render's layers on the same sources share one, uncopied.
-  virtual absl::StatusOr<const DistanceField*> Field(const std::vector<SurfacePoint>& sources,
-                                                     const FieldOptions& options) = 0;
+  // The field with every product the query asks for. The query is forwarded whole: to core
+  // locally, through proto/convert remotely. The field is the backend's, valid until it solves
+  // for other sources or options: a local backend keeps its last solve, so render's layers on the
+  // same sources share one, uncopied.
+  virtual absl::StatusOr<const DistanceField*> Field(const FieldQuery& query) = 0;
   // The query is forwarded whole: to core locally, through proto/convert remotely.
   virtual absl::StatusOr<AtValues> DistancesAt(const PointQuery& query) = 0;
   virtual absl::StatusOr<PathQueryResult> Path(const SurfacePoint& from, const SurfacePoint& to,

@@ -517,24 +517,25 @@ int RunDistances(Backend& backend, const Args& args) {
   if (args.positional.size() != 1 || !args.options.count("sources")) {
     return Fail(kExitUsage, "usage: geodex distances MESH --sources SPEC [options]");
   }
-  FieldOptions options;
-  options.method = args.options.count("method") ? args.options.at("method") : "exact";
-  if (options.method == "exact") {
-    options.solver.method = Method::kExact;
-  } else if (options.method == "ich") {
-    options.solver.method = Method::kIch;
-  } else if (options.method == "dijkstra") {
-    options.solver.method = Method::kDijkstra;
+  // The field asked whole; its sources are filled in once the mesh is open.
+  FieldQuery query;
+  const std::string method = args.options.count("method") ? args.options.at("method") : "exact";
+  if (method == "exact") {
+    query.options.method = Method::kExact;
+  } else if (method == "ich") {
+    query.options.method = Method::kIch;
+  } else if (method == "dijkstra") {
+    query.options.method = Method::kDijkstra;
   } else {
     return Fail(kExitUsage, "--method must be exact, ich or dijkstra");
   }
-  if (!GetSolverFlags(args, &options.solver, &error)) return Fail(kExitUsage, error);
-  options.directions = args.options.count("directions") > 0;
-  if (options.directions && args.options.count("at") && IsGeoJsonPath(args)) {
+  if (!GetSolverFlags(args, &query.options, &error)) return Fail(kExitUsage, error);
+  query.directions = args.options.count("directions") > 0;
+  if (query.directions && args.options.count("at") && IsGeoJsonPath(args)) {
     return Fail(kExitUsage, "--directions: not in GeoJSON (print them, or --format json)");
   }
-  options.solver.use_filter = !args.options.count("no-filter");
-  options.solver.use_one_angle_one_split = !args.options.count("no-one-split");
+  query.options.use_filter = !args.options.count("no-filter");
+  query.options.use_one_angle_one_split = !args.options.count("no-one-split");
   absl::StatusOr<std::vector<SurfacePoint>> parsed = ParseSpec(nullptr, "sources", args.options.at("sources"));
   if (!parsed.ok()) return Fail(kExitUsage, std::string(parsed.status().message()));
   // Rasters (GeoTIFF, aligned with the DEM's grid): the distances with --output X.tif, the
@@ -549,7 +550,7 @@ int RunDistances(Backend& backend, const Args& args) {
   if (!labels_output.empty() && !is_raster(labels_output)) {
     return Fail(kExitUsage, "--labels-output: a GeoTIFF path (.tif) is expected");
   }
-  if ((raster && (args.options.count("at") || options.directions || json)) ||
+  if ((raster && (args.options.count("at") || query.directions || json)) ||
       (!labels_output.empty() && args.options.count("at"))) {
     return Fail(kExitUsage, "--output X.tif and --labels-output: per-vertex values only (a raster "
                             "has no --at points, --directions or JSON)");
@@ -579,7 +580,7 @@ int RunDistances(Backend& backend, const Args& args) {
   const auto t_solve = std::chrono::steady_clock::now();
   if (args.options.count("at")) {
     // Surface points: the unfolding estimate and the exact value, one line each.
-    absl::StatusOr<AtValues> values = backend.DistancesAt({sources, at, options.solver, options.directions});
+    absl::StatusOr<AtValues> values = backend.DistancesAt({sources, at, query.options, query.directions});
     if (!values.ok()) return FailQuery(values.status());
     text = FormatAt(at, *values, json);
     if (IsGeoJsonPath(args)) {  // Point features with the exact distance and the nearest source
@@ -601,7 +602,8 @@ int RunDistances(Backend& backend, const Args& args) {
       text.clear();
     }
   } else {
-    absl::StatusOr<const DistanceField*> field = backend.Field(sources, options);
+    query.sources = sources;
+    absl::StatusOr<const DistanceField*> field = backend.Field(query);
     if (!field.ok()) return FailQuery(field.status());
     stats = (*field)->stats;
     if (stats.solve_ms == 0) stats.solve_ms = MsSince(t_solve);
@@ -623,7 +625,7 @@ int RunDistances(Backend& backend, const Args& args) {
   }
   if (args.options.count("stats")) {
     const std::string leading = absl::StrFormat("\"method\": \"%s\", \"sources\": %d, %s",
-                                                options.method, sources.size(), SnapJson(snap));
+                                                method, sources.size(), SnapJson(snap));
     const std::string trailing = absl::StrFormat("\"output_ms\": %.3f, ", MsSince(t_out));
     std::fputs(StatsJson(backend, leading, stats, trailing).c_str(), stderr);
   }

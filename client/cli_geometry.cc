@@ -280,7 +280,7 @@ int RunIsolines(Backend& backend, const Args& args) {
   json += "]}\n";
   if (format == Format::kGeoJson) {
     // Isochrones: per level, the area within that distance (union of each face's part below it).
-    absl::StatusOr<const DistanceField*> field = backend.Field(s.points, FieldOptions{});
+    absl::StatusOr<const DistanceField*> field = backend.Field({s.points, {}, false});
     if (!field.ok()) return FailQuery(field.status());
     return WriteGeoJsonOutput(backend, args,
                               terrain::IsochroneFeatures(*s.data, (*field)->distance, iso->levels));

@@ -17,11 +17,11 @@
 namespace geodex::cli {
 namespace {
 
-std::string Key(const std::vector<SurfacePoint>& sources, const FieldOptions& o) {
+std::string Key(const std::vector<SurfacePoint>& sources, const GeodesicOptions& o) {
   std::string key =
-      absl::StrFormat("%s|%.17g|%d|%.17g|%d|%d|%d|", o.method, o.solver.lambda,
-                      static_cast<int>(o.solver.lambda_scale), o.solver.max_distance,
-                      o.solver.max_windows, o.solver.use_filter, o.solver.use_one_angle_one_split);
+      absl::StrFormat("%d|%.17g|%d|%.17g|%d|%d|%d|", static_cast<int>(o.method), o.lambda,
+                      static_cast<int>(o.lambda_scale), o.max_distance, o.max_windows,
+                      o.use_filter, o.use_one_angle_one_split);
   for (const SurfacePoint& p : sources) absl::StrAppend(&key, SurfacePointToString(p), ",");
   return key;
 }
@@ -81,20 +81,15 @@ class LocalBackend final : public Backend {
     return v;
   }
 
-  absl::StatusOr<const DistanceField*> Field(const std::vector<SurfacePoint>& sources,
-                                             const FieldOptions& options) override {
-    absl::StatusOr<const DistanceField*> f = CachedField(sources, options);
+  absl::StatusOr<const DistanceField*> Field(const FieldQuery& query) override {
+    absl::StatusOr<const DistanceField*> f = CachedField(query.sources, query.options);
     if (!f.ok()) return f.status();
-    if (options.directions && field_->direction.empty()) {
-      field_->direction = ComputeDirectionField(loaded_->mesh, *field_);
-    }
+    ComputeFieldProducts(loaded_->mesh, *field_, query, field_.get());
     return field_.get();
   }
 
   absl::StatusOr<AtValues> DistancesAt(const PointQuery& query) override {
-    FieldOptions field_options;
-    field_options.solver = query.options;
-    absl::StatusOr<const DistanceField*> field = CachedField(query.sources, field_options);
+    absl::StatusOr<const DistanceField*> field = CachedField(query.sources, query.options);
     if (!field.ok()) return field.status();
     AtValues out;
     absl::StatusOr<PointValues> exact = Reachable(ComputePointValues(loaded_->mesh, query));
@@ -123,20 +118,20 @@ class LocalBackend final : public Backend {
 
   absl::StatusOr<Isolines> ComputeIsolines(const std::vector<SurfacePoint>& sources,
                                            const IsolineOptions& levels) override {
-    absl::StatusOr<const DistanceField*> field = CachedField(sources, FieldOptions{});
+    absl::StatusOr<const DistanceField*> field = CachedField(sources, GeodesicOptions{});
     if (!field.ok()) return field.status();
     return ExtractIsolines(loaded_->mesh, **field, levels);
   }
 
   absl::StatusOr<VoronoiDiagram> ComputeVoronoi(const std::vector<SurfacePoint>& sites) override {
-    absl::StatusOr<const DistanceField*> field = CachedField(sites, FieldOptions{});
+    absl::StatusOr<const DistanceField*> field = CachedField(sites, GeodesicOptions{});
     if (!field.ok()) return field.status();
     return BuildVoronoi(loaded_->mesh, **field);
   }
 
   absl::StatusOr<DelaunayTriangulation> ComputeDelaunay(
       const std::vector<SurfacePoint>& sites) override {
-    absl::StatusOr<const DistanceField*> field = CachedField(sites, FieldOptions{});
+    absl::StatusOr<const DistanceField*> field = CachedField(sites, GeodesicOptions{});
     if (!field.ok()) return field.status();
     return BuildDelaunay(loaded_->mesh, **field);
   }
@@ -152,11 +147,10 @@ class LocalBackend final : public Backend {
 
  private:
   absl::StatusOr<const DistanceField*> CachedField(const std::vector<SurfacePoint>& sources,
-                                                   const FieldOptions& options) {
+                                                   const GeodesicOptions& options) {
     const std::string key = Key(sources, options);
     if (field_ != nullptr && key == field_key_) return field_.get();
-    absl::StatusOr<DistanceField> field =
-        ComputeDistanceField(loaded_->mesh, sources, options.solver);
+    absl::StatusOr<DistanceField> field = ComputeDistanceField(loaded_->mesh, sources, options);
     if (!field.ok()) return field.status();
     field_ = std::make_unique<DistanceField>(*std::move(field));
     field_key_ = key;

@@ -240,11 +240,9 @@ class RemoteBackend final : public Backend {
     return v;
   }
 
-  absl::StatusOr<const DistanceField*> Field(const std::vector<SurfacePoint>& sources,
-                                             const FieldOptions& options) override {
-    absl::StatusOr<DistanceField> f = Flagged(
-        client_->Field(mesh_, sources, ToProto(options.solver), &cached_, options.directions),
-        {{"sources", "sources"}});
+  absl::StatusOr<const DistanceField*> Field(const FieldQuery& query) override {
+    absl::StatusOr<DistanceField> f =
+        Flagged(client_->Field(mesh_, query, &cached_), {{"sources", "sources"}});
     if (!f.ok()) return f.status();
     field_ = *std::move(f);
     return &field_;

@@ -130,7 +130,7 @@ int RunRender(Backend& backend, const Args& args) {
   Layers layers;
   IsolineOptions levels;
   levels.count = isoline_count;
-  absl::StatusOr<const DistanceField*> field = backend.Field(*sources, FieldOptions{});
+  absl::StatusOr<const DistanceField*> field = backend.Field({*sources, {}, false});
   if (!field.ok()) return FailQuery(field.status());
   layers.field = *field;
   if (isoline_count) {

@@ -357,45 +357,23 @@ absl::StatusOr<MeshRef> GeodexClient::ResolveMesh(const std::string& mesh) {
   return ref;
 }
 
-absl::StatusOr<DistanceField> GeodexClient::Field(MeshRef& mesh,
-                                                          const std::vector<SurfacePoint>& sources,
-                                                          const v1::SolverOptions& options,
-                                                          bool* cached, bool directions) {
+absl::StatusOr<DistanceField> GeodexClient::Field(MeshRef& mesh, const FieldQuery& query,
+                                                  bool* cached) {
   v1::ComputeDistanceFieldRequest request;
   request.set_mesh(mesh.name);
-  for (const SurfacePoint& p : sources) api::SurfacePointToProto(p, request.add_sources());
-  *request.mutable_options() = options;
+  api::FieldQueryToProto(query, &request);
   request.set_want_stats(true);
-  request.set_want_directions(directions);
-  geodex::DistanceField field;
+  api::FieldAssembler field;
   grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
-    field = geodex::DistanceField();
+    field = api::FieldAssembler();
     auto reader = stub_->ComputeDistanceField(context, request);
     v1::ComputeDistanceFieldResponse response;
-    while (reader->Read(&response)) {
-      if (field.distance.empty()) {
-        field.distance.reserve(response.vertex_count());
-        field.source.reserve(response.vertex_count());
-        for (const auto& p : response.resolved_sources()) {
-          field.sources.push_back(api::SurfacePointFromProto(p));
-        }
-      }
-      field.distance.insert(field.distance.end(), response.distances_f64().begin(),
-                            response.distances_f64().end());
-      field.source.insert(field.source.end(), response.labels().begin(), response.labels().end());
-      for (int i = 0; i + 2 < response.directions_size(); i += 3) {
-        field.direction.push_back(
-            {response.directions(i), response.directions(i + 1), response.directions(i + 2)});
-      }
-      if (response.has_stats()) {
-        field.stats = api::StatsFromProto(response.stats());
-        if (cached != nullptr) *cached = response.stats().cached();
-      }
-    }
+    while (reader->Read(&response)) field.Add(response);
     return reader->Finish();
   });
   if (!status.ok()) return ToAbsl(status);
-  return field;
+  if (cached != nullptr) *cached = field.cached();
+  return std::move(field.result());
 }
 
 absl::StatusOr<MeshData> GeodexClient::GetMeshGeometry(MeshRef& mesh) {

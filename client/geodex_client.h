@@ -104,10 +104,10 @@ class GeodexClient {
                                       const std::string& alias = "");
 
   // Queries (options: the proto's SolverOptions). Results in core's types.
-  // With `directions`, the field's direction field too (DistanceField::direction).
-  absl::StatusOr<DistanceField> Field(MeshRef& mesh, const std::vector<SurfacePoint>& sources,
-                                      const v1::SolverOptions& options, bool* cached = nullptr,
-                                      bool directions = false);
+  // A field asked whole (api::FieldQueryToProto) and put back together (api::FieldAssembler),
+  // with every product the query asks for; `cached`: the server's cache answered.
+  absl::StatusOr<DistanceField> Field(MeshRef& mesh, const FieldQuery& query,
+                                      bool* cached = nullptr);
   absl::StatusOr<PathQueryResult> ShortestPath(MeshRef& mesh, const SurfacePoint& from,
                                                const SurfacePoint& to,
                                                const v1::SolverOptions& options);

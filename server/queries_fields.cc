@@ -35,57 +35,32 @@ absl::StatusOr<MessageStream<v1::ComputeDistanceFieldResponse>> RunComputeDistan
       SolveField(env, request.mesh(), request.sources(), request.options());
   if (!solved.ok()) return solved.status();
 
-  // Produced lazily from the field: no second copy of a large result.
+  // Produced lazily from the field: no second copy of a large result. The products the request
+  // asks for go beside the cached field, which stays as it is.
+  FieldQuery query;
+  query.directions = request.want_directions();
   struct State {
-    SolvedField solved;  // the shared field: chunks are read from it, never copied whole
+    SolvedField solved;     // the shared field: chunks are read from it, never copied whole
+    DistanceField products; // ComputeFieldProducts' members only
     size_t next = 0;
     bool started = false;
   };
   auto state = std::make_shared<State>();
   state->solved = *std::move(solved);
-  std::vector<std::array<double, 3>> directions;  // the cached field stays as it is
-  if (request.want_directions()) {
-    directions = ComputeDirectionField(*state->solved.mesh->mesh, *state->solved.field);
-  }
-  const bool f32 = request.value_type() == v1::VALUE_TYPE_FLOAT32;
+  ComputeFieldProducts(*state->solved.mesh->mesh, *state->solved.field, query, &state->products);
+  api::FieldEncoding encoding;
+  encoding.f32 = request.value_type() == v1::VALUE_TYPE_FLOAT32;
+  encoding.labels = !request.omit_labels();
   const bool want_stats = request.want_stats();
-  const bool labels = !request.omit_labels();
-  const size_t bytes_per_value =
-      (f32 ? 4 : 8) + (labels ? 4 : 0) + (request.want_directions() ? 24 : 0);
-  const size_t chunk = std::max<size_t>(1, env.limits->stream_chunk_bytes / bytes_per_value);
+  const size_t chunk = std::max<size_t>(
+      1, env.limits->stream_chunk_bytes / api::FieldBytesPerVertex(encoding, state->products));
   return MessageProducer<v1::ComputeDistanceFieldResponse>(
-      [state, f32, want_stats, labels, chunk,
-       directions = std::move(directions)](v1::ComputeDistanceFieldResponse* out) {
+      [state, encoding, want_stats, chunk](v1::ComputeDistanceFieldResponse* out) {
         const DistanceField& field = *state->solved.field;
         const size_t n = field.distance.size();
         if (state->started && state->next >= n) return false;
-        out->set_vertex_count(n);
-        out->set_offset(state->next);
-        if (!state->started) {
-          for (const SurfacePoint& p : state->solved.sources) {
-            SurfacePointToProto(p, out->add_resolved_sources());
-          }
-        }
         const size_t begin = state->next, end = std::min(n, begin + chunk);
-        if (f32) {
-          auto* values = out->mutable_distances_f32();
-          values->Reserve(static_cast<int>(end - begin));
-          for (size_t i = begin; i < end; ++i) {
-            values->AddAlreadyReserved(static_cast<float>(field.distance[i]));
-          }
-        } else {
-          out->mutable_distances_f64()->Add(field.distance.begin() + begin,
-                                            field.distance.begin() + end);
-        }
-        if (labels) {
-          out->mutable_labels()->Add(field.source.begin() + begin, field.source.begin() + end);
-        }
-        if (!directions.empty()) {
-          out->mutable_directions()->Reserve(static_cast<int>(3 * (end - begin)));
-          for (size_t i = begin; i < end; ++i) {
-            for (double c : directions[i]) out->mutable_directions()->AddAlreadyReserved(c);
-          }
-        }
+        api::FieldChunkToProto(field, state->products, begin, end, encoding, out);
         if (end == n && want_stats) {
           FieldStatsToProto(field, state->solved.cached, out->mutable_stats());
         }

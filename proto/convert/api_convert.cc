@@ -236,4 +236,67 @@ PointValues PointValuesFromProto(const v1::EstimateDistancesResponse& response) 
   return out;
 }
 
+void FieldQueryToProto(const FieldQuery& query, v1::ComputeDistanceFieldRequest* out) {
+  for (const SurfacePoint& p : query.sources) SurfacePointToProto(p, out->add_sources());
+  SolverOptionsToProto(query.options, out->mutable_options());
+  out->set_want_directions(query.directions);
+}
+
+size_t FieldBytesPerVertex(const FieldEncoding& encoding, const DistanceField& products) {
+  return (encoding.f32 ? 4 : 8) + (encoding.labels ? 4 : 0) +
+         (products.direction.empty() ? 0 : 24);
+}
+
+void FieldChunkToProto(const DistanceField& field, const DistanceField& products, size_t begin,
+                       size_t end, const FieldEncoding& encoding,
+                       v1::ComputeDistanceFieldResponse* out) {
+  out->set_vertex_count(field.distance.size());
+  out->set_offset(begin);
+  if (begin == 0) {
+    for (const SurfacePoint& p : field.sources) SurfacePointToProto(p, out->add_resolved_sources());
+  }
+  if (encoding.f32) {
+    auto* values = out->mutable_distances_f32();
+    values->Reserve(static_cast<int>(end - begin));
+    for (size_t i = begin; i < end; ++i) {
+      values->AddAlreadyReserved(static_cast<float>(field.distance[i]));
+    }
+  } else {
+    out->mutable_distances_f64()->Add(field.distance.begin() + begin,
+                                      field.distance.begin() + end);
+  }
+  if (encoding.labels) {
+    out->mutable_labels()->Add(field.source.begin() + begin, field.source.begin() + end);
+  }
+  if (!products.direction.empty()) {
+    out->mutable_directions()->Reserve(static_cast<int>(3 * (end - begin)));
+    for (size_t i = begin; i < end; ++i) {
+      for (double c : products.direction[i]) out->mutable_directions()->AddAlreadyReserved(c);
+    }
+  }
+}
+
+void FieldAssembler::Add(const v1::ComputeDistanceFieldResponse& message) {
+  if (message.offset() == 0) {
+    field_.distance.reserve(message.vertex_count());
+    field_.source.reserve(message.vertex_count());
+    for (const auto& p : message.resolved_sources()) {
+      field_.sources.push_back(SurfacePointFromProto(p));
+    }
+  }
+  field_.distance.insert(field_.distance.end(), message.distances_f64().begin(),
+                         message.distances_f64().end());
+  field_.distance.insert(field_.distance.end(), message.distances_f32().begin(),
+                         message.distances_f32().end());
+  field_.source.insert(field_.source.end(), message.labels().begin(), message.labels().end());
+  for (int i = 0; i + 2 < message.directions_size(); i += 3) {
+    field_.direction.push_back(
+        {message.directions(i), message.directions(i + 1), message.directions(i + 2)});
+  }
+  if (message.has_stats()) {
+    field_.stats = StatsFromProto(message.stats());
+    cached_ = message.stats().cached();
+  }
+}
+
 }  // namespace geodex::api

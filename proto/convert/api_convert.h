@@ -51,4 +51,32 @@ void PointQueryToProto(const PointQuery& query, v1::EstimateDistancesRequest* ou
 void PointValuesToProto(const PointValues& values, v1::EstimateDistancesResponse* out);
 PointValues PointValuesFromProto(const v1::EstimateDistancesResponse& response);
 
+// ComputeDistanceField's stream, both directions. The query into the request: its sources,
+// options and the products it asks for (value type, labels and stats are the caller's).
+void FieldQueryToProto(const FieldQuery& query, v1::ComputeDistanceFieldRequest* out);
+// How a field is cut into messages: float32 or float64 distances, with or without labels.
+struct FieldEncoding {
+  bool f32 = false;
+  bool labels = true;
+};
+// Bytes one vertex takes in a message (to size the chunks), with `products`' members.
+size_t FieldBytesPerVertex(const FieldEncoding& encoding, const DistanceField& products);
+// Vertices [begin, end) of `field` into one message, with the members `products` holds
+// (ComputeFieldProducts) for them; the first message (begin == 0) also carries the resolved
+// sources. Stats are the caller's (the last message).
+void FieldChunkToProto(const DistanceField& field, const DistanceField& products, size_t begin,
+                       size_t end, const FieldEncoding& encoding,
+                       v1::ComputeDistanceFieldResponse* out);
+// The messages, in order, back into one DistanceField (float32 distances widened).
+class FieldAssembler {
+ public:
+  void Add(const v1::ComputeDistanceFieldResponse& message);
+  DistanceField& result() { return field_; }
+  bool cached() const { return cached_; }  // the last stats said the server's cache answered
+
+ private:
+  DistanceField field_;
+  bool cached_ = false;
+};
+
 }  // namespace geodex::api

@@ -4,7 +4,9 @@
 
 #include "api_convert.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -12,6 +14,7 @@
 #include "geodex/delaunay.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/isolines.h"
+#include "geodex/shortest_path.h"
 #include "geodex/voronoi.h"
 #include "geometry_convert.h"
 #include "gtest/gtest.h"
@@ -264,6 +267,63 @@ TEST(ApiConvertTest, PointQueryAndValuesRoundTrip) {
   EXPECT_EQ(back.distance, values->distance);
   EXPECT_EQ(back.source, values->source);
   EXPECT_EQ(back.stats.windows_processed, values->stats.windows_processed);
+}
+
+// ComputeDistanceField's stream: a field with its directions cut into many messages (what
+// geodexd sends) and put back together (what the client does) is the field, bit for bit; the
+// query survives the request.
+TEST(ApiConvertTest, FieldRoundTripsThroughManyMessages) {
+  absl::StatusOr<TriangleMesh> mesh = LoadTestMesh("kitten.off");
+  ASSERT_TRUE(mesh.ok());
+  FieldQuery query;
+  query.sources = {SurfacePoint::AtVertex(0), SurfacePoint::InFace(100, 0.2, 0.3, 0.5)};
+  query.options.max_distance = 40;  // some vertices unreachable: inf, no label, NaN directions
+  query.directions = true;
+  v1::ComputeDistanceFieldRequest request;
+  api::FieldQueryToProto(query, &request);
+  EXPECT_EQ(request.sources_size(), 2);
+  EXPECT_EQ(request.options().max_distance(), 40);
+  EXPECT_TRUE(request.want_directions());
+
+  absl::StatusOr<DistanceField> field = ComputeDistanceField(*mesh, query.sources, query.options);
+  ASSERT_TRUE(field.ok());
+  DistanceField products;
+  ComputeFieldProducts(*mesh, *field, query, &products);
+  ASSERT_EQ(products.direction.size(), field->distance.size());
+  ASSERT_GT(std::count_if(field->distance.begin(), field->distance.end(),
+                          [](double d) { return std::isinf(d); }),
+            0);
+  for (bool f32 : {false, true}) {
+    api::FieldEncoding encoding;
+    encoding.f32 = f32;
+    const size_t n = field->distance.size(), chunk = 97;  // many messages, the last one short
+    api::FieldAssembler assembler;
+    int messages = 0;
+    for (size_t begin = 0; begin < n; begin += chunk) {
+      v1::ComputeDistanceFieldResponse message;
+      api::FieldChunkToProto(*field, products, begin, std::min(n, begin + chunk), encoding,
+                             &message);
+      EXPECT_EQ(message.resolved_sources_size(), begin == 0 ? 2 : 0);
+      v1::ComputeDistanceFieldResponse wire;  // through bytes, as on the wire
+      ASSERT_TRUE(wire.ParseFromString(message.SerializeAsString()));
+      assembler.Add(wire);
+      ++messages;
+    }
+    EXPECT_GT(messages, 20);
+    const DistanceField& back = assembler.result();
+    ASSERT_EQ(back.distance.size(), n);
+    for (size_t v = 0; v < n; ++v) {
+      const double want = f32 ? static_cast<double>(static_cast<float>(field->distance[v]))
+                              : field->distance[v];
+      ASSERT_EQ(std::memcmp(&back.distance[v], &want, sizeof want), 0) << v;
+      for (int c = 0; c < 3; ++c) {
+        ASSERT_EQ(std::memcmp(&back.direction[v][c], &products.direction[v][c], sizeof(double)), 0);
+      }
+    }
+    EXPECT_EQ(back.source, field->source);
+    ASSERT_EQ(back.sources.size(), 2u);
+    EXPECT_EQ(SurfacePointToString(back.sources[1]), SurfacePointToString(query.sources[1]));
+  }
 }
 
 }  // namespace

@@ -51,7 +51,7 @@ TEST_F(ClientTest, FileIsUploadedOnceByContentHashAndFieldsEqualCore) {
   EXPECT_EQ(server_->store().size(), 1u);
 
   absl::StatusOr<DistanceField> field =
-      client.Field(*second, {SurfacePoint::AtVertex(4)}, v1::SolverOptions());
+      client.Field(*second, FieldQuery{{SurfacePoint::AtVertex(4)}, {}, false});
   ASSERT_TRUE(field.ok()) << field.status();
   DistanceField expected =
       *ComputeDistanceField(testing::BuildLocal(off), {SurfacePoint::AtVertex(4)});
@@ -89,7 +89,7 @@ TEST_F(ClientTest, AQueryForALostMeshReuploadsItOnce) {
   // The server loses the mesh (a restart elsewhere, a rebalanced gateway): the query still works.
   ASSERT_TRUE(server_->store().Delete(mesh->id).ok());
   absl::StatusOr<DistanceField> field =
-      client.Field(*mesh, {SurfacePoint::AtVertex(0)}, v1::SolverOptions());
+      client.Field(*mesh, FieldQuery{{SurfacePoint::AtVertex(0)}, {}, false});
   ASSERT_TRUE(field.ok()) << field.status();
   EXPECT_EQ(client.reuploads(), 1);
   EXPECT_EQ(field->distance.size(), 49u);
@@ -97,7 +97,7 @@ TEST_F(ClientTest, AQueryForALostMeshReuploadsItOnce) {
   MeshRef by_id = *client.ResolveMesh(mesh->id);
   ASSERT_TRUE(server_->store().Delete(mesh->id).ok());
   EXPECT_TRUE(absl::IsNotFound(
-      client.Field(by_id, {SurfacePoint::AtVertex(0)}, v1::SolverOptions()).status()));
+      client.Field(by_id, FieldQuery{{SurfacePoint::AtVertex(0)}, {}, false}).status()));
 }
 
 // A full queue (every worker busy, no room to wait) is worth retrying a moment later; a request
@@ -131,7 +131,7 @@ TEST_F(ClientTest, QueueFullIsRetriedWithBackoffButALimitIsNot) {
   });
   const int retries_before = client.retries();
   absl::StatusOr<DistanceField> field =
-      client.Field(mesh, {SurfacePoint::AtVertex(3)}, v1::SolverOptions());
+      client.Field(mesh, FieldQuery{{SurfacePoint::AtVertex(3)}, {}, false});
   releaser.join();
   ASSERT_TRUE(field.ok()) << field.status();
   EXPECT_GE(client.retries() - retries_before, 1);

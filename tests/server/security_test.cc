@@ -81,7 +81,7 @@ class SecurityTest : public testing::ServerFixture {
     std::ofstream(path) << GridOff(5, 5, true);
     absl::StatusOr<client::MeshRef> mesh = client.ResolveMesh(path);
     if (!mesh.ok()) return mesh.status();
-    return client.Field(*mesh, {SurfacePoint::AtVertex(0)}, v1::SolverOptions()).status();
+    return client.Field(*mesh, FieldQuery{{SurfacePoint::AtVertex(0)}, {}, false}).status();
   }
 
   fs::path dir_;

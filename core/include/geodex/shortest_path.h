@@ -42,6 +42,22 @@ absl::StatusOr<GeodesicPath> TracePathFromVertex(const TriangleMesh& mesh,
 std::vector<std::array<double, 3>> ComputeDirectionField(const TriangleMesh& mesh,
                                                          const DistanceField& field);
 
+// A distance field asked whole: what `geodex distances` and ComputeDistanceField ask. The CLI
+// hands it to either backend as it is and proto/convert carries it (api::FieldQueryToProto), so a
+// new per-vertex product is a member here, its computation in ComputeFieldProducts, and its wire
+// fields in proto/convert.
+struct FieldQuery {
+  std::vector<SurfacePoint> sources;
+  GeodesicOptions options;
+  bool directions = false;  // DistanceField::direction (ComputeDirectionField)
+};
+
+// The per-vertex products `query` asks for beyond distances and labels, from its solved `field`,
+// written to `out`'s product members only (`out` may be `field` itself, or another DistanceField
+// so that a shared, cached field stays untouched). Members already filled are kept.
+void ComputeFieldProducts(const TriangleMesh& mesh, const DistanceField& field,
+                          const FieldQuery& query, DistanceField* out);
+
 }  // namespace geodex
 
 namespace geodex {
