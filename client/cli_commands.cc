@@ -442,10 +442,10 @@ std::string FormatAt(const std::vector<SurfacePoint>& points, const AtValues& v,
   for (size_t i = 0; i < points.size(); ++i) {
     const uint32_t source = v.exact.source[i];
     if (json) {
-      text += absl::StrFormat("%s{\"point\": \"%s\", \"estimate\": %s, \"exact\": %s, \"source\": %s",
-                              i ? ", " : "", SurfacePointToString(points[i]),
-                              JsonNumber(v.estimate[i]), JsonNumber(v.exact.distance[i]),
-                              source == kNoIndex ? "null" : absl::StrCat(source));
+      text += absl::StrFormat(
+          "%s{\"point\": \"%s\", \"estimate\": %s, \"exact\": %s, \"source\": %s",
+          i ? ", " : "", SurfacePointToString(points[i]), JsonNumber(v.estimate[i]),
+          JsonNumber(v.exact.distance[i]), source == kNoIndex ? "null" : absl::StrCat(source));
       if (!direction.empty()) {
         absl::StrAppend(&text, ", \"direction\": ",
                         std::isnan(direction[i][0]) ? "null" : JsonXyz(direction[i]));
@@ -580,7 +580,8 @@ int RunDistances(Backend& backend, const Args& args) {
   const auto t_solve = std::chrono::steady_clock::now();
   if (args.options.count("at")) {
     // Surface points: the unfolding estimate and the exact value, one line each.
-    absl::StatusOr<AtValues> values = backend.DistancesAt({sources, at, query.options, query.directions});
+    absl::StatusOr<AtValues> values =
+        backend.DistancesAt({sources, at, query.options, query.directions});
     if (!values.ok()) return FailQuery(values.status());
     text = FormatAt(at, *values, json);
     if (IsGeoJsonPath(args)) {  // Point features with the exact distance and the nearest source
@@ -590,10 +591,11 @@ int RunDistances(Backend& backend, const Args& args) {
       const std::vector<std::string> written = absl::StrSplit(args.options.at("at"), ',');
       std::vector<terrain::PointValue> points;
       for (size_t i = 0; i < at.size(); ++i) {
+        const uint32_t source = values->exact.source[i];
         points.push_back({PositionOf(**data, at[i]),
                           written.size() == at.size() ? written[i] : SurfacePointToString(at[i]),
                           SurfacePointToString(at[i]), values->exact.distance[i],
-                          values->exact.source[i] == kNoIndex ? -1 : int64_t{values->exact.source[i]}});
+                          source == kNoIndex ? -1 : int64_t{source}});
       }
       if (int code = WriteGeoJsonOutput(backend, args, terrain::PointFeatures(points));
           code != kExitOk) {
@@ -864,7 +866,8 @@ int RunLocate(Backend& backend, const Args& args) {
 const std::vector<Command>& QueryCommands() {
   static const std::vector<Command>* commands = new std::vector<Command>{
       {"info", kInfoHelp, {"strict"}, RunInfo},
-      {"distances", kDistancesHelp, {"stats", "no-filter", "no-one-split", "directions"}, RunDistances},
+      {"distances", kDistancesHelp, {"stats", "no-filter", "no-one-split", "directions"},
+       RunDistances},
       {"path", kPathHelp, {"stats"}, RunPath},
       {"matrix", kMatrixHelp, {"stats"}, RunMatrix},
       {"locate", kLocateHelp, {}, RunLocate},

@@ -405,12 +405,7 @@ absl::StatusOr<PathQueryResult> GeodexClient::ShortestPath(MeshRef& mesh, const 
     return stub_->FindShortestPath(context, request, &response);
   });
   if (!status.ok()) return ToAbsl(status);
-  PathQueryResult result;
-  result.distance = response.distance();
-  result.path.length = response.distance();
-  for (const auto& p : response.points()) result.path.points.push_back(api::PathPointFromProto(p));
-  result.stats = api::StatsFromProto(response.stats());
-  return result;
+  return api::PathResultFromProto(response);
 }
 
 absl::StatusOr<DistanceMatrix> GeodexClient::Matrix(MeshRef& mesh,
@@ -426,26 +421,19 @@ absl::StatusOr<DistanceMatrix> GeodexClient::Matrix(MeshRef& mesh,
   for (const SurfacePoint& p : targets) api::SurfacePointToProto(p, request.add_targets());
   *request.mutable_options() = options;
   request.set_want_stats(true);
-  DistanceMatrix matrix;
+  api::MatrixAssembler matrix;
   grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
-    matrix = DistanceMatrix();
+    matrix = api::MatrixAssembler();
     auto reader = stub_->ComputeDistanceMatrix(context, request);
     v1::ComputeDistanceMatrixResponse response;
     while (reader->Read(&response)) {
-      matrix.rows = response.rows();
-      matrix.cols = response.cols();
-      matrix.values.insert(matrix.values.end(), response.values_f64().begin(),
-                           response.values_f64().end());
-      if (response.has_stats()) matrix.stats = api::StatsFromProto(response.stats());
-      if (on_rows && matrix.cols > 0) {  // rows received, or rows' worth of solves done
-        const size_t solved = static_cast<size_t>(response.progress() * matrix.rows);
-        on_rows(std::max(matrix.values.size() / matrix.cols, solved), matrix.rows);
-      }
+      matrix.Add(response);
+      if (on_rows && matrix.result().cols > 0) on_rows(matrix.rows_done(), matrix.result().rows);
     }
     return reader->Finish();
   });
   if (!status.ok()) return ToAbsl(status);
-  return matrix;
+  return std::move(matrix.result());
 }
 
 absl::StatusOr<v1::EstimateDistancesResponse> GeodexClient::PointDistances(
@@ -474,13 +462,9 @@ absl::StatusOr<std::vector<LocatedPoint>> GeodexClient::Locate(
   });
   if (!status.ok()) return ToAbsl(status);
   std::vector<LocatedPoint> out;
-  for (const auto& p : response.points()) {
-    out.push_back({api::SurfacePointFromProto(p.point()), api::PositionFromProto(p.position()),
-                   p.distance()});
-  }
+  for (const auto& p : response.points()) out.push_back(api::LocatedPointFromProto(p));
   return out;
 }
-
 
 absl::StatusOr<Isolines> GeodexClient::ComputeIsolines(MeshRef& mesh,
                                                        const std::vector<SurfacePoint>& sources,

@@ -181,17 +181,10 @@ Produced NextMatrixMessage(MatrixStreamState& state, bool f32, bool want_stats, 
   // Progress alone is worth a message in steps of 1% (rows that wait on others).
   const bool progressed = progress >= state.progress_sent + 0.01;
   if (state.next >= ready && !(state.done && !state.sent) && !progressed) return Produced::kLater;
-  out->set_rows(state.rows);
-  out->set_cols(state.cols);
-  out->set_offset(state.next);
+  const size_t begin = state.next, end = std::min(ready, begin + chunk);
+  api::MatrixChunkToProto(state.rows, state.cols, state.values, begin, end, f32, out);
   out->set_progress(progress);
   state.progress_sent = progress;
-  const size_t begin = state.next, end = std::min(ready, begin + chunk);
-  if (f32) {
-    for (size_t i = begin; i < end; ++i) out->add_values_f32(static_cast<float>(state.values[i]));
-  } else {
-    out->mutable_values_f64()->Add(state.values.begin() + begin, state.values.begin() + end);
-  }
   if (end == n && want_stats) {
     StatsToProto(state.stats, out->mutable_stats());
     out->mutable_stats()->set_cached(state.cached);

@@ -56,10 +56,8 @@ absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPath
         return UnreachableError("to: unreachable from `from`");
       }
       if (!path.ok()) return path.status();
-      response->set_distance(field->distance[to->vertex]);
-      for (auto it = path->points.rbegin(); it != path->points.rend(); ++it) {
-        PathPointToProto(*it, response->add_points());
-      }
+      std::reverse(path->points.begin(), path->points.end());  // traced from `to`
+      api::PathResultToProto(field->distance[to->vertex], path->points, response);
       if (request.want_stats()) FieldStatsToProto(*field, cached, response->mutable_stats());
       return CheckUnaryResponseSize(env, *response, "paths");
     }
@@ -80,8 +78,7 @@ absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPath
     }
     return NameSolveError(result.status(), "from/to");
   }
-  response->set_distance(result->distance);
-  for (const PathPoint& p : result->path.points) PathPointToProto(p, response->add_points());
+  api::PathResultToProto(result->distance, result->path.points, response);
   if (request.want_stats()) StatsToProto(result->stats, response->mutable_stats());
   return CheckUnaryResponseSize(env, *response, "paths");
 }
@@ -137,8 +134,7 @@ absl::Status RunFindShortestPaths(const QueryEnv& env, const v1::FindShortestPat
     AddSolveStats(result->stats, &total);
     for (size_t k = 0; k < groups[g].size(); ++k) {
       v1::FindShortestPathResponse* out = response->mutable_paths(static_cast<int>(groups[g][k]));
-      out->set_distance(result->distance[k]);
-      for (const PathPoint& p : result->paths[k].points) PathPointToProto(p, out->add_points());
+      api::PathResultToProto(result->distance[k], result->paths[k].points, out);
     }
   }
   response->set_solves(static_cast<uint32_t>(groups.size()));
@@ -231,10 +227,7 @@ absl::Status RunLocatePoints(const QueryEnv& env, const v1::LocatePointsRequest&
       return absl::Status(located.status().code(),
                           absl::StrCat(field, ": ", located.status().message()));
     }
-    v1::LocatedPoint* out = response->add_points();
-    SurfacePointToProto(located->point, out->mutable_point());
-    PositionToProto(located->position, out->mutable_position());
-    out->set_distance(located->distance);
+    api::LocatedPointToProto(*located, response->add_points());
   }
   return CheckUnaryResponseSize(env, *response, "positions");
 }

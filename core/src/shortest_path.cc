@@ -326,7 +326,9 @@ std::vector<std::array<double, 3>> ComputeDirectionField(const TriangleMesh& mes
 
 void ComputeFieldProducts(const TriangleMesh& mesh, const DistanceField& field,
                           const FieldQuery& query, DistanceField* out) {
-  if (query.directions && out->direction.empty()) out->direction = ComputeDirectionField(mesh, field);
+  if (query.directions && out->direction.empty()) {
+    out->direction = ComputeDirectionField(mesh, field);
+  }
 }
 
 }  // namespace geodex

@@ -299,4 +299,59 @@ void FieldAssembler::Add(const v1::ComputeDistanceFieldResponse& message) {
   }
 }
 
+void PathResultToProto(double distance, const std::vector<PathPoint>& points,
+                       v1::FindShortestPathResponse* out) {
+  out->set_distance(distance);
+  for (const PathPoint& p : points) PathPointToProto(p, out->add_points());
+}
+
+PathQueryResult PathResultFromProto(const v1::FindShortestPathResponse& response) {
+  PathQueryResult result;
+  result.distance = response.distance();
+  result.path.length = response.distance();
+  for (const auto& p : response.points()) result.path.points.push_back(PathPointFromProto(p));
+  if (response.has_stats()) result.stats = StatsFromProto(response.stats());
+  return result;
+}
+
+void LocatedPointToProto(const LocatedPoint& point, v1::LocatedPoint* out) {
+  SurfacePointToProto(point.point, out->mutable_point());
+  PositionToProto(point.position, out->mutable_position());
+  out->set_distance(point.distance);
+}
+
+LocatedPoint LocatedPointFromProto(const v1::LocatedPoint& point) {
+  return {SurfacePointFromProto(point.point()), PositionFromProto(point.position()),
+          point.distance()};
+}
+
+void MatrixChunkToProto(size_t rows, size_t cols, const std::vector<double>& values, size_t begin,
+                        size_t end, bool f32, v1::ComputeDistanceMatrixResponse* out) {
+  out->set_rows(rows);
+  out->set_cols(cols);
+  out->set_offset(begin);
+  if (f32) {
+    for (size_t i = begin; i < end; ++i) out->add_values_f32(static_cast<float>(values[i]));
+  } else {
+    out->mutable_values_f64()->Add(values.begin() + begin, values.begin() + end);
+  }
+}
+
+void MatrixAssembler::Add(const v1::ComputeDistanceMatrixResponse& message) {
+  matrix_.rows = message.rows();
+  matrix_.cols = message.cols();
+  matrix_.values.insert(matrix_.values.end(), message.values_f64().begin(),
+                        message.values_f64().end());
+  matrix_.values.insert(matrix_.values.end(), message.values_f32().begin(),
+                        message.values_f32().end());
+  if (message.has_stats()) matrix_.stats = StatsFromProto(message.stats());
+  progress_ = message.progress();
+}
+
+size_t MatrixAssembler::rows_done() const {
+  if (matrix_.cols == 0) return 0;
+  const size_t solved = static_cast<size_t>(progress_ * matrix_.rows);
+  return std::max(matrix_.values.size() / matrix_.cols, solved);
+}
+
 }  // namespace geodex::api

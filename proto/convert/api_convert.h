@@ -8,6 +8,7 @@
 
 #include "geodex/distance_field.h"
 #include "geodex/distance_matrix.h"
+#include "geodex/locate.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/shortest_path.h"
 #include "geodex/surface_point.h"
@@ -77,6 +78,34 @@ class FieldAssembler {
  private:
   DistanceField field_;
   bool cached_ = false;
+};
+
+// FindShortestPath's answer (and each of FindShortestPaths'), both directions: the length and the
+// points from `from` to `to` (none when unreachable in FindShortestPaths). Stats are the
+// caller's; FromProto reads them when present.
+void PathResultToProto(double distance, const std::vector<PathPoint>& points,
+                       v1::FindShortestPathResponse* out);
+PathQueryResult PathResultFromProto(const v1::FindShortestPathResponse& response);
+
+// One answer of LocatePoints, both directions.
+void LocatedPointToProto(const LocatedPoint& point, v1::LocatedPoint* out);
+LocatedPoint LocatedPointFromProto(const v1::LocatedPoint& point);
+
+// ComputeDistanceMatrix's stream, both directions: values [begin, end) (row-major) of a rows x
+// cols matrix into one message, float32 or float64 (stats and progress are the caller's); and the
+// messages, in order, back into the matrix.
+void MatrixChunkToProto(size_t rows, size_t cols, const std::vector<double>& values, size_t begin,
+                        size_t end, bool f32, v1::ComputeDistanceMatrixResponse* out);
+class MatrixAssembler {
+ public:
+  void Add(const v1::ComputeDistanceMatrixResponse& message);
+  DistanceMatrix& result() { return matrix_; }
+  // Rows received, or rows' worth of solves done by the server's last progress, if more.
+  size_t rows_done() const;
+
+ private:
+  DistanceMatrix matrix_;
+  double progress_ = 0;
 };
 
 }  // namespace geodex::api

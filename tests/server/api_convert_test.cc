@@ -326,5 +326,58 @@ TEST(ApiConvertTest, FieldRoundTripsThroughManyMessages) {
   }
 }
 
+// FindShortestPath's answer and LocatePoints' through their messages and back.
+TEST(ApiConvertTest, PathAndLocatedPointRoundTrip) {
+  absl::StatusOr<TriangleMesh> mesh = LoadTestMesh("kitten.off");
+  ASSERT_TRUE(mesh.ok());
+  absl::StatusOr<PathQueryResult> path = ComputeShortestPath(
+      *mesh, SurfacePoint::AtVertex(0), SurfacePoint::InFace(100, 0.2, 0.3, 0.5));
+  ASSERT_TRUE(path.ok());
+  ASSERT_GT(path->path.points.size(), 3u);
+  v1::FindShortestPathResponse response;
+  api::PathResultToProto(path->distance, path->path.points, &response);
+  api::StatsToProto(path->stats, response.mutable_stats());
+  const PathQueryResult back = api::PathResultFromProto(response);
+  EXPECT_EQ(back.distance, path->distance);
+  EXPECT_EQ(Text(back.path.points), Text(path->path.points));
+  EXPECT_EQ(back.stats.windows_processed, path->stats.windows_processed);
+
+  const LocatedPoint located{SurfacePoint::OnEdge(3, 7, 0.25), {1.5, -2, 0.125}, 0.75};
+  v1::LocatedPoint proto;
+  api::LocatedPointToProto(located, &proto);
+  const LocatedPoint again = api::LocatedPointFromProto(proto);
+  EXPECT_EQ(SurfacePointToString(again.point), SurfacePointToString(located.point));
+  EXPECT_EQ(again.position, located.position);
+  EXPECT_EQ(again.distance, located.distance);
+}
+
+// ComputeDistanceMatrix's stream: a matrix cut mid-row into many messages and put back together.
+TEST(ApiConvertTest, MatrixRoundTripsThroughManyMessages) {
+  DistanceMatrix m;
+  m.rows = 7;
+  m.cols = 5;
+  for (size_t i = 0; i < m.rows * m.cols; ++i) {
+    m.values.push_back(i % 6 ? 0.1 * i + 1e-17 : kUnreachable);
+  }
+  for (bool f32 : {false, true}) {
+    api::MatrixAssembler assembler;
+    for (size_t begin = 0; begin < m.values.size(); begin += 3) {
+      v1::ComputeDistanceMatrixResponse message;
+      api::MatrixChunkToProto(m.rows, m.cols, m.values, begin,
+                              std::min(m.values.size(), begin + 3), f32, &message);
+      assembler.Add(message);
+      EXPECT_EQ(assembler.rows_done(), std::min(m.values.size(), begin + 3) / m.cols);
+    }
+    const DistanceMatrix& back = assembler.result();
+    EXPECT_EQ(back.rows, m.rows);
+    EXPECT_EQ(back.cols, m.cols);
+    ASSERT_EQ(back.values.size(), m.values.size());
+    for (size_t i = 0; i < m.values.size(); ++i) {
+      EXPECT_EQ(back.values[i], f32 ? static_cast<double>(static_cast<float>(m.values[i]))
+                                    : m.values[i]);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace geodex

@@ -314,8 +314,9 @@ class GeodexClient:
             options=_solver_options(options), want_directions=want_directions)
         r = self._call(self.stub.EstimateDistances, request, mesh)
         d = list(r.exact_directions)
+        directions = [tuple(d[i:i + 3]) for i in range(0, len(d), 3)]
         return PointDistances(list(r.estimates), list(r.estimate_labels), list(r.exact),
-                              list(r.exact_labels), [tuple(d[i:i + 3]) for i in range(0, len(d), 3)])
+                              list(r.exact_labels), directions)
 
     @_typed_errors
     def locate(self, mesh, positions, max_snap=None):
