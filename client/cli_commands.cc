@@ -387,7 +387,6 @@ bool GetSolverFlags(const Args& args, GeodesicOptions* options, std::string* err
   return true;
 }
 
-
 // --stats members for the farthest snap of a p:X:Y:Z point (none without positions).
 std::string SnapJson(const SnapReport& snap) {
   if (snap.point.empty()) return "";
@@ -416,7 +415,6 @@ std::string StatsJson(const Backend& backend, const std::string& leading, const 
       s.max_level, (unsigned long long)s.peak_live_windows, (unsigned long long)s.peak_bytes,
       trailing, s.solve_ms);
 }
-
 
 std::string FormatDistances(const std::vector<double>& distances,
                             const std::vector<std::array<double, 3>>& directions) {

@@ -30,8 +30,9 @@ bool ParseArgs(int argc, char** argv, int first, const std::vector<std::string>&
 
 class Backend;  // cli_backend.h: where the command runs (this process or a geodexd)
 
-// A query command, described next to its code: main dispatches on `name`, parses with its
-// value-less `flags`, and prints `help` (its entry of `geodex --help`, from "  NAME MESH ..." to
+// A query command, described next to its code: main dispatches on `name`, parses knowing its
+// value-less `flags` (every command's, so that another's flag is refused as unknown), and prints
+// `help` (its entry of `geodex --help`, from "  NAME MESH ..." to
 // the end of its description) for `geodex NAME --help`.
 struct Command {
   const char* name;

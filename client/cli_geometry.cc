@@ -2,7 +2,6 @@
 // geometry (paper section 6) and write it as JSON (default, stdout), OBJ lines or an SVG top view.
 // With a server the geometry is computed there and written here exactly the same way.
 
-
 #include "cli_common.h"
 #include "cli_backend.h"
 
@@ -85,7 +84,6 @@ bool OutputFormat(const Args& args, Format* format, std::string* error) {
   return false;
 }
 
-
 // --- JSON ------------------------------------------------------------------------------------
 
 std::string Num(double x) { return absl::StrFormat("%.17g", x); }
@@ -95,7 +93,6 @@ std::string PointsJson(const std::vector<PathPoint>& points) {
   for (size_t i = 0; i < points.size(); ++i) s += (i ? ", " : "") + PathPointJson(points[i]);
   return s + "]";
 }
-
 
 std::string SitesJson(const Solved& s) {
   std::string json = "[";
@@ -353,14 +350,12 @@ int RunVoronoi(Backend& backend, const Args& args) {
   return WriteOutput(args, json);
 }
 
-
 std::string EdgeJson(const DelaunayEdge& e) {
   return absl::StrFormat(
       "{\"sites\": [%d, %d], \"mesh_edge\": [%d, %d], \"length\": %.17g, \"edge_start\": %d, "
       "\"points\": %s}",
       e.site_a, e.site_b, e.vertex_a, e.vertex_b, e.length, e.edge_start, PointsJson(e.points));
 }
-
 
 // geodex delaunay: its entry of `geodex --help`.
 constexpr char kDelaunayHelp[] = R"(  delaunay MESH --sites SPEC [--output FILE.json|.obj|.svg]

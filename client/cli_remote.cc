@@ -244,6 +244,10 @@ class RemoteBackend final : public Backend {
     absl::StatusOr<DistanceField> f =
         Flagged(client_->Field(mesh_, query, &cached_), {{"sources", "sources"}});
     if (!f.ok()) return f.status();
+    if (query.directions && f->direction.size() != f->distance.size()) {
+      return absl::UnimplementedError(
+          "--directions: the server returned no directions (a geodexd older than this geodex?)");
+    }
     field_ = *std::move(f);
     return &field_;
   }
@@ -254,8 +258,23 @@ class RemoteBackend final : public Backend {
                 {{"sources", "sources"}, {"points", "at"}});
     if (!r.ok()) return r.status();
     AtValues out;
-    out.estimate.assign(r->estimates().begin(), r->estimates().end());
+    for (const PointEstimate& e : api::PointEstimatesFromProto(*r)) {
+      out.estimate.push_back(e.distance);
+    }
     out.exact = api::PointValuesFromProto(*r);
+    // What the command prints needs one value per point (a geodexd older than this client
+    // answers without the directions it does not know).
+    const size_t n = query.points.size();
+    if (query.directions && out.exact.direction.size() != n) {
+      return absl::UnimplementedError(
+          "--directions with --at: the server returned no directions (a geodexd older than this "
+          "geodex?)");
+    }
+    if (out.estimate.size() != n || out.exact.distance.size() != n ||
+        out.exact.source.size() != n) {
+      return absl::InternalError(absl::StrFormat(
+          "the server answered %d points for %d asked", out.exact.distance.size(), n));
+    }
     return out;
   }
 

@@ -1,13 +1,13 @@
 // geodex: the command line. Thin: parses the command and runs it on a backend (cli_backend.h):
 // this process, or a geodexd with --server.
 
-#include <cctype>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "cli_backend.h"
 #include "cli_commands.h"
@@ -72,7 +72,6 @@ std::string Usage() {
   return usage + kUsageTail;
 }
 
-
 // `geodex COMMAND --help`: that command's entry, then the point grammar and the exit codes; the
 // whole text for a command it does not know.
 std::string CommandHelp(const std::string& command) {
@@ -83,6 +82,16 @@ std::string CommandHelp(const std::string& command) {
     }
   }
   return Usage();
+}
+
+// Every command's value-less flags: a command given another's (`info --stats`) is told the option
+// is unknown to it, rather than that it needs a value.
+std::vector<std::string> ValueLessFlags() {
+  std::vector<std::string> flags;
+  for (const geodex::cli::Command& c : geodex::cli::QueryCommands()) {
+    flags.insert(flags.end(), c.flags.begin(), c.flags.end());
+  }
+  return flags;
 }
 
 }  // namespace
@@ -150,7 +159,7 @@ int main(int argc, char** argv) {
   if (command == "mesh" || command == "health") {
     Args args;
     std::string error;
-    if (!ParseArgs(argc, argv, first + 1, {}, &args, &error)) {
+    if (!ParseArgs(argc, argv, first + 1, ValueLessFlags(), &args, &error)) {
       std::fprintf(stderr, "geodex: %s\n", error.c_str());
       return kExitUsage;
     }
@@ -164,7 +173,7 @@ int main(int argc, char** argv) {
     if (command != c.name) continue;
     Args args;
     std::string error;
-    if (!ParseArgs(argc, argv, first + 1, c.flags, &args, &error)) {
+    if (!ParseArgs(argc, argv, first + 1, ValueLessFlags(), &args, &error)) {
       std::fprintf(stderr, "geodex: %s\n", error.c_str());
       return kExitUsage;
     }

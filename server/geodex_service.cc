@@ -395,6 +395,8 @@ MethodRow StreamRow(const char* name, Lane lane) {
           &Stream<Request, Response, kRun>};
 }
 
+// Append new methods at the end: the request fuzzer's seeds pick a method by its position among
+// the rows it drives.
 const std::vector<MethodRow>& MethodTable() {
   static const auto* table = new std::vector<MethodRow>{
       {{"CreateMesh", Lane::kSolve}, &Upload},

@@ -37,11 +37,14 @@ absl::StatusOr<MessageStream<v1::ComputeDistanceFieldResponse>> RunComputeDistan
 
   // Produced lazily from the field: no second copy of a large result. The products the request
   // asks for go beside the cached field, which stays as it is.
+  // (The field's own sources, sent in the first message, are solved.sources: the cache keys
+  // fields by them.)
   FieldQuery query;
+  query.sources = solved->sources;
   query.directions = request.want_directions();
   struct State {
-    SolvedField solved;     // the shared field: chunks are read from it, never copied whole
-    DistanceField products; // ComputeFieldProducts' members only
+    SolvedField solved;      // the shared field: chunks are read from it, never copied whole
+    DistanceField products;  // ComputeFieldProducts' members only
     size_t next = 0;
     bool started = false;
   };

@@ -174,8 +174,7 @@ absl::Status RunEstimateDistances(const QueryEnv& env, const v1::EstimateDistanc
     for (size_t i = 0; i < points->size(); ++i) {
       absl::StatusOr<PointEstimate> e = EstimateDistanceAt(tm, **field, (*points)[i]);
       if (!e.ok()) return NameSolveError(e.status(), "points");
-      response->add_estimates(e->distance);
-      response->add_estimate_labels(e->source);
+      api::PointEstimateToProto(*e, response);
     }
     if (request.want_stats()) {
       FieldStatsToProto(**field, cached, response->mutable_estimate_stats());

@@ -2,6 +2,8 @@
 
 // Backtracing from a target answered by a targeted solve (private to core).
 
+#include <array>
+
 #include "absl/status/statusor.h"
 #include "geodex/distance_field.h"
 #include "geodex/shortest_path.h"
@@ -21,5 +23,12 @@ struct VertexPaths {
 absl::StatusOr<GeodesicPath> TraceFromTarget(const TriangleMesh& mesh, const VertexPaths& field,
                                              const ich::TargetResult& result,
                                              const SurfacePoint& where);
+
+// The unit direction (file coordinates) of the first step of that path, read off the solve's
+// record in O(1): from a face or edge point straight towards the image of its origin (into the
+// neighbouring face when the point lies on the image's edge and the image is beyond it), from a
+// vertex as ComputeDirectionField does; 0 0 0 at a source, NaN where unreachable.
+std::array<double, 3> TargetDirection(const TriangleMesh& mesh, const VertexPaths& field,
+                                      const ich::TargetResult& result);
 
 }  // namespace geodex

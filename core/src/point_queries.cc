@@ -376,28 +376,6 @@ absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
   return m;
 }
 
-namespace {
-
-// The first step of a traced path (from its target), as a unit vector; 0 0 0 for a path of no
-// length.
-std::array<double, 3> FirstStep(const GeodesicPath& path) {
-  const std::array<double, 3>& from = path.points.front().position;
-  for (const PathPoint& p : path.points) {
-    double d[3], n2 = 0;
-    for (int k = 0; k < 3; ++k) {
-      d[k] = p.position[k] - from[k];
-      n2 += d[k] * d[k];
-    }
-    if (n2 > 0) {
-      const double n = std::sqrt(n2);
-      return {d[0] / n, d[1] / n, d[2] / n};
-    }
-  }
-  return {0, 0, 0};
-}
-
-}  // namespace
-
 absl::StatusOr<PointValues> ComputePointValues(const TriangleMesh& mesh, const PointQuery& query) {
   if (absl::Status s = CheckOptions(query.options); !s.ok()) return s;
   absl::StatusOr<std::vector<ich::ResolvedSource>> src = ResolveSources(mesh, query.sources);
@@ -407,7 +385,7 @@ absl::StatusOr<PointValues> ComputePointValues(const TriangleMesh& mesh, const P
   std::vector<ich::TargetResult> results;
   PointValues out;
   // One targeted solve (A* towards the points when they are close together), stopping once every
-  // point is final; the solver stays for the traces.
+  // point is final; the solver stays for the directions (read off its per-vertex origins).
   ich::IchSolver solver(mesh, query.options);
   if (absl::Status s = solver.SolveForTargets(*src, *resolved, /*use_heuristic=*/true, true,
                                               &results, &out.stats);
@@ -419,17 +397,9 @@ absl::StatusOr<PointValues> ComputePointValues(const TriangleMesh& mesh, const P
     out.source.push_back(r.label);
   }
   if (query.directions) {
-    constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
     const VertexPaths paths{solver.distances().data(), solver.origins().data()};
-    for (size_t i = 0; i < results.size(); ++i) {
-      if (results[i].distance == kUnreachable) {
-        out.direction.push_back({kNaN, kNaN, kNaN});
-        continue;
-      }
-      absl::StatusOr<GeodesicPath> path = TraceFromTarget(mesh, paths, results[i], query.points[i]);
-      if (!path.ok()) return path.status();
-      out.direction.push_back(results[i].distance > 0 ? FirstStep(*path)
-                                                      : std::array<double, 3>{0, 0, 0});
+    for (const ich::TargetResult& r : results) {
+      out.direction.push_back(TargetDirection(mesh, paths, r));
     }
   }
   return out;

@@ -274,6 +274,55 @@ absl::StatusOr<GeodesicPath> TracePathFromVertex(const TriangleMesh& mesh,
   return path;
 }
 
+namespace {
+
+std::array<double, 3> Unit(const double d[3]) {
+  const double norm = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  if (!(norm > 0)) return {0, 0, 0};
+  return {d[0] / norm, d[1] / norm, d[2] / norm};
+}
+
+// The step from the point at (px, py) in the frame of half-edge g (on g when `on_g`) straight
+// towards (ix, iy): inside face(g), or, from a point on g with the image below it, in the twin's
+// face, which the frame of g shows unfolded below the edge.
+void StepInFrame(const TriangleMesh& mesh, uint32_t g, double px, double py, double ix, double iy,
+                 bool on_g, double d[3]) {
+  const double dx = ix - px, dy = iy - py;
+  const Frame3 f = FrameOf(mesh, g);
+  const uint32_t twin = mesh.Twin(g);
+  if (!on_g || dy >= 0 || twin == kNoIndex) {
+    for (int k = 0; k < 3; ++k) d[k] = dx * f.u[k] + dy * f.n[k];
+  } else {
+    const Frame3 t = FrameOf(mesh, twin);
+    for (int k = 0; k < 3; ++k) d[k] = dx * f.u[k] - dy * t.n[k];
+  }
+}
+
+// The first step from internal vertex v along its origin o (0 0 0 at a source).
+std::array<double, 3> VertexStep(const TriangleMesh& mesh, uint32_t v, double distance,
+                                 const VertexOrigin& o) {
+  const double* pos = mesh.positions();
+  double d[3] = {0, 0, 0};
+  if (o.half_edge == kNoIndex) {
+    // Along an edge towards a neighbour (edge relaxation); a source vertex has no direction.
+    if (o.pseudo_source != kNoIndex && o.pseudo_source != v && distance > 0) {
+      for (int k = 0; k < 3; ++k) d[k] = pos[3 * o.pseudo_source + k] - pos[3 * v + k];
+    }
+  } else {
+    // Straight from v towards the image of its origin, in the frame of o.half_edge (from the
+    // opposite corner the step heads for edge g, so it runs inside face(g)).
+    const uint32_t g = o.half_edge;
+    const double len = mesh.Length(g);
+    const bool opposite = mesh.From(g) != v && mesh.To(g) != v;
+    const double px = mesh.From(g) == v ? 0 : mesh.To(g) == v ? len : mesh.OppX(g);
+    const double py = opposite ? mesh.OppY(g) : 0;
+    StepInFrame(mesh, g, px, py, o.ix, o.iy, !opposite, d);
+  }
+  return Unit(d);
+}
+
+}  // namespace
+
 std::vector<std::array<double, 3>> ComputeDirectionField(const TriangleMesh& mesh,
                                                          const DistanceField& field) {
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -287,41 +336,37 @@ std::vector<std::array<double, 3>> ComputeDirectionField(const TriangleMesh& mes
     const uint32_t f = mesh.FileVertex(v);
     if (field.internal_distance[v] < field.internal_distance[best[f]]) best[f] = v;
   }
-  const double* pos = mesh.positions();
   for (uint32_t file = 0; file < nv; ++file) {
     const uint32_t v = best[file];
     if (!std::isfinite(field.internal_distance[v])) continue;  // undefined: NaN
-    const VertexOrigin& o = field.internal_origin[v];
-    double d[3] = {0, 0, 0};
-    if (o.half_edge == kNoIndex) {
-      // Along an edge towards a neighbour (edge relaxation); a source vertex has no direction.
-      if (o.pseudo_source != kNoIndex && o.pseudo_source != v && field.internal_distance[v] > 0) {
-        for (int k = 0; k < 3; ++k) d[k] = pos[3 * o.pseudo_source + k] - pos[3 * v + k];
-      }
-    } else {
-      // Straight from v towards the image of its origin, in the frame of o.half_edge.
-      const uint32_t g = o.half_edge;
-      const double len = mesh.Length(g);
-      const bool opposite = mesh.From(g) != v && mesh.To(g) != v;
-      const double px = mesh.From(g) == v ? 0 : mesh.To(g) == v ? len : mesh.OppX(g);
-      const double py = opposite ? mesh.OppY(g) : 0;
-      const double dx = o.ix - px, dy = o.iy - py;
-      const Frame3 f = FrameOf(mesh, g);
-      const uint32_t twin = mesh.Twin(g);
-      if (opposite || dy >= 0 || twin == kNoIndex) {
-        // The first step runs inside face(g) (from the opposite corner it heads for edge g).
-        for (int k = 0; k < 3; ++k) d[k] = dx * f.u[k] + dy * f.n[k];
-      } else {
-        // From an endpoint of g with the image below it: the first step runs in the twin's face,
-        // which the frame of g shows unfolded below the edge.
-        const Frame3 t = FrameOf(mesh, twin);
-        for (int k = 0; k < 3; ++k) d[k] = dx * f.u[k] - dy * t.n[k];
-      }
-    }
-    const double norm = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    for (int k = 0; k < 3; ++k) out[file][k] = norm > 0 ? d[k] / norm : 0;
+    out[file] = VertexStep(mesh, v, field.internal_distance[v], field.internal_origin[v]);
   }
   return out;
+}
+
+std::array<double, 3> TargetDirection(const TriangleMesh& mesh, const VertexPaths& field,
+                                      const ich::TargetResult& r) {
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  if (!std::isfinite(r.distance)) return {kNaN, kNaN, kNaN};
+  if (!(r.distance > 0)) return {0, 0, 0};
+  if (r.vertex != kNoIndex) {
+    return VertexStep(mesh, r.vertex, field.distance[r.vertex], field.origin[r.vertex]);
+  }
+  double d[3];
+  if (r.origin.half_edge == kNoIndex) {
+    // Straight to a corner of the point's face (TraceFromTarget's first leg).
+    const Frame3 f = FrameOf(mesh, 3 * r.face);
+    const double* c = mesh.positions() + 3 * r.origin.pseudo_source;
+    for (int k = 0; k < 3; ++k) d[k] = c[k] - (f.o[k] + r.px * f.u[k] + r.py * f.n[k]);
+  } else {
+    // Towards the image, in the frame of its half-edge g, where the point is at (tx, ty); a point
+    // on g itself (ty within the trace's tolerance of 0) steps into the twin's face when the image
+    // is beyond g.
+    const uint32_t g = r.origin.half_edge;
+    const bool on_g = std::abs(r.ty) <= 1e-12 * mesh.Length(g);
+    StepInFrame(mesh, g, r.tx, r.ty, r.origin.ix, r.origin.iy, on_g, d);
+  }
+  return Unit(d);
 }
 
 void ComputeFieldProducts(const TriangleMesh& mesh, const DistanceField& field,

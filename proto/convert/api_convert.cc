@@ -236,6 +236,19 @@ PointValues PointValuesFromProto(const v1::EstimateDistancesResponse& response) 
   return out;
 }
 
+void PointEstimateToProto(const PointEstimate& estimate, v1::EstimateDistancesResponse* out) {
+  out->add_estimates(estimate.distance);
+  out->add_estimate_labels(estimate.source);
+}
+
+std::vector<PointEstimate> PointEstimatesFromProto(const v1::EstimateDistancesResponse& response) {
+  std::vector<PointEstimate> out;
+  for (int i = 0; i < response.estimates_size() && i < response.estimate_labels_size(); ++i) {
+    out.push_back({response.estimates(i), response.estimate_labels(i)});
+  }
+  return out;
+}
+
 void FieldQueryToProto(const FieldQuery& query, v1::ComputeDistanceFieldRequest* out) {
   for (const SurfacePoint& p : query.sources) SurfacePointToProto(p, out->add_sources());
   SolverOptionsToProto(query.options, out->mutable_options());

@@ -9,6 +9,7 @@
 #include "geodex/distance_field.h"
 #include "geodex/distance_matrix.h"
 #include "geodex/locate.h"
+#include "geodex/point_distance.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/shortest_path.h"
 #include "geodex/surface_point.h"
@@ -51,6 +52,9 @@ void SolverOptionsToProto(const GeodesicOptions& options, v1::SolverOptions* out
 void PointQueryToProto(const PointQuery& query, v1::EstimateDistancesRequest* out);
 void PointValuesToProto(const PointValues& values, v1::EstimateDistancesResponse* out);
 PointValues PointValuesFromProto(const v1::EstimateDistancesResponse& response);
+// Its estimate part (paper section 4), one point at a time out and all of them back.
+void PointEstimateToProto(const PointEstimate& estimate, v1::EstimateDistancesResponse* out);
+std::vector<PointEstimate> PointEstimatesFromProto(const v1::EstimateDistancesResponse& response);
 
 // ComputeDistanceField's stream, both directions. The query into the request: its sources,
 // options and the products it asks for (value type, labels and stats are the caller's).

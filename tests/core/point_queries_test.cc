@@ -185,6 +185,13 @@ TEST(PointDirectionTest, OnAPlaneEachPointHeadsStraightAtItsNearestSource) {
   PointQuery query;
   query.sources = {SurfacePoint::AtVertex(30), SurfacePoint::InFace(200, 0.2, 0.5, 0.3)};
   for (int i = 0; i < 40; ++i) query.points.push_back(RandomPoint(data, rng));
+  // Edge points on each of a face's three edges (the solver places them in either face).
+  for (uint32_t f : {7u, 90u, 150u, 251u}) {
+    for (int k = 0; k < 3; ++k) {
+      query.points.push_back(SurfacePoint::OnEdge(data.faces[3 * f + k],
+                                                  data.faces[3 * f + (k + 1) % 3], 0.375));
+    }
+  }
   query.points.push_back(query.sources[1]);
   query.directions = true;
   absl::StatusOr<PointValues> v = ComputePointValues(*mesh, query);
@@ -252,6 +259,61 @@ TEST(PointDirectionTest, InAnLAPointBehindTheCornerHeadsForTheCorner) {
   EXPECT_GT(seen, 0);
 }
 
+// A sheet folded along x = 1/2: from points on the fold (vertices, and edge points the solver may
+// place in the far face) and in the flat half holding the source, the direction is the straight
+// 3D line to the source; a point beyond the fold heads for the fold in its own plane.
+TEST(PointDirectionTest, OnAFoldedSheetPointsOnTheFoldHeadStraightAtTheSource) {
+  GridSpec spec;
+  spec.cells_x = spec.cells_y = 12;
+  MeshData data = MakeGrid(spec);
+  const double slope = 0.8;
+  for (size_t v = 0; v < data.vertex_count(); ++v) {
+    const double x = data.positions[3 * v];
+    if (x > 0.5) data.positions[3 * v + 2] = (x - 0.5) * slope;
+  }
+  absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(data);
+  ASSERT_TRUE(mesh.ok());
+  PointQuery query;
+  query.sources = {SurfacePoint::InFace(124, 0.3, 0.3, 0.4)};  // in the flat half
+  const Vec3 s = PositionOf(data, query.sources[0]);
+  ASSERT_LT(s[0], 0.5);
+  std::vector<bool> on_fold;
+  for (uint32_t j = 0; j < 12; ++j) {
+    const uint32_t a = j * 13 + 6, b = (j + 1) * 13 + 6;  // vertices at x = 1/2
+    query.points.push_back(SurfacePoint::AtVertex(a));
+    query.points.push_back(SurfacePoint::OnEdge(a, b, 0.25 + 0.04 * j));
+    query.points.push_back(SurfacePoint::OnEdge(b, a, 0.6));
+  }
+  on_fold.assign(query.points.size(), true);
+  for (uint32_t f = 0; f < data.face_count(); f += 7) {  // face points on both sides
+    query.points.push_back(SurfacePoint::InFace(f, 0.2, 0.5, 0.3));
+    on_fold.push_back(false);
+  }
+  query.directions = true;
+  absl::StatusOr<PointValues> v = ComputePointValues(*mesh, query);
+  ASSERT_TRUE(v.ok()) << v.status();
+  int beyond = 0;
+  for (size_t j = 0; j < query.points.size(); ++j) {
+    const Vec3 p = PositionOf(data, query.points[j]);
+    Vec3 want;
+    if (p[0] <= 0.5) {
+      want = Unit(p, s);
+    } else {
+      // Unfold the far half onto the plane: the path is straight there and crosses x = 1/2.
+      const double u = 0.5 + (p[0] - 0.5) * std::sqrt(1 + slope * slope);  // unfolded x
+      const double t = (u - 0.5) / (u - s[0]);  // where p -> s meets the fold, as a fraction
+      const Vec3 cross{0.5, p[1] + (s[1] - p[1]) * t, 0};
+      want = Unit(p, cross);
+      ++beyond;
+    }
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(v->direction[j][c], want[c], 1e-9)
+          << SurfacePointToString(query.points[j]) << (on_fold[j] ? " (on the fold)" : "");
+    }
+  }
+  EXPECT_GT(beyond, 5);
+}
+
 // At vertices the directions are the direction field's (ComputeDirectionField reads them off the
 // full field's origins; here they come from a targeted solve's trace); beyond max_distance NaN.
 TEST(PointDirectionTest, AtVerticesTheyAreTheDirectionFieldAndNaNWhereUnreachable) {
@@ -272,7 +334,9 @@ TEST(PointDirectionTest, AtVerticesTheyAreTheDirectionFieldAndNaNWhereUnreachabl
     ASSERT_TRUE(at.ok()) << at.status();
     for (size_t j = 0; j < query.points.size(); ++j) {
       const uint32_t v = query.points[j].vertex;
-      for (int c = 0; c < 3; ++c) EXPECT_NEAR(at->direction[j][c], dir[v][c], 1e-9) << name << " " << v;
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(at->direction[j][c], dir[v][c], 1e-9) << name << " " << v;
+      }
     }
     query.options.max_distance = 1e-9;  // only the source within reach
     query.points = {SurfacePoint::AtVertex(3), SurfacePoint::AtVertex(200)};

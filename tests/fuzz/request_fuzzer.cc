@@ -1,9 +1,10 @@
 // libFuzzer target: the query handlers of geodexd (server/queries.h) on arbitrary requests, against
 // an in-process mesh store with two small meshes ("meshes/hills" and its id) and a DEM's mesh
-// ("meshes/dem", with its map: map points, DeriveMesh's GeoJSON polygons, ExportGis). Byte 0 picks the
-// method from the service's own table (GeodexService::Methods, so a new method is fuzzed without a
-// change here); the rest is parsed as that method's request message. Every outcome must be an answer or
-// a status, never a crash; streamed results are drained. Solves are bounded by a window budget.
+// ("meshes/dem", with its map: map points, DeriveMesh's GeoJSON polygons, ExportGis). Byte 0 picks
+// the method from the service's own table (GeodexService::Methods, so a new method is fuzzed
+// without a change here); the rest is parsed as that method's request message. Every outcome must
+// be an answer or a status, never a crash; streamed results are drained. Solves are bounded by a
+// window budget.
 
 #include <cstddef>
 #include <cstdint>

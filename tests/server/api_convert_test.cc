@@ -237,7 +237,8 @@ TEST(ApiConvertTest, PointQueryAndValuesRoundTrip) {
   ASSERT_TRUE(mesh.ok());
   PointQuery query;
   query.sources = {SurfacePoint::AtVertex(0), SurfacePoint::InFace(5, 0.2, 0.3, 0.5)};
-  query.points = {SurfacePoint::AtVertex(40), SurfacePoint::OnEdge(1, 2, 0.25), SurfacePoint::AtVertex(0)};
+  query.points = {SurfacePoint::AtVertex(40), SurfacePoint::OnEdge(1, 2, 0.25),
+                  SurfacePoint::AtVertex(0)};
   query.options.lambda = 0.125;
   query.options.max_distance = 1e9;
   v1::EstimateDistancesRequest request;
@@ -256,6 +257,9 @@ TEST(ApiConvertTest, PointQueryAndValuesRoundTrip) {
   EXPECT_EQ(request.options().max_distance(), 1e9);
 
   query.options = GeodesicOptions{};
+  query.directions = true;
+  api::PointQueryToProto(query, &request);
+  EXPECT_TRUE(request.want_directions());
   absl::StatusOr<PointValues> values = ComputePointValues(*mesh, query);
   ASSERT_TRUE(values.ok()) << values.status();
   ASSERT_EQ(values->distance.size(), 3u);
@@ -267,6 +271,15 @@ TEST(ApiConvertTest, PointQueryAndValuesRoundTrip) {
   EXPECT_EQ(back.distance, values->distance);
   EXPECT_EQ(back.source, values->source);
   EXPECT_EQ(back.stats.windows_processed, values->stats.windows_processed);
+  ASSERT_EQ(values->direction.size(), 3u);
+  ASSERT_EQ(back.direction.size(), 3u);
+  for (size_t i = 0; i < 3; ++i) EXPECT_EQ(back.direction[i], values->direction[i]);
+  const PointEstimate estimate{1.25, 1};
+  api::PointEstimateToProto(estimate, &response);
+  const std::vector<PointEstimate> estimates = api::PointEstimatesFromProto(response);
+  ASSERT_EQ(estimates.size(), 1u);
+  EXPECT_EQ(estimates[0].distance, 1.25);
+  EXPECT_EQ(estimates[0].source, 1u);
 }
 
 // ComputeDistanceField's stream: a field with its directions cut into many messages (what

@@ -326,7 +326,9 @@ TEST_F(QueriesTest, DirectionsAtPointsEqualCoreAndNeedTheExactMode) {
   const PointValues remote = api::PointValuesFromProto(response);
   ASSERT_EQ(remote.direction.size(), 3u);
   for (size_t i = 0; i < 3; ++i) {
-    for (int c = 0; c < 3; ++c) EXPECT_TRUE(BitEqual(remote.direction[i][c], local->direction[i][c]));
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_TRUE(BitEqual(remote.direction[i][c], local->direction[i][c]));
+    }
     EXPECT_NEAR(std::hypot(remote.direction[i][0], remote.direction[i][1], remote.direction[i][2]),
                 1, 1e-12);
   }
