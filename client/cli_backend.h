@@ -69,12 +69,10 @@ class Backend {
   virtual absl::StatusOr<const DistanceField*> Field(const FieldQuery& query) = 0;
   // The query is forwarded whole: to core locally, through proto/convert remotely.
   virtual absl::StatusOr<AtValues> DistancesAt(const PointQuery& query) = 0;
-  virtual absl::StatusOr<PathQueryResult> Path(const SurfacePoint& from, const SurfacePoint& to,
-                                               const PathQueryOptions& options) = 0;
-  // options.on_row sees rows as they are solved (locally) or arrive (remotely).
-  virtual absl::StatusOr<DistanceMatrix> Matrix(const std::vector<SurfacePoint>& sources,
-                                                const std::vector<SurfacePoint>& targets,
-                                                const MatrixOptions& options) = 0;
+  // Path and matrix are forwarded whole too.
+  virtual absl::StatusOr<PathQueryResult> Path(const PathQuery& query) = 0;
+  // query.options.on_row sees rows as they are solved (locally) or arrive (remotely).
+  virtual absl::StatusOr<DistanceMatrix> Matrix(const MatrixQuery& query) = 0;
   // Section 6 geometry of the exact field of `sources` (a local backend solves it once for all).
   virtual absl::StatusOr<Isolines> ComputeIsolines(const std::vector<SurfacePoint>& sources,
                                                    const IsolineOptions& levels) = 0;

@@ -701,7 +701,7 @@ int RunPath(Backend& backend, const Args& args) {
   SnapReport snap;
   if (absl::Status s = OnePoint(backend, args, "from", &from, &snap); !s.ok()) return FailQuery(s);
   if (absl::Status s = OnePoint(backend, args, "to", &to, &snap); !s.ok()) return FailQuery(s);
-  absl::StatusOr<PathQueryResult> result = backend.Path(from, to, options);
+  absl::StatusOr<PathQueryResult> result = backend.Path({from, to, options});
   if (!result.ok()) return FailQuery(result.status());
   if (IsGeoJsonPath(args)) {  // a 3D LineString with its length
     if (int code = WriteGeoJsonOutput(
@@ -790,7 +790,7 @@ int RunMatrix(Backend& backend, const Args& args) {
   if (absl::Status s = ResolveOption(backend, args, "targets", &targets, &snap); !s.ok()) {
     return FailQuery(s);
   }
-  absl::StatusOr<DistanceMatrix> m = backend.Matrix(sources, targets, options);
+  absl::StatusOr<DistanceMatrix> m = backend.Matrix({sources, targets, options});
   progress.Finish();
   if (!m.ok()) return FailQuery(m.status());
   const std::string text = json ? FormatMatrixJson(*m) : FormatMatrix(*m);

@@ -105,15 +105,12 @@ class LocalBackend final : public Backend {
     return out;
   }
 
-  absl::StatusOr<PathQueryResult> Path(const SurfacePoint& from, const SurfacePoint& to,
-                                       const PathQueryOptions& options) override {
-    return Reachable(ComputeShortestPath(loaded_->mesh, from, to, options));
+  absl::StatusOr<PathQueryResult> Path(const PathQuery& query) override {
+    return Reachable(ComputeShortestPath(loaded_->mesh, query));
   }
 
-  absl::StatusOr<DistanceMatrix> Matrix(const std::vector<SurfacePoint>& sources,
-                                        const std::vector<SurfacePoint>& targets,
-                                        const MatrixOptions& options) override {
-    return Reachable(ComputeDistanceMatrix(loaded_->mesh, sources, targets, options));
+  absl::StatusOr<DistanceMatrix> Matrix(const MatrixQuery& query) override {
+    return Reachable(ComputeDistanceMatrix(loaded_->mesh, query));
   }
 
   absl::StatusOr<Isolines> ComputeIsolines(const std::vector<SurfacePoint>& sources,

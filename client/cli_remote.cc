@@ -60,12 +60,6 @@ std::unique_ptr<GeodexClient> Connect(const std::string& target) {
   return std::make_unique<GeodexClient>(options);
 }
 
-v1::SolverOptions ToProto(const GeodesicOptions& options) {
-  v1::SolverOptions out;
-  api::SolverOptionsToProto(options, &out);
-  return out;
-}
-
 // A request point the server refused, named as the flag that gave it, in local mode's words:
 // "sources[0].vertex: ..." from geodexd becomes "--sources: point 7: ..." (the field's head is
 // looked up in `flags`, request field -> CLI flag). Other errors pass unchanged.
@@ -278,18 +272,12 @@ class RemoteBackend final : public Backend {
     return out;
   }
 
-  absl::StatusOr<PathQueryResult> Path(const SurfacePoint& from, const SurfacePoint& to,
-                                       const PathQueryOptions& options) override {
-    return Flagged(client_->ShortestPath(mesh_, from, to, ToProto(options.solver)),
-                   {{"from", "from"}, {"to", "to"}});
+  absl::StatusOr<PathQueryResult> Path(const PathQuery& query) override {
+    return Flagged(client_->ShortestPath(mesh_, query), {{"from", "from"}, {"to", "to"}});
   }
 
-  absl::StatusOr<DistanceMatrix> Matrix(const std::vector<SurfacePoint>& sources,
-                                        const std::vector<SurfacePoint>& targets,
-                                        const MatrixOptions& options) override {
-    return Flagged(client_->Matrix(mesh_, sources, targets, ToProto(options.solver),
-                                   options.k_nearest, options.on_row),
-                   {{"sources", "sources"}, {"targets", "targets"}});
+  absl::StatusOr<DistanceMatrix> Matrix(const MatrixQuery& query) override {
+    return Flagged(client_->Matrix(mesh_, query), {{"sources", "sources"}, {"targets", "targets"}});
   }
 
   absl::StatusOr<Isolines> ComputeIsolines(const std::vector<SurfacePoint>& sources,

@@ -149,7 +149,7 @@ int RunRender(Backend& backend, const Args& args) {
     layers.delaunay = *std::move(d);
   }
   if (!ends.empty()) {
-    absl::StatusOr<PathQueryResult> p = backend.Path(ends[0], ends[1], PathQueryOptions{});
+    absl::StatusOr<PathQueryResult> p = backend.Path({ends[0], ends[1], PathQueryOptions{}});
     if (!p.ok()) return FailQuery(p.status());
     layers.path = *std::move(p);
   }

@@ -391,14 +391,11 @@ absl::StatusOr<MeshData> GeodexClient::GetMeshGeometry(MeshRef& mesh) {
   return std::move(out.result());
 }
 
-absl::StatusOr<PathQueryResult> GeodexClient::ShortestPath(MeshRef& mesh, const SurfacePoint& from,
-                                                           const SurfacePoint& to,
-                                                           const v1::SolverOptions& options) {
+absl::StatusOr<PathQueryResult> GeodexClient::ShortestPath(MeshRef& mesh,
+                                                           const PathQuery& query) {
   v1::FindShortestPathRequest request;
   request.set_mesh(mesh.name);
-  api::SurfacePointToProto(from, request.mutable_from());
-  api::SurfacePointToProto(to, request.mutable_to());
-  *request.mutable_options() = options;
+  api::PathQueryToProto(query, &request);
   request.set_want_stats(true);
   v1::FindShortestPathResponse response;
   grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
@@ -408,18 +405,10 @@ absl::StatusOr<PathQueryResult> GeodexClient::ShortestPath(MeshRef& mesh, const 
   return api::PathResultFromProto(response);
 }
 
-absl::StatusOr<DistanceMatrix> GeodexClient::Matrix(MeshRef& mesh,
-                                                    const std::vector<SurfacePoint>& sources,
-                                                    const std::vector<SurfacePoint>& targets,
-                                                    const v1::SolverOptions& options,
-                                                    uint32_t k_nearest,
-                                                    const std::function<void(size_t, size_t)>& on_rows) {
+absl::StatusOr<DistanceMatrix> GeodexClient::Matrix(MeshRef& mesh, const MatrixQuery& query) {
   v1::ComputeDistanceMatrixRequest request;
   request.set_mesh(mesh.name);
-  request.set_k_nearest(k_nearest);
-  for (const SurfacePoint& p : sources) api::SurfacePointToProto(p, request.add_sources());
-  for (const SurfacePoint& p : targets) api::SurfacePointToProto(p, request.add_targets());
-  *request.mutable_options() = options;
+  api::MatrixQueryToProto(query, &request);
   request.set_want_stats(true);
   api::MatrixAssembler matrix;
   grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
@@ -428,7 +417,9 @@ absl::StatusOr<DistanceMatrix> GeodexClient::Matrix(MeshRef& mesh,
     v1::ComputeDistanceMatrixResponse response;
     while (reader->Read(&response)) {
       matrix.Add(response);
-      if (on_rows && matrix.result().cols > 0) on_rows(matrix.rows_done(), matrix.result().rows);
+      if (query.options.on_row && matrix.result().cols > 0) {
+        query.options.on_row(matrix.rows_done(), matrix.result().rows);
+      }
     }
     return reader->Finish();
   });

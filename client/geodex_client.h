@@ -108,15 +108,11 @@ class GeodexClient {
   // with every product the query asks for; `cached`: the server's cache answered.
   absl::StatusOr<DistanceField> Field(MeshRef& mesh, const FieldQuery& query,
                                       bool* cached = nullptr);
-  absl::StatusOr<PathQueryResult> ShortestPath(MeshRef& mesh, const SurfacePoint& from,
-                                               const SurfacePoint& to,
-                                               const v1::SolverOptions& options);
-  // k_nearest > 0: per source only its k nearest targets (see the proto). The server streams
-  // rows as they finish; `on_rows(rows received, rows)`, when set, is called as they arrive.
-  absl::StatusOr<DistanceMatrix> Matrix(
-      MeshRef& mesh, const std::vector<SurfacePoint>& sources,
-      const std::vector<SurfacePoint>& targets, const v1::SolverOptions& options,
-      uint32_t k_nearest = 0, const std::function<void(size_t, size_t)>& on_rows = nullptr);
+  // The path asked whole (api::PathQueryToProto; the server answers with A*).
+  absl::StatusOr<PathQueryResult> ShortestPath(MeshRef& mesh, const PathQuery& query);
+  // The matrix asked whole (api::MatrixQueryToProto). The server streams rows as they finish;
+  // query.options.on_row(rows received, rows), when set, is called as they arrive.
+  absl::StatusOr<DistanceMatrix> Matrix(MeshRef& mesh, const MatrixQuery& query);
   // EstimateDistances: the query sent whole (api::PointQueryToProto); read the exact part of the
   // answer with api::PointValuesFromProto.
   absl::StatusOr<v1::EstimateDistancesResponse> PointDistances(MeshRef& mesh,

@@ -142,6 +142,11 @@ absl::StatusOr<PathQueryResult> ComputeShortestPath(const TriangleMesh& mesh,
   return result;
 }
 
+absl::StatusOr<PathQueryResult> ComputeShortestPath(const TriangleMesh& mesh,
+                                                    const PathQuery& query) {
+  return ComputeShortestPath(mesh, query.from, query.to, query.options);
+}
+
 void KeepKNearest(uint32_t k, double* row, size_t n) {
   if (k == 0 || k >= n) return;
   std::vector<size_t> order(n);
@@ -208,6 +213,11 @@ void RunRows(size_t total, unsigned threads, const std::function<void(std::funct
 }
 
 }  // namespace
+
+absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
+                                                     const MatrixQuery& query) {
+  return ComputeDistanceMatrix(mesh, query.sources, query.targets, query.options);
+}
 
 absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
                                                      const std::vector<SurfacePoint>& sources,

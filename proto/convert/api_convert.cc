@@ -312,6 +312,19 @@ void FieldAssembler::Add(const v1::ComputeDistanceFieldResponse& message) {
   }
 }
 
+void PathQueryToProto(const PathQuery& query, v1::FindShortestPathRequest* out) {
+  SurfacePointToProto(query.from, out->mutable_from());
+  SurfacePointToProto(query.to, out->mutable_to());
+  SolverOptionsToProto(query.options.solver, out->mutable_options());
+}
+
+void MatrixQueryToProto(const MatrixQuery& query, v1::ComputeDistanceMatrixRequest* out) {
+  for (const SurfacePoint& p : query.sources) SurfacePointToProto(p, out->add_sources());
+  for (const SurfacePoint& p : query.targets) SurfacePointToProto(p, out->add_targets());
+  SolverOptionsToProto(query.options.solver, out->mutable_options());
+  out->set_k_nearest(query.options.k_nearest);
+}
+
 void PathResultToProto(double distance, const std::vector<PathPoint>& points,
                        v1::FindShortestPathResponse* out) {
   out->set_distance(distance);

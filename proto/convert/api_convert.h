@@ -84,6 +84,10 @@ class FieldAssembler {
   bool cached_ = false;
 };
 
+// The path and matrix requests asked whole: points, solver options and (matrix) k_nearest.
+void PathQueryToProto(const PathQuery& query, v1::FindShortestPathRequest* out);
+void MatrixQueryToProto(const MatrixQuery& query, v1::ComputeDistanceMatrixRequest* out);
+
 // FindShortestPath's answer (and each of FindShortestPaths'), both directions: the length and the
 // points from `from` to `to` (none when unreachable in FindShortestPaths). Stats are the
 // caller's; FromProto reads them when present.

@@ -392,5 +392,34 @@ TEST(ApiConvertTest, MatrixRoundTripsThroughManyMessages) {
   }
 }
 
+// The path and matrix requests asked whole: every member the wire carries arrives.
+TEST(ApiConvertTest, PathAndMatrixQueriesFillTheirRequests) {
+  PathQuery path{SurfacePoint::AtVertex(3), SurfacePoint::InFace(9, 0.5, 0.25, 0.25), {}};
+  path.options.solver.lambda = 0.25;
+  path.options.solver.max_distance = 7;
+  v1::FindShortestPathRequest path_request;
+  api::PathQueryToProto(path, &path_request);
+  EXPECT_EQ(SurfacePointToString(api::SurfacePointFromProto(path_request.from())), "3");
+  EXPECT_EQ(SurfacePointToString(api::SurfacePointFromProto(path_request.to())),
+            SurfacePointToString(path.to));
+  EXPECT_EQ(path_request.options().lambda(), 0.25);
+  EXPECT_EQ(path_request.options().max_distance(), 7);
+
+  MatrixQuery matrix{{SurfacePoint::AtVertex(1), SurfacePoint::AtVertex(2)},
+                     {SurfacePoint::OnEdge(4, 5, 0.5)},
+                     {}};
+  matrix.options.k_nearest = 1;
+  matrix.options.solver.lambda = 0.5;
+  v1::ComputeDistanceMatrixRequest matrix_request;
+  api::MatrixQueryToProto(matrix, &matrix_request);
+  ASSERT_EQ(matrix_request.sources_size(), 2);
+  ASSERT_EQ(matrix_request.targets_size(), 1);
+  EXPECT_EQ(SurfacePointToString(api::SurfacePointFromProto(matrix_request.sources(1))), "2");
+  EXPECT_EQ(SurfacePointToString(api::SurfacePointFromProto(matrix_request.targets(0))),
+            SurfacePointToString(matrix.targets[0]));
+  EXPECT_EQ(matrix_request.k_nearest(), 1u);
+  EXPECT_EQ(matrix_request.options().lambda(), 0.5);
+}
+
 }  // namespace
 }  // namespace geodex

@@ -142,8 +142,8 @@ TEST_F(ClientTest, QueueFullIsRetriedWithBackoffButALimitIsNot) {
   // Two targets with --max_targets=1: RESOURCE_EXHAUSTED (reason LIMIT) at once, no retry.
   const int retries_mid = client.retries();
   absl::StatusOr<DistanceMatrix> matrix = client.Matrix(
-      mesh, {SurfacePoint::AtVertex(0)}, {SurfacePoint::AtVertex(1), SurfacePoint::AtVertex(2)},
-      v1::SolverOptions());
+      mesh, {{SurfacePoint::AtVertex(0)}, {SurfacePoint::AtVertex(1), SurfacePoint::AtVertex(2)},
+             MatrixOptions{}});
   EXPECT_EQ(matrix.status().code(), absl::StatusCode::kResourceExhausted) << matrix.status();
   EXPECT_EQ(client.retries(), retries_mid);
 }

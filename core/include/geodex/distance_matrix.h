@@ -67,6 +67,16 @@ absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
                                                      const std::vector<SurfacePoint>& targets,
                                                      const GeodesicOptions& options = {});
 
+// The same, asked whole: what `geodex matrix` and ComputeDistanceMatrix ask. The CLI hands it to
+// either backend as it is and proto/convert carries it (api::MatrixQueryToProto: the points,
+// solver and k_nearest; threads and callbacks stay on the asking side).
+struct MatrixQuery {
+  std::vector<SurfacePoint> sources, targets;
+  MatrixOptions options;
+};
+absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
+                                                     const MatrixQuery& query);
+
 // The number of cores this process may run on (at least 1).
 unsigned UsableCores();
 

@@ -86,6 +86,15 @@ absl::StatusOr<PathQueryResult> ComputeShortestPath(const TriangleMesh& mesh,
                                                     const SurfacePoint& to,
                                                     const PathQueryOptions& options = {});
 
+// The same, asked whole: what `geodex path` and FindShortestPath ask. The CLI hands it to either
+// backend as it is and proto/convert carries it (api::PathQueryToProto).
+struct PathQuery {
+  SurfacePoint from, to;
+  PathQueryOptions options;
+};
+absl::StatusOr<PathQueryResult> ComputeShortestPath(const TriangleMesh& mesh,
+                                                    const PathQuery& query);
+
 // Paths from one point to several: one targeted solve (A* towards the targets when they are close
 // together, stopping once every target is final), then one trace per target.
 struct PathsQueryResult {
