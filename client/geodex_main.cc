@@ -154,15 +154,15 @@ int main(int argc, char** argv) {
       return kExitOk;
     }
   }
+  Args args;
+  std::string error;
+  if (!ParseArgs(argc, argv, first + 1, ValueLessFlags(), &args, &error)) {
+    std::fprintf(stderr, "geodex: %s\n", error.c_str());
+    return kExitUsage;
+  }
   // A terminal sees elapsed time for anything that takes more than a second.
   Progress progress(server.empty() ? command : command + " on " + server);
   if (command == "mesh" || command == "health") {
-    Args args;
-    std::string error;
-    if (!ParseArgs(argc, argv, first + 1, ValueLessFlags(), &args, &error)) {
-      std::fprintf(stderr, "geodex: %s\n", error.c_str());
-      return kExitUsage;
-    }
     if (!server.empty()) return RunServerCommand(server, command, args);
     std::fprintf(stderr, "geodex: '%s' talks to a server: use --server HOST:PORT\n",
                  command.c_str());
@@ -171,12 +171,6 @@ int main(int argc, char** argv) {
   // Every query command is written once against a backend: this process, or the server.
   for (const Command& c : QueryCommands()) {
     if (command != c.name) continue;
-    Args args;
-    std::string error;
-    if (!ParseArgs(argc, argv, first + 1, ValueLessFlags(), &args, &error)) {
-      std::fprintf(stderr, "geodex: %s\n", error.c_str());
-      return kExitUsage;
-    }
     std::unique_ptr<Backend> backend = server.empty() ? MakeLocalBackend() : MakeRemoteBackend(server);
     if (backend == nullptr) return RunServerCommand(server, command, args);  // built without gRPC
     return c.run(*backend, args);

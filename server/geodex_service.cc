@@ -268,8 +268,7 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
     }
     std::shared_ptr<StoredMesh> candidate;
     // A stored mesh that is this DEM's but was uploaded as a mesh file gains its map: build it.
-    absl::StatusOr<std::shared_ptr<const StoredMesh>> known = env_.store->GetRecord(id);
-    if (known.ok() && (dem == nullptr || (*known)->terrain.has_value())) {
+    if (!env_.store->NeedsBuild(id, dem != nullptr)) {
       // Idempotent re-upload: no rebuild. (Insert adds the new alias to the stored mesh.)
       candidate = std::make_shared<StoredMesh>();
       candidate->id = id;

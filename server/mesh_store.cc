@@ -314,6 +314,11 @@ bool MeshStore::Contains(const std::string& id) const {
   return meshes_.contains(id);
 }
 
+bool MeshStore::NeedsBuild(const std::string& id, bool with_map) const {
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> known = GetRecord(id);
+  return !known.ok() || (with_map && !(*known)->terrain.has_value());
+}
+
 absl::Status MeshStore::Delete(const std::string& id_or_alias) {
   std::lock_guard<std::mutex> lock(mu_);
   Slot* slot = FindLocked(id_or_alias);

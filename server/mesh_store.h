@@ -72,6 +72,10 @@ class MeshStore {
 
   // True if a mesh with this id is stored (in memory or on disk).
   bool Contains(const std::string& id) const;
+  // True if storing mesh `id` needs it built: not stored yet, or stored without the DEM map a new
+  // copy brings (`with_map`), which it then gains. Otherwise Insert of a bare record (id, names)
+  // only adds the names.
+  bool NeedsBuild(const std::string& id, bool with_map) const;
 
   // Removes the mesh with this id or alias, from memory and disk. NotFound otherwise.
   absl::Status Delete(const std::string& id_or_alias);

@@ -114,8 +114,7 @@ absl::Status RunDeriveMesh(const QueryEnv& env, const v1::DeriveMeshRequest& req
   candidate->id = id;
   // Built unless stored already; a copy stored without the map (uploaded as a mesh file by a
   // client that derived it) gains it.
-  absl::StatusOr<std::shared_ptr<const StoredMesh>> known = env.store->GetRecord(id);
-  if (!known.ok() || (from.terrain && !(*known)->terrain)) {
+  if (env.store->NeedsBuild(id, from.terrain.has_value())) {
     absl::StatusOr<TriangleMesh> built = TriangleMesh::Build(derived);
     if (!built.ok()) return FieldError("barrier", built.status().message());
     std::shared_ptr<const terrain::Dem> dem;
