@@ -2,17 +2,23 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <limits>
 #include <mutex>
 #include <utility>
 
 #include "absl/strings/ascii.h"
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "cpl_conv.h"
 #include "cpl_error.h"
+#include "cpl_json.h"
+#include "cpl_string.h"
 #include "gdal_priv.h"
 #include "gdal_quiet.h"
 #include "mem_file.h"
@@ -37,6 +43,7 @@ std::string WktOf(const OGRSpatialReference& srs) {
 using TransformPtr = std::unique_ptr<OGRCoordinateTransformation,
                                      decltype(&OGRCoordinateTransformation::DestroyCT)>;
 TransformPtr MakeTransform(const OGRSpatialReference& from, const OGRSpatialReference& to) {
+  PrepareGdal();  // PROJ's network off before any transformation is made
   return TransformPtr(OGRCreateCoordinateTransformation(&from, &to),
                       &OGRCoordinateTransformation::DestroyCT);
 }
@@ -128,6 +135,120 @@ bool IsDemPath(const std::string& path) {
   return false;
 }
 
+namespace {
+
+// A CRS named in GeoJSON by an identifier PROJ resolves from its own database (EPSG:32633,
+// urn:ogc:def:crs:EPSG::32633, OGC:CRS84): no path, no URL.
+bool IsCrsIdentifier(const std::string& name) {
+  if (name.empty() || name.size() > 128 || name.find(':') == std::string::npos) return false;
+  return std::all_of(name.begin(), name.end(), [](char c) {
+    return absl::ascii_isalnum(static_cast<unsigned char>(c)) || c == ':' || c == '_' || c == '.' || c == '-';
+  });
+}
+
+// GDAL's GeoJSON driver follows a "crs" member of type "link" or "url" (an HTTP request to
+// wherever it names), on the collection and on any geometry, and resolves a "name" with PROJ.
+// Every "crs" member, at any depth (GDAL matches member names in any case), must name its CRS by an
+// identifier (type "name") or an EPSG code (type "EPSG"); anything else is refused before GDAL
+// sees the text. PrepareGdal's refusing fetcher stays the backstop.
+absl::Status CheckGeoJsonCrs(const CPLJSONObject& node, const std::string& where) {
+  if (node.GetType() == CPLJSONObject::Type::Array) {
+    const CPLJSONArray items = node.ToArray();
+    for (int i = 0; i < items.Size(); ++i) {
+      if (absl::Status s = CheckGeoJsonCrs(items[i], where); !s.ok()) return s;
+    }
+    return absl::OkStatus();
+  }
+  if (node.GetType() != CPLJSONObject::Type::Object) return absl::OkStatus();
+  for (const CPLJSONObject& member : node.GetChildren()) {
+    if (!absl::EqualsIgnoreCase(member.GetName(), "crs")) {
+      if (absl::Status s = CheckGeoJsonCrs(member, where); !s.ok()) return s;
+      continue;
+    }
+    auto refuse = [&](const std::string& why) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          where, ": ", why, "; geodex reads no URL or file that its input names: give the CRS as ",
+          R"({"type": "name", "properties": {"name": "EPSG:32633"}})"));
+    };
+    if (member.GetType() == CPLJSONObject::Type::Null) continue;
+    if (member.GetType() != CPLJSONObject::Type::Object) return refuse("its \"crs\" is not an object");
+    std::string type;
+    CPLJSONObject properties;
+    for (const CPLJSONObject& field : member.GetChildren()) {
+      if (absl::EqualsIgnoreCase(field.GetName(), "type")) type = field.ToString();
+      if (absl::EqualsIgnoreCase(field.GetName(), "properties")) properties = field;
+    }
+    std::string value;
+    bool integer_code = false;
+    if (properties.GetType() == CPLJSONObject::Type::Object) {
+      for (const CPLJSONObject& field : properties.GetChildren()) {
+        if (absl::EqualsIgnoreCase(field.GetName(), "name")) value = field.ToString();
+        if (absl::EqualsIgnoreCase(field.GetName(), "code")) {
+          integer_code = field.GetType() == CPLJSONObject::Type::Integer ||
+                         field.GetType() == CPLJSONObject::Type::Long;
+        }
+      }
+    }
+    if (absl::EqualsIgnoreCase(type, "name")) {
+      if (!IsCrsIdentifier(value)) {
+        return refuse(absl::StrCat("its \"crs\" name \"", value.substr(0, 80),
+                                   "\" is not a CRS identifier such as EPSG:32633"));
+      }
+    } else if (!(absl::EqualsIgnoreCase(type, "EPSG") && integer_code)) {
+      return refuse(absl::StrCat("its \"crs\" of type \"", type.substr(0, 40), "\" is not followed"));
+    }
+  }
+  return absl::OkStatus();
+}
+
+// The files beside a local file whose names start with its stem (.prj, .hdr, .shx, .dbf,
+// .aux.xml): its side-cars, given to GDAL by name since PrepareGdal stops it listing directories.
+CPLStringList SideCarsOf(const std::string& path) {
+  CPLStringList siblings;
+  const std::filesystem::path file(path);
+  const std::string stem = absl::AsciiStrToLower(file.stem().string());
+  std::error_code ec;
+  std::filesystem::directory_iterator dir(file.has_parent_path() ? file.parent_path() : ".", ec), end;
+  for (int seen = 0; !ec && dir != end && seen < 10000; dir.increment(ec), ++seen) {
+    const std::string sibling = dir->path().filename().string();
+    if (absl::StartsWith(absl::AsciiStrToLower(sibling), stem)) siblings.AddString(sibling.c_str());
+  }
+  return siblings;
+}
+
+// A barrier file the CLI's user names: GeoJSON (its "crs" checked as for text), a Shapefile,
+// GeoPackage or FlatGeobuf, each through its own driver only (no KML network links, GML schemas
+// or VRT sources).
+absl::StatusOr<GDALDatasetUniquePtr> OpenBarrierFile(const std::string& path, const std::string& name) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return absl::NotFoundError(absl::StrCat(name, ": cannot open: ", std::strerror(errno)));
+  char first = ' ';
+  while (in.get(first) && absl::ascii_isspace(static_cast<unsigned char>(first))) {
+  }
+  if (first == '{') {
+    in.seekg(0);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    CPLJSONDocument document;
+    if (!document.LoadMemory(text)) {
+      return absl::InvalidArgumentError(absl::StrCat(name, ": not GeoJSON (", QuietGdal::LastMessage(), ")"));
+    }
+    if (absl::Status crs = CheckGeoJsonCrs(document.GetRoot(), name); !crs.ok()) return crs;
+  }
+  const char* const geojson[] = {"GeoJSON", nullptr};
+  const char* const others[] = {"ESRI Shapefile", "GPKG", "FlatGeobuf", nullptr};
+  CPLStringList siblings = SideCarsOf(path);
+  GDALDatasetUniquePtr ds(GDALDataset::FromHandle(GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY,
+                                                             first == '{' ? geojson : others, nullptr,
+                                                             siblings.List())));
+  if (ds == nullptr) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        name, ": not a GeoJSON, Shapefile, GeoPackage or FlatGeobuf file (", QuietGdal::LastMessage(), ")"));
+  }
+  return ds;
+}
+
+}  // namespace
+
 absl::StatusOr<MeshData> RemoveFacesInPolygons(const MeshData& mesh, const std::string& geojson,
                                                const DemInfo* dem, const std::string& name,
                                                uint64_t* removed) {
@@ -147,6 +268,9 @@ absl::StatusOr<MeshData> RemoveFacesInPolygons(const MeshData& mesh, const std::
   if (first == std::string::npos || geojson[first] != '{') {
     return bad("not GeoJSON (a JSON object, starting with '{')");
   }
+  CPLJSONDocument document;
+  if (!document.LoadMemory(geojson)) return bad(absl::StrCat("not GeoJSON (", QuietGdal::LastMessage(), ")"));
+  if (absl::Status crs = CheckGeoJsonCrs(document.GetRoot(), name); !crs.ok()) return crs;
   MemFile text(".geojson", geojson);
   if (!text.ok()) return absl::InternalError("GDAL cannot make an in-memory file");
   const char* const drivers[] = {"GeoJSON", nullptr};
@@ -214,7 +338,13 @@ absl::StatusOr<Dem> Dem::Read(const std::string& path, const DemOptions& options
     return absl::NotFoundError(absl::StrCat(path, ": cannot open: No such file or directory"));
   }
   QuietGdal quiet;
-  GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY));
+  // The user's own file, through the drivers of the formats IsDemPath names, with its own side-cars
+  // (.prj, .hdr, .aux.xml: the files beside it whose names start with its stem) given by name, since
+  // PrepareGdal stops GDAL listing directories.
+  const char* const drivers[] = {"GTiff", "VRT", "AAIGrid", "HFA", "SRTMHGT", "USGSDEM", "EHdr", "netCDF", nullptr};
+  CPLStringList siblings = SideCarsOf(path);
+  GDALDatasetUniquePtr ds(GDALDataset::FromHandle(GDALOpenEx(
+      path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, drivers, nullptr, siblings.List())));
   if (ds == nullptr) {
     return absl::InvalidArgumentError(
         absl::StrCat(path, ": not a raster GDAL reads (", QuietGdal::LastMessage(), ")"));
@@ -234,14 +364,23 @@ absl::StatusOr<Dem> Dem::ReadGeoTiffBytes(const std::string& bytes, const std::s
   QuietGdal quiet;
   MemFile tiff(".tif", bytes);
   if (!tiff.ok()) return absl::InternalError("GDAL cannot make an in-memory file");
-  // Only the GTiff driver parses untrusted bytes, and it looks for no side-car files.
+  // Only the GTiff driver parses untrusted bytes; its georeferencing comes from the file alone
+  // (no world file or .aux.xml), and no side-car is listed (PrepareGdal, and an empty sibling list).
   const char* const drivers[] = {"GTiff", nullptr};
-  const char* const open_options[] = {nullptr};
-  GDALDatasetUniquePtr ds(GDALDataset::FromHandle(GDALOpenEx(
-      tiff.path().c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, drivers, open_options, nullptr)));
+  const char* const open_options[] = {"GEOREF_SOURCES=INTERNAL", nullptr};
+  const char* const no_siblings[] = {nullptr};
+  GDALDatasetUniquePtr ds(GDALDataset::FromHandle(GDALOpenEx(tiff.path().c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY,
+                                                             drivers, open_options, no_siblings)));
   if (ds == nullptr) {
     return absl::InvalidArgumentError(
         absl::StrCat(name, ": not a GeoTIFF GDAL reads (", QuietGdal::LastMessage(), ")"));
+  }
+  // A GeoTIFF's own metadata can name an overview file (OVERVIEW_FILE in the OVERVIEWS domain),
+  // which GDAL opens, path or URL, when overviews are asked for. geodex never asks, and refuses
+  // the indirection outright.
+  if (CSLCount(ds->GetMetadata("OVERVIEWS")) > 0) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        name, ": its metadata names an external overview file; geodex reads no file or URL an upload names"));
   }
   return ReadDataset(*ds, name, options);
 }
@@ -421,11 +560,10 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
   OGRPreparedGeometryUniquePtr barrier;
   std::unique_ptr<OGRGeometry> barrier_union;
   if (!options.barrier_file.empty()) {
-    absl::StatusOr<std::unique_ptr<OGRGeometry>> polygons =
-        BarrierPolygonsOf(GDALDatasetUniquePtr(GDALDataset::Open(options.barrier_file.c_str(),
-                                                                 GDAL_OF_VECTOR | GDAL_OF_READONLY))
-                              .get(),
-                          absl::StrCat("--barrier ", options.barrier_file), &file_crs);
+    const std::string name = absl::StrCat("--barrier ", options.barrier_file);
+    absl::StatusOr<GDALDatasetUniquePtr> file = OpenBarrierFile(options.barrier_file, name);
+    if (!file.ok()) return file.status();
+    absl::StatusOr<std::unique_ptr<OGRGeometry>> polygons = BarrierPolygonsOf(file->get(), name, &file_crs);
     if (!polygons.ok()) return polygons.status();
     barrier_union = *std::move(polygons);
     barrier.reset(OGRCreatePreparedGeometry(OGRGeometry::ToHandle(barrier_union.get())));

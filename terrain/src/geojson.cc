@@ -187,16 +187,23 @@ absl::Status WriteGeoJson(const DemInfo& dem, const std::vector<GeoFeature>& fea
     }
   }
 
-  // The fields: every property name, typed by its first value.
+  // The fields: every property name in order of first appearance, typed by its first value that
+  // is not null (a real number when every value is null).
+  std::vector<std::pair<std::string, OGRFieldType>> fields;
+  std::map<std::string, size_t> field_of;
   for (const GeoFeature& f : features) {
     for (const auto& [name, value] : f.properties) {
-      if (layer->GetLayerDefn()->GetFieldIndex(name.c_str()) >= 0) continue;
-      OGRFieldType type = std::holds_alternative<double>(value)    ? OFTReal
-                          : std::holds_alternative<int64_t>(value) ? OFTInteger64
-                                                                   : OFTString;
-      OGRFieldDefn field(name.c_str(), type);
-      if (layer->CreateField(&field) != OGRERR_NONE) return failed(QuietGdal::LastMessage());
+      auto [at, added] = field_of.emplace(name, fields.size());
+      if (added) fields.push_back({name, OFTReal});
+      if (std::holds_alternative<std::monostate>(value) || (!added && fields[at->second].second != OFTReal)) continue;
+      fields[at->second].second = std::holds_alternative<double>(value)    ? OFTReal
+                                  : std::holds_alternative<int64_t>(value) ? OFTInteger64
+                                                                           : OFTString;
     }
+  }
+  for (const auto& [name, type] : fields) {
+    OGRFieldDefn field(name.c_str(), type);
+    if (layer->CreateField(&field) != OGRERR_NONE) return failed(QuietGdal::LastMessage());
   }
   for (const GeoFeature& f : features) {
     std::unique_ptr<OGRGeometry> geometry;
@@ -225,7 +232,9 @@ absl::Status WriteGeoJson(const DemInfo& dem, const std::vector<GeoFeature>& fea
     }
     OGRFeatureUniquePtr feature(OGRFeature::CreateFeature(layer->GetLayerDefn()));
     for (const auto& [name, value] : f.properties) {
-      if (const double* d = std::get_if<double>(&value)) {
+      if (std::holds_alternative<std::monostate>(value)) {
+        feature->SetFieldNull(feature->GetFieldIndex(name.c_str()));
+      } else if (const double* d = std::get_if<double>(&value)) {
         feature->SetField(name.c_str(), *d);
       } else if (const int64_t* i = std::get_if<int64_t>(&value)) {
         feature->SetField(name.c_str(), static_cast<GIntBig>(*i));
@@ -315,9 +324,12 @@ std::vector<GeoFeature> PointFeatures(const std::vector<PointValue>& points) {
     GeoFeature f;
     f.points = {p.position};
     f.properties = {{"point", p.point}, {"surface_point", p.surface_point}};
-    if (std::isfinite(p.distance)) {  // unreachable: distance and source stay null
+    if (std::isfinite(p.distance)) {
       f.properties.push_back({"distance", p.distance});
       f.properties.push_back({"source", p.source});
+    } else {  // unreachable: null, as the proto and docs say (not left out)
+      f.properties.push_back({"distance", std::monostate()});
+      f.properties.push_back({"source", std::monostate()});
     }
     features.push_back(std::move(f));
   }

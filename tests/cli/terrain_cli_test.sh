@@ -173,6 +173,13 @@ check "path geojson: exit 0" test $? -eq 0
   --output "$tmp/at.geojson"
 check "points geojson: exit 0" test $? -eq 0
 "$GEODEX" distances "$P" --sources g:500055:4999795 --at g:500355:4999795,g:500005:4999995 >"$tmp/at.txt"
+"$GEODEX" distances "$P" --sources g:500055:4999795 --at g:500355:4999795,g:500065:4999795 \
+  --max-distance 50 --output "$tmp/at_null.geojson"
+check "points geojson: unreachable is null, not missing" $PY -c "
+import json; f = json.load(open('$tmp/at_null.geojson'))['features']
+p = [x['properties'] for x in f]
+assert p[0]['distance'] is None and p[0]['source'] is None and 'distance' in p[0], p[0]
+assert abs(p[1]['distance'] - 10) < 1e-9 and p[1]['source'] == 0, p[1]"
 "$GEODEX" info "$P" --format json >"$tmp/pond.json"
 check "geojson: valid, right-hand, isochrones with the pond as a hole, cells tiling the surface" \
   $PY - "$tmp" <<'PY'
@@ -279,6 +286,57 @@ PY
   check "bad barrier by name: exit 3" test $? -eq 3
   check "bad barrier by name: names the flag" grep -q -- "--barrier $tmp/point.geojson: .*a barrier is polygons" "$tmp/err.txt"
 fi
+
+# geodex never reaches out (issue 30): a listener on a port the kernel picks counts connections
+# while the CLI reads GeoJSON whose "crs" links to it or names it, a VRT whose source is on it, and
+# a NAD27 DEM with PROJ's network switched on by the environment and pointed at it. Each input
+# is refused (or, for the DEM, read with the grids on this machine) and nothing connects.
+$PY - "$tmp" <<'PY' &
+import socket, sys, time
+out = sys.argv[1]
+srv = socket.socket(); srv.bind(("127.0.0.1", 0)); srv.listen(16); srv.settimeout(0.2)
+open(f"{out}/listener.count", "w").write("0")
+open(f"{out}/listener.port.tmp", "w").write(str(srv.getsockname()[1]))
+import os; os.rename(f"{out}/listener.port.tmp", f"{out}/listener.port")
+n, end = 0, time.time() + 120  # bounded: it stops by itself
+while time.time() < end and not os.path.exists(f"{out}/listener.stop"):
+    try:
+        c, _ = srv.accept(); n += 1; c.close(); open(f"{out}/listener.count", "w").write(str(n))
+    except socket.timeout:
+        pass
+PY
+listener_pid=$!
+for _ in $(seq 100); do [ -s "$tmp/listener.port" ] && break; sleep 0.1; done
+url="http://127.0.0.1:$(cat "$tmp/listener.port")"
+ring='[[[500088, 5000050], [500112, 5000050], [500112, 4999850], [500088, 5000050]]]'
+for crs in "{\"type\": \"link\", \"properties\": {\"href\": \"$url/crs\"}}" \
+           "{\"type\": \"name\", \"properties\": {\"name\": \"$url/crs\"}}"; do
+  echo "{\"type\": \"FeatureCollection\", \"crs\": $crs, \"features\": [{\"type\": \"Feature\", \"properties\": {}, \"geometry\": {\"type\": \"Polygon\", \"coordinates\": $ring}}]}" >"$tmp/linked.geojson"
+  start=$(date +%s)
+  "$GEODEX" info "$tmp/strait.tif" --barrier "$tmp/linked.geojson" 2>"$tmp/err.txt" >/dev/null
+  code=$?
+  check "crs link or URL name: refused (exit $code)" test "$code" -ne 0
+  check "crs link or URL name: says why" grep -q 'reads no URL or file that its input names' "$tmp/err.txt"
+  check "crs link or URL name: quickly" test $(( $(date +%s) - start )) -lt 5
+done
+printf '<VRTDataset rasterXSize="10" rasterYSize="10"><SRS>EPSG:32633</SRS><GeoTransform>500000,10,0,5000000,0,-10</GeoTransform><VRTRasterBand dataType="Float32" band="1"><SimpleSource><SourceFilename>/vsicurl/%s/src.tif</SourceFilename><SourceBand>1</SourceBand></SimpleSource></VRTRasterBand></VRTDataset>\n' "$url" >"$tmp/remote.vrt"
+"$GEODEX" info "$tmp/remote.vrt" 2>"$tmp/err.txt" >/dev/null
+check "VRT with a network source: refused" test $? -ne 0
+$PY - "$tmp" <<'PY'
+import sys
+import numpy as np
+from osgeo import gdal, osr
+ds = gdal.GetDriverByName("GTiff").Create(f"{sys.argv[1]}/nad27.tif", 20, 20, 1, gdal.GDT_Float32)
+ds.SetGeoTransform((-84.31, 0.001, 0, 36.61, 0, -0.001))
+s = osr.SpatialReference(); s.ImportFromEPSG(4267); ds.SetProjection(s.ExportToWkt())
+ds.GetRasterBand(1).WriteArray(np.zeros((20, 20)))
+ds = None
+PY
+PROJ_NETWORK=ON PROJ_NETWORK_ENDPOINT="$url" "$GEODEX" info "$tmp/nad27.tif" >"$tmp/nad27.txt" 2>"$tmp/err.txt"
+check "NAD27 DEM with PROJ_NETWORK=ON: read offline" test $? -eq 0
+touch "$tmp/listener.stop"
+wait "$listener_pid"
+check "nothing connected to the listener" test "$(cat "$tmp/listener.count")" = 0
 
 # Errors: map points need a DEM, a point outside or in the slot is named, --dem-step needs a DEM.
 "$GEODEX" distances "$tmp/tri.off" --sources g:1:2 2>"$tmp/err.txt" >/dev/null

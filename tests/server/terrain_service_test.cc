@@ -2,11 +2,20 @@
 // mesh (Mesh.terrain, across restarts), and map points (SurfacePoint.map_point, lon_lat) dropped
 // by the server exactly as the CLI drops them locally. Fixtures are made with GDAL at test time.
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <array>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <thread>
 #include <tuple>
 #include <vector>
 
@@ -22,6 +31,7 @@
 #include "geodex/terrain.h"
 #include "gtest/gtest.h"
 #include "ogr_spatialref.h"
+#include "geodex_client.h"
 #include "server_test_util.h"
 
 namespace geodex::server {
@@ -31,6 +41,53 @@ namespace fs = std::filesystem;
 
 using testing::BadField;
 using testing::Contains;
+
+
+// A TCP listener on 127.0.0.1, on a port the kernel picks, that counts the connections made to it
+// (each accepted and closed at once) until it is destroyed: what geodexd must never reach.
+class ConnectionCounter {
+ public:
+  ConnectionCounter() {
+    fd_ = socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    address.sin_port = 0;
+    socklen_t size = sizeof(address);
+    if (fd_ < 0 || bind(fd_, reinterpret_cast<sockaddr*>(&address), sizeof(address)) != 0 ||
+        listen(fd_, 16) != 0 || getsockname(fd_, reinterpret_cast<sockaddr*>(&address), &size) != 0) {
+      ADD_FAILURE() << "cannot listen on 127.0.0.1";
+      return;
+    }
+    port_ = ntohs(address.sin_port);
+    thread_ = std::thread([this] {
+      while (!stop_) {
+        pollfd p{fd_, POLLIN, 0};
+        if (poll(&p, 1, 50) == 1) {
+          int client = accept(fd_, nullptr, nullptr);
+          if (client >= 0) {
+            ++connections_;
+            close(client);
+          }
+        }
+      }
+    });
+  }
+  ~ConnectionCounter() {
+    stop_ = true;
+    if (thread_.joinable()) thread_.join();
+    if (fd_ >= 0) close(fd_);
+  }
+  std::string Url(const std::string& path) const { return absl::StrCat("http://127.0.0.1:", port_, path); }
+  int connections() const { return connections_; }
+
+ private:
+  int fd_ = -1;
+  int port_ = 0;
+  std::atomic<bool> stop_{false};
+  std::atomic<int> connections_{0};
+  std::thread thread_;
+};
 
 class TerrainServiceTest : public testing::ServerFixture {
  protected:
@@ -399,6 +456,107 @@ TEST_F(TerrainServiceTest, DeriveMeshByABarrier) {
 }
 
 
+// geodexd never reaches out (issue 30): no URL, file or driver that a request names is followed.
+// Each hostile input is refused as INVALID_ARGUMENT naming its field, quickly (a followed link
+// waited 10 s on a silent peer), no connection reaches the listener, and the server goes on serving.
+TEST_F(TerrainServiceTest, NoRequestMakesTheServerReachOut) {
+  ConnectionCounter listener;
+  StartServer();
+  ASSERT_TRUE(UploadDem(bytes_, "slot").status.ok());
+  const std::string polygon =
+      R"("type": "Polygon", "coordinates": [[[500100, 4999900], [500200, 4999900], [500200, 4999800], [500100, 4999900]]])";
+  auto collection = [&](const std::string& crs) {
+    return absl::StrCat(R"({"type": "FeatureCollection", "crs": )", crs,
+                        R"(, "features": [{"type": "Feature", "properties": {}, "geometry": {)", polygon, "}}]}");
+  };
+  const std::vector<std::string> texts = {
+      collection(absl::StrCat(R"({"type": "link", "properties": {"href": ")", listener.Url("/crs"), R"(", "type": "proj4"}})")),
+      collection(absl::StrCat(R"({"type": "url", "properties": {"url": ")", listener.Url("/crs"), R"("}})")),
+      collection(absl::StrCat(R"({"type": "name", "properties": {"name": ")", listener.Url("/crs"), R"("}})")),
+      collection(absl::StrCat(R"({"type": "LINK", "properties": {"href": ")", listener.Url("/crs"), R"("}})")),
+      collection(R"({"type": "name", "properties": {"name": "/etc/passwd"}})"),
+      collection(R"({"type": "OGC", "properties": {"urn": "urn:ogc:def:crs:EPSG::32633"}})"),
+      // A crs on a geometry, and a member spelled in capitals: GDAL follows both.
+      absl::StrCat(R"({"type": "Feature", "properties": {}, "geometry": {"CRS": {"type": "link", "properties": {"href": ")",
+                   listener.Url("/geometry-crs"), R"("}}, )", polygon, "}}"),
+      absl::StrCat("/vsicurl/", listener.Url("/x.geojson")),
+      "/vsimem/geodex-0.geojson",
+      "file:///etc/passwd",
+      "/etc/passwd",
+      "barrier.geojson",
+      listener.Url("/x.geojson"),
+      absl::StrCat(R"(<OGRVRTDataSource><OGRVRTLayer name="x"><SrcDataSource>/vsicurl/)", listener.Url("/v.geojson"),
+                   "</SrcDataSource></OGRVRTLayer></OGRVRTDataSource>"),
+  };
+  for (const std::string& text : texts) {
+    v1::DeriveMeshRequest request;
+    request.set_mesh("meshes/slot");
+    request.mutable_barrier()->set_polygons_geojson(text);
+    v1::Mesh derived;
+    grpc::ClientContext context;
+    context.set_deadline(testing::In(60));
+    const auto start = std::chrono::steady_clock::now();
+    grpc::Status status = stub_->DeriveMesh(&context, request, &derived);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << text;
+    EXPECT_EQ(BadField(status), "barrier.polygons_geojson") << text << ": " << status.error_message();
+    EXPECT_LT(seconds, 5) << text;  // generous; a followed link waits 10 s
+  }
+  // A crs named by an identifier is still read (and reprojected): the same wall as without it.
+  v1::DeriveMeshRequest named;
+  named.set_mesh("meshes/slot");
+  named.mutable_barrier()->set_polygons_geojson(
+      collection(R"({"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::32633"}})"));
+  v1::Mesh named_mesh;
+  grpc::ClientContext named_context;
+  named_context.set_deadline(testing::In(60));
+  grpc::Status named_status = stub_->DeriveMesh(&named_context, named, &named_mesh);
+  EXPECT_TRUE(named_status.ok()) << named_status.error_message();
+
+  // GeoTIFFs: an overview file named in the file's own metadata (a URL, a local file), and a VRT
+  // sent as a GeoTIFF, are refused; a URL in an ordinary metadata item is only text.
+  auto tiff_with = [&](const std::string& key, const std::string& value, const char* domain) {
+    const std::string path = (dir_ / "in" / absl::StrCat("meta-", key, ".tif")).string();
+    GDALDataset* ds = GetGDALDriverManager()->GetDriverByName("GTiff")->CreateCopy(
+        path.c_str(), GDALDataset::FromHandle(GDALOpen(tif_.c_str(), GA_ReadOnly)), FALSE, nullptr, nullptr, nullptr);
+    EXPECT_NE(ds, nullptr);
+    ds->SetMetadataItem(key.c_str(), value.c_str(), domain);
+    GDALClose(ds);
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  };
+  const std::string local_overview = (dir_ / "in" / "secret.tif").string();
+  fs::copy_file(tif_, local_overview);
+  for (const std::string& target : {absl::StrCat("/vsicurl/", listener.Url("/o.tif")), local_overview}) {
+    const auto start = std::chrono::steady_clock::now();
+    testing::UploadResult refused = UploadDem(tiff_with("OVERVIEW_FILE", target, "OVERVIEWS"), "");
+    EXPECT_EQ(refused.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << target;
+    EXPECT_EQ(BadField(refused.status), "chunk") << refused.status.error_message();
+    EXPECT_TRUE(Contains(refused.status.error_message(), "external overview file")) << refused.status.error_message();
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5);
+  }
+  testing::UploadResult harmless = UploadDem(tiff_with("SOURCE", listener.Url("/meta"), nullptr), "");
+  EXPECT_TRUE(harmless.status.ok()) << harmless.status.error_message();
+  const std::string vrt = absl::StrCat(
+      R"(<VRTDataset rasterXSize="30" rasterYSize="30"><VRTRasterBand dataType="Float32" band="1"><SimpleSource>)",
+      "<SourceFilename>/vsicurl/", listener.Url("/src.tif"), "</SourceFilename><SourceBand>1</SourceBand>",
+      "</SimpleSource></VRTRasterBand></VRTDataset>");
+  for (v1::MeshFormat format : {v1::MESH_FORMAT_GEOTIFF, v1::MESH_FORMAT_UNSPECIFIED}) {
+    testing::UploadResult refused = UploadDem(vrt, "", format, "dem.vrt");
+    EXPECT_EQ(refused.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << refused.status.error_message();
+  }
+
+  // Nothing reached the listener, and geodexd still serves.
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  EXPECT_EQ(listener.connections(), 0);
+  client::ClientOptions options;
+  options.target = absl::StrCat("127.0.0.1:", server_->port());
+  client::GeodexClient client(options);
+  absl::StatusOr<bool> health = client.Health();
+  ASSERT_TRUE(health.ok()) << health.status();
+  EXPECT_TRUE(*health);
+}
+
 // ExportGis: the files the CLI writes, made by geodexd from a stored DEM's mesh.
 TEST_F(TerrainServiceTest, ExportGisMakesTheCliFiles) {
   ServerOptions options;
@@ -474,6 +632,11 @@ TEST_F(TerrainServiceTest, ExportGisMakesTheCliFiles) {
   const std::string points = run(request, &media);
   EXPECT_TRUE(Contains(points, "\"point\": \"g:500205:4999845\"")) << points.substr(0, 600);
   EXPECT_TRUE(Contains(points, "\"point\": \"0\""));
+  // Beyond max_distance: distance and source are null, not left out.
+  request.mutable_options()->set_max_distance(20);
+  const std::string near_only = run(request, &media);
+  EXPECT_TRUE(Contains(near_only, "\"distance\": null, \"source\": null")) << near_only.substr(0, 800);
+  request.clear_options();
 
   // Not a DEM's mesh, no product: INVALID_ARGUMENT naming the field.
   ASSERT_TRUE(testing::Upload(*stub_, testing::GridOff(3, 3, false), "grid").status.ok());

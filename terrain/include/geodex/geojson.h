@@ -23,7 +23,8 @@
 namespace geodex::terrain {
 
 using Polygon2 = std::vector<std::array<double, 2>>;  // one ring, mesh x y (not closed)
-using Property = std::pair<std::string, std::variant<double, int64_t, std::string>>;
+// A property's value; std::monostate is JSON null (written as null, not left out).
+using Property = std::pair<std::string, std::variant<std::monostate, double, int64_t, std::string>>;
 
 struct GeoFeature {
   enum class Kind { kArea, kLine, kPoint };
@@ -55,8 +56,8 @@ std::vector<GeoFeature> VoronoiFeatures(const MeshData& mesh, const VoronoiDiagr
 std::vector<GeoFeature> DelaunayFeatures(const DelaunayTriangulation& delaunay);
 // A path: one 3D LineString (`length`, `units` "m").
 GeoFeature PathFeature(const std::vector<PathPoint>& points, double length);
-// Points with their distance: `point` as the user wrote it, `surface_point` where it landed, and
-// (when reachable) `distance` and `source`.
+// Points with their distance: `point` as the user wrote it, `surface_point` where it landed,
+// `distance` and `source` (both null where the point is unreachable).
 struct PointValue {
   std::array<double, 3> position{};
   std::string point, surface_point;

@@ -1,0 +1,39 @@
+#include <mutex>
+
+#include "cpl_conv.h"
+#include "cpl_http.h"
+#include "cpl_string.h"
+#include "gdal_quiet.h"
+#include "ogr_srs_api.h"
+
+namespace geodex::terrain {
+namespace {
+
+// Every HTTP request GDAL would make through CPLHTTPFetch ends here, unsent. (Returning null would
+// hand the request on to GDAL's own fetcher, so a failed result is returned instead.)
+CPLHTTPResult* RefuseFetch(const char* url, CSLConstList, GDALProgressFunc, void*,
+                           CPLHTTPFetchWriteFunc, void*, void*) {
+  auto* result = static_cast<CPLHTTPResult*>(CPLCalloc(1, sizeof(CPLHTTPResult)));
+  result->nStatus = 1;
+  result->pszErrBuf = CPLStrdup("geodex fetches no URL");
+  CPLError(CE_Failure, CPLE_AppDefined, "geodex fetches no URL (%s)", url != nullptr ? url : "");
+  return result;
+}
+
+}  // namespace
+
+void PrepareGdal() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    CPLSetConfigOption("GDAL_DISABLE_READDIR_ON_OPEN", "EMPTY_DIR");
+    // /vsicurl/, /vsis3/, /vsigs/, ... open only the file named here, which cannot exist.
+    CPLSetConfigOption("CPL_VSIL_CURL_ALLOWED_FILENAME", "/geodex/network-access-is-disabled");
+    CPLSetConfigOption("GDAL_VRT_ENABLE_PYTHON", "NO");
+    CPLSetConfigOption("GDAL_HTTP_TIMEOUT", "1");  // belt and braces, should anything still fetch
+    CPLHTTPSetFetchCallback(RefuseFetch, nullptr);
+    OSRSetPROJEnableNetwork(FALSE);
+    GDALAllRegister();
+  });
+}
+
+}  // namespace geodex::terrain
