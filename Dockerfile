@@ -21,7 +21,7 @@ RUN cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DGEODEX_BUILD_BENCH
 FROM debian:bookworm
 RUN apt-get update \
  && apt-get install -y --no-install-recommends libgrpc++1.51 libprotobuf32 libabsl20220623 \
-      libspdlog1.10 libprometheus-cpp-pull1.0 libprometheus-cpp-core1.0 libpng16-16 zlib1g libssl3 libgdal32 \
+      libspdlog1.10 libprometheus-cpp-pull1.0 libprometheus-cpp-core1.0 libpng16-16 zlib1g libssl3 libgdal32 libgeos-c1v5 \
  && rm -rf /var/lib/apt/lists/* \
  && groupadd --system --gid 10001 geodex \
  && useradd --system --uid 10001 --gid geodex --home-dir /data --shell /usr/sbin/nologin geodex \

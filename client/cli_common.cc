@@ -82,9 +82,8 @@ absl::StatusOr<MeshData> LoadMeshData(const std::string& path,
   if (!dem_options.barrier_file.empty()) {  // polygons in the mesh's own x y
     absl::StatusOr<std::string> text = ReadBarrierText(dem_options.barrier_file);
     if (!text.ok()) return text.status();
-    uint64_t removed = 0;
-    data = terrain::RemoveFacesInPolygons(*data, *text, nullptr,
-                                          "--barrier " + dem_options.barrier_file, &removed);
+    terrain::CutStats cut_stats;
+    data = terrain::CutBarrierPolygons(*data, *text, nullptr, "--barrier " + dem_options.barrier_file, &cut_stats);
   }
   return data;
 }

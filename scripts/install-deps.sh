@@ -22,6 +22,8 @@ packages=(
   libssl-dev
   # terrain: DEMs in, rasters out, map coordinates (GDAL, and through it PROJ)
   libgdal-dev libproj-dev
+  # barrier polygons cut into meshes (GEOS C API: difference, constrained Delaunay triangulation)
+  libgeos-dev
   # tests and benchmarks (CGAL is a test-only reference)
   libgtest-dev libgmock-dev libbenchmark-dev libcgal-dev libgmp-dev libmpfr-dev
   # the Python client package, its example and tests (Debian's gRPC for Python; pip and venv for

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "geodex/limits.h"
 #include "geodex/mesh_id.h"
 #include "geodex/terrain.h"
 #include "geometry_convert.h"
@@ -99,15 +100,27 @@ absl::Status RunDeriveMesh(const QueryEnv& env, const v1::DeriveMeshRequest& req
   MeshData derived = from.dem != nullptr ? from.dem->mesh() : from.mesh->ToMeshData();
   const size_t faces_before = derived.face_count();
   if (barrier.has_below()) derived = terrain::RemoveFacesBelow(derived, barrier.below());
+  uint64_t barrier_faces = faces_before - derived.face_count();
   if (!barrier.polygons_geojson().empty()) {
-    uint64_t inside = 0;
-    absl::StatusOr<MeshData> cut = terrain::RemoveFacesInPolygons(
+    terrain::CutStats cut_stats;
+    absl::StatusOr<MeshData> cut = terrain::CutBarrierPolygons(
         derived, barrier.polygons_geojson(), from.terrain ? &*from.terrain : nullptr,
-        "barrier.polygons_geojson", &inside);
+        "barrier.polygons_geojson", &cut_stats);
     if (!cut.ok()) return FieldError("barrier.polygons_geojson", cut.status().message());
     derived = *std::move(cut);
+    barrier_faces += cut_stats.faces_removed + cut_stats.faces_cut;
   }
   if (derived.faces.empty()) return FieldError("barrier", "covers every face of the mesh");
+  // A cut adds vertices and faces where the polygons cross the mesh: the mesh limits still hold.
+  if (derived.vertex_count() > env.limits->max_vertices) {
+    return LimitExceededError(Limit::kVertices, absl::StrCat("the cut mesh has ", derived.vertex_count(),
+                                                             " vertices, more than --max_vertices ",
+                                                             env.limits->max_vertices));
+  }
+  if (derived.face_count() > env.limits->max_faces) {
+    return LimitExceededError(Limit::kFaces, absl::StrCat("the cut mesh has ", derived.face_count(),
+                                                          " faces, more than --max_faces ", env.limits->max_faces));
+  }
   if (env.cancel->IsCancelled()) return absl::CancelledError("derivation cancelled");
   const std::string id = ComputeMeshId(derived);
   auto candidate = std::make_shared<StoredMesh>();
@@ -120,7 +133,7 @@ absl::Status RunDeriveMesh(const QueryEnv& env, const v1::DeriveMeshRequest& req
     std::shared_ptr<const terrain::Dem> dem;
     if (from.terrain) {
       terrain::DemInfo info = *from.terrain;
-      info.barrier_faces += faces_before - derived.face_count();
+      info.barrier_faces += barrier_faces;
       absl::StatusOr<terrain::Dem> grid = terrain::Dem::FromMesh(derived, std::move(info));
       if (!grid.ok()) return absl::InternalError(grid.status().message());
       dem = std::make_shared<const terrain::Dem>(*std::move(grid));

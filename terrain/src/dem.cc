@@ -20,6 +20,7 @@
 #include "cpl_json.h"
 #include "cpl_string.h"
 #include "gdal_priv.h"
+#include "barrier_cut.h"
 #include "gdal_quiet.h"
 #include "mem_file.h"
 #include "geodex/limits.h"
@@ -249,9 +250,40 @@ absl::StatusOr<GDALDatasetUniquePtr> OpenBarrierFile(const std::string& path, co
 
 }  // namespace
 
-absl::StatusOr<MeshData> RemoveFacesInPolygons(const MeshData& mesh, const std::string& geojson,
-                                               const DemInfo* dem, const std::string& name,
-                                               uint64_t* removed) {
+namespace {
+
+// Polygons in the DEM file's CRS (`dem`) or in the mesh's own x y (no `dem`) cut out of `mesh`:
+// reprojected into the mesh's plane first (a geographic DEM's UTM metres), where their edges are
+// straight.
+absl::StatusOr<MeshData> CutBarrier(const MeshData& mesh, OGRGeometry& polygons, const DemInfo* dem,
+                                    const OGRSpatialReference* file_crs, const std::string& name,
+                                    CutStats* stats) {
+  double scale = 1;
+  if (dem != nullptr && dem->reprojected) {
+    OGRSpatialReference mesh_crs;
+    if (mesh_crs.importFromWkt(dem->mesh_crs_wkt.c_str()) != OGRERR_NONE) {
+      return absl::InvalidArgumentError(absl::StrCat(name, ": the DEM's mesh CRS does not parse"));
+    }
+    mesh_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    TransformPtr to_mesh = MakeTransform(*file_crs, mesh_crs);
+    if (to_mesh == nullptr || polygons.transform(to_mesh.get()) != OGRERR_NONE) {
+      return absl::InvalidArgumentError(absl::StrCat(name, ": the polygons do not project to the mesh's CRS (",
+                                                     QuietGdal::LastMessage(), ")"));
+    }
+  } else if (dem != nullptr) {
+    scale = dem->horizontal_scale;
+  }
+  absl::StatusOr<MeshData> cut = CutOutPolygons(mesh, polygons, scale, stats);
+  if (absl::IsInvalidArgument(cut.status())) {
+    return absl::InvalidArgumentError(absl::StrCat(name, ": ", cut.status().message()));
+  }
+  return cut;
+}
+
+}  // namespace
+
+absl::StatusOr<MeshData> CutBarrierPolygons(const MeshData& mesh, const std::string& geojson,
+                                            const DemInfo* dem, const std::string& name, CutStats* stats) {
   QuietGdal quiet;
   auto bad = [&](const std::string& why) {
     return absl::InvalidArgumentError(absl::StrCat(name, ": ", why));
@@ -280,45 +312,7 @@ absl::StatusOr<MeshData> RemoveFacesInPolygons(const MeshData& mesh, const std::
       ds == nullptr ? bad(absl::StrCat("not GeoJSON polygons (", QuietGdal::LastMessage(), ")"))
                     : BarrierPolygonsOf(ds.get(), name, dem != nullptr ? &file_crs : nullptr);
   if (!polygons.ok()) return polygons.status();
-  OGRPreparedGeometryUniquePtr inside(OGRCreatePreparedGeometry(OGRGeometry::ToHandle(polygons->get())));
-  if (inside == nullptr) return absl::InternalError("GDAL cannot prepare polygons (built without GEOS?)");
-  // Face centres in the polygons' frame: the mesh's x y, or the DEM file's CRS.
-  const size_t faces = mesh.face_count();
-  std::vector<double> cx(faces), cy(faces);
-  for (size_t f = 0; f < faces; ++f) {
-    for (int c = 0; c < 3; ++c) {
-      const size_t v = mesh.faces[3 * f + c];
-      cx[f] += mesh.positions[3 * v] / 3;
-      cy[f] += mesh.positions[3 * v + 1] / 3;
-    }
-  }
-  if (dem != nullptr && dem->reprojected) {
-    OGRSpatialReference mesh_crs;
-    mesh_crs.importFromWkt(dem->mesh_crs_wkt.c_str());
-    mesh_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-    TransformPtr back = MakeTransform(mesh_crs, file_crs);
-    std::vector<int> ok(faces);
-    if (back == nullptr || (faces > 0 && !back->Transform(static_cast<int>(faces), cx.data(), cy.data(), nullptr, ok.data()))) {
-      return bad("the mesh's faces do not project to the DEM's CRS");
-    }
-  } else if (dem != nullptr) {
-    for (size_t f = 0; f < faces; ++f) {
-      cx[f] /= dem->horizontal_scale;
-      cy[f] /= dem->horizontal_scale;
-    }
-  }
-  MeshData out;
-  out.positions = mesh.positions;
-  *removed = 0;
-  for (size_t f = 0; f < faces; ++f) {
-    OGRPoint p(cx[f], cy[f]);
-    if (OGRPreparedGeometryContains(inside.get(), OGRGeometry::ToHandle(&p)) != 0) {
-      ++*removed;
-      continue;
-    }
-    out.faces.insert(out.faces.end(), mesh.faces.begin() + 3 * f, mesh.faces.begin() + 3 * f + 3);
-  }
-  return out;
+  return CutBarrier(mesh, **polygons, dem, &file_crs, name, stats);
 }
 
 bool IsGeoTiffPath(const std::string& path) {
@@ -556,27 +550,16 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
     }
   }
 
-  // A barrier drawn as polygons: one union, in the file's CRS, tested against triangle centres.
-  OGRPreparedGeometryUniquePtr barrier;
-  std::unique_ptr<OGRGeometry> barrier_union;
+  // A barrier drawn as polygons: one union in the file's CRS, cut out of the mesh once it is made.
+  std::unique_ptr<OGRGeometry> barrier;
+  const std::string barrier_name = absl::StrCat("--barrier ", options.barrier_file);
   if (!options.barrier_file.empty()) {
-    const std::string name = absl::StrCat("--barrier ", options.barrier_file);
-    absl::StatusOr<GDALDatasetUniquePtr> file = OpenBarrierFile(options.barrier_file, name);
+    absl::StatusOr<GDALDatasetUniquePtr> file = OpenBarrierFile(options.barrier_file, barrier_name);
     if (!file.ok()) return file.status();
-    absl::StatusOr<std::unique_ptr<OGRGeometry>> polygons = BarrierPolygonsOf(file->get(), name, &file_crs);
+    absl::StatusOr<std::unique_ptr<OGRGeometry>> polygons = BarrierPolygonsOf(file->get(), barrier_name, &file_crs);
     if (!polygons.ok()) return polygons.status();
-    barrier_union = *std::move(polygons);
-    barrier.reset(OGRCreatePreparedGeometry(OGRGeometry::ToHandle(barrier_union.get())));
-    if (barrier == nullptr) {
-      return absl::InternalError("--barrier: GDAL cannot prepare polygons (built without GEOS?)");
-    }
+    barrier = *std::move(polygons);
   }
-  auto in_barrier = [&](double u, double v) {  // used-grid coordinates of a cell-centre frame
-    if (barrier == nullptr) return false;
-    OGRPoint p(info.geotransform[0] + (u + 0.5) * info.geotransform[1],
-               info.geotransform[3] + (v + 0.5) * info.geotransform[5]);
-    return OGRPreparedGeometryContains(barrier.get(), OGRGeometry::ToHandle(&p)) != 0;
-  };
 
   // Faces: per block, corners a (i, j), b (i+1, j), c (i, j+1), d (i+1, j+1), split along a-d:
   // (a, c, d) and (a, d, b), counter-clockwise seen from above when rows run south (gt[5] < 0).
@@ -590,11 +573,6 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
       for (int k = 0; k < 2; ++k) {
         std::array<uint32_t, 3> t = tris[k];
         if (t[0] == kNoVertex || t[1] == kNoVertex || t[2] == kNoVertex) continue;
-        // The triangle's centre: (i + 1/3, j + 2/3) for (a, c, d), (i + 2/3, j + 1/3) for (a, d, b).
-        if (in_barrier(i + (k == 0 ? 1.0 : 2.0) / 3, j + (k == 0 ? 2.0 : 1.0) / 3)) {
-          ++info.barrier_faces;
-          continue;
-        }
         if (flip) std::swap(t[1], t[2]);
         dem.face_of_block_[2 * (size_t{j} * (W - 1) + i) + k] =
             static_cast<uint32_t>(dem.mesh_.face_count());
@@ -607,7 +585,13 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
                    ? "no 2x2 block of cells above the barrier: nothing to triangulate"
                    : "no 2x2 block of cells with data: nothing to triangulate");
   }
-  return dem;
+  if (barrier == nullptr) return dem;
+  CutStats stats;
+  absl::StatusOr<MeshData> cut = CutBarrier(dem.mesh_, *barrier, &info, &file_crs, barrier_name, &stats);
+  if (!cut.ok()) return cut.status();
+  if (cut->faces.empty()) return bad("the barrier covers every face: nothing is left");
+  info.barrier_faces = stats.faces_removed + stats.faces_cut;
+  return FromMesh(*std::move(cut), info);
 }
 
 absl::StatusOr<Dem> Dem::FromMesh(MeshData mesh, DemInfo info) {
@@ -621,7 +605,6 @@ absl::StatusOr<Dem> Dem::FromMesh(MeshData mesh, DemInfo info) {
     return bad("its grid is not a DEM's");
   }
   const size_t n = mesh.vertex_count();
-  if (n > size_t{W} * H) return bad("more vertices than cells");
   // The grid maps are W x H: bounded by the mesh (a DEM up to 255 of 256 cells without data),
   // whatever a header says.
   if (uint64_t{W} * H > 256 * (uint64_t{n} + 1) + (uint64_t{1} << 24)) {
@@ -657,29 +640,59 @@ absl::StatusOr<Dem> Dem::FromMesh(MeshData mesh, DemInfo info) {
   }
   Dem dem;
   dem.vertex_of_cell_.assign(size_t{W} * H, kNoVertex);
-  std::vector<uint32_t> cell_of_vertex(n);
-  size_t previous = 0;
+  // The cells' vertices come first, in row order; after them, a barrier cut's (at no cell centre).
+  std::vector<uint32_t> cell_of_vertex(n, kNoVertex);
+  size_t previous = 0, cells = 0;
   for (size_t v = 0; v < n; ++v) {
     const double u = (xs[v] - gt[0]) / gt[1] - 0.5, w = (ys[v] - gt[3]) / gt[5] - 0.5;
     const double i = std::round(u), j = std::round(w);
     // A cell centre to far better than a cell (projections round-trip to ~1e-9 of one).
-    if (!(std::abs(u - i) < 1e-3 && std::abs(w - j) < 1e-3 && i >= 0 && j >= 0 && i < W && j < H)) {
-      return bad(absl::StrCat("vertex ", v, " is not at a cell centre"));
+    const bool centre = std::abs(u - i) < 1e-6 && std::abs(w - j) < 1e-6 && i >= 0 && j >= 0 && i < W && j < H;
+    const size_t cell = centre ? static_cast<size_t>(j) * W + static_cast<size_t>(i) : 0;
+    if (!centre || (v > 0 && cell <= previous)) {
+      if (v == 0) return bad("vertex 0 is not at a cell centre");
+      break;
     }
-    const size_t cell = static_cast<size_t>(j) * W + static_cast<size_t>(i);
-    if (v > 0 && cell <= previous) return bad(absl::StrCat("vertex ", v, " is out of row order"));
     previous = cell;
     dem.vertex_of_cell_[cell] = static_cast<uint32_t>(v);
     cell_of_vertex[v] = static_cast<uint32_t>(cell);
+    ++cells;
+  }
+  for (size_t v = cells; v < n; ++v) {  // a cut's vertices lie within the grid, at no cell centre
+    const double u = (xs[v] - gt[0]) / gt[1] - 0.5, w = (ys[v] - gt[3]) / gt[5] - 0.5;
+    if (!(u >= -1e-6 && w >= -1e-6 && u <= W - 1 + 1e-6 && w <= H - 1 + 1e-6)) {
+      return bad(absl::StrCat("vertex ", v, " is outside the grid"));
+    }
+    if (std::abs(u - std::round(u)) < 1e-6 && std::abs(w - std::round(w)) < 1e-6) {
+      return bad(absl::StrCat("vertex ", v, " is out of row order"));
+    }
   }
   dem.face_of_block_.assign(2 * size_t{W - 1} * (H - 1), kNoVertex);
+  std::vector<std::pair<uint32_t, uint32_t>> pieces;  // (block triangle, face) of a cut's faces
   for (size_t f = 0; f < mesh.face_count(); ++f) {
     uint32_t ci[3], cj[3];
+    bool on_cells = true;
     for (int c = 0; c < 3; ++c) {
       const uint32_t v = mesh.faces[3 * f + c];
       if (v >= n) return bad(absl::StrCat("face ", f, " has no vertex ", v));
-      ci[c] = cell_of_vertex[v] % W;
-      cj[c] = cell_of_vertex[v] / W;
+      on_cells &= cell_of_vertex[v] != kNoVertex;
+      ci[c] = on_cells ? cell_of_vertex[v] % W : 0;
+      cj[c] = on_cells ? cell_of_vertex[v] / W : 0;
+    }
+    if (!on_cells) {
+      // A piece of a cut face: filed under the block triangle that holds its centre, found again
+      // by DropMeshPoint among that triangle's neighbours too.
+      double u = 0, w = 0;
+      for (int c = 0; c < 3; ++c) {
+        const uint32_t v = mesh.faces[3 * f + c];
+        u += ((xs[v] - gt[0]) / gt[1] - 0.5) / 3;
+        w += ((ys[v] - gt[3]) / gt[5] - 0.5) / 3;
+      }
+      const uint32_t i = static_cast<uint32_t>(std::clamp(std::floor(u), 0.0, W - 2.0));
+      const uint32_t j = static_cast<uint32_t>(std::clamp(std::floor(w), 0.0, H - 2.0));
+      const int k = (w - j) >= (u - i) ? 0 : 1;  // (a, c, d) below the a-d diagonal, else (a, d, b)
+      pieces.push_back({static_cast<uint32_t>(2 * (size_t{j} * (W - 1) + i) + k), static_cast<uint32_t>(f)});
+      continue;
     }
     const uint32_t i = std::min({ci[0], ci[1], ci[2]}), j = std::min({cj[0], cj[1], cj[2]});
     // (a, c, d) has the block's lower-left corner c (i, j + 1); (a, d, b) its b (i + 1, j).
@@ -698,6 +711,8 @@ absl::StatusOr<Dem> Dem::FromMesh(MeshData mesh, DemInfo info) {
     if (slot != kNoVertex) return bad(absl::StrCat("face ", f, " repeats face ", slot));
     slot = static_cast<uint32_t>(f);
   }
+  std::sort(pieces.begin(), pieces.end());
+  dem.pieces_ = std::move(pieces);
   dem.mesh_ = std::move(mesh);
   dem.info_ = std::move(info);
   return dem;
@@ -766,22 +781,30 @@ absl::StatusOr<SurfacePoint> Dem::DropMeshPoint(double mx, double my, double u, 
       const int i = bi + (di == 2 ? -1 : di == 1 ? 1 : 0), j = bj + (dj == 2 ? -1 : dj == 1 ? 1 : 0);
       if (i < 0 || j < 0 || i > static_cast<int>(W) - 2 || j > static_cast<int>(H) - 2) continue;
       for (int k = 0; k < 2; ++k) {
-        const uint32_t f = face_of_block_[2 * (size_t(j) * (W - 1) + i) + k];
-        if (f == kNoVertex) continue;
-        const double* p[3];
-        for (int c = 0; c < 3; ++c) p[c] = &mesh_.positions[3 * size_t{mesh_.faces[3 * size_t{f} + c]}];
-        // Barycentrics of (mx, my) in the face's projection onto the map plane.
-        const double det = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) -
-                           (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]);
-        if (det == 0) continue;
-        const double b1 = ((mx - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (my - p[0][1])) / det;
-        const double b2 = ((p[1][0] - p[0][0]) * (my - p[0][1]) - (mx - p[0][0]) * (p[1][1] - p[0][1])) / det;
-        const std::array<double, 3> b = {1 - b1 - b2, b1, b2};
-        const double lowest = std::min({b[0], b[1], b[2]});
-        if (lowest > best_min) {
-          best_min = lowest;
-          best = b;
-          best_face = f;
+        const uint32_t triangle = static_cast<uint32_t>(2 * (size_t(j) * (W - 1) + i) + k);
+        // The block triangle's face, or the pieces a barrier cut left of it.
+        std::vector<uint32_t> candidates;
+        if (face_of_block_[triangle] != kNoVertex) candidates.push_back(face_of_block_[triangle]);
+        for (auto it = std::lower_bound(pieces_.begin(), pieces_.end(), std::make_pair(triangle, 0u));
+             it != pieces_.end() && it->first == triangle; ++it) {
+          candidates.push_back(it->second);
+        }
+        for (const uint32_t f : candidates) {
+          const double* p[3];
+          for (int c = 0; c < 3; ++c) p[c] = &mesh_.positions[3 * size_t{mesh_.faces[3 * size_t{f} + c]}];
+          // Barycentrics of (mx, my) in the face's projection onto the map plane.
+          const double det = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) -
+                             (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]);
+          if (det == 0) continue;
+          const double b1 = ((mx - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (my - p[0][1])) / det;
+          const double b2 = ((p[1][0] - p[0][0]) * (my - p[0][1]) - (mx - p[0][0]) * (p[1][1] - p[0][1])) / det;
+          const std::array<double, 3> b = {1 - b1 - b2, b1, b2};
+          const double lowest = std::min({b[0], b[1], b[2]});
+          if (lowest > best_min) {
+            best_min = lowest;
+            best = b;
+            best_face = f;
+          }
         }
       }
     }

@@ -254,7 +254,8 @@ class PythonClientTest(unittest.TestCase):
                  (500052, 5000010)]]
         wall = {"type": "Polygon", "coordinates": [ring]}
         walled = self.client.derive_mesh("meshes/slope", polygons_geojson=wall, name="walled")
-        self.assertEqual(walled.terrain.barrier_faces, 2 * 18)
+        # cut exactly: block columns 4 and 6 in part, 5 whole, rows 0-17, two faces a block
+        self.assertEqual(walled.terrain.barrier_faces, 3 * 2 * 18)
         wall_file = os.path.join(self.tmp.name, "wall.geojson")
         with open(wall_file, "w") as f:
             json.dump(wall, f)

@@ -18,6 +18,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -33,8 +34,8 @@ struct DemOptions {
   // A barrier: cells lower than this (metres; the sea at 0) are left out like nodata, so paths
   // go around them. -inf: none.
   double barrier_below = -std::numeric_limits<double>::infinity();
-  // A barrier drawn as polygons (any vector file GDAL reads, GeoJSON first; its own CRS, WGS 84
-  // when it names none): the triangles whose centre lies inside one are left out. "": none.
+  // A barrier drawn as polygons (GeoJSON, Shapefile, GeoPackage or FlatGeobuf; its own CRS, WGS 84
+  // when it names none), cut exactly out of the surface (CutBarrierPolygons). "": none.
   std::string barrier_file;
   // The most cells (width x height of the file) a raster may have, and the most vertices and
   // faces its mesh may have (every used cell with data, two triangles per block); 0: any. What a
@@ -57,7 +58,7 @@ struct DemInfo {
   uint32_t grid_width = 0, grid_height = 0;      // the used cells
   uint64_t nodata_cells = 0;                     // used cells without data
   uint64_t barrier_cells = 0;                    // used cells below DemOptions::barrier_below
-  uint64_t barrier_faces = 0;                    // triangles inside DemOptions::barrier_file
+  uint64_t barrier_faces = 0;                    // grid triangles a barrier file removed or cut
   std::string file_crs_name;  // the file's CRS ("WGS 84 / UTM zone 33N", "WGS 84")
   std::string file_crs_wkt;
   bool reprojected = false;   // the file's CRS is geographic: the mesh is in mesh_crs
@@ -73,14 +74,23 @@ struct DemInfo {
   bool operator==(const DemInfo&) const = default;
 };
 
+// What a barrier cut did to a mesh's faces.
+struct CutStats {
+  uint64_t faces_removed = 0;   // wholly inside a barrier
+  uint64_t faces_cut = 0;       // partly inside: replaced by the pieces outside it
+  uint64_t faces_split = 0;     // outside, split at points a neighbour's cut put on their edges
+  uint64_t vertices_added = 0;  // where a barrier's edges cross the mesh, and its corners
+};
+
 // A barrier drawn as polygons, on any mesh: `geojson` is the text of a GeoJSON FeatureCollection,
 // Feature or geometry (RFC 7946 WGS 84 unless it names its CRS) on a DEM's mesh (`dem`: its map),
-// or, with `dem` null, polygons in the mesh's own x y (no CRS). The faces whose centre lies inside
-// one are removed (vertices keep their ids); `*removed` counts them. InvalidArgument starting
-// with `name` when the text is not GeoJSON polygons. Only GDAL's GeoJSON driver reads it.
-absl::StatusOr<MeshData> RemoveFacesInPolygons(const MeshData& mesh, const std::string& geojson,
-                                               const DemInfo* dem, const std::string& name,
-                                               uint64_t* removed);
+// or, with `dem` null, polygons in the mesh's own x y (no CRS). The polygons are cut exactly out of
+// the surface: what remains is the mesh minus the vertical prism over them, faces crossing a
+// boundary split along it (see terrain/src/barrier_cut.h). Vertices keep their ids, new ones
+// follow. InvalidArgument starting with `name` when the text is not GeoJSON polygons (or names
+// its CRS by anything but an identifier). Only GDAL's GeoJSON driver reads it.
+absl::StatusOr<MeshData> CutBarrierPolygons(const MeshData& mesh, const std::string& geojson,
+                                            const DemInfo* dem, const std::string& name, CutStats* stats);
 
 inline constexpr uint32_t kNoVertex = 0xffffffffu;
 
@@ -110,7 +120,8 @@ class Dem {
   uint64_t MemoryBytes() const {
     return mesh_.positions.capacity() * sizeof(double) +
            (mesh_.faces.capacity() + vertex_of_cell_.capacity() + face_of_block_.capacity()) *
-               sizeof(uint32_t);
+               sizeof(uint32_t) +
+           pieces_.capacity() * sizeof(pieces_[0]);
   }
   // The vertex of used cell (col, row), or kNoVertex (nodata).
   uint32_t VertexAt(uint32_t col, uint32_t row) const {
@@ -148,6 +159,9 @@ class Dem {
   DemInfo info_;
   std::vector<uint32_t> vertex_of_cell_;  // grid_width * grid_height
   std::vector<uint32_t> face_of_block_;   // 2 per block ((grid_width-1) * (grid_height-1))
+  // A barrier cut's faces: (block triangle, face), sorted; the triangle's face_of_block_ is then
+  // kNoVertex.
+  std::vector<std::pair<uint32_t, uint32_t>> pieces_;
 };
 
 // True when `path` names a raster by its extension (.tif, .tiff, .vrt, .asc, .img, .hgt, .dem,

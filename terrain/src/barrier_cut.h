@@ -1,0 +1,33 @@
+#pragma once
+
+// Barrier polygons cut exactly into a triangle mesh (issue 32): the surface that remains is the
+// mesh minus the vertical prism over the polygons, whatever its shape or width.
+//
+// Each face is clipped against the polygons in the mesh's own x-y plane by GEOS (its difference),
+// and what remains is triangulated by GEOS's constrained Delaunay triangulation; new vertices lie
+// on the original face's plane, so heights follow the terrain. Neighbouring faces meet exactly: a
+// point where a barrier crosses a mesh edge is made once per edge (from its lower vertex id) and
+// shared by both faces, and a face that keeps an edge whole gains the points its neighbour put on
+// it, so the result is conforming (no T-junctions) and each face's pieces add up to what is left.
+//
+// Vertices keep their ids (new ones follow them, a vertex inside a barrier stays, unused); faces
+// keep their order, a cut face replaced in place by its pieces. A face seen edge-on from above (its
+// x-y area below 1e-12 of its squared size, a vertical wall) is not cut: it goes when its centre
+// lies inside a barrier.
+
+#include <cstdint>
+
+#include "absl/status/statusor.h"
+#include "geodex/mesh_data.h"
+#include "geodex/terrain.h"
+
+class OGRGeometry;
+
+namespace geodex::terrain {
+
+// `polygons`: (Multi)Polygons whose coordinates times `scale` are the mesh's x y. Internal error
+// only when GEOS fails.
+absl::StatusOr<MeshData> CutOutPolygons(const MeshData& mesh, const OGRGeometry& polygons, double scale,
+                                        CutStats* stats);
+
+}  // namespace geodex::terrain

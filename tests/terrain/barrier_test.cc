@@ -1,0 +1,386 @@
+// Barrier polygons cut exactly into the surface (terrain/src/barrier_cut.h, issue 32), checked
+// against analytic answers: a tilted plane is flat in its own metric, so the shortest path around
+// a polygonal hole is the taut string through the hole's corners, found here by Dijkstra on the
+// visibility graph; the cut mesh must conform (no T-junctions) and keep exactly the plane's area
+// outside the polygons.
+
+#include <array>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <queue>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
+#include "gdal_priv.h"
+#include "geodex/geodesic_solver.h"
+#include "geodex/terrain.h"
+#include "geodex/triangle_mesh.h"
+#include "gtest/gtest.h"
+#include "ogr_spatialref.h"
+
+namespace geodex::terrain {
+namespace {
+
+using Point2 = std::array<double, 2>;
+constexpr double kSlopeX = 0.3, kSlopeY = -0.2;  // the plane z = 0.3 x - 0.2 y
+
+// An N x N grid of unit cells on the plane, two triangles a block (split along alternating
+// diagonals, so both kinds of crossing are met).
+MeshData TiltedGrid(int n) {
+  MeshData mesh;
+  for (int j = 0; j <= n; ++j) {
+    for (int i = 0; i <= n; ++i) mesh.positions.insert(mesh.positions.end(), {1.0 * i, 1.0 * j, kSlopeX * i + kSlopeY * j});
+  }
+  auto id = [n](int i, int j) { return static_cast<uint32_t>(j * (n + 1) + i); };
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      const uint32_t a = id(i, j), b = id(i + 1, j), c = id(i, j + 1), d = id(i + 1, j + 1);
+      if ((i + j) % 2 == 0) {
+        mesh.faces.insert(mesh.faces.end(), {a, b, d, a, d, c});
+      } else {
+        mesh.faces.insert(mesh.faces.end(), {a, b, c, b, d, c});
+      }
+    }
+  }
+  return mesh;
+}
+
+std::array<double, 3> OnPlane(const Point2& p) { return {p[0], p[1], kSlopeX * p[0] + kSlopeY * p[1]}; }
+double Length3(const Point2& p, const Point2& q) {
+  const auto a = OnPlane(p), b = OnPlane(q);
+  return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+}
+
+// Does segment p-q pass through the open interior of the convex counter-clockwise polygon?
+bool Blocked(const Point2& p, const Point2& q, const std::vector<Point2>& polygon) {
+  double lo = 0, hi = 1;
+  for (size_t k = 0; k < polygon.size(); ++k) {
+    const Point2 &a = polygon[k], &b = polygon[(k + 1) % polygon.size()];
+    const double nx = -(b[1] - a[1]), ny = b[0] - a[0];  // inward normal
+    const double at_p = nx * (p[0] - a[0]) + ny * (p[1] - a[1]);
+    const double slope = nx * (q[0] - p[0]) + ny * (q[1] - p[1]);
+    if (std::abs(slope) < 1e-15) {
+      if (at_p <= 1e-12) return false;
+      continue;
+    }
+    const double t = -at_p / slope;
+    if (slope > 0) lo = std::max(lo, t); else hi = std::min(hi, t);
+  }
+  return hi - lo > 1e-9;
+}
+
+// The taut string from s to t around convex holes: Dijkstra on the visibility graph.
+double TautString(const Point2& s, const Point2& t, const std::vector<std::vector<Point2>>& holes) {
+  std::vector<Point2> nodes = {s, t};
+  for (const auto& h : holes) nodes.insert(nodes.end(), h.begin(), h.end());
+  std::vector<double> best(nodes.size(), std::numeric_limits<double>::infinity());
+  std::priority_queue<std::pair<double, size_t>, std::vector<std::pair<double, size_t>>, std::greater<>> queue;
+  best[0] = 0;
+  queue.push({0, 0});
+  while (!queue.empty()) {
+    auto [d, u] = queue.top();
+    queue.pop();
+    if (d > best[u]) continue;
+    for (size_t v = 0; v < nodes.size(); ++v) {
+      bool visible = v != u;
+      for (const auto& h : holes) visible = visible && !Blocked(nodes[u], nodes[v], h);
+      if (visible && d + Length3(nodes[u], nodes[v]) < best[v]) {
+        best[v] = d + Length3(nodes[u], nodes[v]);
+        queue.push({best[v], v});
+      }
+    }
+  }
+  return best[1];
+}
+
+std::string PolygonJson(const std::vector<std::vector<Point2>>& polygons) {
+  std::string parts;
+  for (const auto& ring : polygons) {
+    std::string coordinates;
+    for (size_t k = 0; k <= ring.size(); ++k) {
+      absl::StrAppendFormat(&coordinates, "%s[%.17g, %.17g]", k == 0 ? "" : ", ", ring[k % ring.size()][0],
+                            ring[k % ring.size()][1]);
+    }
+    absl::StrAppend(&parts, parts.empty() ? "" : ", ", "[[", coordinates, "]]");
+  }
+  return absl::StrCat(R"({"type": "MultiPolygon", "coordinates": [)", parts, "]}");
+}
+
+double Area3(const MeshData& m) {
+  double total = 0;
+  for (size_t f = 0; f < m.face_count(); ++f) {
+    const double* p[3];
+    for (int c = 0; c < 3; ++c) p[c] = &m.positions[3 * size_t{m.faces[3 * f + c]}];
+    const double u[3] = {p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]};
+    const double v[3] = {p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]};
+    total += std::hypot(u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]) / 2;
+  }
+  return total;
+}
+
+double Shoelace(const std::vector<Point2>& ring) {
+  double a = 0;
+  for (size_t k = 0; k < ring.size(); ++k) {
+    const Point2 &p = ring[k], &q = ring[(k + 1) % ring.size()];
+    a += p[0] * q[1] - q[0] * p[1];
+  }
+  return a / 2;
+}
+
+double DistanceToBoundary(const Point2& p, const std::vector<Point2>& ring) {
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t k = 0; k < ring.size(); ++k) {
+    const Point2 &a = ring[k], &b = ring[(k + 1) % ring.size()];
+    const double dx = b[0] - a[0], dy = b[1] - a[1];
+    const double t = std::clamp(((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / (dx * dx + dy * dy), 0.0, 1.0);
+    best = std::min(best, std::hypot(p[0] - a[0] - t * dx, p[1] - a[1] - t * dy));
+  }
+  return best;
+}
+
+// Conforming: each directed edge once; an edge with one face lies on the grid's outer boundary or
+// on a polygon's boundary (a T-junction would leave one inside). Every vertex on the plane.
+void ExpectConforming(const MeshData& cut, int n, const std::vector<std::vector<Point2>>& polygons) {
+  std::map<std::pair<uint32_t, uint32_t>, int> directed;
+  for (size_t f = 0; f < cut.face_count(); ++f) {
+    for (int c = 0; c < 3; ++c) ++directed[{cut.faces[3 * f + c], cut.faces[3 * f + (c + 1) % 3]}];
+  }
+  int boundary = 0, bad = 0;
+  for (const auto& [edge, count] : directed) {
+    EXPECT_EQ(count, 1) << edge.first << "-" << edge.second;
+    if (directed.count({edge.second, edge.first}) != 0) continue;
+    ++boundary;
+    const double* a = &cut.positions[3 * size_t{edge.first}];
+    const double* b = &cut.positions[3 * size_t{edge.second}];
+    const Point2 mid = {(a[0] + b[0]) / 2, (a[1] + b[1]) / 2};
+    bool ok = std::abs(mid[0]) < 1e-12 || std::abs(mid[1]) < 1e-12 || std::abs(mid[0] - n) < 1e-12 ||
+              std::abs(mid[1] - n) < 1e-12;
+    for (const auto& ring : polygons) {
+      ok = ok || (DistanceToBoundary(mid, ring) < 1e-9 && DistanceToBoundary({a[0], a[1]}, ring) < 1e-9 &&
+                  DistanceToBoundary({b[0], b[1]}, ring) < 1e-9);
+    }
+    bad += ok ? 0 : 1;
+  }
+  EXPECT_GT(boundary, 0);
+  EXPECT_EQ(bad, 0) << "edges with one face inside the surface: T-junctions";
+  for (size_t v = 0; v < cut.vertex_count(); ++v) {
+    const double* p = &cut.positions[3 * v];
+    EXPECT_NEAR(p[2], kSlopeX * p[0] + kSlopeY * p[1], 1e-12) << v;
+  }
+}
+
+TEST(BarrierCutTest, SquareHoleGivesTheTautString) {
+  const int n = 20;
+  const MeshData grid = TiltedGrid(n);
+  // A square turned 20 degrees, its corners inside cells.
+  std::vector<Point2> hole;
+  const double angle = 20 * M_PI / 180;
+  for (int k = 0; k < 4; ++k) {
+    const double a = angle + k * M_PI / 2;
+    hole.push_back({10.13 + 4.3 * std::cos(a) * std::sqrt(2.0), 9.87 + 4.3 * std::sin(a) * std::sqrt(2.0)});
+  }
+  ASSERT_GT(Shoelace(hole), 0);
+  CutStats stats;
+  absl::StatusOr<MeshData> cut = CutBarrierPolygons(grid, PolygonJson({hole}), nullptr, "hole", &stats);
+  ASSERT_TRUE(cut.ok()) << cut.status();
+  EXPECT_GT(stats.faces_cut, 0u);
+  EXPECT_GT(stats.faces_removed, 0u);
+  EXPECT_GT(stats.vertices_added, 0u);
+  ExpectConforming(*cut, n, {hole});
+  const double sec = std::sqrt(1 + kSlopeX * kSlopeX + kSlopeY * kSlopeY);
+  EXPECT_NEAR(Area3(*cut), (n * n - Shoelace(hole)) * sec, 1e-10 * n * n);
+  absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(*cut);
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+
+  // From grid vertices on one side to every grid vertex: the taut string wherever the hole is in
+  // the way, the straight line elsewhere.
+  for (const Point2 source : {Point2{1, 9}, Point2{10, 1}, Point2{3, 17}}) {
+    const uint32_t s = static_cast<uint32_t>(source[1] * (n + 1) + source[0]);
+    absl::StatusOr<DistanceField> field = ComputeDistanceField(*mesh, {SurfacePoint::AtVertex(s)});
+    ASSERT_TRUE(field.ok()) << field.status();
+    double worst = 0;
+    int around = 0;
+    for (int j = 0; j <= n; ++j) {
+      for (int i = 0; i <= n; ++i) {
+        const Point2 target = {1.0 * i, 1.0 * j};
+        const double d = field->distance[j * (n + 1) + i];
+        bool inside = true;  // a vertex inside the hole is unused: unreachable
+        for (size_t k = 0; k < 4; ++k) inside &= Shoelace({hole[k], hole[(k + 1) % 4], target}) > 0;
+        if (inside) {
+          EXPECT_TRUE(std::isinf(d)) << i << " " << j;
+          continue;
+        }
+        const double expected = TautString(source, target, {hole});
+        around += Blocked(source, target, hole) ? 1 : 0;
+        worst = std::max(worst, std::abs(d - expected) / std::max(expected, 1.0));
+      }
+    }
+    EXPECT_GT(around, 5) << "the hole is in the way of some paths";
+    EXPECT_LT(worst, 1e-9) << source[0] << " " << source[1];
+  }
+}
+
+TEST(BarrierCutTest, AWallNarrowerThanACellSeparates) {
+  const int n = 16;
+  const MeshData grid = TiltedGrid(n);
+  // 0.3 wide, across the whole grid at 17 degrees off its columns.
+  const double angle = 17 * M_PI / 180, cx = 8.4, cy = 8;
+  const Point2 along = {std::sin(angle), std::cos(angle)}, across = {std::cos(angle), -std::sin(angle)};
+  std::vector<Point2> wall;
+  for (auto [u, w] : std::vector<std::pair<double, double>>{{-20, -0.15}, {-20, 0.15}, {20, 0.15}, {20, -0.15}}) {
+    wall.push_back({cx + u * along[0] + w * across[0], cy + u * along[1] + w * across[1]});
+  }
+  if (Shoelace(wall) < 0) std::reverse(wall.begin(), wall.end());
+  CutStats stats;
+  absl::StatusOr<MeshData> cut = CutBarrierPolygons(grid, PolygonJson({wall}), nullptr, "wall", &stats);
+  ASSERT_TRUE(cut.ok()) << cut.status();
+  ExpectConforming(*cut, n, {wall});
+  absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(*cut);
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  absl::StatusOr<DistanceField> field = ComputeDistanceField(*mesh, {SurfacePoint::AtVertex(0)});
+  ASSERT_TRUE(field.ok()) << field.status();
+  int near = 0, far = 0;
+  for (int j = 0; j <= n; ++j) {
+    for (int i = 0; i <= n; ++i) {
+      const double side = (i - cx) * across[0] + (j - cy) * across[1];
+      const double d = field->distance[j * (n + 1) + i];
+      if (side < -0.15) {
+        EXPECT_NEAR(d, Length3({0, 0}, {1.0 * i, 1.0 * j}), 1e-9 * n) << i << " " << j;
+        ++near;
+      } else if (side > 0.15) {
+        EXPECT_TRUE(std::isinf(d)) << i << " " << j << ": " << d;
+        ++far;
+      }
+    }
+  }
+  EXPECT_GT(near, 50);
+  EXPECT_GT(far, 50);
+  // The old rule (faces whose centre is inside) left this wall full of gaps.
+  EXPECT_GT(stats.faces_cut, stats.faces_removed);
+}
+
+TEST(BarrierCutTest, TwoHolesAndAPolygonAlongGridLines) {
+  const int n = 12;
+  const MeshData grid = TiltedGrid(n);
+  // One square exactly on grid lines (its faces go whole, its neighbours stay whole), and a
+  // triangle with a corner on a grid vertex.
+  const std::vector<Point2> square = {{2, 2}, {5, 2}, {5, 5}, {2, 5}};
+  const std::vector<Point2> triangle = {{7, 7}, {10.5, 8.5}, {8.25, 10.5}};
+  // Touching cases: the faces on the other side of a grid edge lose nothing but must take the
+  // points put on it (a corner in the middle of an edge; an edge along part of a grid line).
+  const std::vector<Point2> tip = {{3.5, 8}, {4.7, 9.6}, {2.6, 9.4}};
+  // A corner a hair (1e-12) inside a face, next to its edge: put on the edge (GEOS's rounding is
+  // far larger), so the face beyond, which the polygon does not reach, must take it too.
+  const std::vector<Point2> hair = {{9.5, 5 + 1e-12}, {10.6, 6.4}, {8.7, 6.2}};
+  const std::vector<Point2> ledge = {{6.5, 2}, {8.5, 2}, {8.5, 3.7}, {6.5, 3.7}};
+  const std::vector<std::vector<Point2>> all = {square, triangle, tip, ledge, hair};
+  CutStats stats;
+  absl::StatusOr<MeshData> cut = CutBarrierPolygons(grid, PolygonJson(all), nullptr, "holes", &stats);
+  ASSERT_TRUE(cut.ok()) << cut.status();
+  ExpectConforming(*cut, n, all);
+  EXPECT_GT(stats.faces_split, 0u);
+  const double sec = std::sqrt(1 + kSlopeX * kSlopeX + kSlopeY * kSlopeY);
+  double holes = 0;
+  for (const auto& ring : all) holes += Shoelace(ring);
+  EXPECT_NEAR(Area3(*cut), (n * n - holes) * sec, 1e-10 * n * n);
+  EXPECT_GE(stats.faces_removed, 18u);  // the square's 9 blocks, and what the triangle covers
+  absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(*cut);
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  absl::StatusOr<DistanceField> field = ComputeDistanceField(*mesh, {SurfacePoint::AtVertex(0)});
+  ASSERT_TRUE(field.ok());
+  for (const Point2 target : {Point2{12, 12}, Point2{6, 3}, Point2{3, 12}, Point2{11, 9}, Point2{9, 4}, Point2{4, 10}}) {
+    const double d = field->distance[static_cast<size_t>(target[1] * (n + 1) + target[0])];
+    EXPECT_NEAR(d, TautString({0, 0}, target, all), 1e-9 * d) << target[0] << " " << target[1];
+  }
+  // A polygon that misses the mesh changes nothing.
+  absl::StatusOr<MeshData> away = CutBarrierPolygons(grid, PolygonJson({{{30, 30}, {31, 30}, {31, 31}}}), nullptr, "away", &stats);
+  ASSERT_TRUE(away.ok());
+  EXPECT_EQ(away->faces, grid.faces);
+  EXPECT_EQ(away->positions, grid.positions);
+}
+
+// On a DEM, a barrier given in longitude/latitude and the same one in the DEM's own CRS make the
+// same cut; the stored mesh (Dem::FromMesh) drops map points as the read one does.
+TEST(BarrierCutTest, DemBarrierInEitherCrsAndStoredAgain) {
+  GDALAllRegister();
+  const std::string path = (std::filesystem::path(::testing::TempDir()) / "geodex-barrier-plane.tif").string();
+  GDALDataset* ds = GetGDALDriverManager()->GetDriverByName("GTiff")->Create(path.c_str(), 30, 20, 1, GDT_Float64, nullptr);
+  double gt[6] = {500000, 10, 0, 5000000, 0, -10};
+  ds->SetGeoTransform(gt);
+  OGRSpatialReference utm, wgs84;
+  utm.importFromEPSG(32633);
+  wgs84.importFromEPSG(4326);
+  utm.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  ds->SetSpatialRef(&utm);
+  std::vector<double> row(30);
+  for (int j = 0; j < 20; ++j) {
+    for (int i = 0; i < 30; ++i) row[i] = 0.1 * i - 0.05 * j;
+    ASSERT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Write, 0, j, 30, 1, row.data(), 30, 1, GDT_Float64, 0, 0), CE_None);
+  }
+  GDALClose(ds);
+  absl::StatusOr<Dem> dem = Dem::Read(path);
+  ASSERT_TRUE(dem.ok()) << dem.status();
+
+  const std::vector<Point2> ring = {{500083.3, 4999912.1}, {500191.7, 4999897.4}, {500172.2, 4999832.6}, {500101.9, 4999851.5}};
+  std::string native, lonlat;
+  OGRCoordinateTransformation* to_ll = OGRCreateCoordinateTransformation(&utm, &wgs84);
+  for (size_t k = 0; k <= ring.size(); ++k) {
+    double x = ring[k % ring.size()][0], y = ring[k % ring.size()][1];
+    absl::StrAppendFormat(&native, "%s[%.17g, %.17g]", k == 0 ? "" : ", ", x, y);
+    ASSERT_TRUE(to_ll->Transform(1, &x, &y));
+    absl::StrAppendFormat(&lonlat, "%s[%.17g, %.17g]", k == 0 ? "" : ", ", x, y);
+  }
+  OGRCoordinateTransformation::DestroyCT(to_ll);
+  CutStats a_stats, b_stats;
+  absl::StatusOr<MeshData> a = CutBarrierPolygons(
+      dem->mesh(),
+      absl::StrCat(R"({"type": "Polygon", "crs": {"type": "name", "properties": {"name": "EPSG:32633"}}, "coordinates": [[)",
+                   native, "]]}"),
+      &dem->info(), "native", &a_stats);
+  absl::StatusOr<MeshData> b = CutBarrierPolygons(
+      dem->mesh(), absl::StrCat(R"({"type": "Polygon", "coordinates": [[)", lonlat, "]]}"), &dem->info(), "lonlat", &b_stats);
+  ASSERT_TRUE(a.ok()) << a.status();
+  ASSERT_TRUE(b.ok()) << b.status();
+  EXPECT_EQ(a->faces, b->faces);
+  ASSERT_EQ(a->positions.size(), b->positions.size());
+  double worst = 0;
+  for (size_t k = 0; k < a->positions.size(); ++k) worst = std::max(worst, std::abs(a->positions[k] - b->positions[k]));
+  EXPECT_LT(worst, 1e-6);
+  EXPECT_GT(a_stats.faces_cut, 0u);
+
+  absl::StatusOr<Dem> stored = Dem::FromMesh(*a, dem->info());
+  ASSERT_TRUE(stored.ok()) << stored.status();
+  // Map points beside the barrier land in its pieces, on the plane; inside it they are in a hole.
+  int landed = 0;
+  for (double x = 500080; x < 500200; x += 3.7) {
+    for (double y = 4999820; y < 4999920; y += 4.1) {
+      absl::StatusOr<SurfacePoint> p = stored->DropMapPoint(x, y);
+      std::vector<Point2> local;
+      for (const Point2& q : ring) local.push_back({q[0], q[1]});
+      bool inside = true;
+      for (size_t k = 0; k < 4; ++k) inside &= Shoelace({local[k], local[(k + 1) % 4], Point2{x, y}}) < 0;
+      if (inside) {
+        EXPECT_FALSE(p.ok()) << x << " " << y;
+        continue;
+      }
+      ASSERT_TRUE(p.ok()) << x << " " << y << ": " << p.status();
+      double pos[3] = {0, 0, 0};
+      for (int c = 0; c < 3; ++c) {
+        for (int d = 0; d < 3; ++d) pos[d] += p->bary[c] * a->positions[3 * size_t{a->faces[3 * size_t{p->face} + c]} + d];
+      }
+      EXPECT_NEAR(pos[0], x, 1e-6);
+      EXPECT_NEAR(pos[1], y, 1e-6);
+      ++landed;
+    }
+  }
+  EXPECT_GT(landed, 100);
+}
+
+}  // namespace
+}  // namespace geodex::terrain
