@@ -231,6 +231,13 @@ absl::StatusOr<terrain::DemOptions> MeshReadOptions(const Args& args, const std:
     return absl::InvalidArgumentError("--barrier-below must be a number");
   }
   if (args.options.count("barrier")) dem.barrier_file = args.options.at("barrier");
+  if (!GetDouble(args, "barrier-width", &dem.barrier_width, &error)) return absl::InvalidArgumentError(error);
+  if (!(dem.barrier_width >= 0) || !std::isfinite(dem.barrier_width)) {
+    return absl::InvalidArgumentError("--barrier-width must be a finite number of metres, 0 or more");
+  }
+  if (args.options.count("barrier-width") && dem.barrier_file.empty()) {
+    return absl::InvalidArgumentError("--barrier-width goes with --barrier (the width of its lines and points)");
+  }
   if (args.options.count("dem-step") && !terrain::IsDemPath(mesh)) {
     return absl::InvalidArgumentError(
         absl::StrCat("--dem-step: ", mesh, " is not a DEM (a raster such as .tif)"));

@@ -61,6 +61,23 @@ absl::StatusOr<std::string> ReadBarrierText(const std::string& path) {
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
+// A barrier that cuts nothing is most often drawn in the wrong place or CRS: said, not an error.
+void WarnBarrierMisses(const terrain::DemOptions& dem_options) {
+  std::fprintf(stderr,
+               "geodex: warning: --barrier %s cuts nothing: it misses the surface (drawn in another CRS, or "
+               "lon/lat swapped?)\n",
+               dem_options.barrier_file.c_str());
+}
+
+void WarnIfBarrierSplits(const terrain::DemOptions& dem_options, uint64_t components) {
+  const bool barrier = std::isfinite(dem_options.barrier_below) || !dem_options.barrier_file.empty();
+  if (!barrier || components < 2) return;
+  std::fprintf(stderr,
+               "geodex: warning: with its barriers the surface is in %llu parts: a point in another part "
+               "than every source is unreachable (inf)\n",
+               static_cast<unsigned long long>(components));
+}
+
 // Reads a mesh file, or a built-in sample ("sample:terrain").
 absl::StatusOr<MeshData> LoadMeshData(const std::string& path,
                                       const terrain::DemOptions& dem_options,
@@ -68,6 +85,7 @@ absl::StatusOr<MeshData> LoadMeshData(const std::string& path,
   if (terrain::IsDemPath(path) && path.rfind("sample:", 0) != 0) {
     absl::StatusOr<terrain::Dem> read = terrain::Dem::Read(path, dem_options);
     if (!read.ok()) return read.status();
+    if (!dem_options.barrier_file.empty() && read->info().barrier_faces == 0) WarnBarrierMisses(dem_options);
     auto shared = std::make_shared<const terrain::Dem>(*std::move(read));
     MeshData data = shared->mesh();
     if (dem != nullptr) *dem = std::move(shared);
@@ -83,7 +101,9 @@ absl::StatusOr<MeshData> LoadMeshData(const std::string& path,
     absl::StatusOr<std::string> text = ReadBarrierText(dem_options.barrier_file);
     if (!text.ok()) return text.status();
     terrain::CutStats cut_stats;
-    data = terrain::CutBarrierPolygons(*data, *text, nullptr, "--barrier " + dem_options.barrier_file, &cut_stats);
+    data = terrain::CutBarrierPolygons(*data, *text, nullptr, dem_options.barrier_width,
+                                       "--barrier " + dem_options.barrier_file, &cut_stats);
+    if (data.ok() && cut_stats.faces_removed + cut_stats.faces_cut == 0) WarnBarrierMisses(dem_options);
   }
   return data;
 }
@@ -100,6 +120,7 @@ absl::StatusOr<LoadedMesh> LoadMesh(const std::string& path, const MeshBuildOpti
   if (!mesh.ok()) {
     return absl::Status(mesh.status().code(), path + ": " + std::string(mesh.status().message()));
   }
+  WarnIfBarrierSplits(dem_options, mesh->report().components);
   return LoadedMesh{std::move(*data), std::move(*mesh), load_ms, MsSince(t1), std::move(dem)};
 }
 

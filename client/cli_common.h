@@ -51,10 +51,14 @@ absl::StatusOr<LoadedMesh> LoadMesh(const std::string& path, const MeshBuildOpti
 // --key as a number; absent leaves *out unchanged. False with *error naming the option.
 bool GetDouble(const Args& args, const std::string& key, double* out, std::string* error);
 bool GetUint(const Args& args, const std::string& key, uint64_t* out, std::string* error);
+// With a barrier (--barrier-below, --barrier), says on stderr when the surface is in several parts
+// (what lies in another part than the sources is unreachable). Local and remote mode alike.
+void WarnIfBarrierSplits(const terrain::DemOptions& dem_options, uint64_t components);
+
 // How MESH is read (--dem-step, --barrier-below, --barrier) and GeoJSON written (--crs): options
 // of every command that takes a MESH, checked by MeshReadOptions (cli_backend.h).
 inline const std::set<std::string> kMeshReadingFlags = {"dem-step", "barrier-below", "barrier",
-                                                        "crs"};
+                                                        "barrier-width", "crs"};
 // False with *error naming the first option neither in `known` nor in kMeshReadingFlags.
 bool CheckKnown(const Args& args, const std::set<std::string>& known, std::string* error);
 

@@ -120,6 +120,10 @@ class RemoteBackend final : public Backend {
       // The mesh the server gets is this one (the barrier applied): draw and place sites on it.
       if (dem_ == nullptr) data_ = std::make_unique<MeshData>(*data);
       ref = UploadDerived(*client_, mesh, dem_options, *data);
+      if (ref.ok() && barrier) {  // the server's count of its parts, as local mode says it
+        absl::StatusOr<v1::Mesh> stored = client_->GetMesh(ref->name);
+        if (stored.ok()) WarnIfBarrierSplits(dem_options, stored->components());
+      }
     } else {
       ref = client_->ResolveMesh(mesh);
     }
@@ -140,6 +144,7 @@ class RemoteBackend final : public Backend {
       absl::StatusOr<std::string> text = ReadBarrierText(options.barrier_file);
       if (!text.ok()) return text.status();
       barrier.set_polygons_geojson(*std::move(text));
+      barrier.set_width(options.barrier_width);
     }
     absl::StatusOr<v1::Mesh> derived = client_->DeriveMesh(base->name, barrier);
     if (!derived.ok()) {
@@ -152,6 +157,7 @@ class RemoteBackend final : public Backend {
       }
       return derived.status();
     }
+    WarnIfBarrierSplits(options, derived->components());
     mesh_.name = derived->name();
     mesh_.id = derived->name().substr(7);
     return absl::OkStatus();

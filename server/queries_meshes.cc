@@ -90,6 +90,9 @@ absl::Status RunDeriveMesh(const QueryEnv& env, const v1::DeriveMeshRequest& req
   if (barrier.has_below() && !std::isfinite(barrier.below())) {
     return FieldError("barrier.below", "must be finite");
   }
+  if (!(barrier.width() >= 0) || !std::isfinite(barrier.width())) {
+    return FieldError("barrier.width", "must be a finite number of metres, 0 or more");
+  }
   if (absl::Status valid = ValidateDisplayName(request.display_name(), "display_name"); !valid.ok()) {
     return valid;
   }
@@ -104,7 +107,7 @@ absl::Status RunDeriveMesh(const QueryEnv& env, const v1::DeriveMeshRequest& req
   if (!barrier.polygons_geojson().empty()) {
     terrain::CutStats cut_stats;
     absl::StatusOr<MeshData> cut = terrain::CutBarrierPolygons(
-        derived, barrier.polygons_geojson(), from.terrain ? &*from.terrain : nullptr,
+        derived, barrier.polygons_geojson(), from.terrain ? &*from.terrain : nullptr, barrier.width(),
         "barrier.polygons_geojson", &cut_stats);
     if (!cut.ok()) return FieldError("barrier.polygons_geojson", cut.status().message());
     derived = *std::move(cut);

@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <utility>
@@ -110,7 +111,7 @@ uint64_t EdgeKey(uint32_t a, uint32_t b) {
 }  // namespace
 
 absl::StatusOr<MeshData> CutOutPolygons(const MeshData& mesh, const OGRGeometry& polygons, double scale,
-                                        CutStats* stats) {
+                                        double width, CutStats* stats) {
   *stats = CutStats{};
   const size_t n = mesh.vertex_count();
   const size_t faces = mesh.face_count();
@@ -144,8 +145,43 @@ absl::StatusOr<MeshData> CutOutPolygons(const MeshData& mesh, const OGRGeometry&
   };
   double frame[3] = {scale, origin[0], origin[1]};
   barrier = geos.Own(GEOSGeom_transformXY_r(h, barrier.get(), shift, frame));
-  if (barrier != nullptr && GEOSisValid_r(h, barrier.get()) != 1) barrier = geos.Own(GEOSMakeValid_r(h, barrier.get()));
   if (barrier == nullptr) return absl::InternalError("GEOS cannot place the barrier polygons");
+  // Polygons as they are (made valid); lines and points buffered into polygons `width` wide.
+  std::vector<GEOSGeometry*> parts;  // owned until handed to the collection below
+  std::vector<const GEOSGeometry*> flat;
+  std::function<void(const GEOSGeometry*)> flatten = [&](const GEOSGeometry* g) {
+    const int type = GEOSGeomTypeId_r(h, g);
+    if (type == GEOS_GEOMETRYCOLLECTION || type == GEOS_MULTIPOLYGON || type == GEOS_MULTILINESTRING ||
+        type == GEOS_MULTIPOINT) {
+      for (int i = 0; i < GEOSGetNumGeometries_r(h, g); ++i) flatten(GEOSGetGeometryN_r(h, g, i));
+    } else {
+      flat.push_back(g);
+    }
+  };
+  flatten(barrier.get());
+  for (const GEOSGeometry* g : flat) {
+    const int type = GEOSGeomTypeId_r(h, g);
+    GEOSGeometry* part = nullptr;
+    if (type == GEOS_POLYGON) {
+      part = GEOSisValid_r(h, g) == 1 ? GEOSGeom_clone_r(h, g) : GEOSMakeValid_r(h, g);
+    } else {
+      if (!(width > 0)) {
+        for (GEOSGeometry* p : parts) GEOSGeom_destroy_r(h, p);
+        return absl::InvalidArgumentError(
+            "lines and points are barriers with a width (metres): --barrier-width, barrier.width");
+      }
+      part = GEOSBuffer_r(h, g, width / 2, 8);
+    }
+    if (part == nullptr) {
+      for (GEOSGeometry* p : parts) GEOSGeom_destroy_r(h, p);
+      return absl::InternalError("GEOS cannot make the barrier's polygons");
+    }
+    parts.push_back(part);
+  }
+  Geos::Ptr collection = geos.Own(GEOSGeom_createCollection_r(h, GEOS_GEOMETRYCOLLECTION, parts.data(),
+                                                              static_cast<unsigned>(parts.size())));
+  barrier = geos.Own(collection != nullptr ? GEOSUnaryUnion_r(h, collection.get()) : nullptr);
+  if (barrier == nullptr) return absl::InternalError("GEOS cannot merge the barrier's polygons");
   double box[4];  // xmin ymin xmax ymax
   if (GEOSisEmpty_r(h, barrier.get()) == 1 ||
       GEOSGeom_getExtent_r(h, barrier.get(), &box[0], &box[1], &box[2], &box[3]) == 0) {

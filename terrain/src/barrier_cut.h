@@ -25,9 +25,11 @@ class OGRGeometry;
 
 namespace geodex::terrain {
 
-// `polygons`: (Multi)Polygons whose coordinates times `scale` are the mesh's x y. Internal error
-// only when GEOS fails.
-absl::StatusOr<MeshData> CutOutPolygons(const MeshData& mesh, const OGRGeometry& polygons, double scale,
-                                        CutStats* stats);
+// `barrier`: polygons, lines and points whose coordinates times `scale` are the mesh's x y; lines
+// and points are buffered into polygons `width` wide (round ends), and need width > 0. The union
+// of it all is cut out. InvalidArgument for lines or points without a width, or coordinates that
+// are not finite; Internal only when GEOS fails.
+absl::StatusOr<MeshData> CutOutPolygons(const MeshData& mesh, const OGRGeometry& barrier, double scale,
+                                        double width, CutStats* stats);
 
 }  // namespace geodex::terrain

@@ -61,8 +61,8 @@ double MetresPerHeightUnit(std::string unit) {
   return 0;
 }
 
-// Every polygon of a vector dataset, in `crs` (null: as they are, no CRS), unioned. Errors start
-// with `name`.
+// Every polygon, line and point of a vector dataset, in `crs` (null: as they are, no CRS), as one
+// collection (a cut buffers the lines and points and unions everything). Errors start with `name`.
 absl::StatusOr<std::unique_ptr<OGRGeometry>> BarrierPolygonsOf(GDALDataset* ds,
                                                                const std::string& name,
                                                                const OGRSpatialReference* crs) {
@@ -73,7 +73,7 @@ absl::StatusOr<std::unique_ptr<OGRGeometry>> BarrierPolygonsOf(GDALDataset* ds,
   OGRSpatialReference wgs84;
   wgs84.SetWellKnownGeogCS("WGS84");
   wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  auto all = std::make_unique<OGRMultiPolygon>();
+  auto all = std::make_unique<OGRGeometryCollection>();
   for (OGRLayer* layer : ds->GetLayers()) {
     const OGRSpatialReference* layer_crs = layer->GetSpatialRef();
     OGRSpatialReference from(layer_crs != nullptr ? *layer_crs : wgs84);
@@ -90,21 +90,23 @@ absl::StatusOr<std::unique_ptr<OGRGeometry>> BarrierPolygonsOf(GDALDataset* ds,
       if (to_dem != nullptr && copy->transform(to_dem.get()) != OGRERR_NONE) {
         return bad(absl::StrCat("cannot project a feature to the DEM's CRS (", QuietGdal::LastMessage(), ")"));
       }
-      const OGRwkbGeometryType type = wkbFlatten(copy->getGeometryType());
-      if (type == wkbPolygon) {
-        all->addGeometryDirectly(copy.release());
-      } else if (type == wkbMultiPolygon) {
-        for (const OGRPolygon* p : *copy->toMultiPolygon()) all->addGeometry(p);
-      } else {
-        return bad(absl::StrCat("feature ", feature->GetFID(), " is a ", copy->getGeometryName(),
-                                "; a barrier is polygons"));
+      switch (wkbFlatten(copy->getGeometryType())) {
+        case wkbPolygon:
+        case wkbMultiPolygon:
+        case wkbLineString:
+        case wkbMultiLineString:
+        case wkbPoint:
+        case wkbMultiPoint:
+          all->addGeometryDirectly(copy.release());
+          break;
+        default:
+          return bad(absl::StrCat("feature ", feature->GetFID(), " is a ", copy->getGeometryName(),
+                                  "; a barrier is polygons, lines or points"));
       }
     }
   }
-  if (all->IsEmpty()) return bad("no polygon");
-  std::unique_ptr<OGRGeometry> merged(all->UnionCascaded());
-  if (merged == nullptr) return bad(absl::StrCat("the polygons do not merge (", QuietGdal::LastMessage(), ")"));
-  return merged;
+  if (all->IsEmpty()) return bad("no polygon, line or point");
+  return std::unique_ptr<OGRGeometry>(std::move(all));
 }
 
 }  // namespace
@@ -256,8 +258,8 @@ namespace {
 // reprojected into the mesh's plane first (a geographic DEM's UTM metres), where their edges are
 // straight.
 absl::StatusOr<MeshData> CutBarrier(const MeshData& mesh, OGRGeometry& polygons, const DemInfo* dem,
-                                    const OGRSpatialReference* file_crs, const std::string& name,
-                                    CutStats* stats) {
+                                    const OGRSpatialReference* file_crs, double width,
+                                    const std::string& name, CutStats* stats) {
   double scale = 1;
   if (dem != nullptr && dem->reprojected) {
     OGRSpatialReference mesh_crs;
@@ -273,7 +275,7 @@ absl::StatusOr<MeshData> CutBarrier(const MeshData& mesh, OGRGeometry& polygons,
   } else if (dem != nullptr) {
     scale = dem->horizontal_scale;
   }
-  absl::StatusOr<MeshData> cut = CutOutPolygons(mesh, polygons, scale, stats);
+  absl::StatusOr<MeshData> cut = CutOutPolygons(mesh, polygons, scale, width, stats);
   if (absl::IsInvalidArgument(cut.status())) {
     return absl::InvalidArgumentError(absl::StrCat(name, ": ", cut.status().message()));
   }
@@ -283,7 +285,8 @@ absl::StatusOr<MeshData> CutBarrier(const MeshData& mesh, OGRGeometry& polygons,
 }  // namespace
 
 absl::StatusOr<MeshData> CutBarrierPolygons(const MeshData& mesh, const std::string& geojson,
-                                            const DemInfo* dem, const std::string& name, CutStats* stats) {
+                                            const DemInfo* dem, double width, const std::string& name,
+                                            CutStats* stats) {
   QuietGdal quiet;
   auto bad = [&](const std::string& why) {
     return absl::InvalidArgumentError(absl::StrCat(name, ": ", why));
@@ -312,7 +315,7 @@ absl::StatusOr<MeshData> CutBarrierPolygons(const MeshData& mesh, const std::str
       ds == nullptr ? bad(absl::StrCat("not GeoJSON polygons (", QuietGdal::LastMessage(), ")"))
                     : BarrierPolygonsOf(ds.get(), name, dem != nullptr ? &file_crs : nullptr);
   if (!polygons.ok()) return polygons.status();
-  return CutBarrier(mesh, **polygons, dem, &file_crs, name, stats);
+  return CutBarrier(mesh, **polygons, dem, &file_crs, width, name, stats);
 }
 
 bool IsGeoTiffPath(const std::string& path) {
@@ -587,7 +590,8 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
   }
   if (barrier == nullptr) return dem;
   CutStats stats;
-  absl::StatusOr<MeshData> cut = CutBarrier(dem.mesh_, *barrier, &info, &file_crs, barrier_name, &stats);
+  absl::StatusOr<MeshData> cut =
+      CutBarrier(dem.mesh_, *barrier, &info, &file_crs, options.barrier_width, barrier_name, &stats);
   if (!cut.ok()) return cut.status();
   if (cut->faces.empty()) return bad("the barrier covers every face: nothing is left");
   info.barrier_faces = stats.faces_removed + stats.faces_cut;

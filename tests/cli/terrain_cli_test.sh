@@ -141,6 +141,37 @@ import json; d = json.load(open('$tmp/bw.json')); assert d['barrier_faces'] == 3
 check "barrier polygons: beyond is inf" $PY -c "
 import math; d = [float(x) for x in open('$tmp/bw.txt')]
 assert len(d) >= 200 and math.isinf(d[15]) and math.isfinite(d[5]), (d[5], d[15])"
+"$GEODEX" distances "$tmp/strait.tif" --sources g:500005:4999995 >"$tmp/nb.txt"
+# Lines are walls --barrier-width wide: a fence across the whole DEM separates (and says the
+# surface is in 2 parts), the same fence with a 20 m gap lets paths through it, longer than the
+# straight line; a line without a width is refused; a polygon that misses the DEM is said.
+crs='"crs": {"type": "name", "properties": {"name": "EPSG:32633"}}'
+echo "{\"type\": \"FeatureCollection\", $crs, \"features\": [{\"type\": \"Feature\", \"properties\": {}, \"geometry\": {\"type\": \"LineString\", \"coordinates\": [[500152, 5000050], [500152, 4999850]]}}]}" >"$tmp/fence.geojson"
+echo "{\"type\": \"FeatureCollection\", $crs, \"features\": [{\"type\": \"Feature\", \"properties\": {}, \"geometry\": {\"type\": \"MultiLineString\", \"coordinates\": [[[500152, 5000050], [500152, 4999950]], [[500152, 4999930], [500152, 4999850]]]}}]}" >"$tmp/gap.geojson"
+"$GEODEX" distances "$tmp/strait.tif" --sources g:500005:4999995 --barrier "$tmp/fence.geojson" --barrier-width 4 \
+  >"$tmp/fence.txt" 2>"$tmp/fence.err"
+check "line barrier: exit 0" test $? -eq 0
+check "line barrier: the surface is in 2 parts, said" grep -q "the surface is in 2 parts" "$tmp/fence.err"
+"$GEODEX" distances "$tmp/strait.tif" --sources g:500005:4999995 --barrier "$tmp/gap.geojson" --barrier-width 4 \
+  >"$tmp/gap.txt"
+check "line barrier: a fence separates, a gap lets paths through, around" $PY - "$tmp" <<'PY'
+import math, sys
+t = sys.argv[1]
+fence = [float(x) for x in open(f"{t}/fence.txt")]
+gap = [float(x) for x in open(f"{t}/gap.txt")]
+plain = [float(x) for x in open(f"{t}/nb.txt")]
+assert math.isinf(fence[15]) and math.isfinite(fence[5]), (fence[5], fence[15])
+assert math.isfinite(gap[15]) and gap[15] > plain[15] + 1, (gap[15], plain[15])
+assert abs(gap[5] - plain[5]) < 1e-9, (gap[5], plain[5])
+PY
+"$GEODEX" distances "$tmp/strait.tif" --sources 0 --barrier "$tmp/fence.geojson" 2>"$tmp/err.txt" >/dev/null
+check "line barrier without a width: refused" test $? -ne 0
+check "line barrier without a width: says so" grep -q "lines and points are barriers with a width" "$tmp/err.txt"
+echo '{"type": "Polygon", "coordinates": [[[-84.3, 36.6], [-84.2, 36.6], [-84.2, 36.7], [-84.3, 36.6]]]}' >"$tmp/far.geojson"
+"$GEODEX" info "$tmp/strait.tif" --barrier "$tmp/far.geojson" >/dev/null 2>"$tmp/err.txt"
+check "a barrier that misses: exit 0" test $? -eq 0
+check "a barrier that misses: said" grep -q "cuts nothing" "$tmp/err.txt"
+
 # On a mesh file, --barrier's polygons are in the mesh's own x y: the unit square's upper-left
 # triangle (centre (1/3, 2/3)) goes, and its corner vertex 3 is unreachable.
 printf 'OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n' >"$tmp/sq.off"
@@ -284,7 +315,7 @@ PY
   echo '{"type": "Point", "coordinates": [15, 45]}' >"$tmp/point.geojson"
   "$GEODEX" distances strait --sources 0 --barrier "$tmp/point.geojson" 2>"$tmp/err.txt" >/dev/null
   check "bad barrier by name: exit 3" test $? -eq 3
-  check "bad barrier by name: names the flag" grep -q -- "--barrier $tmp/point.geojson: .*a barrier is polygons" "$tmp/err.txt"
+  check "bad barrier by name: names the flag" grep -q -- "--barrier $tmp/point.geojson: .*lines and points are barriers with a width" "$tmp/err.txt"
 fi
 
 # geodex never reaches out (issue 30): a listener on a port the kernel picks counts connections

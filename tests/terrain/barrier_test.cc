@@ -186,7 +186,7 @@ TEST(BarrierCutTest, SquareHoleGivesTheTautString) {
   }
   ASSERT_GT(Shoelace(hole), 0);
   CutStats stats;
-  absl::StatusOr<MeshData> cut = CutBarrierPolygons(grid, PolygonJson({hole}), nullptr, "hole", &stats);
+  absl::StatusOr<MeshData> cut = CutBarrierPolygons(grid, PolygonJson({hole}), nullptr, 0, "hole", &stats);
   ASSERT_TRUE(cut.ok()) << cut.status();
   EXPECT_GT(stats.faces_cut, 0u);
   EXPECT_GT(stats.faces_removed, 0u);
@@ -237,7 +237,7 @@ TEST(BarrierCutTest, AWallNarrowerThanACellSeparates) {
   }
   if (Shoelace(wall) < 0) std::reverse(wall.begin(), wall.end());
   CutStats stats;
-  absl::StatusOr<MeshData> cut = CutBarrierPolygons(grid, PolygonJson({wall}), nullptr, "wall", &stats);
+  absl::StatusOr<MeshData> cut = CutBarrierPolygons(grid, PolygonJson({wall}), nullptr, 0, "wall", &stats);
   ASSERT_TRUE(cut.ok()) << cut.status();
   ExpectConforming(*cut, n, {wall});
   absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(*cut);
@@ -264,6 +264,31 @@ TEST(BarrierCutTest, AWallNarrowerThanACellSeparates) {
   EXPECT_GT(stats.faces_cut, stats.faces_removed);
 }
 
+TEST(BarrierCutTest, LinesAreWallsOfTheirWidth) {
+  const int n = 10;
+  const MeshData grid = TiltedGrid(n);
+  const std::string fence = R"({"type": "LineString", "coordinates": [[4.37, -1], [6.11, 11]]})";
+  CutStats stats;
+  absl::Status refused = CutBarrierPolygons(grid, fence, nullptr, 0, "--barrier f", &stats).status();
+  EXPECT_EQ(refused.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(refused.message().rfind("--barrier f: lines and points are barriers with a width", 0), 0u) << refused;
+  absl::StatusOr<MeshData> cut = CutBarrierPolygons(grid, fence, nullptr, 0.25, "--barrier f", &stats);
+  ASSERT_TRUE(cut.ok()) << cut.status();
+  // The wall's area is its length times its width plus its two round ends (GEOS's buffer: 8
+  // segments a quarter circle, so a little less than pi r^2).
+  const double length = std::hypot(6.11 - 4.37, 12.0), r = 0.125;
+  const double sec = std::sqrt(1 + kSlopeX * kSlopeX + kSlopeY * kSlopeY);
+  const double inside_length = length * (static_cast<double>(n) / 12);  // the part over the grid
+  EXPECT_NEAR(Area3(*cut), (n * n - inside_length * 2 * r) * sec, 1e-6);
+  absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(*cut);
+  ASSERT_TRUE(mesh.ok());
+  EXPECT_EQ(mesh->report().components, 2u);
+  absl::StatusOr<DistanceField> field = ComputeDistanceField(*mesh, {SurfacePoint::AtVertex(0)});
+  ASSERT_TRUE(field.ok());
+  EXPECT_TRUE(std::isfinite(field->distance[3]));
+  EXPECT_TRUE(std::isinf(field->distance[n]));  // (10, 0), across the fence
+}
+
 TEST(BarrierCutTest, TwoHolesAndAPolygonAlongGridLines) {
   const int n = 12;
   const MeshData grid = TiltedGrid(n);
@@ -280,7 +305,7 @@ TEST(BarrierCutTest, TwoHolesAndAPolygonAlongGridLines) {
   const std::vector<Point2> ledge = {{6.5, 2}, {8.5, 2}, {8.5, 3.7}, {6.5, 3.7}};
   const std::vector<std::vector<Point2>> all = {square, triangle, tip, ledge, hair};
   CutStats stats;
-  absl::StatusOr<MeshData> cut = CutBarrierPolygons(grid, PolygonJson(all), nullptr, "holes", &stats);
+  absl::StatusOr<MeshData> cut = CutBarrierPolygons(grid, PolygonJson(all), nullptr, 0, "holes", &stats);
   ASSERT_TRUE(cut.ok()) << cut.status();
   ExpectConforming(*cut, n, all);
   EXPECT_GT(stats.faces_split, 0u);
@@ -298,7 +323,7 @@ TEST(BarrierCutTest, TwoHolesAndAPolygonAlongGridLines) {
     EXPECT_NEAR(d, TautString({0, 0}, target, all), 1e-9 * d) << target[0] << " " << target[1];
   }
   // A polygon that misses the mesh changes nothing.
-  absl::StatusOr<MeshData> away = CutBarrierPolygons(grid, PolygonJson({{{30, 30}, {31, 30}, {31, 31}}}), nullptr, "away", &stats);
+  absl::StatusOr<MeshData> away = CutBarrierPolygons(grid, PolygonJson({{{30, 30}, {31, 30}, {31, 31}}}), nullptr, 0, "away", &stats);
   ASSERT_TRUE(away.ok());
   EXPECT_EQ(away->faces, grid.faces);
   EXPECT_EQ(away->positions, grid.positions);
@@ -342,9 +367,9 @@ TEST(BarrierCutTest, DemBarrierInEitherCrsAndStoredAgain) {
       dem->mesh(),
       absl::StrCat(R"({"type": "Polygon", "crs": {"type": "name", "properties": {"name": "EPSG:32633"}}, "coordinates": [[)",
                    native, "]]}"),
-      &dem->info(), "native", &a_stats);
+      &dem->info(), 0, "native", &a_stats);
   absl::StatusOr<MeshData> b = CutBarrierPolygons(
-      dem->mesh(), absl::StrCat(R"({"type": "Polygon", "coordinates": [[)", lonlat, "]]}"), &dem->info(), "lonlat", &b_stats);
+      dem->mesh(), absl::StrCat(R"({"type": "Polygon", "coordinates": [[)", lonlat, "]]}"), &dem->info(), 0, "lonlat", &b_stats);
   ASSERT_TRUE(a.ok()) << a.status();
   ASSERT_TRUE(b.ok()) << b.status();
   EXPECT_EQ(a->faces, b->faces);

@@ -214,15 +214,16 @@ class GeodexClient:
                 return meshes
 
     @_typed_errors
-    def derive_mesh(self, mesh, below=None, polygons_geojson="", name="", pin=False):
+    def derive_mesh(self, mesh, below=None, polygons_geojson="", name="", pin=False, width=0.0):
         """The stored mesh without what a barrier covers, stored by the server (by its content's
         id); returns its Mesh resource. `below`: faces with a corner lower than this z go (the
         sea at 0 on a DEM's mesh); `polygons_geojson`: the text (or a dict) of GeoJSON polygons,
-        faces whose centre lies inside go (WGS 84 on a DEM's mesh, the mesh's x y otherwise)."""
+        cut exactly out of the surface (WGS 84 on a DEM's mesh, the mesh's x y otherwise);
+        lines and points in it are barriers `width` metres wide."""
         if not isinstance(polygons_geojson, str):
             import json
             polygons_geojson = json.dumps(polygons_geojson)
-        barrier = pb.Barrier(polygons_geojson=polygons_geojson)
+        barrier = pb.Barrier(polygons_geojson=polygons_geojson, width=width)
         if below is not None:
             barrier.below = below
         return self._call(self.stub.DeriveMesh, pb.DeriveMeshRequest(

@@ -37,6 +37,8 @@ struct DemOptions {
   // A barrier drawn as polygons (GeoJSON, Shapefile, GeoPackage or FlatGeobuf; its own CRS, WGS 84
   // when it names none), cut exactly out of the surface (CutBarrierPolygons). "": none.
   std::string barrier_file;
+  // The width (metres) of the lines and points in barrier_file; 0: they are refused.
+  double barrier_width = 0;
   // The most cells (width x height of the file) a raster may have, and the most vertices and
   // faces its mesh may have (every used cell with data, two triangles per block); 0: any. What a
   // server sets before GDAL reads untrusted bytes: checked before any row is read, a
@@ -89,8 +91,11 @@ struct CutStats {
 // boundary split along it (see terrain/src/barrier_cut.h). Vertices keep their ids, new ones
 // follow. InvalidArgument starting with `name` when the text is not GeoJSON polygons (or names
 // its CRS by anything but an identifier). Only GDAL's GeoJSON driver reads it.
+// Lines and points (LineString, Point and their Multi-) are barriers `width` wide (metres in the
+// mesh's plane, buffered with round ends) and need width > 0.
 absl::StatusOr<MeshData> CutBarrierPolygons(const MeshData& mesh, const std::string& geojson,
-                                            const DemInfo* dem, const std::string& name, CutStats* stats);
+                                            const DemInfo* dem, double width, const std::string& name,
+                                            CutStats* stats);
 
 inline constexpr uint32_t kNoVertex = 0xffffffffu;
 
