@@ -115,11 +115,11 @@ std::unique_ptr<Backend> MakeRemoteBackend(const std::string& target);
 int QueryExitCode(const absl::Status& status);
 // Prints the status as one line and returns QueryExitCode.
 int FailQuery(const absl::Status& status);
-// --output FILE.geojson: writes `features` (mesh coordinates of the backend's DEM) as RFC 7946
-// GeoJSON, or in the DEM's own CRS with --crs native. Exit 2 without a DEM, or when FILE cannot be
-// written (the reason given).
-bool IsGeoJsonPath(const Args& args);  // --output ends in .geojson
-int WriteGeoJsonOutput(const Backend& backend, const Args& args,
+// --output FILE with a vector file's extension (.geojson, .gpkg, .shp, .fgb: gis_formats.h): writes
+// `features` (mesh coordinates of the backend's DEM), GeoJSON as RFC 7946 unless --crs native, the
+// others in the DEM's CRS. Exit 2 without a DEM, or when FILE cannot be written (the reason given).
+bool IsVectorPath(const Args& args);
+int WriteVectorOutput(const Backend& backend, const Args& args,
                        const std::vector<terrain::GeoFeature>& features);
 // How MESH is read (--dem-step, --barrier-below, --barrier) and GeoJSON written (--crs), checked:
 // InvalidArgument naming the flag.

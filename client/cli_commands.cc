@@ -17,6 +17,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "geodex/gis_formats.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
 #include "cli_backend.h"
@@ -196,21 +197,23 @@ int FailQuery(const absl::Status& status) {
   return Fail(QueryExitCode(status), std::string(status.message()));
 }
 
-bool IsGeoJsonPath(const Args& args) {
-  return args.options.count("output") && absl::EndsWithIgnoreCase(args.options.at("output"), ".geojson");
+bool IsVectorPath(const Args& args) {
+  if (!args.options.count("output")) return false;
+  const terrain::GisFormat* format = terrain::GisFormatOf(args.options.at("output"));
+  return format != nullptr && format->kind == terrain::GisFileKind::kVector;
 }
 
-int WriteGeoJsonOutput(const Backend& backend, const Args& args,
-                       const std::vector<terrain::GeoFeature>& features) {
+int WriteVectorOutput(const Backend& backend, const Args& args,
+                      const std::vector<terrain::GeoFeature>& features) {
   const std::string& path = args.options.at("output");
   const terrain::Dem* dem = backend.Terrain();
   if (dem == nullptr) {
     return Fail(kExitUsage, absl::StrCat("--output ", path,
-                                         ": GeoJSON needs a DEM as MESH (map coordinates)"));
+                                         ": a GIS file needs a DEM as MESH (map coordinates)"));
   }
   // --crs was checked with the mesh's other reading options (OpenMesh).
   const bool native = args.options.count("crs") && args.options.at("crs") == "native";
-  absl::Status written = terrain::WriteGeoJson(dem->info(), features, path, native);
+  absl::Status written = terrain::WriteVectorFile(dem->info(), features, path, native);
   if (!written.ok()) return Fail(kExitUsage, std::string(written.message()));
   return kExitOk;
 }
@@ -493,9 +496,10 @@ constexpr char kDistancesHelp[] = R"(  distances MESH --sources SPEC [--method e
                  [--max-distance D] [--max-windows N] [--stats] [--output FILE] [--format json]
                  [--directions] [--labels-output FILE.tif]
       One distance per vertex in the file's vertex order (%.17g; 'inf' if unreachable).
-      On a DEM, --output FILE.tif writes a float32 GeoTIFF aligned with the DEM's grid (same
-      geotransform and CRS; nodata -1 where unreachable or no data) and --labels-output
-      FILE.tif the nearest source's index (int32, nodata -1).
+      On a DEM, --output FILE.tif (.asc, .nc) writes float32 distances aligned with the DEM's
+      grid (same geotransform and CRS; -1, the nodata, where there is no surface, -2 where it
+      is unreachable) and --labels-output FILE.tif the nearest source's index (int32, the
+      same -1 and -2). docs/gis-files.md lists the formats.
       --stats prints one JSON object with counters and times (*_ms) on stderr.
       --no-filter / --no-one-split switch off Lemma 2 / Lemma 1 (slower; same answer).
       --at SPEC: instead, one line per surface point: its unfolding estimate (paper section 4)
@@ -536,7 +540,7 @@ int RunDistances(Backend& backend, const Args& args) {
   }
   if (!GetSolverFlags(args, &query.options, &error)) return Fail(kExitUsage, error);
   query.directions = args.options.count("directions") > 0;
-  if (query.directions && args.options.count("at") && IsGeoJsonPath(args)) {
+  if (query.directions && args.options.count("at") && IsVectorPath(args)) {
     return Fail(kExitUsage, "--directions: not in GeoJSON (print them, or --format json)");
   }
   query.options.use_filter = !args.options.count("no-filter");
@@ -546,22 +550,24 @@ int RunDistances(Backend& backend, const Args& args) {
   // Rasters (GeoTIFF, aligned with the DEM's grid): the distances with --output X.tif, the
   // nearest source's index with --labels-output X.tif.
   auto is_raster = [](const std::string& path) {
-    return absl::EndsWithIgnoreCase(path, ".tif") || absl::EndsWithIgnoreCase(path, ".tiff");
+    const terrain::GisFormat* format = terrain::GisFormatOf(path);
+    return format != nullptr && format->kind == terrain::GisFileKind::kRaster;
   };
   const std::string output = args.options.count("output") ? args.options.at("output") : "";
   const std::string labels_output =
       args.options.count("labels-output") ? args.options.at("labels-output") : "";
   const bool raster = is_raster(output);
   if (!labels_output.empty() && !is_raster(labels_output)) {
-    return Fail(kExitUsage, "--labels-output: a GeoTIFF path (.tif) is expected");
+    return Fail(kExitUsage, absl::StrCat("--labels-output: a raster is expected (",
+                                         terrain::GisExtensions(terrain::GisFileKind::kRaster), ")"));
   }
   if ((raster && (args.options.count("at") || query.directions || json)) ||
       (!labels_output.empty() && args.options.count("at"))) {
-    return Fail(kExitUsage, "--output X.tif and --labels-output: per-vertex values only (a raster "
-                            "has no --at points, --directions or JSON)");
+    return Fail(kExitUsage, "--output X.tif (a raster) and --labels-output: per-vertex values only (a "
+                            "raster has no --at points, --directions or JSON)");
   }
-  if (IsGeoJsonPath(args) && !args.options.count("at")) {
-    return Fail(kExitUsage, "--output X.geojson: GeoJSON of distances is per point: use --at SPEC (or --output X.tif for a raster)");
+  if (IsVectorPath(args) && !args.options.count("at")) {
+    return Fail(kExitUsage, "--output X.geojson (a vector file): distances in a vector file are per point: use --at SPEC (or --output X.tif for a raster)");
   }
   if (int code = OpenMesh(backend, args, args.positional[0], MeshBuildOptions{})) return code;
   const terrain::Dem* dem = backend.Terrain();
@@ -589,7 +595,7 @@ int RunDistances(Backend& backend, const Args& args) {
         backend.DistancesAt({sources, at, query.options, query.directions});
     if (!values.ok()) return FailQuery(values.status());
     text = FormatAt(at, *values, json);
-    if (IsGeoJsonPath(args)) {  // Point features with the exact distance and the nearest source
+    if (IsVectorPath(args)) {  // Point features with the exact distance and the nearest source
       absl::StatusOr<const MeshData*> data = backend.Geometry();
       if (!data.ok()) return FailQuery(data.status());
       // Each feature names its point as the user wrote it (g:, ll:, a vertex...), and where it is.
@@ -602,7 +608,7 @@ int RunDistances(Backend& backend, const Args& args) {
                           SurfacePointToString(at[i]), values->exact.distance[i],
                           source == kNoIndex ? -1 : int64_t{source}});
       }
-      if (int code = WriteGeoJsonOutput(backend, args, terrain::PointFeatures(points));
+      if (int code = WriteVectorOutput(backend, args, terrain::PointFeatures(points));
           code != kExitOk) {
         return code;
       }
@@ -627,7 +633,7 @@ int RunDistances(Backend& backend, const Args& args) {
   }
   if (stats.solve_ms == 0) stats.solve_ms = MsSince(t_solve);
   const auto t_out = std::chrono::steady_clock::now();
-  if (!raster && !IsGeoJsonPath(args)) {
+  if (!raster && !IsVectorPath(args)) {
     if (int code = WriteOutput(args, text); code != kExitOk) return code;
   }
   if (args.options.count("stats")) {
@@ -710,8 +716,8 @@ int RunPath(Backend& backend, const Args& args) {
   if (absl::Status s = OnePoint(backend, args, "to", &to, &snap); !s.ok()) return FailQuery(s);
   absl::StatusOr<PathQueryResult> result = backend.Path({from, to, options});
   if (!result.ok()) return FailQuery(result.status());
-  if (IsGeoJsonPath(args)) {  // a 3D LineString with its length
-    if (int code = WriteGeoJsonOutput(
+  if (IsVectorPath(args)) {  // a 3D LineString with its length
+    if (int code = WriteVectorOutput(
             backend, args, {terrain::PathFeature(result->path.points, result->distance)});
         code != kExitOk) {
       return code;

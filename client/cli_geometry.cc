@@ -16,6 +16,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "geodex/gis_formats.h"
 #include "absl/strings/str_split.h"
 #include "geodex/delaunay.h"
 #include "geodex/geodesic_solver.h"
@@ -67,7 +68,7 @@ bool OutputFormat(const Args& args, Format* format, std::string* error) {
     const std::string e(ext);
     return path.size() > e.size() && path.compare(path.size() - e.size(), e.size(), e) == 0;
   };
-  if (IsGeoJsonPath(args)) {
+  if (IsVectorPath(args)) {
     *format = Format::kGeoJson;
     return true;
   }
@@ -80,7 +81,8 @@ bool OutputFormat(const Args& args, Format* format, std::string* error) {
     *format = Format::kSvg;
     return true;
   }
-  *error = absl::StrFormat("--output: '%s' must end in .json, .obj, .svg or .geojson", path);
+  *error = absl::StrFormat("--output: '%s' must end in .json, .obj, .svg or, on a DEM, a vector file's %s", path,
+                           terrain::GisExtensions(terrain::GisFileKind::kVector));
   return false;
 }
 
@@ -279,7 +281,7 @@ int RunIsolines(Backend& backend, const Args& args) {
     // Isochrones: per level, the area within that distance (union of each face's part below it).
     absl::StatusOr<const DistanceField*> field = backend.Field({s.points, {}, false});
     if (!field.ok()) return FailQuery(field.status());
-    return WriteGeoJsonOutput(backend, args,
+    return WriteVectorOutput(backend, args,
                               terrain::IsochroneFeatures(*s.data, (*field)->distance, iso->levels));
   }
   if (format == Format::kObj) return WriteOutput(args, Obj("isolines", lines));
@@ -343,7 +345,7 @@ int RunVoronoi(Backend& backend, const Args& args) {
   json += "]}\n";
   if (format == Format::kGeoJson) {
     // One (Multi)Polygon per site: its whole faces and its fragments, unioned.
-    return WriteGeoJsonOutput(backend, args, terrain::VoronoiFeatures(*s.data, *vd));
+    return WriteVectorOutput(backend, args, terrain::VoronoiFeatures(*s.data, *vd));
   }
   if (format == Format::kObj) return WriteOutput(args, Obj("voronoi", lines));
   if (format == Format::kSvg) return WriteOutput(args, Svg("voronoi", *s.data, lines, SitePositions(s)));
@@ -417,7 +419,7 @@ int RunDelaunay(Backend& backend, const Args& args) {
   json += "]}\n";
   if (format == Format::kGeoJson) {
     // One 3D LineString per Delaunay edge: the geodesic between its two sites.
-    return WriteGeoJsonOutput(backend, args, terrain::DelaunayFeatures(*dt));
+    return WriteVectorOutput(backend, args, terrain::DelaunayFeatures(*dt));
   }
   if (format == Format::kObj) return WriteOutput(args, Obj("delaunay", lines));
   if (format == Format::kSvg) return WriteOutput(args, Svg("delaunay", *s.data, lines, SitePositions(s)));

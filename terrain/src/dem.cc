@@ -22,6 +22,7 @@
 #include "gdal_priv.h"
 #include "barrier_cut.h"
 #include "gdal_quiet.h"
+#include "geodex/gis_formats.h"
 #include "mem_file.h"
 #include "geodex/limits.h"
 #include "ogr_api.h"
@@ -823,19 +824,29 @@ absl::StatusOr<SurfacePoint> Dem::DropMeshPoint(double mx, double my, double u, 
 
 namespace {
 
+// One band on the used grid, made in memory and copied out by the format the path's extension
+// names (GisFormatOf): a cell without a vertex, or whose vertex no face uses (inside a barrier), has
+// no surface (kRasterNoSurface, the band's nodata); `value_of_vertex` gives the others.
 absl::Status WriteRaster(const DemInfo& info, const std::vector<uint32_t>& vertex_of_cell,
-                         const std::string& path, GDALDataType type,
+                         const MeshData& mesh, const std::string& path, GDALDataType type,
+                         const char* description, const char* unit,
                          const std::function<double(uint32_t)>& value_of_vertex) {
   QuietGdal quiet;
-  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GTiff");
-  if (driver == nullptr) return absl::InternalError("GDAL has no GTiff driver");
-  const char* create_options[] = {"COMPRESS=DEFLATE", "TILED=YES", nullptr};
-  GDALDatasetUniquePtr ds(driver->Create(path.c_str(), static_cast<int>(info.grid_width),
-                                         static_cast<int>(info.grid_height), 1, type,
-                                         const_cast<char**>(create_options)));
+  const GisFormat* format = GisFormatOf(path);
+  if (format == nullptr || format->kind != GisFileKind::kRaster) {
+    return absl::InvalidArgumentError(absl::StrCat("cannot write ", path, ": a raster is one of ",
+                                                   GisExtensions(GisFileKind::kRaster)));
+  }
+  GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
+  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName(format->driver);
+  if (mem == nullptr || driver == nullptr || driver->GetMetadataItem(GDAL_DCAP_CREATECOPY) == nullptr) {
+    return absl::InvalidArgumentError(absl::StrCat("cannot write ", path, ": this GDAL writes no ", format->description));
+  }
   auto failed = [&] {
     return absl::PermissionDeniedError(absl::StrCat("cannot write ", path, ": ", QuietGdal::LastMessage()));
   };
+  GDALDatasetUniquePtr ds(mem->Create("", static_cast<int>(info.grid_width), static_cast<int>(info.grid_height),
+                                      1, type, nullptr));
   if (ds == nullptr) return failed();
   double gt[6];
   std::copy(info.geotransform.begin(), info.geotransform.end(), gt);
@@ -844,20 +855,34 @@ absl::Status WriteRaster(const DemInfo& info, const std::vector<uint32_t>& verte
   crs.importFromWkt(info.file_crs_wkt.c_str());
   ds->SetSpatialRef(&crs);
   GDALRasterBand* band = ds->GetRasterBand(1);
-  band->SetNoDataValue(-1);
+  band->SetNoDataValue(kRasterNoSurface);
+  band->SetDescription(description);
+  if (unit != nullptr) band->SetUnitType(unit);
+  std::vector<bool> on_surface(mesh.vertex_count());
+  for (uint32_t v : mesh.faces) {
+    if (v < on_surface.size()) on_surface[v] = true;
+  }
   std::vector<double> row(info.grid_width);
   for (uint32_t j = 0; j < info.grid_height; ++j) {
     for (uint32_t i = 0; i < info.grid_width; ++i) {
       const uint32_t v = vertex_of_cell[size_t{j} * info.grid_width + i];
-      row[i] = v == kNoVertex ? -1 : value_of_vertex(v);
+      row[i] = v == kNoVertex || !on_surface[v] ? kRasterNoSurface : value_of_vertex(v);
     }
     if (band->RasterIO(GF_Write, 0, static_cast<int>(j), static_cast<int>(info.grid_width), 1,
                        row.data(), static_cast<int>(info.grid_width), 1, GDT_Float64, 0, 0) != CE_None) {
       return failed();
     }
   }
-  ds->FlushCache(true);
-  ds.reset();  // closes the file: a late write error shows in GDAL's last error
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(path, ec)) driver->Delete(path.c_str());  // with its side-cars
+  CPLStringList options;
+  if (std::string(format->driver) == "GTiff") {
+    options.AddString("COMPRESS=DEFLATE");
+    options.AddString("TILED=YES");
+  }
+  GDALDatasetUniquePtr out(driver->CreateCopy(path.c_str(), ds.get(), FALSE, options.List(), nullptr, nullptr));
+  if (out == nullptr) return failed();
+  out.reset();  // closes the file: a late write error shows in GDAL's last error
   if (CPLGetLastErrorType() >= CE_Failure) return failed();
   return absl::OkStatus();
 }
@@ -866,15 +891,15 @@ absl::Status WriteRaster(const DemInfo& info, const std::vector<uint32_t>& verte
 
 absl::Status Dem::WriteFloatRaster(const std::string& path, const std::vector<double>& values) const {
   if (values.size() < mesh_.vertex_count()) return absl::InternalError("one value per vertex expected");
-  return WriteRaster(info_, vertex_of_cell_, path, GDT_Float32, [&](uint32_t v) {
-    return std::isfinite(values[v]) ? values[v] : -1.0;
+  return WriteRaster(info_, vertex_of_cell_, mesh_, path, GDT_Float32, "geodesic distance", "m", [&](uint32_t v) {
+    return std::isfinite(values[v]) ? values[v] : kRasterUnreachable;
   });
 }
 
 absl::Status Dem::WriteIndexRaster(const std::string& path, const std::vector<uint32_t>& values) const {
   if (values.size() < mesh_.vertex_count()) return absl::InternalError("one value per vertex expected");
-  return WriteRaster(info_, vertex_of_cell_, path, GDT_Int32, [&](uint32_t v) {
-    return values[v] >= 0x80000000u ? -1.0 : static_cast<double>(values[v]);
+  return WriteRaster(info_, vertex_of_cell_, mesh_, path, GDT_Int32, "nearest source", nullptr, [&](uint32_t v) {
+    return values[v] >= 0x80000000u ? kRasterUnreachable : static_cast<double>(values[v]);
   });
 }
 

@@ -10,6 +10,7 @@
 #include "cpl_error.h"
 #include "gdal_priv.h"
 #include "gdal_quiet.h"
+#include "geodex/gis_formats.h"
 #include "mem_file.h"
 #include "ogr_geometry.h"
 #include "ogrsf_frmts.h"
@@ -154,17 +155,26 @@ std::vector<Polygon2> SublevelPieces(const MeshData& mesh, const std::vector<dou
   return out;
 }
 
-absl::Status WriteGeoJson(const DemInfo& dem, const std::vector<GeoFeature>& features,
-                          const std::string& path, bool native_crs) {
+absl::Status WriteVectorFile(const DemInfo& dem, const std::vector<GeoFeature>& features,
+                             const std::string& path, bool native_crs) {
   QuietGdal quiet;
   auto failed = [&](const std::string& why) {
     return absl::PermissionDeniedError(absl::StrCat("cannot write ", path, ": ", why));
   };
+  const GisFormat* format = GisFormatOf(path);
+  if (format == nullptr || format->kind != GisFileKind::kVector) {
+    return absl::InvalidArgumentError(absl::StrCat("cannot write ", path, ": a vector file is one of ",
+                                                   GisExtensions(GisFileKind::kVector)));
+  }
   if (!OGRGeometryFactory::haveGEOS()) return absl::InternalError("GDAL was built without GEOS");
-  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName("GeoJSON");
-  if (driver == nullptr) return absl::InternalError("GDAL has no GeoJSON driver");
+  GDALDriver* driver = GetGDALDriverManager()->GetDriverByName(format->driver);
+  if (driver == nullptr) {
+    return absl::InvalidArgumentError(absl::StrCat("cannot write ", path, ": this GDAL writes no ", format->description));
+  }
+  const bool geojson = std::string(format->driver) == "GeoJSON";
+  native_crs = native_crs || !geojson;  // RFC 7946 is GeoJSON's; every other format keeps the DEM's CRS
   std::error_code ec;
-  if (std::filesystem::is_regular_file(path, ec)) std::filesystem::remove(path, ec);  // the driver will not overwrite
+  if (std::filesystem::is_regular_file(path, ec)) driver->Delete(path.c_str());  // it will not overwrite
   GDALDatasetUniquePtr ds(driver->Create(path.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
   if (ds == nullptr) return failed(QuietGdal::LastMessage());
   // Geometries are built in the mesh's CRS when it was reprojected, else in the file's.
@@ -176,7 +186,7 @@ absl::Status WriteGeoJson(const DemInfo& dem, const std::vector<GeoFeature>& fea
   const char* rfc[] = {"RFC7946=YES", "WRITE_NAME=NO", nullptr};
   const char* native[] = {"WRITE_NAME=NO", nullptr};
   OGRLayer* layer = ds->CreateLayer("geodex", native_crs ? &file : &built, wkbUnknown,
-                                    const_cast<char**>(native_crs ? native : rfc));
+                                    geojson ? const_cast<char**>(native_crs ? native : rfc) : nullptr);
   if (layer == nullptr) return failed(QuietGdal::LastMessage());
   std::unique_ptr<OGRCoordinateTransformation, decltype(&OGRCoordinateTransformation::DestroyCT)>
       to_file(nullptr, &OGRCoordinateTransformation::DestroyCT);
@@ -254,7 +264,7 @@ absl::Status WriteGeoJson(const DemInfo& dem, const std::vector<GeoFeature>& fea
 absl::StatusOr<std::string> GeoJsonText(const DemInfo& dem, const std::vector<GeoFeature>& features,
                                         bool native_crs) {
   MemFile file(".geojson");
-  if (absl::Status written = WriteGeoJson(dem, features, file.path(), native_crs); !written.ok()) {
+  if (absl::Status written = WriteVectorFile(dem, features, file.path(), native_crs); !written.ok()) {
     return absl::InternalError(written.message());
   }
   return file.Take();

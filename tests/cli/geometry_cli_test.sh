@@ -124,7 +124,7 @@ expect_code "levels and count" 2 "usage" isolines "$DATA/kitten.off" --sources 0
 expect_code "neither levels nor count" 2 "usage" isolines "$DATA/kitten.off" --sources 0
 expect_code "bad count" 2 "--count" isolines "$DATA/kitten.off" --sources 0 --count 1
 expect_code "bad level" 2 "--levels" isolines "$DATA/kitten.off" --sources 0 --levels 1,x
-expect_code "bad output extension" 2 ".json, .obj, .svg or .geojson" voronoi "$DATA/kitten.off" --sites 0 --output "$tmp/x.txt"
+expect_code "bad output extension" 2 ".json, .obj, .svg or, on a DEM, a vector file's .geojson, .gpkg, .shp, .fgb" voronoi "$DATA/kitten.off" --sites 0 --output "$tmp/x.txt"
 expect_code "missing sites" 2 "usage" voronoi "$DATA/kitten.off"
 expect_code "unknown site vertex" 2 "vertex 99999" delaunay "$DATA/kitten.off" --sites 0,99999
 expect_code "bad site spec" 2 "--sites" delaunay "$DATA/kitten.off" --sites x:1

@@ -119,9 +119,10 @@ assert abs(near[8] - 80) < 1e-9  # along the first row to the shore
 PY
 "$GEODEX" distances "$tmp/strait.tif" --sources g:500005:4999995 --barrier-below 0 \
   --output "$tmp/b.tif"
-check "barrier raster: far shore and sea nodata" $PY -c "
-from osgeo import gdal; a = gdal.Open('$tmp/b.tif').ReadAsArray()
-assert (a[:, 9:] == -1).all() and (a[:, :9] >= 0).all()"
+check "barrier raster: the sea has no surface (nodata -1), the far shore is unreachable (-2)" $PY -c "
+from osgeo import gdal; d = gdal.Open('$tmp/b.tif'); a = d.ReadAsArray(); b = d.GetRasterBand(1)
+assert (a[:, 9:11] == -1).all() and (a[:, 11:] == -2).all() and (a[:, :9] >= 0).all(), a[0]
+assert b.GetNoDataValue() == -1 and b.GetDescription() == 'geodesic distance' and b.GetUnitType() == 'm'"
 # The same strait drawn as a polygon (GeoJSON in WGS 84, as RFC 7946 has it) on flat land.
 $PY - "$tmp" <<'PY'
 import json, sys
@@ -265,7 +266,7 @@ assert all(f["properties"]["surface_point"].startswith("f:") for f in pts)
 PY
 "$GEODEX" isolines "$tmp/tri.off" --sources 0 --count 3 --output "$tmp/x.geojson" 2>"$tmp/err.txt"
 check "geojson from a mesh: exit 2" test $? -eq 2
-check "geojson from a mesh: says why" grep -q "GeoJSON needs a DEM" "$tmp/err.txt"
+check "geojson from a mesh: says why" grep -q "a GIS file needs a DEM" "$tmp/err.txt"
 
 # --labels-output beside a text --output: both written.
 "$GEODEX" distances "$tmp/slot.tif" --sources g:500105:4999845 --labels-output "$tmp/n2.tif" \
@@ -368,6 +369,47 @@ check "NAD27 DEM with PROJ_NETWORK=ON: read offline" test $? -eq 0
 touch "$tmp/listener.stop"
 wait "$listener_pid"
 check "nothing connected to the listener" test "$(cat "$tmp/listener.count")" = 0
+
+# GIS files by extension (terrain/src/gis_formats.cc): rasters .asc and .nc hold the GeoTIFF's
+# values; isochrones as GeoPackage, Shapefile and FlatGeobuf are the native GeoJSON's polygons in
+# the DEM's CRS; an extension that is not a vector file's is refused, naming those that are.
+"$GEODEX" distances "$P" --sources g:500055:4999795 --output "$tmp/pd.tif" --labels-output "$tmp/pl.asc"
+"$GEODEX" distances "$P" --sources g:500055:4999795 --output "$tmp/pd.asc"
+"$GEODEX" distances "$P" --sources g:500055:4999795 --output "$tmp/pd.nc"
+for ext in gpkg shp fgb; do
+  "$GEODEX" isolines "$P" --sources g:500055:4999795 --levels 60,150,400 --output "$tmp/iso.$ext"
+done
+check "GIS files: rasters and vectors read back by GDAL/OGR" $PY - "$tmp" <<'PY'
+import json, sys
+import numpy as np
+from osgeo import gdal, ogr, osr
+from shapely import wkb
+from shapely.geometry import shape
+gdal.UseExceptions()
+t = sys.argv[1]
+tif = gdal.Open(f"{t}/pd.tif").ReadAsArray()
+for ext, tol in (("asc", 1e-3), ("nc", 0)):
+    d = gdal.Open(f"{t}/pd.{ext}")
+    a = d.ReadAsArray()
+    assert a.shape == tif.shape, (ext, a.shape)
+    assert np.allclose(a, tif, atol=tol, rtol=0), (ext, np.abs(a - tif).max())
+    assert d.GetGeoTransform() == gdal.Open(f"{t}/pd.tif").GetGeoTransform(), ext
+    assert (a == -1).sum() == 100 and d.GetRasterBand(1).GetNoDataValue() == -1, ext  # the pond
+labels = gdal.Open(f"{t}/pl.asc").ReadAsArray()
+assert ((labels == 0) | (labels == -1)).all() and (labels == -1).sum() == 100
+native = [shape(f["geometry"]) for f in json.load(open(f"{t}/iso_native.geojson"))["features"]]
+for ext in ("gpkg", "shp", "fgb"):
+    ds = ogr.Open(f"{t}/iso.{ext}")
+    layer = ds.GetLayer(0)
+    assert layer.GetSpatialRef().GetAuthorityCode(None) == "32633", ext
+    polygons = [wkb.loads(bytes(f.GetGeometryRef().ExportToWkb())) for f in layer]
+    assert len(polygons) == 3, (ext, len(polygons))
+    for p, q in zip(polygons, native):
+        assert p.geom_type in ("Polygon", "MultiPolygon") and abs(p.area - q.area) < 1e-6 * q.area, (ext, p.area, q.area)
+PY
+"$GEODEX" isolines "$P" --sources g:500055:4999795 --levels 60 --output "$tmp/iso.kml" 2>"$tmp/err.txt" >/dev/null
+check "unknown vector extension: exit 2" test $? -eq 2
+check "unknown vector extension: names the supported ones" grep -q ".geojson, .gpkg, .shp, .fgb" "$tmp/err.txt"
 
 # Errors: map points need a DEM, a point outside or in the slot is named, --dem-step needs a DEM.
 "$GEODEX" distances "$tmp/tri.off" --sources g:1:2 2>"$tmp/err.txt" >/dev/null

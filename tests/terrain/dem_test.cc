@@ -16,6 +16,7 @@
 #include "geodex/distance_matrix.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/geojson.h"
+#include "geodex/gis_formats.h"
 #include "geodex/terrain.h"
 #include "geodex/triangle_mesh.h"
 #include "gtest/gtest.h"
@@ -339,8 +340,10 @@ TEST_F(DemTest, RastersOutAreAlignedWithTheGridAndMarkNodata) {
         const double got = read[size_t{j} * dem->info().grid_width + i];
         // The pixel's centre, by the output's own geotransform, is the vertex's x.
         const double centre_x = gt[0] + (i + 0.5) * gt[1] - 500000;
-        if (v == kNoVertex || v == 1) {
-          EXPECT_EQ(got, -1) << i << "," << j;
+        if (v == kNoVertex) {
+          EXPECT_EQ(got, kRasterNoSurface) << i << "," << j;  // no surface: nodata
+        } else if (v == 1) {
+          EXPECT_EQ(got, kRasterUnreachable) << i << "," << j;  // on the surface, unreachable
         } else {
           EXPECT_NEAR(got, centre_x, 1e-3) << i << "," << j;
         }
@@ -355,7 +358,7 @@ TEST_F(DemTest, RastersOutAreAlignedWithTheGridAndMarkNodata) {
     int32_t first = 0;
     ASSERT_EQ(ls->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, 1, 1, &first, 1, 1, GDT_Int32, 0, 0),
               CE_None);
-    EXPECT_EQ(first, -1);  // vertex 0: no label
+    EXPECT_EQ(first, kRasterUnreachable);  // vertex 0: no label (unreachable)
     GDALClose(ls);
   }
 }
@@ -464,7 +467,7 @@ TEST_F(DemTest, TiledUnionEqualsTheGeneralUnionWithTouchingLobes) {
     f.pieces = SublevelPieces(dem->mesh(), value, 5);
     f.exact_tiling = tiled;
     const std::string path = (dir_ / name).string();
-    EXPECT_TRUE(WriteGeoJson(dem->info(), {f}, path, /*native_crs=*/true).ok());
+    EXPECT_TRUE(WriteVectorFile(dem->info(), {f}, path, /*native_crs=*/true).ok());
     GDALDatasetUniquePtr ds(GDALDataset::Open(path.c_str(), GDAL_OF_VECTOR));
     EXPECT_NE(ds, nullptr);
     OGRFeatureUniquePtr feature(ds->GetLayer(0)->GetNextFeature());

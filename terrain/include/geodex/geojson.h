@@ -38,9 +38,12 @@ struct GeoFeature {
   std::vector<Property> properties;
 };
 
-// Writes `features` as one FeatureCollection. Errors name the path (with GDAL's reason).
-absl::Status WriteGeoJson(const DemInfo& dem, const std::vector<GeoFeature>& features,
-                          const std::string& path, bool native_crs);
+// Writes `features` as one layer, in the vector format the path's extension names (gis_formats.h:
+// .geojson, .gpkg, .shp, .fgb). GeoJSON is RFC 7946 (WGS 84) unless `native_crs`; every other
+// format is in the DEM's CRS. Errors name the path (with GDAL's reason); an extension that is not a
+// vector format's is InvalidArgument listing them.
+absl::Status WriteVectorFile(const DemInfo& dem, const std::vector<GeoFeature>& features,
+                             const std::string& path, bool native_crs);
 // The same file's text (what geodexd's ExportGis sends).
 absl::StatusOr<std::string> GeoJsonText(const DemInfo& dem, const std::vector<GeoFeature>& features,
                                         bool native_crs);

@@ -1,0 +1,32 @@
+#pragma once
+
+// Every GIS file geodex writes, chosen by the output path's extension: the one table of extension
+// to GDAL/OGR driver (terrain/src/gis_formats.cc). Rasters are written on the DEM's grid, vectors
+// in WGS 84 for GeoJSON (RFC 7946) and in the DEM's own CRS otherwise.
+
+#include <string>
+
+namespace geodex::terrain {
+
+enum class GisFileKind { kRaster, kVector };
+
+struct GisFormat {
+  const char* extension;  // lower case, with its dot
+  const char* driver;     // GDAL's short name
+  GisFileKind kind;
+  const char* description;
+};
+
+// The format of `path` by its extension (any case), or null when it is not a GIS file's.
+const GisFormat* GisFormatOf(const std::string& path);
+// The extensions of one kind, for messages: ".tif, .tiff, .asc, .nc".
+std::string GisExtensions(GisFileKind kind);
+
+// Raster values (docs/gis-files.md): a cell with no surface (nodata in the DEM, below
+// --barrier-below, inside a barrier) is the band's nodata value; a cell on the surface that no
+// path reaches (another part of the surface, beyond --max-distance) has its own value, so that
+// both read apart in formats without a mask band.
+inline constexpr double kRasterNoSurface = -1;
+inline constexpr double kRasterUnreachable = -2;
+
+}  // namespace geodex::terrain
