@@ -30,8 +30,9 @@ cell (a quick look). --barrier-below Z (any MESH) removes what lies below Z (the
 cells, a mesh's faces with a corner below Z; paths go around it, exactly, and beyond it is inf.
 --barrier FILE (GeoJSON; on a DEM also Shapefile, GeoPackage, FlatGeobuf) cuts its polygons exactly
 out of the surface (on a DEM in the file's CRS, WGS 84 when it names none; on a mesh in its own
-x y); its lines and points are walls --barrier-width W metres wide (docs/barriers.md). A barrier
-that cuts nothing, or splits the surface, is said on stderr.
+x y); its lines are slits (both sides kept, paths go around their ends), or with --barrier-width W
+walls W metres wide, as are its points (docs/barriers.md). A barrier that cuts nothing, or splits
+the surface, is said on stderr.
 
 Local by default; remote with --server HOST:PORT (or GEODEX_SERVER=HOST:PORT), plus --tls,
 --ca FILE (PEM roots; implies --tls) and --token-file FILE (or GEODEX_TOKEN) for a server with TLS

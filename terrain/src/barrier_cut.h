@@ -25,10 +25,11 @@ class OGRGeometry;
 
 namespace geodex::terrain {
 
-// `barrier`: polygons, lines and points whose coordinates times `scale` are the mesh's x y; lines
-// and points are buffered into polygons `width` wide (round ends), and need width > 0. The union
-// of it all is cut out. InvalidArgument for lines or points without a width, or coordinates that
-// are not finite; Internal only when GEOS fails.
+// `barrier`: polygons, lines and points whose coordinates times `scale` are the mesh's x y. With
+// width > 0, lines and points are buffered into polygons that wide (round ends); the union of the
+// polygons is cut out. With width 0, lines are slits: the surface is split along them and every
+// vertex on a line (but its ends) gets one copy per side. InvalidArgument for points without a
+// width, or coordinates that are not finite; Internal only when GEOS fails.
 absl::StatusOr<MeshData> CutOutPolygons(const MeshData& mesh, const OGRGeometry& barrier, double scale,
                                         double width, CutStats* stats);
 

@@ -669,7 +669,13 @@ absl::StatusOr<Dem> Dem::FromMesh(MeshData mesh, DemInfo info) {
       return bad(absl::StrCat("vertex ", v, " is outside the grid"));
     }
     if (std::abs(u - std::round(u)) < 1e-6 && std::abs(w - std::round(w)) < 1e-6) {
-      return bad(absl::StrCat("vertex ", v, " is out of row order"));
+      // At a cell centre only as a copy of that cell's vertex (a line barrier's two sides).
+      const size_t cell = static_cast<size_t>(std::round(w)) * W + static_cast<size_t>(std::round(u));
+      const uint32_t original = std::round(u) < W && std::round(w) < H ? dem.vertex_of_cell_[cell] : kNoVertex;
+      if (original == kNoVertex ||
+          !std::equal(&mesh.positions[3 * v], &mesh.positions[3 * v] + 3, &mesh.positions[3 * size_t{original}])) {
+        return bad(absl::StrCat("vertex ", v, " is out of row order"));
+      }
     }
   }
   dem.face_of_block_.assign(2 * size_t{W - 1} * (H - 1), kNoVertex);

@@ -165,9 +165,14 @@ assert math.isinf(fence[15]) and math.isfinite(fence[5]), (fence[5], fence[15])
 assert math.isfinite(gap[15]) and gap[15] > plain[15] + 1, (gap[15], plain[15])
 assert abs(gap[5] - plain[5]) < 1e-9, (gap[5], plain[5])
 PY
-"$GEODEX" distances "$tmp/strait.tif" --sources 0 --barrier "$tmp/fence.geojson" 2>"$tmp/err.txt" >/dev/null
-check "line barrier without a width: refused" test $? -ne 0
-check "line barrier without a width: says so" grep -q "lines and points are barriers with a width" "$tmp/err.txt"
+"$GEODEX" distances "$tmp/strait.tif" --sources g:500005:4999995 --barrier "$tmp/fence.geojson" >"$tmp/slit.txt" 2>/dev/null
+check "line barrier without a width: a slit, it separates" $PY -c "
+import math; d = [float(x) for x in open('$tmp/slit.txt')]
+assert math.isinf(d[15]) and math.isfinite(d[5]) and abs(d[5] - 50) < 1e-9, (d[5], d[15])"
+echo '{"type": "MultiPoint", "coordinates": [[15, 45]]}' >"$tmp/points.geojson"
+"$GEODEX" distances "$tmp/strait.tif" --sources 0 --barrier "$tmp/points.geojson" 2>"$tmp/err.txt" >/dev/null
+check "point barrier without a width: refused" test $? -ne 0
+check "point barrier without a width: says so" grep -q "points are barriers with a width" "$tmp/err.txt"
 echo '{"type": "Polygon", "coordinates": [[[-84.3, 36.6], [-84.2, 36.6], [-84.2, 36.7], [-84.3, 36.6]]]}' >"$tmp/far.geojson"
 "$GEODEX" info "$tmp/strait.tif" --barrier "$tmp/far.geojson" >/dev/null 2>"$tmp/err.txt"
 check "a barrier that misses: exit 0" test $? -eq 0
@@ -316,7 +321,7 @@ PY
   echo '{"type": "Point", "coordinates": [15, 45]}' >"$tmp/point.geojson"
   "$GEODEX" distances strait --sources 0 --barrier "$tmp/point.geojson" 2>"$tmp/err.txt" >/dev/null
   check "bad barrier by name: exit 3" test $? -eq 3
-  check "bad barrier by name: names the flag" grep -q -- "--barrier $tmp/point.geojson: .*lines and points are barriers with a width" "$tmp/err.txt"
+  check "bad barrier by name: names the flag" grep -q -- "--barrier $tmp/point.geojson: .*points are barriers with a width" "$tmp/err.txt"
 fi
 
 # geodex never reaches out (issue 30): a listener on a port the kernel picks counts connections

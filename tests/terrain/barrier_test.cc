@@ -50,6 +50,10 @@ MeshData TiltedGrid(int n) {
   return mesh;
 }
 
+double Cross(const Point2& o, const Point2& a, const Point2& b) {
+  return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+}
+
 std::array<double, 3> OnPlane(const Point2& p) { return {p[0], p[1], kSlopeX * p[0] + kSlopeY * p[1]}; }
 double Length3(const Point2& p, const Point2& q) {
   const auto a = OnPlane(p), b = OnPlane(q);
@@ -269,9 +273,10 @@ TEST(BarrierCutTest, LinesAreWallsOfTheirWidth) {
   const MeshData grid = TiltedGrid(n);
   const std::string fence = R"({"type": "LineString", "coordinates": [[4.37, -1], [6.11, 11]]})";
   CutStats stats;
-  absl::Status refused = CutBarrierPolygons(grid, fence, nullptr, 0, "--barrier f", &stats).status();
+  absl::Status refused =
+      CutBarrierPolygons(grid, R"({"type": "Point", "coordinates": [3, 3]})", nullptr, 0, "--barrier f", &stats).status();
   EXPECT_EQ(refused.code(), absl::StatusCode::kInvalidArgument);
-  EXPECT_EQ(refused.message().rfind("--barrier f: lines and points are barriers with a width", 0), 0u) << refused;
+  EXPECT_EQ(refused.message().rfind("--barrier f: points are barriers with a width", 0), 0u) << refused;
   absl::StatusOr<MeshData> cut = CutBarrierPolygons(grid, fence, nullptr, 0.25, "--barrier f", &stats);
   ASSERT_TRUE(cut.ok()) << cut.status();
   // The wall's area is its length times its width plus its two round ends (GEOS's buffer: 8
@@ -287,6 +292,115 @@ TEST(BarrierCutTest, LinesAreWallsOfTheirWidth) {
   ASSERT_TRUE(field.ok());
   EXPECT_TRUE(std::isfinite(field->distance[3]));
   EXPECT_TRUE(std::isinf(field->distance[n]));  // (10, 0), across the fence
+}
+
+// Lines without a width are slits: the surface is cut along them, both sides kept.
+using Segment = std::array<Point2, 2>;
+
+// Does p-q cross segment a-b (each passing through the other's inside)? Touching an end is not.
+bool Crosses(const Point2& p, const Point2& q, const Segment& s) {
+  const double eps = 1e-12;
+  const double o1 = Cross(s[0], s[1], p), o2 = Cross(s[0], s[1], q), o3 = Cross(p, q, s[0]), o4 = Cross(p, q, s[1]);
+  return ((o1 > eps && o2 < -eps) || (o1 < -eps && o2 > eps)) && ((o3 > eps && o4 < -eps) || (o3 < -eps && o4 > eps));
+}
+
+// The shortest path from s to t on the plane around the slits, through their ends inside the grid.
+double AroundSlits(const Point2& s, const Point2& t, const std::vector<Segment>& slits, int n) {
+  std::vector<Point2> nodes = {s, t};
+  for (const Segment& l : slits) {
+    for (const Point2& e : l) {
+      if (e[0] > 0 && e[0] < n && e[1] > 0 && e[1] < n) nodes.push_back(e);
+    }
+  }
+  std::vector<double> best(nodes.size(), std::numeric_limits<double>::infinity());
+  std::vector<bool> done(nodes.size(), false);
+  best[0] = 0;
+  for (size_t round = 0; round < nodes.size(); ++round) {
+    size_t u = nodes.size();
+    for (size_t k = 0; k < nodes.size(); ++k) {
+      if (!done[k] && (u == nodes.size() || best[k] < best[u])) u = k;
+    }
+    if (u == nodes.size() || !std::isfinite(best[u])) break;
+    done[u] = true;
+    for (size_t v = 0; v < nodes.size(); ++v) {
+      bool visible = v != u;
+      for (const Segment& l : slits) visible = visible && !Crosses(nodes[u], nodes[v], l);
+      if (visible) best[v] = std::min(best[v], best[u] + Length3(nodes[u], nodes[v]));
+    }
+  }
+  return best[1];
+}
+
+double DistanceToSegment(const Point2& p, const Segment& s) { return DistanceToBoundary(p, {s[0], s[1]}); }
+
+std::string LinesJson(const std::vector<Segment>& lines) {
+  std::string parts;
+  for (const Segment& l : lines) {
+    absl::StrAppendFormat(&parts, "%s[[%.17g, %.17g], [%.17g, %.17g]]", parts.empty() ? "" : ", ", l[0][0], l[0][1],
+                          l[1][0], l[1][1]);
+  }
+  return absl::StrCat(R"({"type": "MultiLineString", "coordinates": [)", parts, "]}");
+}
+
+TEST(BarrierCutTest, LinesWithoutAWidthAreExactSlits) {
+  const int n = 16;
+  const MeshData grid = TiltedGrid(n);
+  // A wall with a gap (both inner ends inside faces), and a line lying along mesh edges through
+  // two vertices (its ends on vertices).
+  const std::vector<Segment> slits = {Segment{Point2{6.2, -1}, Point2{8.1, 7.35}},
+                                      Segment{Point2{8.55, 9.3}, Point2{10.4, 17}},
+                                      Segment{Point2{12, 2}, Point2{15, 5}}};
+  CutStats stats;
+  absl::StatusOr<MeshData> cut = CutBarrierPolygons(grid, LinesJson(slits), nullptr, 0, "slits", &stats);
+  ASSERT_TRUE(cut.ok()) << cut.status();
+  EXPECT_GT(stats.faces_cut, 0u);
+  EXPECT_EQ(stats.faces_removed, 0u);
+  // Nothing removed: the area is the plane's; every edge with one face lies on the grid's edge or
+  // on a line (a slit's two sides).
+  const double sec = std::sqrt(1 + kSlopeX * kSlopeX + kSlopeY * kSlopeY);
+  EXPECT_NEAR(Area3(*cut), n * n * sec, 1e-10 * n * n);
+  std::vector<std::vector<Point2>> as_rings;
+  for (const Segment& l : slits) as_rings.push_back({l[0], l[1]});
+  ExpectConforming(*cut, n, as_rings);
+  absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(*cut);
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  EXPECT_EQ(mesh->report().components, 1u);  // the gap and the ends keep it whole
+
+  for (const Point2 source : {Point2{2, 8}, Point2{13, 1}, Point2{15, 3}}) {
+    const uint32_t s = static_cast<uint32_t>(source[1] * (n + 1) + source[0]);
+    absl::StatusOr<DistanceField> field = ComputeDistanceField(*mesh, {SurfacePoint::AtVertex(s)});
+    ASSERT_TRUE(field.ok()) << field.status();
+    double worst = 0;
+    int around = 0;
+    for (int j = 0; j <= n; ++j) {
+      for (int i = 0; i <= n; ++i) {
+        const Point2 target = {1.0 * i, 1.0 * j};
+        bool on_line = false;
+        for (const Segment& l : slits) on_line |= DistanceToSegment(target, l) < 1e-9;
+        if (on_line) continue;  // a point of the slit itself is on both sides
+        const double d = field->distance[j * (n + 1) + i];
+        const double expected = AroundSlits(source, target, slits, n);
+        bool blocked = false;
+        for (const Segment& l : slits) blocked |= Crosses(source, target, l);
+        around += blocked ? 1 : 0;
+        worst = std::max(worst, std::abs(d - expected) / std::max(expected, 1.0));
+      }
+    }
+    EXPECT_GT(around, 10) << "the lines are in the way of some paths";
+    EXPECT_LT(worst, 1e-9) << source[0] << " " << source[1];
+  }
+
+  // A line across the whole grid separates.
+  absl::StatusOr<MeshData> across = CutBarrierPolygons(grid, LinesJson({Segment{Point2{-1, 4.37}, Point2{17, 5.91}}}),
+                                                       nullptr, 0, "across", &stats);
+  ASSERT_TRUE(across.ok()) << across.status();
+  absl::StatusOr<TriangleMesh> halves = TriangleMesh::Build(*across);
+  ASSERT_TRUE(halves.ok());
+  EXPECT_EQ(halves->report().components, 2u);
+  absl::StatusOr<DistanceField> field = ComputeDistanceField(*halves, {SurfacePoint::AtVertex(0)});
+  ASSERT_TRUE(field.ok());
+  EXPECT_NEAR(field->distance[3 * (n + 1) + 5], Length3({0, 0}, {5, 3}), 1e-9);
+  EXPECT_TRUE(std::isinf(field->distance[8 * (n + 1) + 5]));
 }
 
 TEST(BarrierCutTest, TwoHolesAndAPolygonAlongGridLines) {
@@ -405,6 +519,25 @@ TEST(BarrierCutTest, DemBarrierInEitherCrsAndStoredAgain) {
     }
   }
   EXPECT_GT(landed, 100);
+
+  // A line along a column of cell centres slits the grid through its vertices: the stored mesh
+  // takes the copies (at cell centres, each its cell vertex's twin) and the two sides part.
+  absl::StatusOr<MeshData> slit = CutBarrierPolygons(
+      dem->mesh(),
+      R"({"type": "LineString", "crs": {"type": "name", "properties": {"name": "EPSG:32633"}}, "coordinates": [[500105, 5000010], [500105, 4999790]]})",
+      &dem->info(), 0, "column", &a_stats);
+  ASSERT_TRUE(slit.ok()) << slit.status();
+  EXPECT_EQ(slit->vertex_count(), dem->mesh().vertex_count() + 20);  // one copy a row
+  absl::StatusOr<Dem> slit_dem = Dem::FromMesh(*slit, dem->info());
+  ASSERT_TRUE(slit_dem.ok()) << slit_dem.status();
+  absl::StatusOr<TriangleMesh> halves = TriangleMesh::Build(*slit);
+  ASSERT_TRUE(halves.ok());
+  EXPECT_EQ(halves->report().components, 2u);
+  absl::StatusOr<SurfacePoint> west = slit_dem->DropMapPoint(500051, 4999901), east = slit_dem->DropMapPoint(500161, 4999901);
+  ASSERT_TRUE(west.ok() && east.ok());
+  absl::StatusOr<DistanceField> field = ComputeDistanceField(*halves, {*west});
+  ASSERT_TRUE(field.ok());
+  EXPECT_TRUE(std::isinf(field->distance[slit->faces[3 * size_t{east->face}]]));
 }
 
 }  // namespace

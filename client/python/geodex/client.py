@@ -219,7 +219,8 @@ class GeodexClient:
         id); returns its Mesh resource. `below`: faces with a corner lower than this z go (the
         sea at 0 on a DEM's mesh); `polygons_geojson`: the text (or a dict) of GeoJSON polygons,
         cut exactly out of the surface (WGS 84 on a DEM's mesh, the mesh's x y otherwise);
-        lines and points in it are barriers `width` metres wide."""
+        lines in it are slits (paths go around their ends), or with `width` (metres) walls that
+        wide, as are its points."""
         if not isinstance(polygons_geojson, str):
             import json
             polygons_geojson = json.dumps(polygons_geojson)

@@ -37,7 +37,7 @@ struct DemOptions {
   // A barrier drawn as polygons (GeoJSON, Shapefile, GeoPackage or FlatGeobuf; its own CRS, WGS 84
   // when it names none), cut exactly out of the surface (CutBarrierPolygons). "": none.
   std::string barrier_file;
-  // The width (metres) of the lines and points in barrier_file; 0: they are refused.
+  // The width (metres) of the lines and points in barrier_file; 0: lines are slits, points refused.
   double barrier_width = 0;
   // The most cells (width x height of the file) a raster may have, and the most vertices and
   // faces its mesh may have (every used cell with data, two triangles per block); 0: any. What a
@@ -91,8 +91,9 @@ struct CutStats {
 // boundary split along it (see terrain/src/barrier_cut.h). Vertices keep their ids, new ones
 // follow. InvalidArgument starting with `name` when the text is not GeoJSON polygons (or names
 // its CRS by anything but an identifier). Only GDAL's GeoJSON driver reads it.
-// Lines and points (LineString, Point and their Multi-) are barriers `width` wide (metres in the
-// mesh's plane, buffered with round ends) and need width > 0.
+// Lines (LineString, MultiLineString) are slits with width 0 (both sides kept, paths go around
+// their ends); with width > 0 they and points are walls that wide (metres in the mesh's plane,
+// buffered with round ends). Points need a width.
 absl::StatusOr<MeshData> CutBarrierPolygons(const MeshData& mesh, const std::string& geojson,
                                             const DemInfo* dem, double width, const std::string& name,
                                             CutStats* stats);
