@@ -16,7 +16,9 @@
 #include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "absl/container/flat_hash_map.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_replace.h"
 #include "geodex/gis_formats.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
@@ -110,6 +112,21 @@ absl::Status ResolvePoints(Backend& backend, const Args& args, const std::string
   return backend.Check(option, *points);
 }
 
+// The points written as map coordinates, by the face point each was dropped to, so that messages
+// quote them as the user wrote them (`ll:-84.3:36.6`, not `f:222302:0.5:...`). One CLI run, one
+// table.
+absl::flat_hash_map<std::string, std::string>& WrittenPoints() {
+  static auto* written = new absl::flat_hash_map<std::string, std::string>();
+  return *written;
+}
+
+std::string InWrittenTerms(std::string message) {
+  for (const auto& [dropped, written] : WrittenPoints()) {
+    message = absl::StrReplaceAll(message, {{dropped, written}});
+  }
+  return message;
+}
+
 // Map coordinates in a SPEC list (`g:X:Y` in the DEM's CRS, `ll:LON:LAT` in WGS 84) dropped
 // vertically onto the DEM, each rewritten as the face point it lands on (lossless, %.17g).
 // Without a backend (before the mesh is open) only their syntax is checked (they become "0").
@@ -136,7 +153,9 @@ absl::StatusOr<std::string> DropMapPoints(const Backend* backend, const std::str
     }
     absl::StatusOr<SurfacePoint> p = native ? dem->DropMapPoint(a, b) : dem->DropLonLat(a, b);
     if (!p.ok()) return absl::InvalidArgumentError(absl::StrCat("point ", p.status().message()));
+    const std::string written = item;
     item = SurfacePointToString(*p);
+    WrittenPoints()[item] = written;
   }
   return absl::StrJoin(items, ",");
 }
@@ -194,7 +213,7 @@ int QueryExitCode(const absl::Status& status) {
 }
 
 int FailQuery(const absl::Status& status) {
-  return Fail(QueryExitCode(status), std::string(status.message()));
+  return Fail(QueryExitCode(status), InWrittenTerms(std::string(status.message())));
 }
 
 bool IsVectorPath(const Args& args) {
@@ -818,9 +837,11 @@ int RunMatrix(Backend& backend, const Args& args) {
 }
 
 // geodex locate: its entry of `geodex --help`.
-constexpr char kLocateHelp[] = R"(  locate MESH --points p:X:Y:Z,... [--max-snap D] [--format text|json]
+constexpr char kLocateHelp[] = R"(  locate MESH --points p:X:Y:Z,g:X:Y,ll:LON:LAT,... [--max-snap D] [--format text|json]
       The nearest surface point to each 3D position: 'QUERY<TAB>SPEC<TAB>x y z<TAB>snap D', D
       the distance it moved. --max-snap D refuses a position farther than D from the surface.
+      On a DEM, map points (g:X:Y in its CRS, ll:LON:LAT) are dropped vertically onto it
+      (snap 0); QUERY is the point as written.
 )";
 
 int RunLocate(Backend& backend, const Args& args) {
@@ -831,32 +852,51 @@ int RunLocate(Backend& backend, const Args& args) {
     return Fail(kExitUsage, error);
   }
   if (args.positional.size() != 1 || !args.options.count("points")) {
-    return Fail(kExitUsage, "usage: geodex locate MESH --points p:X:Y:Z,... [--max-snap D]");
+    return Fail(kExitUsage, "usage: geodex locate MESH --points p:X:Y:Z,g:X:Y,ll:LON:LAT,... [--max-snap D]");
   }
   double max_snap = std::numeric_limits<double>::infinity();
   if (!GetDouble(args, "max-snap", &max_snap, &error)) return Fail(kExitUsage, error);
   if (!(max_snap > 0)) return Fail(kExitUsage, "--max-snap must be positive");
-  absl::StatusOr<std::vector<SurfacePoint>> points = ParseSurfacePoints(args.options.at("points"));
-  if (!points.ok()) return Fail(kExitUsage, "--points: " + std::string(points.status().message()));
+  const std::vector<std::string> items = absl::StrSplit(args.options.at("points"), ',');
+  auto is_map = [](const std::string& item) { return absl::StartsWith(item, "g:") || absl::StartsWith(item, "ll:"); };
+  // Positions are snapped (Locate); map points, checked here, are dropped once the mesh is open.
   std::vector<std::array<double, 3>> xyz;
-  for (const SurfacePoint& p : *points) {
-    if (p.kind != SurfacePoint::Kind::kPosition) {
-      return Fail(kExitUsage,
-                  absl::StrFormat("--points: %s is not a position (locate takes p:X:Y:Z)",
-                                  SurfacePointToString(p)));
+  for (const std::string& item : items) {
+    absl::StatusOr<std::vector<SurfacePoint>> p = ParseSpec(nullptr, "points", item);
+    if (!p.ok()) return Fail(kExitUsage, std::string(p.status().message()));
+    if (is_map(item)) continue;
+    if (p->size() != 1 || p->front().kind != SurfacePoint::Kind::kPosition) {
+      return Fail(kExitUsage, absl::StrFormat("--points: %s is not a position (locate takes p:X:Y:Z, g:X:Y, ll:LON:LAT)", item));
     }
-    xyz.push_back(p.position);
+    xyz.push_back(p->front().position);
   }
   if (int code = OpenMesh(backend, args, args.positional[0], MeshBuildOptions{})) return code;
-  absl::StatusOr<std::vector<LocatedPoint>> located = backend.Locate(xyz);
-  if (!located.ok()) return FailQuery(located.status());
+  std::vector<LocatedPoint> located;
+  if (!xyz.empty()) {
+    absl::StatusOr<std::vector<LocatedPoint>> snapped = backend.Locate(xyz);
+    if (!snapped.ok()) return FailQuery(snapped.status());
+    located = *std::move(snapped);
+  }
   std::string text = json ? "{\"points\": [" : "";
-  for (size_t i = 0; i < xyz.size(); ++i) {
-    const LocatedPoint& at = (*located)[i];
-    if (absl::Status s = CheckSnapDistance(xyz[i], at, max_snap); !s.ok()) {
-      return Fail(kExitUsage, absl::StrFormat("--points: %s", s.message()));
+  size_t next_position = 0;
+  for (size_t i = 0; i < items.size(); ++i) {
+    LocatedPoint at;
+    if (is_map(items[i])) {
+      absl::StatusOr<std::vector<SurfacePoint>> dropped = ParseSpec(&backend, "points", items[i]);
+      if (!dropped.ok()) return FailQuery(dropped.status());
+      absl::StatusOr<const MeshData*> data = backend.Geometry();
+      if (!data.ok()) return FailQuery(data.status());
+      at.point = dropped->front();
+      at.position = PositionOf(**data, at.point);
+      at.distance = 0;
+    } else {
+      const std::array<double, 3>& p = xyz[next_position];
+      at = located[next_position++];
+      if (absl::Status s = CheckSnapDistance(p, at, max_snap); !s.ok()) {
+        return Fail(kExitUsage, absl::StrFormat("--points: %s", s.message()));
+      }
     }
-    const std::string query = SurfacePointToString((*points)[i]);
+    const std::string& query = items[i];
     if (json) {
       text += absl::StrFormat(
           "%s{\"query\": \"%s\", \"point\": \"%s\", \"p\": %s, \"snap_distance\": %.17g}",

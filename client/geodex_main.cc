@@ -52,7 +52,8 @@ SPEC: comma-separated points: 17 (vertex), e:V1:V2:T (the point (1-T)*V1 + T*V2 
       f:FACE:B0:B1:B2 (barycentric in the face's vertex order as in the file),
       g:X:Y and ll:LON:LAT (on a DEM: map coordinates in the DEM's CRS, or WGS 84 longitude and
       latitude, dropped vertically onto the surface; outside the DEM or in a nodata hole is an
-      error naming the point),
+      error naming the point as written, with the DEM's extent and a hint when x and y, or
+      longitude and latitude, look swapped),
       p:X:Y:Z (a 3D position, snapped to the nearest point of the surface). Snapping is never
       silent: --stats reports the farthest snap (snap_max), a snap beyond 1% of the mesh's
       diagonal is warned about on stderr, and --max-snap D (every command taking a SPEC)

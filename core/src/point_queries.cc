@@ -26,6 +26,60 @@
 namespace geodex {
 namespace {
 
+// The internal vertices a surface point lies on or in (a split vertex's copies too).
+std::vector<uint32_t> TouchedVertices(const TriangleMesh& mesh, const SurfacePoint& p) {
+  std::vector<uint32_t> out;
+  auto vertex = [&](uint32_t v) {
+    if (v >= mesh.file_vertex_count()) return;
+    out.push_back(v);
+    for (uint32_t u = mesh.file_vertex_count(); u < mesh.vertex_count(); ++u) {
+      if (mesh.FileVertex(u) == v) out.push_back(u);
+    }
+  };
+  switch (p.kind) {
+    case SurfacePoint::Kind::kVertex:
+      vertex(p.vertex);
+      break;
+    case SurfacePoint::Kind::kEdge:
+      vertex(p.edge_from);
+      vertex(p.edge_to);
+      break;
+    case SurfacePoint::Kind::kFace:
+      if (p.face < mesh.face_count()) {
+        for (int k = 0; k < 3; ++k) out.push_back(mesh.FaceVertex(p.face, k));
+      }
+      break;
+    default:
+      break;
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string UnreachableReason(const TriangleMesh& mesh, const SurfacePoint& from, const SurfacePoint& to,
+                              double max_distance) {
+  const std::vector<uint32_t> at_to = TouchedVertices(mesh, to), at_from = TouchedVertices(mesh, from);
+  if (to.kind == SurfacePoint::Kind::kVertex && !at_to.empty() &&
+      std::all_of(at_to.begin(), at_to.end(), [&](uint32_t v) { return mesh.IsIsolated(v); })) {
+    return "it is a vertex no face uses";
+  }
+  bool shared = false;
+  for (uint32_t a : at_to) {
+    for (uint32_t b : at_from) shared |= mesh.Component(a) == mesh.Component(b);
+  }
+  if (!shared && !at_to.empty() && !at_from.empty()) {
+    return absl::StrFormat(
+        "it is on another part of the surface (a barrier, a hole or a gap parts them; the mesh has %d parts)",
+        mesh.report().components);
+  }
+  if (std::isfinite(max_distance)) return absl::StrFormat("it is farther than the max_distance limit (%.6g)", max_distance);
+  return "no path reaches it";
+}
+
+namespace {
+
+
 absl::Status CheckOptions(const GeodesicOptions& options) {
   if (!IsExactMethod(options.method)) {
     return absl::InvalidArgumentError("point queries and paths need an exact method (exact or ich)");
@@ -131,9 +185,9 @@ absl::StatusOr<PathQueryResult> ComputeShortestPath(const TriangleMesh& mesh,
   absl::StatusOr<PathsQueryResult> paths = ComputeShortestPaths(mesh, from, {to}, options);
   if (!paths.ok()) return paths.status();
   if (paths->distance[0] == kUnreachable) {
-    return absl::NotFoundError(absl::StrFormat("%s is unreachable from %s",
-                                               SurfacePointToString(to),
-                                               SurfacePointToString(from)));
+    return absl::NotFoundError(absl::StrFormat("%s is unreachable from %s: %s", SurfacePointToString(to),
+                                               SurfacePointToString(from),
+                                               UnreachableReason(mesh, from, to, options.solver.max_distance)));
   }
   PathQueryResult result;
   result.distance = paths->distance[0];

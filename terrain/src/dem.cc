@@ -1,6 +1,7 @@
 #include "geodex/terrain.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cerrno>
 #include <cstring>
@@ -729,8 +730,67 @@ absl::StatusOr<Dem> Dem::FromMesh(MeshData mesh, DemInfo info) {
   return dem;
 }
 
+namespace {
+// The shortest text that reads back as `value` (500301.9, not 500301.90000000002): how a person
+// writes the coordinates that messages quote.
+std::string Shortest(double value) {
+  char text[400];
+  const double a = std::abs(value);
+  const auto end = (a == 0 || (a >= 1e-4 && a < 1e15))
+                       ? std::to_chars(text, text + sizeof(text), value, std::chars_format::fixed).ptr
+                       : std::to_chars(text, text + sizeof(text), value).ptr;
+  return std::string(text, end);
+}
+
+bool OutsideTheDem(const absl::Status& status) {
+  return absl::IsInvalidArgument(status) && absl::EndsWith(status.message(), ": outside the DEM");
+}
+}  // namespace
+
+bool Dem::InGrid(double x, double y) const {
+  const std::array<double, 6>& gt = info_.geotransform;
+  const double u = (x - gt[0]) / gt[1] - 0.5, v = (y - gt[3]) / gt[5] - 0.5;
+  return u >= 0 && v >= 0 && u <= info_.grid_width - 1.0 && v <= info_.grid_height - 1.0;
+}
+
+absl::StatusOr<std::array<double, 4>> Dem::LonLatExtent() const {
+  QuietGdal quiet;
+  OGRSpatialReference wgs84, file_crs;
+  wgs84.SetWellKnownGeogCS("WGS84");
+  wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  file_crs.importFromWkt(info_.file_crs_wkt.c_str());
+  file_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  TransformPtr t = MakeTransform(file_crs, wgs84);
+  if (t == nullptr) return absl::InternalError("the DEM's CRS does not project to WGS 84");
+  // The used cells' centres around the grid's edge (a projection bends straight lines).
+  const std::array<double, 6>& gt = info_.geotransform;
+  std::array<double, 4> box = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+                               -std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+  const uint32_t W = info_.grid_width, H = info_.grid_height;
+  for (int k = 0; k <= 64; ++k) {
+    const double f = k / 64.0;
+    for (auto [u, v] : {std::pair{f * (W - 1), 0.0}, std::pair{f * (W - 1), H - 1.0}, std::pair{0.0, f * (H - 1)},
+                        std::pair{W - 1.0, f * (H - 1)}}) {
+      double x = gt[0] + (u + 0.5) * gt[1], y = gt[3] + (v + 0.5) * gt[5];
+      if (!t->Transform(1, &x, &y)) continue;
+      box = {std::min(box[0], x), std::min(box[1], y), std::max(box[2], x), std::max(box[3], y)};
+    }
+  }
+  return box;
+}
+
 absl::StatusOr<SurfacePoint> Dem::DropMapPoint(double x, double y) const {
-  return DropNamed(x, y, absl::StrFormat("g:%.17g:%.17g", x, y));
+  absl::StatusOr<SurfacePoint> p = DropNamed(x, y, absl::StrCat("g:", Shortest(x), ":", Shortest(y)));
+  if (!OutsideTheDem(p.status())) return p;
+  // Where the DEM is, in the same coordinates, and whether x and y were given the other way round.
+  const std::array<double, 6>& gt = info_.geotransform;
+  const double x0 = gt[0] + 0.5 * gt[1], x1 = gt[0] + (info_.grid_width - 0.5) * gt[1];
+  const double y0 = gt[3] + 0.5 * gt[5], y1 = gt[3] + (info_.grid_height - 0.5) * gt[5];
+  std::string message = absl::StrFormat("%s (it covers x %.10g to %.10g, y %.10g to %.10g in %s)", p.status().message(),
+                                        std::min(x0, x1), std::max(x0, x1), std::min(y0, y1), std::max(y0, y1),
+                                        info_.file_crs_name);
+  if (InGrid(y, x)) absl::StrAppend(&message, "; g:", Shortest(y), ":", Shortest(x), " would be inside (x and y swapped?)");
+  return absl::InvalidArgumentError(message);
 }
 
 absl::StatusOr<SurfacePoint> Dem::DropNamed(double x, double y, const std::string& name) const {
@@ -754,7 +814,7 @@ absl::StatusOr<SurfacePoint> Dem::DropNamed(double x, double y, const std::strin
 }
 
 absl::StatusOr<SurfacePoint> Dem::DropLonLat(double lon, double lat) const {
-  const std::string name = absl::StrFormat("ll:%.17g:%.17g", lon, lat);
+  const std::string name = absl::StrCat("ll:", Shortest(lon), ":", Shortest(lat));
   if (!(std::abs(lon) <= 180 && std::abs(lat) <= 90)) {
     return absl::InvalidArgumentError(absl::StrCat(name, ": longitude must be in [-180, 180] and latitude in [-90, 90]"));
   }
@@ -770,7 +830,18 @@ absl::StatusOr<SurfacePoint> Dem::DropLonLat(double lon, double lat) const {
     return absl::InvalidArgumentError(
         absl::StrCat(name, ": cannot project it to the DEM's CRS (", QuietGdal::LastMessage(), ")"));
   }
-  return DropNamed(x, y, name);
+  absl::StatusOr<SurfacePoint> p = DropNamed(x, y, name);
+  if (!OutsideTheDem(p.status())) return p;
+  std::string message(p.status().message());
+  if (absl::StatusOr<std::array<double, 4>> box = LonLatExtent(); box.ok()) {
+    absl::StrAppendFormat(&message, " (it covers longitude %.8g to %.8g, latitude %.8g to %.8g)", (*box)[0],
+                          (*box)[2], (*box)[1], (*box)[3]);
+  }
+  double sx = lat, sy = lon;  // longitude and latitude the other way round
+  if (std::abs(lat) <= 180 && std::abs(lon) <= 90 && t->Transform(1, &sx, &sy) && InGrid(sx, sy)) {
+    absl::StrAppend(&message, "; ll:", Shortest(lat), ":", Shortest(lon), " would be inside (longitude first: ll:LON:LAT)");
+  }
+  return absl::InvalidArgumentError(message);
 }
 
 absl::StatusOr<SurfacePoint> Dem::DropMeshPoint(double mx, double my, double u, double v,

@@ -416,6 +416,33 @@ PY
 check "unknown vector extension: exit 2" test $? -eq 2
 check "unknown vector extension: names the supported ones" grep -q ".geojson, .gpkg, .shp, .fgb" "$tmp/err.txt"
 
+# Messages in map terms: a point outside the DEM gets the DEM's extent in its own coordinates and
+# a hint when its coordinates swapped would be inside; an unreachable point is quoted as written,
+# with the reason; locate drops g: and ll: points.
+"$GEODEX" distances "$tmp/plane.tif" --sources g:4999722.2:500301.9 2>"$tmp/err.txt" >/dev/null
+check "outside: the DEM's extent" grep -q "it covers x 500005 to 500395, y 4999705 to 4999995 in WGS 84 / UTM zone 33N" "$tmp/err.txt"
+check "outside: x and y swapped" grep -q "g:500301.9:4999722.2 would be inside (x and y swapped?)" "$tmp/err.txt"
+swapped=$(echo "$ll" | awk -F: '{print "ll:" $3 ":" $2}')
+"$GEODEX" distances "$tmp/plane.tif" --sources "$swapped" 2>"$tmp/err.txt" >/dev/null
+check "outside: longitude and latitude extent" grep -q "it covers longitude 15.0000[0-9]* to 15.00[0-9]*, latitude 45.1" "$tmp/err.txt"
+check "outside: longitude and latitude swapped" grep -q "would be inside (longitude first: ll:LON:LAT)" "$tmp/err.txt"
+"$GEODEX" path "$tmp/strait.tif" --from g:500005:4999995 --to g:500195.0:4999995 --barrier-below 0 \
+  2>"$tmp/err.txt" >/dev/null
+check "unreachable: exit 1" test $? -eq 1
+check "unreachable: quoted as written, with why" grep -q "g:500195.0:4999995 is unreachable from g:500005:4999995: it is on another part of the surface" "$tmp/err.txt"
+"$GEODEX" locate "$tmp/plane.tif" --points "g:500013.3:4999981.7,$ll,p:500100:4999900:100" --format json >"$tmp/loc.json"
+check "locate: g: and ll: points dropped, p: snapped" $PY - "$tmp/loc.json" "$ll" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))["points"]
+z = lambda x, y: 0.1 * (x - 500000) + 0.2 * (y - 4999700)
+assert [p["query"] for p in d] == ["g:500013.3:4999981.7", sys.argv[2], "p:500100:4999900:100"], d
+x, y, h = d[0]["p"]
+assert abs(x - 500013.3) < 1e-6 and abs(y - 4999981.7) < 1e-6 and abs(h - z(x, y)) < 1e-6 and d[0]["snap_distance"] == 0
+x, y, h = d[1]["p"]
+assert abs(x - 500301.9) < 1e-3 and abs(y - 4999722.2) < 1e-3 and abs(h - z(x, y)) < 1e-6
+assert d[2]["snap_distance"] > 0
+PY
+
 # Errors: map points need a DEM, a point outside or in the slot is named, --dem-step needs a DEM.
 "$GEODEX" distances "$tmp/tri.off" --sources g:1:2 2>"$tmp/err.txt" >/dev/null
 check "g: on a mesh: exit 2" test $? -eq 2

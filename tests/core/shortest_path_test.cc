@@ -244,5 +244,30 @@ TEST(PathTest, UnreachableAndUnknownVerticesAreErrors) {
             absl::StatusCode::kInvalidArgument);
 }
 
+// An unreachable target's error says why: another part of the surface, a vertex no face uses, or
+// beyond max_distance.
+TEST(UnreachableReasonTest, SaysWhy) {
+  // Two triangles apart (0-1-2 and 3-4-5) and vertex 6 that no face uses.
+  MeshData data;
+  data.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0, 5, 0, 0, 6, 0, 0, 5, 1, 0, 9, 9, 9};
+  data.faces = {0, 1, 2, 3, 4, 5};
+  absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(data);
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  PathQueryOptions options;
+  absl::StatusOr<PathQueryResult> apart = ComputeShortestPath(*mesh, SurfacePoint::AtVertex(0), SurfacePoint::AtVertex(4), options);
+  EXPECT_EQ(apart.status().code(), absl::StatusCode::kNotFound);
+  EXPECT_NE(apart.status().message().find("it is on another part of the surface"), std::string::npos) << apart.status();
+  EXPECT_NE(apart.status().message().find("the mesh has 2 parts"), std::string::npos) << apart.status();
+  EXPECT_EQ(UnreachableReason(*mesh, SurfacePoint::AtVertex(0), SurfacePoint::AtVertex(6), kUnreachable),
+            "it is a vertex no face uses");
+  options.solver.max_distance = 0.5;
+  absl::StatusOr<PathQueryResult> far = ComputeShortestPath(*mesh, SurfacePoint::AtVertex(0), SurfacePoint::AtVertex(1), options);
+  EXPECT_EQ(far.status().code(), absl::StatusCode::kNotFound);
+  EXPECT_NE(far.status().message().find("farther than the max_distance limit (0.5)"), std::string::npos) << far.status();
+  EXPECT_EQ(UnreachableReason(*mesh, SurfacePoint::OnEdge(0, 1, 0.5), SurfacePoint::InFace(1, 0.2, 0.3, 0.5), kUnreachable)
+                .rfind("it is on another part", 0),
+            0u);
+}
+
 }  // namespace
 }  // namespace geodex

@@ -137,8 +137,14 @@ class Dem {
   // A map point dropped vertically onto the surface, as a face point: (x, y) in the file's CRS
   // (`g:X:Y`) or WGS 84 longitude/latitude (`ll:LON:LAT`). InvalidArgument naming the point when
   // it lies outside the used grid or in a hole (nodata or a barrier).
+  // Outside the DEM, the message gives its extent in the point's own terms (x y in its CRS, or
+  // longitude and latitude) and says when the point with its coordinates swapped would be inside.
   absl::StatusOr<SurfacePoint> DropMapPoint(double x, double y) const;
   absl::StatusOr<SurfacePoint> DropLonLat(double lon, double lat) const;
+  // The used grid's cell centres in longitude/latitude: {lon min, lat min, lon max, lat max}.
+  absl::StatusOr<std::array<double, 4>> LonLatExtent() const;
+  // Whether (x, y) in the file's CRS lies within the used grid's cell centres.
+  bool InGrid(double x, double y) const;
 
   // Writes one value per vertex as a single-band GeoTIFF aligned with the used grid (its
   // geotransform and the file's CRS): float32 with nodata -1 where a cell has no vertex or the
