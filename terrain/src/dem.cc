@@ -742,6 +742,16 @@ std::string Shortest(double value) {
   return std::string(text, end);
 }
 
+// WGS 84 longitude/latitude to the DEM file's CRS (from_wgs84), or back.
+TransformPtr Wgs84Transform(const DemInfo& info, bool from_wgs84) {
+  OGRSpatialReference wgs84, file_crs;
+  wgs84.SetWellKnownGeogCS("WGS84");
+  wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  file_crs.importFromWkt(info.file_crs_wkt.c_str());
+  file_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  return from_wgs84 ? MakeTransform(wgs84, file_crs) : MakeTransform(file_crs, wgs84);
+}
+
 bool OutsideTheDem(const absl::Status& status) {
   return absl::IsInvalidArgument(status) && absl::EndsWith(status.message(), ": outside the DEM");
 }
@@ -755,12 +765,7 @@ bool Dem::InGrid(double x, double y) const {
 
 absl::StatusOr<std::array<double, 4>> Dem::LonLatExtent() const {
   QuietGdal quiet;
-  OGRSpatialReference wgs84, file_crs;
-  wgs84.SetWellKnownGeogCS("WGS84");
-  wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  file_crs.importFromWkt(info_.file_crs_wkt.c_str());
-  file_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  TransformPtr t = MakeTransform(file_crs, wgs84);
+  TransformPtr t = Wgs84Transform(info_, /*from_wgs84=*/false);
   if (t == nullptr) return absl::InternalError("the DEM's CRS does not project to WGS 84");
   // The used cells' centres around the grid's edge (a projection bends straight lines).
   const std::array<double, 6>& gt = info_.geotransform;
@@ -819,12 +824,7 @@ absl::StatusOr<SurfacePoint> Dem::DropLonLat(double lon, double lat) const {
     return absl::InvalidArgumentError(absl::StrCat(name, ": longitude must be in [-180, 180] and latitude in [-90, 90]"));
   }
   QuietGdal quiet;
-  OGRSpatialReference wgs84, file_crs;
-  wgs84.SetWellKnownGeogCS("WGS84");
-  wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  file_crs.importFromWkt(info_.file_crs_wkt.c_str());
-  file_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  TransformPtr t = MakeTransform(wgs84, file_crs);
+  TransformPtr t = Wgs84Transform(info_, /*from_wgs84=*/true);
   double x = lon, y = lat;
   if (t == nullptr || !t->Transform(1, &x, &y)) {
     return absl::InvalidArgumentError(
