@@ -120,6 +120,33 @@ absl::flat_hash_map<std::string, std::string>& WrittenPoints() {
   return *written;
 }
 
+// Map points read from --sources-file / --targets-file, by their SPEC item: the feature that gave
+// each, for messages.
+absl::flat_hash_map<std::string, std::string>& FilePointNames() {
+  static auto* names = new absl::flat_hash_map<std::string, std::string>();
+  return *names;
+}
+
+absl::Status ExpandPointFiles(Args* args) {
+  for (const auto& [flag, option] : {std::pair<std::string, std::string>{"sources-file", "sources"},
+                                     std::pair<std::string, std::string>{"targets-file", "targets"}}) {
+    auto it = args->options.find(flag);
+    if (it == args->options.end()) continue;
+    const std::string name = absl::StrCat("--", flag, " ", it->second);
+    absl::StatusOr<std::vector<terrain::FilePoint>> points = terrain::ReadPointsFile(it->second, name);
+    if (!points.ok()) return points.status();
+    std::string spec = args->options.count(option) ? args->options.at(option) : "";
+    for (const terrain::FilePoint& p : *points) {
+      absl::StatusOr<std::string> item = terrain::FilePointSpec(p);
+      if (!item.ok()) return absl::InvalidArgumentError(absl::StrCat(p.name, ": ", item.status().message()));
+      absl::StrAppend(&spec, spec.empty() ? "" : ",", *item);
+      FilePointNames()[*item] = p.name;
+    }
+    args->options[option] = spec;
+  }
+  return absl::OkStatus();
+}
+
 std::string InWrittenTerms(std::string message) {
   for (const auto& [dropped, written] : WrittenPoints()) {
     message = absl::StrReplaceAll(message, {{dropped, written}});
@@ -152,8 +179,13 @@ absl::StatusOr<std::string> DropMapPoints(const Backend* backend, const std::str
           absl::StrFormat("point %s: map coordinates need a DEM as MESH (a raster such as .tif)", item));
     }
     absl::StatusOr<SurfacePoint> p = native ? dem->DropMapPoint(a, b) : dem->DropLonLat(a, b);
-    if (!p.ok()) return absl::InvalidArgumentError(absl::StrCat("point ", p.status().message()));
-    const std::string written = item;
+    if (!p.ok()) {
+      auto from_file = FilePointNames().find(item);
+      return absl::InvalidArgumentError(absl::StrCat(
+          "point ", from_file != FilePointNames().end() ? from_file->second + " at " : "", p.status().message()));
+    }
+    auto from_file = FilePointNames().find(item);
+    const std::string written = from_file != FilePointNames().end() ? from_file->second : item;
     item = SurfacePointToString(*p);
     WrittenPoints()[item] = written;
   }
@@ -702,7 +734,8 @@ constexpr char kPathHelp[] = R"(  path MESH --from SPEC --to SPEC [--method asta
       'x y z' and the simplex it lies on ('v ID', 'e V1 V2 T' or 'f FACE B0 B1 B2').
       astar (default) uses the paper's section 5 heuristic and stops at the target.
       --lambda L (as for distances) trades exactness for speed; --max-distance D: a target
-      farther than D is unreachable.
+      farther than D is unreachable. Several --from points: the path from the nearest (named
+      on stderr).
 )";
 
 int RunPath(Backend& backend, const Args& args) {
@@ -716,7 +749,7 @@ int RunPath(Backend& backend, const Args& args) {
     return Fail(kExitUsage, error);
   }
   if (args.positional.size() != 1 || !args.options.count("from") || !args.options.count("to")) {
-    return Fail(kExitUsage, "usage: geodex path MESH --from SPEC --to SPEC [--method astar|full]");
+    return Fail(kExitUsage, "usage: geodex path MESH --from SPEC[,SPEC...] --to SPEC [--method astar|full]");
   }
   PathQueryOptions options;
   const std::string method = args.options.count("method") ? args.options.at("method") : "astar";
@@ -729,11 +762,26 @@ int RunPath(Backend& backend, const Args& args) {
   }
   if (!GetSolverFlags(args, &options.solver, &error)) return Fail(kExitUsage, error);
   if (int code = OpenMesh(backend, args, args.positional[0], MeshBuildOptions{})) return code;
-  SurfacePoint from, to;
+  SurfacePoint to;
+  std::vector<SurfacePoint> froms;
   SnapReport snap;
-  if (absl::Status s = OnePoint(backend, args, "from", &from, &snap); !s.ok()) return FailQuery(s);
+  if (absl::Status s = ResolveOption(backend, args, "from", &froms, &snap); !s.ok()) return FailQuery(s);
   if (absl::Status s = OnePoint(backend, args, "to", &to, &snap); !s.ok()) return FailQuery(s);
-  absl::StatusOr<PathQueryResult> result = backend.Path({from, to, options});
+  // Several --from points: the path from the nearest (an exact distance at `to` from all of them
+  // names it; distances are symmetric), said on stderr.
+  size_t nearest = 0;
+  if (froms.size() > 1) {
+    absl::StatusOr<AtValues> at = backend.DistancesAt({froms, {to}, options.solver, false});
+    if (!at.ok()) return FailQuery(at.status());
+    if (std::isfinite(at->exact.distance[0]) && at->exact.source[0] < froms.size()) {
+      nearest = at->exact.source[0];
+      const std::vector<std::string> written = absl::StrSplit(args.options.at("from"), ',');
+      std::fprintf(stderr, "geodex: --from: the nearest is point %zu (%s), %.17g away\n", nearest,
+                   written.size() == froms.size() ? written[nearest].c_str() : SurfacePointToString(froms[nearest]).c_str(),
+                   at->exact.distance[0]);
+    }
+  }
+  absl::StatusOr<PathQueryResult> result = backend.Path({froms[nearest], to, options});
   if (!result.ok()) return FailQuery(result.status());
   if (IsVectorPath(args)) {  // a 3D LineString with its length
     if (int code = WriteVectorOutput(

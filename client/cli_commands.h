@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "absl/status/status.h"
+
 namespace geodex::cli {
 
 // Exit codes, documented in `geodex --help`.
@@ -27,6 +29,10 @@ struct Args {
 // Parses argv[first..]; `boolean_flags` take no value. Returns false with *error set on failure.
 bool ParseArgs(int argc, char** argv, int first, const std::vector<std::string>& boolean_flags,
                Args* out, std::string* error);
+
+// --sources-file F / --targets-file F: the file's points (terrain::ReadPointsFile) appended to
+// --sources / --targets as map points, named in messages as the file's features.
+absl::Status ExpandPointFiles(Args* args);
 
 class Backend;  // cli_backend.h: where the command runs (this process or a geodexd)
 

@@ -15,6 +15,7 @@
 
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/match.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
 #include "absl/strings/str_join.h"
@@ -146,8 +147,11 @@ bool GetUint(const Args& args, const std::string& key, uint64_t* out, std::strin
 
 bool CheckKnown(const Args& args, const std::set<std::string>& known, std::string* error) {
   for (const auto& [key, value] : args.options) {
-    if (!known.count(key) && !kMeshReadingFlags.count(key)) {
-      *error = absl::StrFormat("unknown option --%s (see geodex --help)", key);
+    // --X-file (points from a file) goes with a command that takes --X.
+    const bool file_of_known = absl::EndsWith(key, "-file") && known.count(key.substr(0, key.size() - 5));
+    if (!known.count(key) && !kMeshReadingFlags.count(key) && !file_of_known) {
+      const std::string flag = args.options.count(key + "-file") ? key + "-file" : key;
+      *error = absl::StrFormat("unknown option --%s (see geodex --help)", flag);
       return false;
     }
   }

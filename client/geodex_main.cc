@@ -58,6 +58,9 @@ SPEC: comma-separated points: 17 (vertex), e:V1:V2:T (the point (1-T)*V1 + T*V2 
       silent: --stats reports the farthest snap (snap_max), a snap beyond 1% of the mesh's
       diagonal is warned about on stderr, and --max-snap D (every command taking a SPEC)
       refuses a point farther than D from the surface.
+--sources-file F, --targets-file F (on a DEM): the points of a GeoJSON, GeoPackage, Shapefile,
+      FlatGeobuf or CSV file (x,y columns in the DEM's CRS, or lon,lat), in its own CRS, added to
+      --sources / --targets; messages name them as the file's features.
 
 --format json (distances, path, matrix, locate, info) prints one JSON object instead of text:
       distances {"distances": [...]} (or {"points": [...]} with --at), path {"length", "points"
@@ -163,6 +166,10 @@ int main(int argc, char** argv) {
   if (!ParseArgs(argc, argv, first + 1, ValueLessFlags(), &args, &error)) {
     std::fprintf(stderr, "geodex: %s\n", error.c_str());
     return kExitUsage;
+  }
+  if (absl::Status points = ExpandPointFiles(&args); !points.ok()) {
+    std::fprintf(stderr, "geodex: %s\n", std::string(points.message()).c_str());
+    return absl::IsNotFound(points) ? kExitInput : kExitUsage;
   }
   // A terminal sees elapsed time for anything that takes more than a second.
   Progress progress(server.empty() ? command : command + " on " + server);

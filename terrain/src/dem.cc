@@ -16,6 +16,8 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_split.h"
+#include "absl/strings/strip.h"
 #include "cpl_conv.h"
 #include "cpl_error.h"
 #include "cpl_json.h"
@@ -34,6 +36,17 @@
 namespace geodex::terrain {
 namespace {
 
+
+// The shortest text that reads back as `value` (500301.9, not 500301.90000000002): how a person
+// writes the coordinates that messages quote.
+std::string Shortest(double value) {
+  char text[400];
+  const double a = std::abs(value);
+  const auto end = (a == 0 || (a >= 1e-4 && a < 1e15))
+                       ? std::to_chars(text, text + sizeof(text), value, std::chars_format::fixed).ptr
+                       : std::to_chars(text, text + sizeof(text), value).ptr;
+  return std::string(text, end);
+}
 
 std::string WktOf(const OGRSpatialReference& srs) {
   char* wkt = nullptr;
@@ -285,6 +298,105 @@ absl::StatusOr<MeshData> CutBarrier(const MeshData& mesh, OGRGeometry& polygons,
 }
 
 }  // namespace
+
+absl::StatusOr<std::vector<FilePoint>> ReadPointsFile(const std::string& path, const std::string& name) {
+  QuietGdal quiet;
+  auto bad = [&](const std::string& why) { return absl::InvalidArgumentError(absl::StrCat(name, ": ", why)); };
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return absl::NotFoundError(absl::StrCat(name, ": cannot open: ", std::strerror(errno)));
+  char first = ' ';
+  while (in.get(first) && absl::ascii_isspace(static_cast<unsigned char>(first))) {
+  }
+  const std::string ext = absl::AsciiStrToLower(std::filesystem::path(path).extension().string());
+  const bool csv = ext == ".csv";
+  GDALDatasetUniquePtr ds;
+  if (csv) {
+    // x,y columns (the DEM's CRS), or lon,lat / longitude,latitude (WGS 84).
+    const char* const drivers[] = {"CSV", nullptr};
+    const char* const options[] = {"X_POSSIBLE_NAMES=x,lon,longitude,lng", "Y_POSSIBLE_NAMES=y,lat,latitude",
+                                   "KEEP_GEOM_COLUMNS=NO", nullptr};
+    const char* const no_siblings[] = {nullptr};
+    ds.reset(GDALDataset::FromHandle(GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, drivers, options,
+                                                no_siblings)));
+    if (ds == nullptr) return bad(absl::StrCat("not a CSV file with x,y or lon,lat columns (", QuietGdal::LastMessage(), ")"));
+  } else {
+    absl::StatusOr<GDALDatasetUniquePtr> file = OpenBarrierFile(path, name);
+    if (!file.ok()) return file.status();
+    ds = *std::move(file);
+  }
+  std::vector<FilePoint> points;
+  for (OGRLayer* layer : ds->GetLayers()) {
+    const OGRSpatialReference* layer_crs = layer->GetSpatialRef();
+    std::string wkt;
+    if (layer_crs != nullptr) {
+      wkt = WktOf(*layer_crs);
+    } else if (csv) {
+      OGRFeatureDefn* defn = layer->GetLayerDefn();
+      bool lonlat = false;
+      for (int i = 0; i < defn->GetFieldCount(); ++i) {
+        const std::string field = absl::AsciiStrToLower(defn->GetFieldDefn(i)->GetNameRef());
+        lonlat |= field == "lon" || field == "longitude" || field == "lng";
+      }
+      // KEEP_GEOM_COLUMNS=NO drops the coordinate columns: read the header for which they were.
+      if (!lonlat) {
+        std::ifstream header(path);
+        std::string line;
+        std::getline(header, line);
+        const std::string lower = absl::AsciiStrToLower(line);
+        for (const char* word : {"lon", "longitude", "lng"}) {
+          for (absl::string_view cell : absl::StrSplit(lower, ',')) {
+            lonlat |= absl::StripAsciiWhitespace(cell) == word;
+          }
+        }
+      }
+      if (lonlat) {
+        OGRSpatialReference wgs84;
+        wgs84.SetWellKnownGeogCS("WGS84");
+        wkt = WktOf(wgs84);
+      }
+    } else if (first == '{') {  // GeoJSON without a crs: RFC 7946's WGS 84
+      OGRSpatialReference wgs84;
+      wgs84.SetWellKnownGeogCS("WGS84");
+      wkt = WktOf(wgs84);
+    }
+    for (const auto& feature : *layer) {
+      const OGRGeometry* g = feature->GetGeometryRef();
+      if (g == nullptr) continue;
+      const std::string feature_name = absl::StrCat(name, " feature ", feature->GetFID());
+      auto add = [&](const OGRPoint* p) {
+        points.push_back({p->getX(), p->getY(), wkt, feature_name});
+      };
+      switch (wkbFlatten(g->getGeometryType())) {
+        case wkbPoint:
+          add(g->toPoint());
+          break;
+        case wkbMultiPoint:
+          for (const OGRPoint* p : *g->toMultiPoint()) add(p);
+          break;
+        default:
+          return bad(absl::StrCat("feature ", feature->GetFID(), " is a ", g->getGeometryName(), "; points are expected"));
+      }
+    }
+  }
+  if (points.empty()) return bad("no point");
+  return points;
+}
+
+absl::StatusOr<std::string> FilePointSpec(const FilePoint& point) {
+  if (point.crs_wkt.empty()) return absl::StrCat("g:", Shortest(point.x), ":", Shortest(point.y));
+  QuietGdal quiet;
+  OGRSpatialReference from, wgs84;
+  if (from.importFromWkt(point.crs_wkt.c_str()) != OGRERR_NONE) return absl::InvalidArgumentError("its CRS does not parse");
+  from.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  wgs84.SetWellKnownGeogCS("WGS84");
+  wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  TransformPtr t = MakeTransform(from, wgs84);
+  double x = point.x, y = point.y;
+  if (t == nullptr || !t->Transform(1, &x, &y)) {
+    return absl::InvalidArgumentError(absl::StrCat("cannot project it to WGS 84 (", QuietGdal::LastMessage(), ")"));
+  }
+  return absl::StrCat("ll:", Shortest(x), ":", Shortest(y));
+}
 
 absl::StatusOr<MeshData> CutBarrierPolygons(const MeshData& mesh, const std::string& geojson,
                                             const DemInfo* dem, double width, const std::string& name,
@@ -731,16 +843,6 @@ absl::StatusOr<Dem> Dem::FromMesh(MeshData mesh, DemInfo info) {
 }
 
 namespace {
-// The shortest text that reads back as `value` (500301.9, not 500301.90000000002): how a person
-// writes the coordinates that messages quote.
-std::string Shortest(double value) {
-  char text[400];
-  const double a = std::abs(value);
-  const auto end = (a == 0 || (a >= 1e-4 && a < 1e15))
-                       ? std::to_chars(text, text + sizeof(text), value, std::chars_format::fixed).ptr
-                       : std::to_chars(text, text + sizeof(text), value).ptr;
-  return std::string(text, end);
-}
 
 // WGS 84 longitude/latitude to the DEM file's CRS (from_wgs84), or back.
 TransformPtr Wgs84Transform(const DemInfo& info, bool from_wgs84) {

@@ -129,7 +129,16 @@ expect_usage "unknown option" "--frobnicate" distances "$DATA/knight.off" --sour
 expect_usage "unknown command" "frobnicate" frobnicate
 expect_usage "missing sources" "usage" distances "$DATA/knight.off"
 expect_usage "path to unknown vertex" "vertex 9999" path "$DATA/knight.off" --from 0 --to 9999
-expect_usage "path with two points" "one point" path "$DATA/knight.off" --from 0,1 --to 2
+# Several --from points: the path from the nearest, named on stderr, its length the smallest.
+"$GEODEX" path "$DATA/knight.off" --from 0,1,5 --to 2 >"$tmp/many.txt" 2>"$tmp/many.err"
+check "path from the nearest of several: exit 0" test $? -eq 0
+best=""
+for v in 0 1 5; do
+  d=$("$GEODEX" path "$DATA/knight.off" --from $v --to 2 | head -1)
+  if [ -z "$best" ] || python3 -c "import sys; sys.exit(0 if float('$d') < float('$best') else 1)"; then best=$d; nearest=$v; fi
+done
+check "path from the nearest of several: the shortest length" test "$(head -1 "$tmp/many.txt")" = "$best"
+check "path from the nearest of several: named" grep -q "the nearest is point [0-9] ($nearest)" "$tmp/many.err"
 expect_usage "bad path method" "--method" path "$DATA/knight.off" --from 0 --to 2 --method foo
 expect_usage "matrix bad target" "--targets" matrix "$DATA/knight.off" --sources 0 --targets f:0:2:0:0
 expect_usage "bad position" "p:1:2" distances "$DATA/knight.off" --sources p:1:2

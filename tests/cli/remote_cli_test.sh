@@ -106,7 +106,7 @@ check "max-snap: the same message" diff "$tmp/local.err" "$tmp/remote.err"
 same_error "bad option" matrix "$DATA/kitten.off" --sources 0 --targets 1 --bogus 1
 same_error "unreachable target" path "$DATA/kitten.off" --from 3 --to 400 --max-distance 1
 same_error "bad lambda" path "$DATA/kitten.off" --from 3 --to 400 --lambda 2
-same_error "two --from points" path "$DATA/kitten.off" --from 3,4 --to 400
+same "two --from points: the path from the nearest" path "$DATA/kitten.off" --from 3,4,120 --to 400
 for flag in "--max-windows 10" "--no-filter" "--method dijkstra"; do
   "${R[@]}" distances "$DATA/kitten.off" --sources 0 $flag 2>"$tmp/err.txt" >/dev/null
   check "remote $flag: exit 2" test $? -eq 2

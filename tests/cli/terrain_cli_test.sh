@@ -443,6 +443,50 @@ assert abs(x - 500301.9) < 1e-3 and abs(y - 4999722.2) < 1e-3 and abs(h - z(x, y
 assert d[2]["snap_distance"] > 0
 PY
 
+# Points from files: the same two sources from GeoJSON (WGS 84), GeoPackage (UTM 33N), Shapefile
+# (WGS 84), FlatGeobuf (UTM) and CSV (x,y in the DEM's CRS; lon,lat) give the same field as the
+# sources written out; --targets-file feeds a matrix; a point outside is named as the file's feature.
+$PY - "$tmp" <<'PY'
+import sys
+from osgeo import gdal, ogr, osr
+gdal.UseExceptions()
+t = sys.argv[1]
+utm = osr.SpatialReference(); utm.ImportFromEPSG(32633)
+wgs = osr.SpatialReference(); wgs.ImportFromEPSG(4326); wgs.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
+to_ll = osr.CoordinateTransformation(utm, wgs)
+pts = [(500013.3, 4999981.7), (500301.9, 4999722.2)]
+ll = [to_ll.TransformPoint(x, y)[:2] for x, y in pts]
+def write(name, driver, srs, coords):
+    ds = ogr.GetDriverByName(driver).CreateDataSource(f"{t}/{name}")
+    layer = ds.CreateLayer("p", srs, ogr.wkbPoint)
+    for x, y in coords:
+        f = ogr.Feature(layer.GetLayerDefn()); g = ogr.Geometry(ogr.wkbPoint); g.AddPoint_2D(x, y); f.SetGeometry(g); layer.CreateFeature(f)
+    ds = None
+write("pts.geojson", "GeoJSON", wgs, ll)
+write("pts.gpkg", "GPKG", utm, pts)
+write("pts.shp", "ESRI Shapefile", wgs, ll)
+write("pts.fgb", "FlatGeobuf", utm, pts)
+open(f"{t}/xy.csv", "w").write("name,x,y\n" + "".join(f"p{i},{x!r},{y!r}\n" for i, (x, y) in enumerate(pts)))
+open(f"{t}/ll.csv", "w").write("lon,lat\n" + "".join(f"{x!r},{y!r}\n" for x, y in ll))
+open(f"{t}/far.csv", "w").write("x,y\n500013.3,4999981.7\n400000,4999981.7\n")
+PY
+"$GEODEX" distances "$tmp/plane.tif" --sources g:500013.3:4999981.7,g:500301.9:4999722.2 >"$tmp/two.txt"
+for f in pts.geojson pts.gpkg pts.shp pts.fgb xy.csv ll.csv; do
+  "$GEODEX" distances "$tmp/plane.tif" --sources-file "$tmp/$f" >"$tmp/file.txt" 2>"$tmp/err.txt"
+  check "--sources-file $f: exit 0" test $? -eq 0
+  check "--sources-file $f: the field of the points written out (within 1e-6 m)" $PY -c "
+a = [float(x) for x in open('$tmp/two.txt')]; b = [float(x) for x in open('$tmp/file.txt')]
+assert len(a) == len(b) and max(abs(x - y) for x, y in zip(a, b)) < 1e-6, max(abs(x - y) for x, y in zip(a, b))"
+done
+"$GEODEX" matrix "$tmp/plane.tif" --sources g:500100:4999900 --targets-file "$tmp/pts.gpkg" >"$tmp/m.txt"
+check "--targets-file: a matrix row of two" $PY -c "
+r = open('$tmp/m.txt').read().split(); assert len(r) == 2 and all(float(x) > 0 for x in r), r"
+"$GEODEX" distances "$tmp/plane.tif" --sources-file "$tmp/far.csv" 2>"$tmp/err.txt" >/dev/null
+check "--sources-file: a point outside: exit 2" test $? -eq 2
+check "--sources-file: a point outside is the file's feature" grep -q -- "--sources-file $tmp/far.csv feature 2 at g:400000:4999981.7: outside the DEM" "$tmp/err.txt"
+"$GEODEX" info "$tmp/plane.tif" --targets-file "$tmp/pts.gpkg" 2>"$tmp/err.txt" >/dev/null
+check "--targets-file where there are no targets: named" grep -q "unknown option --targets-file" "$tmp/err.txt"
+
 # Errors: map points need a DEM, a point outside or in the slot is named, --dem-step needs a DEM.
 "$GEODEX" distances "$tmp/tri.off" --sources g:1:2 2>"$tmp/err.txt" >/dev/null
 check "g: on a mesh: exit 2" test $? -eq 2

@@ -98,6 +98,21 @@ absl::StatusOr<MeshData> CutBarrierPolygons(const MeshData& mesh, const std::str
                                             const DemInfo* dem, double width, const std::string& name,
                                             CutStats* stats);
 
+// A point read from a file (--sources-file, --targets-file): its coordinates in the file's CRS
+// (crs_wkt; "" when the file names none: then in the DEM's CRS) and how messages name it.
+struct FilePoint {
+  double x = 0, y = 0;
+  std::string crs_wkt;
+  std::string name;  // "--sources-file pts.gpkg feature 3"
+};
+// Points (Point, MultiPoint) from a file the CLI's user names: GeoJSON (RFC 7946's WGS 84 unless
+// its "crs" names another by an identifier), GeoPackage, Shapefile or FlatGeobuf (each its own
+// driver only; their CRS, none: the DEM's), or CSV with x,y columns (the DEM's CRS) or lon,lat
+// (WGS 84). InvalidArgument starting with `name` for anything else.
+absl::StatusOr<std::vector<FilePoint>> ReadPointsFile(const std::string& path, const std::string& name);
+// The point as a SPEC item: ll:LON:LAT when its CRS is known, else g:X:Y.
+absl::StatusOr<std::string> FilePointSpec(const FilePoint& point);
+
 inline constexpr uint32_t kNoVertex = 0xffffffffu;
 
 class Dem {
