@@ -145,6 +145,24 @@ bool GetUint(const Args& args, const std::string& key, uint64_t* out, std::strin
   return true;
 }
 
+bool GetLevels(const Args& args, const std::string& count_flag, IsolineOptions* options, std::string* error) {
+  if (args.options.count("levels")) {
+    for (absl::string_view item : absl::StrSplit(args.options.at("levels"), ',')) {
+      double level;
+      if (!absl::SimpleAtod(item, &level) || !std::isfinite(level)) {
+        *error = absl::StrFormat("--levels: '%s' is not a finite number", item);
+        return false;
+      }
+      options->levels.push_back(level);
+    }
+  } else if (args.options.count(count_flag) &&
+             (!absl::SimpleAtoi(args.options.at(count_flag), &options->count) || options->count < 2)) {
+    *error = absl::StrFormat("--%s: '%s' is not an integer >= 2", count_flag, args.options.at(count_flag));
+    return false;
+  }
+  return true;
+}
+
 bool CheckKnown(const Args& args, const std::set<std::string>& known, std::string* error) {
   for (const auto& [key, value] : args.options) {
     // --X-file (points from a file) goes with a command that takes --X.

@@ -244,18 +244,7 @@ int RunIsolines(Backend& backend, const Args& args) {
     return Usage("isolines", "sources", " (--levels L1,L2,... | --count K)");
   }
   IsolineOptions options;
-  if (args.options.count("levels")) {
-    for (absl::string_view item : absl::StrSplit(args.options.at("levels"), ',')) {
-      double level;
-      if (!absl::SimpleAtod(item, &level) || !std::isfinite(level)) {
-        return Fail(kExitUsage, absl::StrFormat("--levels: '%s' is not a finite number", item));
-      }
-      options.levels.push_back(level);
-    }
-  } else if (!absl::SimpleAtoi(args.options.at("count"), &options.count) || options.count < 2) {
-    return Fail(kExitUsage,
-                absl::StrFormat("--count: '%s' is not an integer >= 2", args.options.at("count")));
-  }
+  if (!GetLevels(args, "count", &options, &error)) return Fail(kExitUsage, error);
   Format format;
   if (!OutputFormat(args, &format, &error)) return Fail(kExitUsage, error);
   Solved s;

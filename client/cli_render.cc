@@ -44,21 +44,23 @@ struct Layers {
 };
 
 // geodex render: its entry of `geodex --help`.
-constexpr char kRenderHelp[] = R"(  render MESH --sources SPEC [--isolines K] [--voronoi] [--delaunay] [--path A B]
-         --output out.png|.ply|.gltf [--view auto|iso|top|bottom|front|back|left|right]
+constexpr char kRenderHelp[] = R"(  render MESH --sources SPEC [--isolines K | --levels L1,L2,...] [--voronoi] [--delaunay]
+         [--path A B] --output out.png|.ply|.gltf [--view auto|iso|top|bottom|front|back|left|right]
          [--size WxH]
       A picture of the field: the shaded mesh coloured by distance (viridis; grey where
-      unreachable) with a colour bar (0 to the largest distance, labelled, at least 320 pixels
-      wide), isolines (dark), Voronoi boundaries (white), Delaunay edges (orange), the path (red)
-      and the sources (black dots), framed automatically (z up; 800x600). The default view, auto,
-      is the one of iso and the six axis views that shows the most sources, then the most of the
-      lines.
+      unreachable) with a colour bar (0 to the largest distance, ticks at round values that
+      always fit, m or km on a DEM; at least 320 pixels wide), isolines (dark, each labelled
+      with its level; --isolines K or --levels as for isolines), Voronoi boundaries (white),
+      Delaunay edges (orange), the path (red) and the sources (black dots), framed
+      automatically (z up; 800x600); on a DEM a scale bar at the bottom left. The default view,
+      auto, is the one of iso and the six axis views that shows the most sources, then the most
+      of the lines.
       .ply and .gltf write the coloured mesh for 3D viewers instead.
 )";
 
 int RunRender(Backend& backend, const Args& args) {
   std::string error;
-  if (!CheckKnown(args, {"sources", "isolines", "voronoi", "delaunay", "path", "output", "view",
+  if (!CheckKnown(args, {"sources", "isolines", "levels", "voronoi", "delaunay", "path", "output", "view",
                          "size", "max-snap"},
                   &error)) {
     return Fail(kExitUsage, error);
@@ -72,7 +74,7 @@ int RunRender(Backend& backend, const Args& args) {
   }
   if (positional.size() != 1 || !args.options.count("sources") || !args.options.count("output")) {
     return Fail(kExitUsage,
-                "usage: geodex render MESH --sources SPEC [--isolines K] [--voronoi] [--delaunay] "
+                "usage: geodex render MESH --sources SPEC [--isolines K | --levels L,...] [--voronoi] [--delaunay] "
                 "[--path A B] --output out.png|.ply|.gltf [--view auto|iso|top|front|...] [--size WxH]");
   }
   const std::string output = args.options.at("output");
@@ -91,11 +93,12 @@ int RunRender(Backend& backend, const Args& args) {
                                               args.options.at("size")));
     }
   }
-  int isoline_count = 0;
-  if (args.options.count("isolines") &&
-      (!absl::SimpleAtoi(args.options.at("isolines"), &isoline_count) || isoline_count < 2)) {
-    return Fail(kExitUsage, "--isolines: expected an integer >= 2");
+  IsolineOptions levels;  // --isolines K or --levels L1,L2,... as for `geodex isolines`
+  if (args.options.count("isolines") && args.options.count("levels")) {
+    return Fail(kExitUsage, "--isolines K and --levels L1,L2,...: one or the other");
   }
+  if (!GetLevels(args, "isolines", &levels, &error)) return Fail(kExitUsage, error);
+  const bool isolines = levels.count > 0 || !levels.levels.empty();
   const bool voronoi = args.options.count("voronoi") > 0, delaunay = args.options.count("delaunay") > 0;
 
   absl::StatusOr<std::vector<SurfacePoint>> sources = ParseSpec(nullptr, "sources", args.options.at("sources"));
@@ -128,12 +131,10 @@ int RunRender(Backend& backend, const Args& args) {
 
   // A local backend solves the field once and derives the layers from it.
   Layers layers;
-  IsolineOptions levels;
-  levels.count = isoline_count;
   absl::StatusOr<const DistanceField*> field = backend.Field({*sources, {}, false});
   if (!field.ok()) return FailQuery(field.status());
   layers.field = *field;
-  if (isoline_count) {
+  if (isolines) {
     absl::StatusOr<Isolines> iso = backend.ComputeIsolines(*sources, levels);
     if (!iso.ok()) return FailQuery(iso.status());
     layers.isolines = *std::move(iso);
@@ -156,22 +157,26 @@ int RunRender(Backend& backend, const Args& args) {
 
   render::Scene scene;
   scene.mesh = *data;
-  if (backend.Terrain() != nullptr) scene.units = "m";  // a DEM is in metres
+  if (backend.Terrain() != nullptr) {  // a DEM is in metres, and gets a scale bar
+    scene.units = "m";
+    scene.scale_bar = true;
+  }
   scene.vertex_colors = render::FieldColors(layers.field->distance);
   for (double d : layers.field->distance) {
     if (std::isfinite(d)) scene.max_distance = std::max(scene.max_distance, d);
   }
-  for (const IsolinePolyline& line : layers.isolines.polylines) {
-    scene.lines.push_back({Positions(line.points), line.closed, Rgb{25, 25, 25}, 1.5});
+  for (const IsolinePolyline& line : layers.isolines.polylines) {  // labelled with its level
+    scene.lines.push_back({Positions(line.points), line.closed, Rgb{25, 25, 25}, 1.5,
+                           render::NiceLabel(line.level, scene.units)});
   }
   for (const VoronoiBoundary& b : layers.voronoi.boundaries) {
-    scene.lines.push_back({Positions(b.points), b.closed, Rgb{255, 255, 255}, 2.5});
+    scene.lines.push_back({Positions(b.points), b.closed, Rgb{255, 255, 255}, 2.5, ""});
   }
   for (const DelaunayEdge& e : layers.delaunay.edges) {
-    scene.lines.push_back({Positions(e.points), false, Rgb{255, 140, 0}, 2});
+    scene.lines.push_back({Positions(e.points), false, Rgb{255, 140, 0}, 2, ""});
   }
   if (!layers.path.path.points.empty()) {
-    scene.lines.push_back({Positions(layers.path.path.points), false, Rgb{220, 20, 60}, 3});
+    scene.lines.push_back({Positions(layers.path.path.points), false, Rgb{220, 20, 60}, 3, ""});
     for (const SurfacePoint& p : ends) scene.markers.push_back(PositionOf(**data, p));
   }
   for (const SurfacePoint& p : *sources) scene.markers.push_back(PositionOf(**data, p));

@@ -5,6 +5,7 @@
 #include <png.h>
 
 #include <algorithm>
+#include <tuple>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -258,6 +259,7 @@ const uint8_t* Glyph(char c) {
       {'n', {0, 0, 22, 25, 17, 17, 17}},   {'s', {0, 0, 14, 16, 14, 1, 30}},
       {'t', {8, 8, 28, 8, 8, 9, 6}},       {'u', {0, 0, 17, 17, 17, 19, 13}},
       {'(', {2, 4, 8, 8, 8, 4, 2}},        {')', {8, 4, 2, 2, 2, 4, 8}},
+      {'k', {16, 16, 18, 20, 24, 20, 18}},
   };
   for (const auto& [ch, rows] : kFont) {
     if (ch == c) return rows.data();
@@ -286,8 +288,72 @@ void Text(Image* image, int x, int y, const std::string& text, int scale) {
   }
 }
 
-// The colour bar in the right strip: the map from 0 (bottom) to max (top), five labels, the
-// caption "distance" and the units.
+// The width in pixels of `text` at `scale`.
+int TextWidth(const std::string& text, int scale) { return static_cast<int>(text.size()) * 6 * scale - scale; }
+
+// White under `text` (a label over the picture stays readable).
+void TextBackground(Image* image, int x, int y, const std::string& text, int scale) {
+  for (int py = y - 1; py < y + 7 * scale + 1; ++py) {
+    for (int px = x - 2; px < x + TextWidth(text, scale) + 2; ++px) {
+      if (px < 0 || py < 0 || px >= image->width || py >= image->height) continue;
+      const size_t i = 3 * (size_t(py) * image->width + px);
+      image->rgb[i] = image->rgb[i + 1] = image->rgb[i + 2] = 255;
+    }
+  }
+}
+
+}  // namespace
+
+NiceScale NiceTicks(double max_value, const std::string& units, int most) {
+  NiceScale out;
+  out.units = units;
+  out.divisor = 1;
+  if (units == "m" && max_value >= 2000) {  // kilometres read better from 2 km on
+    out.units = "km";
+    out.divisor = 1000;
+  }
+  const double top = max_value / out.divisor;
+  if (!(top > 0) || !std::isfinite(top)) return out;
+  // The smallest step of 1, 2 or 5 times a power of ten that puts at most `most` ticks above 0.
+  double step = std::pow(10.0, std::floor(std::log10(top / most)));
+  for (double m : {1.0, 2.0, 5.0, 10.0}) {
+    if (top / (m * step) <= most) {
+      step *= m;
+      break;
+    }
+  }
+  out.step = step * out.divisor;
+  const int decimals = std::max(0, -static_cast<int>(std::floor(std::log10(step) + 1e-9)));
+  for (int k = 0; k * step <= top * (1 + 1e-12); ++k) {
+    const double value = k * step;
+    std::string label = decimals > 6 || value >= 1e9 ? absl::StrFormat("%.3g", value)
+                                                      : absl::StrFormat("%.*f", decimals, value);
+    out.ticks.push_back({value * out.divisor, label});
+  }
+  return out;
+}
+
+std::string NiceLabel(double value, const std::string& units) {
+  std::string unit = units == "m" ? "m" : "";  // mesh units go unnamed on the picture
+  if (units == "m" && std::abs(value) >= 2000) {
+    unit = "km";
+    value /= 1000;
+  }
+  // Three significant digits, no exponent.
+  const int digits = std::clamp(2 - static_cast<int>(std::floor(std::log10(std::max(std::abs(value), 1e-300)))), 0, 6);
+  std::string text = absl::StrFormat("%.*f", digits, value);
+  if (text.find('.') != std::string::npos) {  // 12.50 -> 12.5, 3.00 -> 3
+    while (text.back() == '0') text.pop_back();
+    if (text.back() == '.') text.pop_back();
+  }
+  return unit.empty() ? text : text + " " + unit;
+}
+
+namespace {
+
+// The colour bar in the right strip: the map from 0 (bottom) to max (top), ticks at round values
+// (1, 2 or 5 times a power of ten; km from 2 km on a DEM) whose labels always fit in the strip
+// (drawn smaller when needed), the caption "distance" and the units.
 void DrawColorBar(Image* image, double max_distance, const std::string& units) {
   const int x0 = image->width - kColorBarWidth + 8, bar = 16;
   const int top = static_cast<int>(0.15 * image->height), bottom = static_cast<int>(0.85 * image->height);
@@ -298,16 +364,55 @@ void DrawColorBar(Image* image, double max_distance, const std::string& units) {
       for (int ch = 0; ch < 3; ++ch) image->rgb[i + ch] = c[ch];
     }
   }
-  for (int k = 0; k <= 4; ++k) {
-    const int y = bottom - 1 - (bottom - 1 - top) * k / 4;
+  const NiceScale scale = NiceTicks(max_distance, units, 5);
+  const int room = image->width - (x0 + bar + 9) - 2;  // to the image's edge, less a margin
+  int text_scale = 2;
+  for (const auto& tick : scale.ticks) {
+    if (TextWidth(tick.label, 2) > room) text_scale = 1;
+  }
+  for (const auto& tick : scale.ticks) {
+    const int y = bottom - 1 - static_cast<int>(std::lround((bottom - 1 - top) * (tick.value / max_distance)));
     for (int x = x0 + bar; x < x0 + bar + 4; ++x) {  // a tick
       const size_t i = 3 * (size_t(y) * image->width + x);
       image->rgb[i] = image->rgb[i + 1] = image->rgb[i + 2] = 30;
     }
-    Text(image, x0 + bar + 9, y - 7, absl::StrFormat("%.4g", max_distance * k / 4), 2);
+    std::string label = tick.label;
+    while (TextWidth(label, text_scale) > room && !label.empty()) label.pop_back();  // never past the edge
+    Text(image, x0 + bar + 9, y - 7 * text_scale / 2, label, text_scale);
   }
   Text(image, x0 - 4, top - 40, "distance", 2);
-  Text(image, x0 - 4, top - 22, "(" + units + ")", 1);
+  Text(image, x0 - 4, top - 22, "(" + scale.units + ")", 1);
+}
+
+// A scale bar at the bottom left: a round length (1, 2 or 5 times a power of ten, m or km) about a
+// fifth of the picture wide, in the view's own scale (lengths across the line of sight).
+void DrawScaleBar(Image* image, const Projector& project, int mesh_width) {
+  const double target = mesh_width * 0.25 / project.scale;  // metres
+  if (!(target > 0) || !std::isfinite(target)) return;
+  const double power = std::pow(10.0, std::floor(std::log10(target)));
+  double length = power;
+  for (double m : {2.0, 5.0}) {
+    if (m * power <= target) length = m * power;
+  }
+  const int pixels = static_cast<int>(std::lround(length * project.scale));
+  const int x = 12, y = image->height - 14;
+  const std::string label = NiceLabel(length, "m");
+  TextBackground(image, x, y - 12, label, 1);
+  for (int px = x - 2; px < x + pixels + 2; ++px) {
+    for (int py = y - 2; py < y + 5; ++py) {
+      if (px < 0 || py < 0 || px >= image->width || py >= image->height) continue;
+      const size_t i = 3 * (size_t(py) * image->width + px);
+      image->rgb[i] = image->rgb[i + 1] = image->rgb[i + 2] = 255;
+    }
+  }
+  for (int px = x; px < x + pixels; ++px) {
+    for (int py = y; py < y + 3; ++py) {
+      if (px < 0 || py < 0 || px >= image->width || py >= image->height) continue;
+      const size_t i = 3 * (size_t(py) * image->width + px);
+      image->rgb[i] = image->rgb[i + 1] = image->rgb[i + 2] = 30;
+    }
+  }
+  Text(image, x, y - 12, label, 1);
 }
 
 }  // namespace
@@ -359,8 +464,41 @@ Image Render(const Scene& scene, View view, int width, int height) {
     canvas.Dot(p[0], p[1], p[2], 6, {255, 255, 255}, kSurfaceBias * 3);
     canvas.Dot(p[0], p[1], p[2], 4, {0, 0, 0}, kSurfaceBias * 3);
   }
+  // Which lines' labels show: a label sits at its line's visible point nearest the middle of the
+  // picture, on white, and is left out where it would cover another label.
+  std::vector<std::array<int, 4>> placed;  // x0 y0 x1 y1
+  std::vector<std::tuple<int, int, std::string>> labels;
+  for (const Polyline& line : scene.lines) {
+    if (line.label.empty()) continue;
+    double best = kInf;
+    std::array<double, 3> at{};
+    for (const Point3& point : line.points) {
+      const auto p = project(point);
+      if (!canvas.Visible(p[0], p[1], p[2], kSurfaceBias)) continue;
+      const double d = std::hypot(p[0] - mesh_width / 2.0, p[1] - height / 2.0);
+      if (d < best) {
+        best = d;
+        at = p;
+      }
+    }
+    if (!std::isfinite(best)) continue;
+    const int w = TextWidth(line.label, 1);
+    const int x = std::clamp(static_cast<int>(at[0]) - w / 2, 2, std::max(2, mesh_width - w - 2));
+    const int y = std::clamp(static_cast<int>(at[1]) - 3, 2, std::max(2, height - 10));
+    const std::array<int, 4> box = {x - 2, y - 1, x + w + 2, y + 8};
+    bool overlaps = false;
+    for (const auto& b : placed) overlaps |= box[0] < b[2] && b[0] < box[2] && box[1] < b[3] && b[1] < box[3];
+    if (overlaps) continue;
+    placed.push_back(box);
+    labels.push_back({x, y, line.label});
+  }
   Image image = canvas.Take();
+  for (const auto& [x, y, text] : labels) {
+    TextBackground(&image, x, y, text, 1);
+    Text(&image, x, y, text, 1);
+  }
   if (bar) DrawColorBar(&image, scene.max_distance, scene.units);
+  if (scene.scale_bar) DrawScaleBar(&image, project, mesh_width);
   return image;
 }
 

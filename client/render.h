@@ -33,6 +33,7 @@ struct Polyline {
   bool closed = false;
   Rgb color{0, 0, 0};
   double width = 1.5;  // pixels
+  std::string label;   // drawn on the line (an isoline's level); "" for none
 };
 
 struct Scene {
@@ -44,7 +45,25 @@ struct Scene {
   // wide): the colour map from 0 (bottom) to max_distance (top), labelled, with `units`.
   double max_distance = 0;
   std::string units = "mesh units";
+  bool scale_bar = false;  // a round length at the bottom left (a DEM: metres)
 };
+
+// Round values for a colour bar or a scale: ticks at 0, s, 2s, ... <= max_value with s 1, 2 or 5
+// times a power of ten and at most `most` ticks above 0; on "m" from 2 km on, in km. Labels have
+// no exponent (but for values beyond 1e9) and as many decimals as the step needs.
+struct NiceScale {
+  std::string units;
+  double divisor = 1;  // the labels are value / divisor in `units`
+  double step = 0;     // in the caller's units
+  struct Tick {
+    double value;       // in the caller's units
+    std::string label;  // in `units`
+  };
+  std::vector<Tick> ticks;
+};
+NiceScale NiceTicks(double max_value, const std::string& units, int most);
+// One value in the same terms ("350 m", "2.5 km").
+std::string NiceLabel(double value, const std::string& units);
 // The colour bar's strip: the rightmost kColorBarWidth pixels; the bar itself is the 16 pixels
 // from width - kColorBarWidth + 8, from 15% to 85% of the height (tests sample it there).
 inline constexpr int kColorBarWidth = 112;

@@ -40,6 +40,44 @@ probe "$tmp/b.png" --bar-width 0 >"$tmp/b.json"
 check "moving the source moves the dark corner" \
   test "$(value "$tmp/b.json" "d['brightness']['tr'] < d['brightness']['bl'] - 50")" = True
 
+# The legend's labels are round numbers that fit: no text pixel (the font's grey 30) in the
+# image's last two columns, at 1200 px and at the narrowest picture with a bar; the labels are
+# there (text pixels right of the bar); --levels labels each isoline (more text in the mesh's area).
+legend_fits() {  # legend_fits PNG: text right of the bar, none at the edge
+  /usr/bin/python3 - "$1" "$PROBE" <<'PY'
+import importlib.util, sys
+spec = importlib.util.spec_from_file_location("probe", sys.argv[2]); probe = importlib.util.module_from_spec(spec); spec.loader.exec_module(probe)
+w, h, rows = probe.read_png(sys.argv[1])
+text = lambda x, y: rows[y][3 * x:3 * x + 3] == bytes([30, 30, 30])
+right = [(x, y) for y in range(h) for x in range(w - 112 + 8 + 16 + 4, w) if text(x, y)]
+edge = [(x, y) for y in range(h) for x in range(w - 2, w) if text(x, y)]
+sys.exit(0 if len(right) > 100 and not edge else 1)
+PY
+}
+"$GEODEX" render sample:terrain --sources 0 --view top --size 1200x900 --output "$tmp/wide.png"
+check "legend labels fit (1200 px)" legend_fits "$tmp/wide.png"
+"$GEODEX" render sample:terrain --sources 0 --view top --size 320x200 --output "$tmp/narrow.png"
+check "legend labels fit (320 px)" legend_fits "$tmp/narrow.png"
+"$GEODEX" render "$DATA/knight.off" --sources 0 --view top --size 400x300 --output "$tmp/knight.png"
+check "legend labels fit (knight)" legend_fits "$tmp/knight.png"
+"$GEODEX" render sample:terrain --sources 0 --view top --levels 0.5,1,1.5 --output "$tmp/levels.png"
+check "render --levels: exit 0" test $? -eq 0
+"$GEODEX" render sample:terrain --sources 0 --view top --isolines 2 --levels 1 --output "$tmp/x.png" 2>"$tmp/err.txt"
+check "render --isolines and --levels: refused" test $? -eq 2
+check "labelled isolines: text in the mesh's area" /usr/bin/python3 - "$tmp/levels.png" "$tmp/bar0.png" "$PROBE" <<'PY'
+import importlib.util, subprocess, sys
+spec = importlib.util.spec_from_file_location("probe", sys.argv[3]); probe = importlib.util.module_from_spec(spec); spec.loader.exec_module(probe)
+def grey_on_white(path):  # text pixels with white right above or below them (the label's box)
+    w, h, rows = probe.read_png(path)
+    n = 0
+    for y in range(1, h - 1):
+        for x in range(w - 112):
+            if rows[y][3 * x:3 * x + 3] == bytes([30, 30, 30]) and (rows[y - 1][3 * x:3 * x + 3] == b"\xff\xff\xff" or rows[y + 1][3 * x:3 * x + 3] == b"\xff\xff\xff"):
+                n += 1
+    return n
+sys.exit(0 if grey_on_white(sys.argv[1]) > 30 else 1)
+PY
+
 # The colour bar (800 wide): the map from purple (0, bottom) to yellow (the largest distance, top)
 # in the rightmost 112 pixels, its bar at x = 800 - 112 + 8 .. +24, y from 15% to 85%.
 "$GEODEX" render sample:terrain --sources 0 --view top --output "$tmp/bar.png"

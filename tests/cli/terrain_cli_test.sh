@@ -487,6 +487,22 @@ check "--sources-file: a point outside is the file's feature" grep -q -- "--sour
 "$GEODEX" info "$tmp/plane.tif" --targets-file "$tmp/pts.gpkg" 2>"$tmp/err.txt" >/dev/null
 check "--targets-file where there are no targets: named" grep -q "unknown option --targets-file" "$tmp/err.txt"
 
+# A DEM's picture has a scale bar: a dark run at the bottom left, as long as a round length at
+# the picture's scale (the cell centres span 390 m; the top view frames them in 90% of 688 px, so
+# 100 m is 688 * 0.9 / 390 * 100 = 159 px).
+"$GEODEX" render "$tmp/plane.tif" --sources g:500013.3:4999981.7 --view top --levels 100,200 --output "$tmp/plane.png"
+check "render a DEM: exit 0" test $? -eq 0
+check "render a DEM: a scale bar of a round length" $PY - "$tmp/plane.png" "$(dirname "$0")/png_probe.py" <<'PY'
+import importlib.util, sys
+spec = importlib.util.spec_from_file_location("probe", sys.argv[2]); probe = importlib.util.module_from_spec(spec); spec.loader.exec_module(probe)
+w, h, rows = probe.read_png(sys.argv[1])
+y = h - 13
+run = 0
+while rows[y][3 * (12 + run):3 * (12 + run) + 3] == bytes([30, 30, 30]):
+    run += 1
+assert abs(run - 688 * 0.9 / 390 * 100) <= 2, run
+PY
+
 # Errors: map points need a DEM, a point outside or in the slot is named, --dem-step needs a DEM.
 "$GEODEX" distances "$tmp/tri.off" --sources g:1:2 2>"$tmp/err.txt" >/dev/null
 check "g: on a mesh: exit 2" test $? -eq 2
