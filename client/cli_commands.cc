@@ -608,6 +608,11 @@ int RunDistances(Backend& backend, const Args& args) {
   const std::string labels_output =
       args.options.count("labels-output") ? args.options.at("labels-output") : "";
   const bool raster = is_raster(output);
+  if (terrain::IsOtherGisExtension(output)) {
+    return Fail(kExitUsage, absl::StrCat("--output ", output, ": not a format geodex writes; rasters: ",
+                                         terrain::GisExtensions(terrain::GisFileKind::kRaster), "; vectors (with --at): ",
+                                         terrain::GisExtensions(terrain::GisFileKind::kVector), "; text: .txt (or any name no GIS format uses)"));
+  }
   if (!labels_output.empty() && !is_raster(labels_output)) {
     return Fail(kExitUsage, absl::StrCat("--labels-output: a raster is expected (",
                                          terrain::GisExtensions(terrain::GisFileKind::kRaster), ")"));

@@ -3,7 +3,11 @@
 #include <filesystem>
 
 #include "absl/strings/ascii.h"
+#include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_split.h"
+#include "gdal_priv.h"
+#include "gdal_quiet.h"
 
 namespace geodex::terrain {
 namespace {
@@ -27,6 +31,24 @@ const GisFormat* GisFormatOf(const std::string& path) {
     if (ext == f.extension) return &f;
   }
   return nullptr;
+}
+
+bool IsOtherGisExtension(const std::string& path) {
+  const std::string ext = absl::AsciiStrToLower(std::filesystem::path(path).extension().string());
+  if (ext.size() < 2 || GisFormatOf(path) != nullptr) return false;
+  for (const char* plain : {".txt", ".csv", ".json", ".dat", ".out", ".tsv"}) {
+    if (ext == plain) return false;  // text the CLI writes itself
+  }
+  PrepareGdal();
+  GDALDriverManager* drivers = GetGDALDriverManager();
+  for (int i = 0; i < drivers->GetDriverCount(); ++i) {
+    const char* extensions = drivers->GetDriver(i)->GetMetadataItem(GDAL_DMD_EXTENSIONS);
+    if (extensions == nullptr) continue;
+    for (absl::string_view e : absl::StrSplit(extensions, ' ', absl::SkipEmpty())) {
+      if (absl::EqualsIgnoreCase(e, ext.substr(1))) return true;
+    }
+  }
+  return false;
 }
 
 std::string GisExtensions(GisFileKind kind) {

@@ -415,6 +415,9 @@ PY
 "$GEODEX" isolines "$P" --sources g:500055:4999795 --levels 60 --output "$tmp/iso.kml" 2>"$tmp/err.txt" >/dev/null
 check "unknown vector extension: exit 2" test $? -eq 2
 check "unknown vector extension: names the supported ones" grep -q ".geojson, .gpkg, .shp, .fgb" "$tmp/err.txt"
+"$GEODEX" distances "$P" --sources g:500055:4999795 --output "$tmp/pd.img" 2>"$tmp/err.txt" >/dev/null
+check "a GIS raster extension geodex does not write: exit 2" test $? -eq 2
+check "a GIS raster extension geodex does not write: names the supported ones" grep -q "rasters: .tif, .tiff, .asc, .nc" "$tmp/err.txt"
 
 # Messages in map terms: a point outside the DEM gets the DEM's extent in its own coordinates and
 # a hint when its coordinates swapped would be inside; an unreachable point is quoted as written,

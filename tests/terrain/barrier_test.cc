@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <map>
 #include <queue>
@@ -441,6 +442,90 @@ TEST(BarrierCutTest, TwoHolesAndAPolygonAlongGridLines) {
   ASSERT_TRUE(away.ok());
   EXPECT_EQ(away->faces, grid.faces);
   EXPECT_EQ(away->positions, grid.positions);
+}
+
+// On a GDAL-made tilted plane (a DEM in UTM 33N, 10 m cells), a square hole turned 30 degrees,
+// its corners inside cells, read from a GeoJSON file with --barrier's route (Dem::Read): map point
+// to map point, the distance is the taut string around the hole's corners to 1e-9.
+TEST(BarrierCutTest, DemHoleGivesTheTautString) {
+  GDALAllRegister();
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "geodex-barrier-dem-hole";
+  std::filesystem::create_directories(dir);
+  const std::string tif = (dir / "plane.tif").string(), hole_file = (dir / "hole.geojson").string();
+  const double ax = 0.12, ay = -0.07;  // z = ax (x - 500000) + ay (y - 5000000)
+  GDALDataset* ds = GetGDALDriverManager()->GetDriverByName("GTiff")->Create(tif.c_str(), 40, 30, 1, GDT_Float64, nullptr);
+  double gt[6] = {500000, 10, 0, 5000000, 0, -10};
+  ds->SetGeoTransform(gt);
+  OGRSpatialReference utm;
+  utm.importFromEPSG(32633);
+  ds->SetSpatialRef(&utm);
+  std::vector<double> row(40);
+  for (int j = 0; j < 30; ++j) {
+    for (int i = 0; i < 40; ++i) row[i] = ax * (i + 0.5) * 10 + ay * -(j + 0.5) * 10;
+    ASSERT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Write, 0, j, 40, 1, row.data(), 40, 1, GDT_Float64, 0, 0), CE_None);
+  }
+  GDALClose(ds);
+  std::vector<Point2> hole;
+  for (int k = 0; k < 4; ++k) {
+    const double a = (30 + 90 * k) * M_PI / 180;
+    hole.push_back({500203.7 + 60 * std::cos(a), 4999851.3 + 60 * std::sin(a)});
+  }
+  std::string ring;
+  for (size_t k = 0; k <= hole.size(); ++k) {
+    absl::StrAppendFormat(&ring, "%s[%.17g, %.17g]", k == 0 ? "" : ", ", hole[k % 4][0], hole[k % 4][1]);
+  }
+  std::ofstream(hole_file) << R"({"type": "Polygon", "crs": {"type": "name", "properties": {"name": "EPSG:32633"}}, "coordinates": [[)"
+                           << ring << "]]}";
+  DemOptions options;
+  options.barrier_file = hole_file;
+  absl::StatusOr<Dem> dem = Dem::Read(tif, options);
+  ASSERT_TRUE(dem.ok()) << dem.status();
+  EXPECT_GT(dem->info().barrier_faces, 0u);
+  absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(dem->mesh());
+  ASSERT_TRUE(mesh.ok());
+  auto on_plane = [&](const Point2& p) {
+    return std::array<double, 3>{p[0], p[1], ax * (p[0] - 500000) + ay * (p[1] - 5000000)};
+  };
+  auto length = [&](const Point2& p, const Point2& q) {
+    const auto a = on_plane(p), b = on_plane(q);
+    return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+  };
+  const Point2 source = {500063.1, 4999847.9};
+  absl::StatusOr<SurfacePoint> from = dem->DropMapPoint(source[0], source[1]);
+  ASSERT_TRUE(from.ok()) << from.status();
+  absl::StatusOr<DistanceField> field = ComputeDistanceField(*mesh, {*from});
+  ASSERT_TRUE(field.ok());
+  int around = 0;
+  double worst = 0;
+  for (uint32_t j = 0; j < 30; ++j) {
+    for (uint32_t i = 0; i < 40; ++i) {
+      const Point2 target = {500005.0 + 10 * i, 4999995.0 - 10 * j};
+      bool inside = true;
+      for (size_t k = 0; k < 4; ++k) inside &= Cross(hole[k], hole[(k + 1) % 4], target) > 0;
+      const double d = field->distance[dem->VertexAt(i, j)];
+      if (inside) {
+        EXPECT_TRUE(std::isinf(d)) << i << " " << j;
+        continue;
+      }
+      // The taut string: straight, or through one or two of the hole's corners.
+      double expected = Blocked(source, target, hole) ? std::numeric_limits<double>::infinity() : length(source, target);
+      for (size_t a = 0; a < 4; ++a) {
+        if (!Blocked(source, hole[a], hole) && !Blocked(hole[a], target, hole)) {
+          expected = std::min(expected, length(source, hole[a]) + length(hole[a], target));
+        }
+        for (size_t b = 0; b < 4; ++b) {
+          if (a != b && !Blocked(source, hole[a], hole) && !Blocked(hole[a], hole[b], hole) && !Blocked(hole[b], target, hole)) {
+            expected = std::min(expected, length(source, hole[a]) + length(hole[a], hole[b]) + length(hole[b], target));
+          }
+        }
+      }
+      around += Blocked(source, target, hole) ? 1 : 0;
+      worst = std::max(worst, std::abs(d - expected) / expected);
+    }
+  }
+  EXPECT_GT(around, 20);
+  EXPECT_LT(worst, 1e-9);
+  std::filesystem::remove_all(dir);
 }
 
 // On a DEM, a barrier given in longitude/latitude and the same one in the DEM's own CRS make the

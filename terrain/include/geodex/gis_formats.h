@@ -19,6 +19,9 @@ struct GisFormat {
 
 // The format of `path` by its extension (any case), or null when it is not a GIS file's.
 const GisFormat* GisFormatOf(const std::string& path);
+// True for an extension some GDAL driver reads or writes that is not in the table (nor plain text
+// the CLI writes itself: .txt, .csv, .json, ...): `--output x.img` is refused, not written as text.
+bool IsOtherGisExtension(const std::string& path);
 // The extensions of one kind, for messages: ".tif, .tiff, .asc, .nc".
 std::string GisExtensions(GisFileKind kind);
 
