@@ -108,7 +108,8 @@ absl::Status RunDeriveMesh(const QueryEnv& env, const v1::DeriveMeshRequest& req
     terrain::CutStats cut_stats;
     absl::StatusOr<MeshData> cut = terrain::CutBarrierPolygons(
         derived, barrier.polygons_geojson(), from.terrain ? &*from.terrain : nullptr, barrier.width(),
-        "barrier.polygons_geojson", &cut_stats);
+        "barrier.polygons_geojson", &cut_stats, env.limits->max_vertices);
+    if (ExceededLimit(cut.status())) return cut.status();  // names --max_vertices on the way out
     if (!cut.ok()) return FieldError("barrier.polygons_geojson", cut.status().message());
     derived = *std::move(cut);
     barrier_faces += cut_stats.faces_removed + cut_stats.faces_cut;

@@ -14,6 +14,7 @@
 
 #include "absl/container/flat_hash_map.h"
 #include "absl/strings/str_cat.h"
+#include "geodex/limits.h"
 #include "ogr_geometry.h"
 
 namespace geodex::terrain {
@@ -117,8 +118,9 @@ enum class Fate : uint8_t { kKeep, kRemove, kPieces };
 // triangulated with every point their neighbours put on shared edges.
 class Surgery {
  public:
-  Surgery(const MeshData& mesh, const Geos& geos, const double origin[2], double reach, CutStats* stats)
-      : mesh_(mesh), geos_(geos), h_(geos.h()), reach_(reach), stats_(stats),
+  Surgery(const MeshData& mesh, const Geos& geos, const double origin[2], double reach, uint64_t max_vertices,
+          CutStats* stats)
+      : mesh_(mesh), geos_(geos), h_(geos.h()), reach_(reach), max_vertices_(max_vertices), stats_(stats),
         fate_(mesh.face_count(), Fate::kKeep) {
     origin_[0] = origin[0];
     origin_[1] = origin[1];
@@ -208,10 +210,25 @@ class Surgery {
   // Pass 2: the faces out, pieces (and whole faces with points on their edges) triangulated by
   // GEOS's constrained Delaunay triangulation with every edge point in their boundary, so that
   // neighbours share their edges piece for piece. `*pieces_made` lists the faces made from pieces.
+  // More vertices than the budget (or than 32-bit ids hold): ResourceExhausted naming --max_vertices.
+  absl::Status CheckBudget() const {
+    const uint64_t n = out_.positions.size() / 3;
+    if ((max_vertices_ != 0 && n > max_vertices_) || n >= kInterior) {
+      return LimitExceededError(Limit::kVertices, absl::StrCat("the barrier's cut makes more than ",
+                                                               max_vertices_ != 0 ? max_vertices_ : uint64_t{kInterior},
+                                                               " vertices"));
+    }
+    return absl::OkStatus();
+  }
+
   absl::StatusOr<MeshData> Emit(std::vector<uint32_t>* pieces_made) {
+    if (absl::Status budget = CheckBudget(); !budget.ok()) return budget;
     for (size_t f = 0; f < mesh_.face_count(); ++f) {
       const uint32_t* c = &mesh_.faces[3 * f];
       if (fate_[f] == Fate::kRemove) continue;
+      if ((f & 1023) == 0) {
+        if (absl::Status budget = CheckBudget(); !budget.ok()) return budget;
+      }
       if (fate_[f] == Fate::kKeep) {
         bool has_points = false;
         if (Valid(c)) {
@@ -222,6 +239,11 @@ class Surgery {
           continue;
         }
         ++stats_->faces_split;
+        const double area2 = Cross(local_[c[0]], local_[c[1]], local_[c[2]]);
+        if (!(std::abs(area2) > 1e-12 * SizeSquared(local_[c[0]], local_[c[1]], local_[c[2]]))) {
+          FanFromCentre(f, pieces_made);  // edge-on from above: no triangulation in x-y
+          continue;
+        }
         Pieces whole = {{{RingVertex{c[0], local_[c[0]]}, RingVertex{c[1], local_[c[1]]}, RingVertex{c[2], local_[c[2]]}}}};
         if (absl::Status s = Triangulate(f, whole, pieces_made); !s.ok()) return s;
         continue;
@@ -266,6 +288,35 @@ class Surgery {
       }
     }
     return false;
+  }
+
+  // A face seen edge-on from above (a vertical wall) that its neighbours put points on: a fan
+  // from a new vertex at its centre through its corners and those points, in its own winding.
+  void FanFromCentre(size_t f, std::vector<uint32_t>* pieces_made) {
+    const uint32_t* c = &mesh_.faces[3 * f];
+    std::vector<uint32_t> ring;
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t a = c[k], b = c[(k + 1) % 3];
+      ring.push_back(a);
+      auto it = edge_points_.find(EdgeKey(a, b));
+      if (it == edge_points_.end()) continue;
+      std::vector<struct EdgePoint> along = it->second;
+      const bool forward = a < b;  // t runs from the lower id
+      std::sort(along.begin(), along.end(), [&](const struct EdgePoint& x, const struct EdgePoint& y) {
+        return forward ? x.t < y.t : x.t > y.t;
+      });
+      for (const struct EdgePoint& e : along) ring.push_back(e.vertex);
+    }
+    const uint32_t centre = static_cast<uint32_t>(out_.positions.size() / 3);
+    for (int d = 0; d < 3; ++d) {
+      out_.positions.push_back((mesh_.positions[3 * size_t{c[0]} + d] + mesh_.positions[3 * size_t{c[1]} + d] +
+                                mesh_.positions[3 * size_t{c[2]} + d]) / 3);
+    }
+    ++stats_->vertices_added;
+    for (size_t i = 0; i < ring.size(); ++i) {
+      if (pieces_made != nullptr) pieces_made->push_back(static_cast<uint32_t>(out_.face_count()));
+      out_.faces.insert(out_.faces.end(), {centre, ring[i], ring[(i + 1) % ring.size()]});
+    }
   }
 
   absl::Status Triangulate(size_t f, const Pieces& pieces, std::vector<uint32_t>* pieces_made) {
@@ -354,6 +405,7 @@ class Surgery {
   GEOSContextHandle_t h_;
   double origin_[2];
   double reach_;
+  uint64_t max_vertices_;
   CutStats* stats_;
   std::vector<Point2> local_;
   MeshData out_;
@@ -380,7 +432,7 @@ bool BoxesMiss(const Point2& A, const Point2& B, const Point2& C, const double b
 
 // The polygons (valid, unioned) cut out of `mesh`.
 absl::StatusOr<MeshData> CutPolygons(const MeshData& mesh, const Geos& geos, const GEOSGeometry* barrier,
-                                     const double origin[2], double reach, CutStats* stats) {
+                                     const double origin[2], double reach, uint64_t max_vertices, CutStats* stats) {
   GEOSContextHandle_t h = geos.h();
   double box[4];  // xmin ymin xmax ymax
   if (GEOSisEmpty_r(h, barrier) == 1 || GEOSGeom_getExtent_r(h, barrier, &box[0], &box[1], &box[2], &box[3]) == 0) {
@@ -388,7 +440,7 @@ absl::StatusOr<MeshData> CutPolygons(const MeshData& mesh, const Geos& geos, con
   }
   PreparedGeometry prepared(h, barrier);
   if (prepared.p == nullptr) return absl::InternalError("GEOS cannot prepare the barrier polygons");
-  Surgery surgery(mesh, geos, origin, reach, stats);
+  Surgery surgery(mesh, geos, origin, reach, max_vertices, stats);
   for (size_t f = 0; f < mesh.face_count(); ++f) {
     const uint32_t* c = &mesh.faces[3 * f];
     if (!surgery.Valid(c)) continue;  // left for TriangleMesh::Build to report
@@ -434,7 +486,7 @@ struct LineEnd {
 // sides of a line share no vertex and no edge: paths go around the line's ends.
 absl::StatusOr<MeshData> SlitLines(const MeshData& mesh, const Geos& geos, const GEOSGeometry* lines,
                                    const std::vector<LineEnd>& ends, const double origin[2], double reach,
-                                   CutStats* stats) {
+                                   uint64_t max_vertices, CutStats* stats) {
   GEOSContextHandle_t h = geos.h();
   double box[4];
   if (GEOSisEmpty_r(h, lines) == 1 || GEOSGeom_getExtent_r(h, lines, &box[0], &box[1], &box[2], &box[3]) == 0) {
@@ -442,7 +494,7 @@ absl::StatusOr<MeshData> SlitLines(const MeshData& mesh, const Geos& geos, const
   }
   PreparedGeometry prepared(h, lines);
   if (prepared.p == nullptr) return absl::InternalError("GEOS cannot prepare the barrier lines");
-  Surgery surgery(mesh, geos, origin, reach, stats);
+  Surgery surgery(mesh, geos, origin, reach, max_vertices, stats);
   for (size_t f = 0; f < mesh.face_count(); ++f) {
     const uint32_t* c = &mesh.faces[3 * f];
     if (!surgery.Valid(c)) continue;
@@ -588,7 +640,12 @@ absl::StatusOr<MeshData> SlitLines(const MeshData& mesh, const Geos& geos, const
       if (slit_neighbours.contains(out.faces[3 * f + k])) faces_at[out.faces[3 * f + k]].push_back({static_cast<uint32_t>(f), k});
     }
   }
-  for (auto& [v, around] : faces_at) {
+  // In vertex order, so that the copies' ids (and the mesh's id) are the same in every process.
+  std::vector<uint32_t> on_lines;
+  for (const auto& entry : faces_at) on_lines.push_back(entry.first);
+  std::sort(on_lines.begin(), on_lines.end());
+  for (const uint32_t v : on_lines) {
+    const std::vector<std::pair<uint32_t, int>>& around = faces_at[v];
     const std::vector<uint32_t>& slits = slit_neighbours[v];
     std::vector<size_t> parent(around.size());
     for (size_t i = 0; i < parent.size(); ++i) parent[i] = i;
@@ -618,13 +675,17 @@ absl::StatusOr<MeshData> SlitLines(const MeshData& mesh, const Geos& geos, const
       out.faces[3 * size_t{around[i].first} + around[i].second] = copy->second;
     }
   }
+  if ((max_vertices != 0 && out.vertex_count() > max_vertices) || out.vertex_count() >= kInterior) {
+    return LimitExceededError(Limit::kVertices, absl::StrCat("the barrier's cut makes ", out.vertex_count(),
+                                                             " vertices, more than the ", max_vertices, " allowed"));
+  }
   return split;
 }
 
 }  // namespace
 
 absl::StatusOr<MeshData> CutOutPolygons(const MeshData& mesh, const OGRGeometry& polygons, double scale,
-                                        double width, CutStats* stats) {
+                                        double width, uint64_t max_vertices, CutStats* stats) {
   *stats = CutStats{};
   const size_t n = mesh.vertex_count();
   Geos geos;
@@ -647,13 +708,14 @@ absl::StatusOr<MeshData> CutOutPolygons(const MeshData& mesh, const OGRGeometry&
   if (barrier == nullptr) return absl::InternalError("GEOS cannot take the barrier polygons");
   auto shift = [](double* x, double* y, void* data) {
     const double* o = static_cast<const double*>(data);  // scale, origin x, origin y
+    if (!std::isfinite(*x) || !std::isfinite(*y)) return 0;  // every coordinate, not only the extent's
     *x = *x * o[0] - o[1];
     *y = *y * o[0] - o[2];
     return 1;
   };
   double frame[3] = {scale, origin[0], origin[1]};
   barrier = geos.Own(GEOSGeom_transformXY_r(h, barrier.get(), shift, frame));
-  if (barrier == nullptr) return absl::InternalError("GEOS cannot place the barrier polygons");
+  if (barrier == nullptr) return absl::InvalidArgumentError("the polygons' coordinates are not finite numbers here");
   double extent[4];
   if (GEOSisEmpty_r(h, barrier.get()) != 1 &&
       (GEOSGeom_getExtent_r(h, barrier.get(), &extent[0], &extent[1], &extent[2], &extent[3]) == 0 ||
@@ -683,7 +745,15 @@ absl::StatusOr<MeshData> CutOutPolygons(const MeshData& mesh, const OGRGeometry&
     const int type = GEOSGeomTypeId_r(h, g);
     GEOSGeometry* part = nullptr;
     if (type == GEOS_POLYGON) {
-      part = GEOSisValid_r(h, g) == 1 ? GEOSGeom_clone_r(h, g) : GEOSMakeValid_r(h, g);
+      if (GEOSisValid_r(h, g) == 1) {
+        part = GEOSGeom_clone_r(h, g);
+      } else {  // made valid as areas (shells less holes), collapsed parts (spikes) dropped
+        GEOSMakeValidParams* params = GEOSMakeValidParams_create_r(h);
+        GEOSMakeValidParams_setMethod_r(h, params, GEOS_MAKE_VALID_STRUCTURE);
+        GEOSMakeValidParams_setKeepCollapsed_r(h, params, 0);
+        part = GEOSMakeValidWithParams_r(h, g, params);
+        GEOSMakeValidParams_destroy_r(h, params);
+      }
     } else if (width > 0) {
       part = GEOSBuffer_r(h, g, width / 2, 8);
     } else if (type == GEOS_LINESTRING) {
@@ -692,14 +762,15 @@ absl::StatusOr<MeshData> CutOutPolygons(const MeshData& mesh, const OGRGeometry&
       GEOSCoordSeq_getSize_r(h, seq, &size);
       std::vector<Point2> p(size);
       for (unsigned i = 0; i < size; ++i) GEOSCoordSeq_getXY_r(h, seq, i, &p[i][0], &p[i][1]);
-      if (size >= 2) {
+      p.erase(std::unique(p.begin(), p.end()), p.end());  // a repeated point is no direction
+      if (p.size() >= 2) {
         auto end = [&](const Point2& at, const Point2& before) {
           const double dx = at[0] - before[0], dy = at[1] - before[1], l = std::hypot(dx, dy);
           if (l > 0) ends.push_back({at, {dx / l, dy / l}});
         };
-        end(p[size - 1], p[size - 2]);
+        end(p[p.size() - 1], p[p.size() - 2]);
         end(p[0], p[1]);
-        lines.push_back(GEOSGeom_clone_r(h, g));
+        lines.push_back(GEOSRemoveRepeatedPoints_r(h, g, 0));  // as the ends were read
       }
       continue;
     } else {
@@ -719,9 +790,9 @@ absl::StatusOr<MeshData> CutOutPolygons(const MeshData& mesh, const OGRGeometry&
   Geos::Ptr area = geos.Own(area_collection != nullptr ? GEOSUnaryUnion_r(h, area_collection.get()) : nullptr);
   Geos::Ptr line = geos.Own(line_collection != nullptr ? GEOSUnaryUnion_r(h, line_collection.get()) : nullptr);
   if (area == nullptr || line == nullptr) return absl::InternalError("GEOS cannot merge the barrier's parts");
-  absl::StatusOr<MeshData> cut = CutPolygons(mesh, geos, area.get(), origin, reach, stats);
+  absl::StatusOr<MeshData> cut = CutPolygons(mesh, geos, area.get(), origin, reach, max_vertices, stats);
   if (!cut.ok() || lines.empty()) return cut;
-  return SlitLines(*cut, geos, line.get(), ends, origin, reach, stats);
+  return SlitLines(*cut, geos, line.get(), ends, origin, reach, max_vertices, stats);
 }
 
 }  // namespace geodex::terrain

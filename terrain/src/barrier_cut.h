@@ -30,7 +30,9 @@ namespace geodex::terrain {
 // polygons is cut out. With width 0, lines are slits: the surface is split along them and every
 // vertex on a line (but its ends) gets one copy per side. InvalidArgument for points without a
 // width, or coordinates that are not finite; Internal only when GEOS fails.
+// `max_vertices` (0: none) bounds the mesh made: ResourceExhausted (geodex/limits.h kVertices)
+// beyond it, checked as the cut goes.
 absl::StatusOr<MeshData> CutOutPolygons(const MeshData& mesh, const OGRGeometry& barrier, double scale,
-                                        double width, CutStats* stats);
+                                        double width, uint64_t max_vertices, CutStats* stats);
 
 }  // namespace geodex::terrain

@@ -10,6 +10,7 @@
 #include <functional>
 #include <limits>
 #include <mutex>
+#include <set>
 #include <utility>
 
 #include "absl/strings/ascii.h"
@@ -190,6 +191,20 @@ absl::Status CheckGeoJsonCrs(const CPLJSONObject& node, const std::string& where
     };
     if (member.GetType() == CPLJSONObject::Type::Null) continue;
     if (member.GetType() != CPLJSONObject::Type::Object) return refuse("its \"crs\" is not an object");
+    // GDAL reads the first member of a name in any case; this check would read another: refuse
+    // names that differ only in case ("name" and "NAME").
+    auto repeats = [](const CPLJSONObject& object) {
+      std::set<std::string> seen;
+      for (const CPLJSONObject& field : object.GetChildren()) {
+        if (!seen.insert(absl::AsciiStrToLower(field.GetName())).second) return true;
+      }
+      return false;
+    };
+    bool repeated = repeats(member);
+    for (const CPLJSONObject& field : member.GetChildren()) {
+      if (field.GetType() == CPLJSONObject::Type::Object) repeated |= repeats(field);
+    }
+    if (repeated) return refuse("its \"crs\" repeats a member (names differing only in case)");
     std::string type;
     CPLJSONObject properties;
     for (const CPLJSONObject& field : member.GetChildren()) {
@@ -273,7 +288,7 @@ namespace {
 // reprojected into the mesh's plane first (a geographic DEM's UTM metres), where their edges are
 // straight.
 absl::StatusOr<MeshData> CutBarrier(const MeshData& mesh, OGRGeometry& polygons, const DemInfo* dem,
-                                    const OGRSpatialReference* file_crs, double width,
+                                    const OGRSpatialReference* file_crs, double width, uint64_t max_vertices,
                                     const std::string& name, CutStats* stats) {
   double scale = 1;
   if (dem != nullptr && dem->reprojected) {
@@ -290,7 +305,7 @@ absl::StatusOr<MeshData> CutBarrier(const MeshData& mesh, OGRGeometry& polygons,
   } else if (dem != nullptr) {
     scale = dem->horizontal_scale;
   }
-  absl::StatusOr<MeshData> cut = CutOutPolygons(mesh, polygons, scale, width, stats);
+  absl::StatusOr<MeshData> cut = CutOutPolygons(mesh, polygons, scale, width, max_vertices, stats);
   if (absl::IsInvalidArgument(cut.status())) {
     return absl::InvalidArgumentError(absl::StrCat(name, ": ", cut.status().message()));
   }
@@ -400,7 +415,7 @@ absl::StatusOr<std::string> FilePointSpec(const FilePoint& point) {
 
 absl::StatusOr<MeshData> CutBarrierPolygons(const MeshData& mesh, const std::string& geojson,
                                             const DemInfo* dem, double width, const std::string& name,
-                                            CutStats* stats) {
+                                            CutStats* stats, uint64_t max_vertices) {
   QuietGdal quiet;
   auto bad = [&](const std::string& why) {
     return absl::InvalidArgumentError(absl::StrCat(name, ": ", why));
@@ -429,7 +444,7 @@ absl::StatusOr<MeshData> CutBarrierPolygons(const MeshData& mesh, const std::str
       ds == nullptr ? bad(absl::StrCat("not GeoJSON polygons (", QuietGdal::LastMessage(), ")"))
                     : BarrierPolygonsOf(ds.get(), name, dem != nullptr ? &file_crs : nullptr);
   if (!polygons.ok()) return polygons.status();
-  return CutBarrier(mesh, **polygons, dem, &file_crs, width, name, stats);
+  return CutBarrier(mesh, **polygons, dem, &file_crs, width, max_vertices, name, stats);
 }
 
 bool IsGeoTiffPath(const std::string& path) {
@@ -452,7 +467,13 @@ absl::StatusOr<Dem> Dem::Read(const std::string& path, const DemOptions& options
   // The user's own file, through the drivers of the formats IsDemPath names, with its own side-cars
   // (.prj, .hdr, .aux.xml: the files beside it whose names start with its stem) given by name, since
   // PrepareGdal stops GDAL listing directories.
-  const char* const drivers[] = {"GTiff", "VRT", "AAIGrid", "HFA", "SRTMHGT", "USGSDEM", "EHdr", "netCDF", nullptr};
+  // Not VRT: its sources name files and URLs of their own, opened by any driver.
+  const char* const drivers[] = {"GTiff", "AAIGrid", "HFA", "SRTMHGT", "USGSDEM", "EHdr", "netCDF", nullptr};
+  if (absl::EndsWithIgnoreCase(path, ".vrt")) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        path, ": a VRT is not read (its sources may name other files or URLs); make it a GeoTIFF "
+              "(gdal_translate in.vrt out.tif)"));
+  }
   CPLStringList siblings = SideCarsOf(path);
   GDALDatasetUniquePtr ds(GDALDataset::FromHandle(GDALOpenEx(
       path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, drivers, nullptr, siblings.List())));
@@ -485,6 +506,28 @@ absl::StatusOr<Dem> Dem::ReadGeoTiffBytes(const std::string& bytes, const std::s
   if (ds == nullptr) {
     return absl::InvalidArgumentError(
         absl::StrCat(name, ": not a GeoTIFF GDAL reads (", QuietGdal::LastMessage(), ")"));
+  }
+  // Its CRS may carry PROJ text (a PROJ4 extension, a user-defined citation) naming grid files or
+  // +init files, which PROJ would open on the server: refused.
+  if (const OGRSpatialReference* srs = ds->GetSpatialRef(); srs != nullptr) {
+    char* proj4 = nullptr;
+    srs->exportToProj4(&proj4);
+    const std::string text = proj4 != nullptr ? proj4 : "";
+    CPLFree(proj4);
+    for (absl::string_view token : absl::StrSplit(text, ' ', absl::SkipEmpty())) {
+      bool names_file = absl::StartsWith(token, "+init=");
+      for (const char* key : {"+nadgrids=", "+geoidgrids="}) {
+        if (!absl::StartsWith(token, key)) continue;
+        for (absl::string_view grid : absl::StrSplit(token.substr(std::strlen(key)), ',')) {
+          names_file |= grid != "@null";  // "@null" is no file: the identity
+        }
+      }
+      if (names_file) {
+        return absl::InvalidArgumentError(absl::StrCat(name, ": its CRS names files (",
+                                                       std::string(token.substr(0, 60)),
+                                                       "); geodex reads no file or URL an upload names"));
+      }
+    }
   }
   // A GeoTIFF's own metadata can name an overview file (OVERVIEW_FILE in the OVERVIEWS domain),
   // which GDAL opens, path or URL, when overviews are asked for. geodex never asks, and refuses
@@ -705,7 +748,7 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
   if (barrier == nullptr) return dem;
   CutStats stats;
   absl::StatusOr<MeshData> cut =
-      CutBarrier(dem.mesh_, *barrier, &info, &file_crs, options.barrier_width, barrier_name, &stats);
+      CutBarrier(dem.mesh_, *barrier, &info, &file_crs, options.barrier_width, options.max_vertices, barrier_name, &stats);
   if (!cut.ok()) return cut.status();
   if (cut->faces.empty()) return bad("the barrier covers every face: nothing is left");
   info.barrier_faces = stats.faces_removed + stats.faces_cut;
@@ -792,7 +835,7 @@ absl::StatusOr<Dem> Dem::FromMesh(MeshData mesh, DemInfo info) {
     }
   }
   dem.face_of_block_.assign(2 * size_t{W - 1} * (H - 1), kNoVertex);
-  std::vector<std::pair<uint32_t, uint32_t>> pieces;  // (block triangle, face) of a cut's faces
+  std::vector<std::pair<uint64_t, uint32_t>> pieces;  // (block triangle, face) of a cut's faces
   for (size_t f = 0; f < mesh.face_count(); ++f) {
     uint32_t ci[3], cj[3];
     bool on_cells = true;
@@ -815,7 +858,7 @@ absl::StatusOr<Dem> Dem::FromMesh(MeshData mesh, DemInfo info) {
       const uint32_t i = static_cast<uint32_t>(std::clamp(std::floor(u), 0.0, W - 2.0));
       const uint32_t j = static_cast<uint32_t>(std::clamp(std::floor(w), 0.0, H - 2.0));
       const int k = (w - j) >= (u - i) ? 0 : 1;  // (a, c, d) below the a-d diagonal, else (a, d, b)
-      pieces.push_back({static_cast<uint32_t>(2 * (size_t{j} * (W - 1) + i) + k), static_cast<uint32_t>(f)});
+      pieces.push_back({2 * (uint64_t{j} * (W - 1) + i) + k, static_cast<uint32_t>(f)});
       continue;
     }
     const uint32_t i = std::min({ci[0], ci[1], ci[2]}), j = std::min({cj[0], cj[1], cj[2]});
@@ -965,11 +1008,11 @@ absl::StatusOr<SurfacePoint> Dem::DropMeshPoint(double mx, double my, double u, 
       const int i = bi + (di == 2 ? -1 : di == 1 ? 1 : 0), j = bj + (dj == 2 ? -1 : dj == 1 ? 1 : 0);
       if (i < 0 || j < 0 || i > static_cast<int>(W) - 2 || j > static_cast<int>(H) - 2) continue;
       for (int k = 0; k < 2; ++k) {
-        const uint32_t triangle = static_cast<uint32_t>(2 * (size_t(j) * (W - 1) + i) + k);
+        const uint64_t triangle = 2 * (uint64_t(j) * (W - 1) + i) + k;
         // The block triangle's face, or the pieces a barrier cut left of it.
         std::vector<uint32_t> candidates;
         if (face_of_block_[triangle] != kNoVertex) candidates.push_back(face_of_block_[triangle]);
-        for (auto it = std::lower_bound(pieces_.begin(), pieces_.end(), std::make_pair(triangle, 0u));
+        for (auto it = std::lower_bound(pieces_.begin(), pieces_.end(), std::make_pair(triangle, uint32_t{0}));
              it != pieces_.end() && it->first == triangle; ++it) {
           candidates.push_back(it->second);
         }
@@ -1052,8 +1095,7 @@ absl::Status WriteRaster(const DemInfo& info, const std::vector<uint32_t>& verte
       return failed();
     }
   }
-  std::error_code ec;
-  if (std::filesystem::is_regular_file(path, ec)) driver->Delete(path.c_str());  // with its side-cars
+  RemoveOldOutput(path);  // CreateCopy will not overwrite
   CPLStringList options;
   if (std::string(format->driver) == "GTiff") {
     options.AddString("COMPRESS=DEFLATE");

@@ -16,7 +16,8 @@ namespace geodex::terrain {
 // GDAL may not follow"):
 // - no network: every CPLHTTPFetch (a GeoJSON "crs" link, importFromUrl, WMS-like drivers) is
 //   answered by a refusing callback; /vsicurl/ and the other network file systems open nothing
-//   (CPL_VSIL_CURL_ALLOWED_FILENAME names no file); PROJ fetches no grid (OSRSetPROJEnableNetwork);
+//   (CPL_VSIL_CURL_ALLOWED_FILENAME names no file, CPL_VSIL_CURL_ALLOWED_EXTENSIONS allows no
+//   extension for the *_streaming ones); PROJ fetches no grid (OSRSetPROJEnableNetwork);
 // - no side-car files found by listing a directory (GDAL_DISABLE_READDIR_ON_OPEN=EMPTY_DIR): a
 //   caller that wants a local file's own side-cars (.prj, .hdr, .aux.xml) passes them by name;
 // - no Python in VRT pixel functions (GDAL_VRT_ENABLE_PYTHON=NO).

@@ -28,6 +28,8 @@ void PrepareGdal() {
     CPLSetConfigOption("GDAL_DISABLE_READDIR_ON_OPEN", "EMPTY_DIR");
     // /vsicurl/, /vsis3/, /vsigs/, ... open only the file named here, which cannot exist.
     CPLSetConfigOption("CPL_VSIL_CURL_ALLOWED_FILENAME", "/geodex/network-access-is-disabled");
+    // The *_streaming file systems check only the extensions: none is allowed.
+    CPLSetConfigOption("CPL_VSIL_CURL_ALLOWED_EXTENSIONS", ".geodex-network-access-is-disabled");
     CPLSetConfigOption("GDAL_VRT_ENABLE_PYTHON", "NO");
     CPLSetConfigOption("GDAL_HTTP_TIMEOUT", "1");  // belt and braces, should anything still fetch
     CPLHTTPSetFetchCallback(RefuseFetch, nullptr);

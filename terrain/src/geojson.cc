@@ -173,8 +173,7 @@ absl::Status WriteVectorFile(const DemInfo& dem, const std::vector<GeoFeature>& 
   }
   const bool geojson = std::string(format->driver) == "GeoJSON";
   native_crs = native_crs || !geojson;  // RFC 7946 is GeoJSON's; every other format keeps the DEM's CRS
-  std::error_code ec;
-  if (std::filesystem::is_regular_file(path, ec)) driver->Delete(path.c_str());  // it will not overwrite
+  RemoveOldOutput(path);  // the driver will not overwrite
   GDALDatasetUniquePtr ds(driver->Create(path.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
   if (ds == nullptr) return failed(QuietGdal::LastMessage());
   // Geometries are built in the mesh's CRS when it was reprojected, else in the file's.

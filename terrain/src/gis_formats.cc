@@ -51,6 +51,21 @@ bool IsOtherGisExtension(const std::string& path) {
   return false;
 }
 
+void RemoveOldOutput(const std::string& path) {
+  // By name, never through a GDAL driver's Delete: that opens the old file with every driver (a
+  // file named .tif may be a VRT) and removes whatever it lists.
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return;
+  std::filesystem::remove(path, ec);
+  std::filesystem::path side(path);
+  if (absl::EqualsIgnoreCase(side.extension().string(), ".shp")) {
+    for (const char* ext : {".shx", ".dbf", ".prj", ".cpg", ".qix", ".sbn", ".sbx"}) {
+      std::filesystem::remove(std::filesystem::path(path).replace_extension(ext), ec);
+    }
+  }
+  std::filesystem::remove(path + ".aux.xml", ec);
+}
+
 std::string GisExtensions(GisFileKind kind) {
   std::string out;
   for (const GisFormat& f : kFormats) {

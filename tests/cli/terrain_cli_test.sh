@@ -359,6 +359,7 @@ done
 printf '<VRTDataset rasterXSize="10" rasterYSize="10"><SRS>EPSG:32633</SRS><GeoTransform>500000,10,0,5000000,0,-10</GeoTransform><VRTRasterBand dataType="Float32" band="1"><SimpleSource><SourceFilename>/vsicurl/%s/src.tif</SourceFilename><SourceBand>1</SourceBand></SimpleSource></VRTRasterBand></VRTDataset>\n' "$url" >"$tmp/remote.vrt"
 "$GEODEX" info "$tmp/remote.vrt" 2>"$tmp/err.txt" >/dev/null
 check "VRT with a network source: refused" test $? -ne 0
+check "VRT: says why" grep -q "a VRT is not read (its sources may name other files or URLs)" "$tmp/err.txt"
 $PY - "$tmp" <<'PY'
 import sys
 import numpy as np

@@ -477,6 +477,10 @@ TEST_F(TerrainServiceTest, NoRequestMakesTheServerReachOut) {
       collection(absl::StrCat(R"({"type": "LINK", "properties": {"href": ")", listener.Url("/crs"), R"("}})")),
       collection(R"({"type": "name", "properties": {"name": "/etc/passwd"}})"),
       collection(R"({"type": "OGC", "properties": {"urn": "urn:ogc:def:crs:EPSG::32633"}})"),
+      // GDAL reads the first "name" in any case, a check reading the last would pass a PROJ string
+      // naming a local grid file: names differing only in case are refused.
+      collection(R"({"type": "name", "properties": {"NAME": "+proj=longlat +datum=WGS84 +nadgrids=/etc/passwd +type=crs", "name": "EPSG:4326"}})"),
+      collection(R"({"TYPE": "link", "type": "name", "properties": {"name": "EPSG:4326"}})"),
       // A crs on a geometry, and a member spelled in capitals: GDAL follows both.
       absl::StrCat(R"({"type": "Feature", "properties": {}, "geometry": {"CRS": {"type": "link", "properties": {"href": ")",
                    listener.Url("/geometry-crs"), R"("}}, )", polygon, "}}"),

@@ -404,6 +404,37 @@ TEST(BarrierCutTest, LinesWithoutAWidthAreExactSlits) {
   EXPECT_TRUE(std::isinf(field->distance[8 * (n + 1) + 5]));
 }
 
+// Hostile or careless barriers: NaN coordinates are refused, a self-touching (invalid) polygon
+// is made valid as areas, a line ending in a repeated point keeps its end, and a cut that would
+// make more vertices than allowed stops with the vertex limit.
+TEST(BarrierCutTest, BadBarriersAreClearErrorsOrRepaired) {
+  const int n = 8;
+  const MeshData grid = TiltedGrid(n);
+  CutStats stats;
+  absl::Status nan = CutBarrierPolygons(grid, R"({"type": "LineString", "coordinates": [[1, 1], [2, NaN]]})", nullptr, 0,
+                                        "--barrier f", &stats).status();
+  EXPECT_EQ(nan.code(), absl::StatusCode::kInvalidArgument) << nan;
+  // A bow tie (self-intersecting ring): its two triangles are cut.
+  absl::StatusOr<MeshData> bowtie = CutBarrierPolygons(
+      grid, R"({"type": "Polygon", "coordinates": [[[1.3, 1.2], [4.7, 4.6], [4.7, 1.2], [1.3, 4.6], [1.3, 1.2]]]})", nullptr,
+      0, "bowtie", &stats);
+  ASSERT_TRUE(bowtie.ok()) << bowtie.status();
+  const double sec = std::sqrt(1 + kSlopeX * kSlopeX + kSlopeY * kSlopeY);
+  EXPECT_NEAR(Area3(*bowtie), (n * n - 2 * (3.4 * 1.7 / 2)) * sec, 1e-9 * n * n);
+  // A line whose last point repeats still ends where it ends (the slit reaches it).
+  absl::StatusOr<MeshData> repeated = CutBarrierPolygons(
+      grid, R"({"type": "LineString", "coordinates": [[-1, 3.3], [4.55, 3.3], [4.55, 3.3]]})", nullptr, 0, "line", &stats);
+  absl::StatusOr<MeshData> plain = CutBarrierPolygons(
+      grid, R"({"type": "LineString", "coordinates": [[-1, 3.3], [4.55, 3.3]]})", nullptr, 0, "line", &stats);
+  ASSERT_TRUE(repeated.ok() && plain.ok());
+  EXPECT_EQ(repeated->faces, plain->faces) << repeated->face_count() << " " << plain->face_count();
+  EXPECT_EQ(repeated->positions, plain->positions) << repeated->vertex_count() << " " << plain->vertex_count();
+  // The vertex budget.
+  absl::Status budget = CutBarrierPolygons(grid, R"({"type": "LineString", "coordinates": [[-1, 3.3], [9, 4.1]]})", nullptr,
+                                           0, "line", &stats, grid.vertex_count() + 2).status();
+  EXPECT_EQ(budget.code(), absl::StatusCode::kResourceExhausted) << budget;
+}
+
 TEST(BarrierCutTest, TwoHolesAndAPolygonAlongGridLines) {
   const int n = 12;
   const MeshData grid = TiltedGrid(n);

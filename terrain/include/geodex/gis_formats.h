@@ -22,6 +22,8 @@ const GisFormat* GisFormatOf(const std::string& path);
 // True for an extension some GDAL driver reads or writes that is not in the table (nor plain text
 // the CLI writes itself: .txt, .csv, .json, ...): `--output x.img` is refused, not written as text.
 bool IsOtherGisExtension(const std::string& path);
+// Removes an earlier output at `path` (and a Shapefile's side-cars, an .aux.xml) by name.
+void RemoveOldOutput(const std::string& path);
 // The extensions of one kind, for messages: ".tif, .tiff, .asc, .nc".
 std::string GisExtensions(GisFileKind kind);
 

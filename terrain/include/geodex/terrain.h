@@ -94,9 +94,11 @@ struct CutStats {
 // Lines (LineString, MultiLineString) are slits with width 0 (both sides kept, paths go around
 // their ends); with width > 0 they and points are walls that wide (metres in the mesh's plane,
 // buffered with round ends). Points need a width.
+// `max_vertices` (0: none) bounds the cut mesh: ResourceExhausted (geodex/limits.h kVertices)
+// beyond it, checked as the cut goes (a barrier crossing many faces adds vertices at each).
 absl::StatusOr<MeshData> CutBarrierPolygons(const MeshData& mesh, const std::string& geojson,
                                             const DemInfo* dem, double width, const std::string& name,
-                                            CutStats* stats);
+                                            CutStats* stats, uint64_t max_vertices = 0);
 
 // A point read from a file (--sources-file, --targets-file): its coordinates in the file's CRS
 // (crs_wkt; "" when the file names none: then in the DEM's CRS) and how messages name it.
@@ -188,7 +190,7 @@ class Dem {
   std::vector<uint32_t> face_of_block_;   // 2 per block ((grid_width-1) * (grid_height-1))
   // A barrier cut's faces: (block triangle, face), sorted; the triangle's face_of_block_ is then
   // kNoVertex.
-  std::vector<std::pair<uint32_t, uint32_t>> pieces_;
+  std::vector<std::pair<uint64_t, uint32_t>> pieces_;
 };
 
 // True when `path` names a raster by its extension (.tif, .tiff, .vrt, .asc, .img, .hgt, .dem,
