@@ -23,8 +23,8 @@ constexpr char kUsageHead[] = R"(geodex - exact geodesic distances on triangle m
 usage: geodex [--server HOST:PORT] COMMAND MESH [options]
 
 MESH is a mesh file (OFF, OBJ, PLY, STL, optionally .gz), a built-in sample (sample:terrain,
-sample:torus, sample:sphere), or a DEM: a raster GDAL reads (.tif, .tiff, .vrt, .asc, .img, .hgt,
-.dem, .bil, .nc), triangulated cell centre by cell centre, nodata cells left out, in metres (a
+sample:torus, sample:sphere), or a DEM: a raster GDAL reads (.tif, .tiff, .asc, .img, .hgt, .dem,
+.bil, .nc; a .vrt is refused: its sources may name other files or URLs), triangulated cell centre by cell centre, nodata cells left out, in metres (a
 longitude/latitude grid is projected to the UTM zone of its centre). --dem-step N uses every Nth
 cell (a quick look). --barrier-below Z (any MESH) removes what lies below Z (the sea at 0): a DEM's
 cells, a mesh's faces with a corner below Z; paths go around it, exactly, and beyond it is inf.
