@@ -120,7 +120,7 @@ int FailQuery(const absl::Status& status);
 // others in the DEM's CRS. Exit 2 without a DEM, or when FILE cannot be written (the reason given).
 bool IsVectorPath(const Args& args);
 int WriteVectorOutput(const Backend& backend, const Args& args,
-                       const std::vector<terrain::GeoFeature>& features);
+                      const std::vector<terrain::GeoFeature>& features);
 // How MESH is read (--dem-step, --barrier-below, --barrier) and GeoJSON written (--crs), checked:
 // InvalidArgument naming the flag.
 absl::StatusOr<terrain::DemOptions> MeshReadOptions(const Args& args, const std::string& mesh);

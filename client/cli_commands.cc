@@ -13,19 +13,19 @@
 #include <memory>
 #include <set>
 
+#include "absl/container/flat_hash_map.h"
 #include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
-#include "absl/container/flat_hash_map.h"
 #include "absl/strings/str_format.h"
-#include "absl/strings/str_replace.h"
-#include "geodex/gis_formats.h"
 #include "absl/strings/str_join.h"
+#include "absl/strings/str_replace.h"
 #include "absl/strings/str_split.h"
 #include "cli_backend.h"
 #include "cli_common.h"
 #include "geodex/distance_matrix.h"
 #include "geodex/geodesic_solver.h"
+#include "geodex/gis_formats.h"
 #include "geodex/locate.h"
 #include "geodex/mesh_io.h"
 #include "geodex/point_distance.h"
@@ -128,17 +128,20 @@ absl::flat_hash_map<std::string, std::string>& FilePointNames() {
 }
 
 absl::Status ExpandPointFiles(Args* args) {
-  for (const auto& [flag, option] : {std::pair<std::string, std::string>{"sources-file", "sources"},
-                                     std::pair<std::string, std::string>{"targets-file", "targets"}}) {
+  for (const auto& [flag, option] :
+       {std::pair<std::string, std::string>{"sources-file", "sources"},
+        std::pair<std::string, std::string>{"targets-file", "targets"}}) {
     auto it = args->options.find(flag);
     if (it == args->options.end()) continue;
     const std::string name = absl::StrCat("--", flag, " ", it->second);
-    absl::StatusOr<std::vector<terrain::FilePoint>> points = terrain::ReadPointsFile(it->second, name);
+    absl::StatusOr<std::vector<terrain::FilePoint>> points =
+        terrain::ReadPointsFile(it->second, name);
     if (!points.ok()) return points.status();
     std::string spec = args->options.count(option) ? args->options.at(option) : "";
     for (const terrain::FilePoint& p : *points) {
       absl::StatusOr<std::string> item = terrain::FilePointSpec(p);
-      if (!item.ok()) return absl::InvalidArgumentError(absl::StrCat(p.name, ": ", item.status().message()));
+      if (!item.ok())
+        return absl::InvalidArgumentError(absl::StrCat(p.name, ": ", item.status().message()));
       absl::StrAppend(&spec, spec.empty() ? "" : ",", *item);
       FilePointNames()[*item] = p.name;
     }
@@ -182,7 +185,8 @@ absl::StatusOr<std::string> DropMapPoints(const Backend* backend, const std::str
     if (!p.ok()) {
       auto from_file = FilePointNames().find(item);
       return absl::InvalidArgumentError(absl::StrCat(
-          "point ", from_file != FilePointNames().end() ? from_file->second + " at " : "", p.status().message()));
+          "point ", from_file != FilePointNames().end() ? from_file->second + " at " : "",
+          p.status().message()));
     }
     auto from_file = FilePointNames().find(item);
     const std::string written = from_file != FilePointNames().end() ? from_file->second : item;
@@ -285,12 +289,15 @@ absl::StatusOr<terrain::DemOptions> MeshReadOptions(const Args& args, const std:
     return absl::InvalidArgumentError("--barrier-below must be a number");
   }
   if (args.options.count("barrier")) dem.barrier_file = args.options.at("barrier");
-  if (!GetDouble(args, "barrier-width", &dem.barrier_width, &error)) return absl::InvalidArgumentError(error);
+  if (!GetDouble(args, "barrier-width", &dem.barrier_width, &error))
+    return absl::InvalidArgumentError(error);
   if (!(dem.barrier_width >= 0) || !std::isfinite(dem.barrier_width)) {
-    return absl::InvalidArgumentError("--barrier-width must be a finite number of metres, 0 or more");
+    return absl::InvalidArgumentError(
+        "--barrier-width must be a finite number of metres, 0 or more");
   }
   if (args.options.count("barrier-width") && dem.barrier_file.empty()) {
-    return absl::InvalidArgumentError("--barrier-width goes with --barrier (the width of its lines and points)");
+    return absl::InvalidArgumentError(
+        "--barrier-width goes with --barrier (the width of its lines and points)");
   }
   if (args.options.count("dem-step") && !terrain::IsDemPath(mesh)) {
     return absl::InvalidArgumentError(
@@ -543,7 +550,8 @@ std::string FormatDistancesJson(const std::vector<double>& distances,
 }
 
 // geodex distances: its entry of `geodex --help`.
-constexpr char kDistancesHelp[] = R"(  distances MESH --sources SPEC [--method exact|ich|dijkstra] [--lambda L] [--lambda-scale max|mean]
+constexpr char kDistancesHelp[] =
+    R"(  distances MESH --sources SPEC [--method exact|ich|dijkstra] [--lambda L] [--lambda-scale max|mean]
                  [--max-distance D] [--max-windows N] [--stats] [--output FILE] [--format json]
                  [--directions] [--labels-output FILE.tif]
       One distance per vertex in the file's vertex order (%.17g; 'inf' if unreachable).
@@ -609,21 +617,28 @@ int RunDistances(Backend& backend, const Args& args) {
       args.options.count("labels-output") ? args.options.at("labels-output") : "";
   const bool raster = is_raster(output);
   if (terrain::IsOtherGisExtension(output)) {
-    return Fail(kExitUsage, absl::StrCat("--output ", output, ": not a format geodex writes; rasters: ",
-                                         terrain::GisExtensions(terrain::GisFileKind::kRaster), "; vectors (with --at): ",
-                                         terrain::GisExtensions(terrain::GisFileKind::kVector), "; text: .txt (or any name no GIS format uses)"));
+    return Fail(kExitUsage,
+                absl::StrCat("--output ", output, ": not a format geodex writes; rasters: ",
+                             terrain::GisExtensions(terrain::GisFileKind::kRaster),
+                             "; vectors (with --at): ",
+                             terrain::GisExtensions(terrain::GisFileKind::kVector),
+                             "; text: .txt (or any name no GIS format uses)"));
   }
   if (!labels_output.empty() && !is_raster(labels_output)) {
-    return Fail(kExitUsage, absl::StrCat("--labels-output: a raster is expected (",
-                                         terrain::GisExtensions(terrain::GisFileKind::kRaster), ")"));
+    return Fail(kExitUsage,
+                absl::StrCat("--labels-output: a raster is expected (",
+                             terrain::GisExtensions(terrain::GisFileKind::kRaster), ")"));
   }
   if ((raster && (args.options.count("at") || query.directions || json)) ||
       (!labels_output.empty() && args.options.count("at"))) {
-    return Fail(kExitUsage, "--output X.tif (a raster) and --labels-output: per-vertex values only (a "
-                            "raster has no --at points, --directions or JSON)");
+    return Fail(kExitUsage,
+                "--output X.tif (a raster) and --labels-output: per-vertex values only (a "
+                "raster has no --at points, --directions or JSON)");
   }
   if (IsVectorPath(args) && !args.options.count("at")) {
-    return Fail(kExitUsage, "--output X.geojson (a vector file): distances in a vector file are per point: use --at SPEC (or --output X.tif for a raster)");
+    return Fail(kExitUsage,
+                "--output X.geojson (a vector file): distances in a vector file are per point: use "
+                "--at SPEC (or --output X.tif for a raster)");
   }
   if (int code = OpenMesh(backend, args, args.positional[0], MeshBuildOptions{})) return code;
   const terrain::Dem* dem = backend.Terrain();
@@ -733,7 +748,8 @@ std::string FormatPathJson(const PathQueryResult& result) {
 }
 
 // geodex path: its entry of `geodex --help`.
-constexpr char kPathHelp[] = R"(  path MESH --from SPEC --to SPEC [--method astar|full] [--stats] [--lambda L]
+constexpr char kPathHelp[] =
+    R"(  path MESH --from SPEC --to SPEC [--method astar|full] [--stats] [--lambda L]
        [--max-distance D] [--format json]
       The exact shortest path: line 1 its length; then one line per polyline point,
       'x y z' and the simplex it lies on ('v ID', 'e V1 V2 T' or 'f FACE B0 B1 B2').
@@ -754,7 +770,8 @@ int RunPath(Backend& backend, const Args& args) {
     return Fail(kExitUsage, error);
   }
   if (args.positional.size() != 1 || !args.options.count("from") || !args.options.count("to")) {
-    return Fail(kExitUsage, "usage: geodex path MESH --from SPEC[,SPEC...] --to SPEC [--method astar|full]");
+    return Fail(kExitUsage,
+                "usage: geodex path MESH --from SPEC[,SPEC...] --to SPEC [--method astar|full]");
   }
   PathQueryOptions options;
   const std::string method = args.options.count("method") ? args.options.at("method") : "astar";
@@ -770,7 +787,8 @@ int RunPath(Backend& backend, const Args& args) {
   SurfacePoint to;
   std::vector<SurfacePoint> froms;
   SnapReport snap;
-  if (absl::Status s = ResolveOption(backend, args, "from", &froms, &snap); !s.ok()) return FailQuery(s);
+  if (absl::Status s = ResolveOption(backend, args, "from", &froms, &snap); !s.ok())
+    return FailQuery(s);
   if (absl::Status s = OnePoint(backend, args, "to", &to, &snap); !s.ok()) return FailQuery(s);
   // Several --from points: the path from the nearest (an exact distance at `to` from all of them
   // names it; distances are symmetric), said on stderr.
@@ -782,15 +800,16 @@ int RunPath(Backend& backend, const Args& args) {
       nearest = at->exact.source[0];
       const std::vector<std::string> written = absl::StrSplit(args.options.at("from"), ',');
       std::fprintf(stderr, "geodex: --from: the nearest is point %zu (%s), %.17g away\n", nearest,
-                   written.size() == froms.size() ? written[nearest].c_str() : SurfacePointToString(froms[nearest]).c_str(),
+                   written.size() == froms.size() ? written[nearest].c_str()
+                                                  : SurfacePointToString(froms[nearest]).c_str(),
                    at->exact.distance[0]);
     }
   }
   absl::StatusOr<PathQueryResult> result = backend.Path({froms[nearest], to, options});
   if (!result.ok()) return FailQuery(result.status());
   if (IsVectorPath(args)) {  // a 3D LineString with its length
-    if (int code = WriteVectorOutput(
-            backend, args, {terrain::PathFeature(result->path.points, result->distance)});
+    if (int code = WriteVectorOutput(backend, args,
+                                     {terrain::PathFeature(result->path.points, result->distance)});
         code != kExitOk) {
       return code;
     }
@@ -890,7 +909,8 @@ int RunMatrix(Backend& backend, const Args& args) {
 }
 
 // geodex locate: its entry of `geodex --help`.
-constexpr char kLocateHelp[] = R"(  locate MESH --points p:X:Y:Z,g:X:Y,ll:LON:LAT,... [--max-snap D] [--format text|json]
+constexpr char kLocateHelp[] =
+    R"(  locate MESH --points p:X:Y:Z,g:X:Y,ll:LON:LAT,... [--max-snap D] [--format text|json]
       The nearest surface point to each 3D position: 'QUERY<TAB>SPEC<TAB>x y z<TAB>snap D', D
       the distance it moved. --max-snap D refuses a position farther than D from the surface.
       On a DEM, map points (g:X:Y in its CRS, ll:LON:LAT) are dropped vertically onto it
@@ -905,13 +925,16 @@ int RunLocate(Backend& backend, const Args& args) {
     return Fail(kExitUsage, error);
   }
   if (args.positional.size() != 1 || !args.options.count("points")) {
-    return Fail(kExitUsage, "usage: geodex locate MESH --points p:X:Y:Z,g:X:Y,ll:LON:LAT,... [--max-snap D]");
+    return Fail(kExitUsage,
+                "usage: geodex locate MESH --points p:X:Y:Z,g:X:Y,ll:LON:LAT,... [--max-snap D]");
   }
   double max_snap = std::numeric_limits<double>::infinity();
   if (!GetDouble(args, "max-snap", &max_snap, &error)) return Fail(kExitUsage, error);
   if (!(max_snap > 0)) return Fail(kExitUsage, "--max-snap must be positive");
   const std::vector<std::string> items = absl::StrSplit(args.options.at("points"), ',');
-  auto is_map = [](const std::string& item) { return absl::StartsWith(item, "g:") || absl::StartsWith(item, "ll:"); };
+  auto is_map = [](const std::string& item) {
+    return absl::StartsWith(item, "g:") || absl::StartsWith(item, "ll:");
+  };
   // Positions are snapped (Locate); map points, checked here, are dropped once the mesh is open.
   std::vector<std::array<double, 3>> xyz;
   for (const std::string& item : items) {
@@ -919,7 +942,10 @@ int RunLocate(Backend& backend, const Args& args) {
     if (!p.ok()) return Fail(kExitUsage, std::string(p.status().message()));
     if (is_map(item)) continue;
     if (p->size() != 1 || p->front().kind != SurfacePoint::Kind::kPosition) {
-      return Fail(kExitUsage, absl::StrFormat("--points: %s is not a position (locate takes p:X:Y:Z, g:X:Y, ll:LON:LAT)", item));
+      return Fail(
+          kExitUsage,
+          absl::StrFormat(
+              "--points: %s is not a position (locate takes p:X:Y:Z, g:X:Y, ll:LON:LAT)", item));
     }
     xyz.push_back(p->front().position);
   }

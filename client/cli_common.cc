@@ -1,26 +1,25 @@
 #include "cli_common.h"
 
-#include "output_file.h"
-
 #include <unistd.h>
 
 #include <cerrno>
 #include <cmath>
-#include <cstring>
 #include <condition_variable>
 #include <cstdio>
+#include <cstring>
+#include <fstream>
 #include <mutex>
 #include <thread>
-#include <fstream>
 
+#include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
-#include "absl/strings/match.h"
 #include "absl/strings/str_format.h"
-#include "absl/strings/str_split.h"
 #include "absl/strings/str_join.h"
+#include "absl/strings/str_split.h"
 #include "geodex/mesh_io.h"
 #include "geodex/samples.h"
+#include "output_file.h"
 
 namespace geodex::cli {
 namespace {
@@ -64,19 +63,22 @@ absl::StatusOr<std::string> ReadBarrierText(const std::string& path) {
 
 // A barrier that cuts nothing is most often drawn in the wrong place or CRS: said, not an error.
 void WarnBarrierMisses(const terrain::DemOptions& dem_options) {
-  std::fprintf(stderr,
-               "geodex: warning: --barrier %s cuts nothing: it misses the surface (drawn in another CRS, or "
-               "lon/lat swapped?)\n",
-               dem_options.barrier_file.c_str());
+  std::fprintf(
+      stderr,
+      "geodex: warning: --barrier %s cuts nothing: it misses the surface (drawn in another CRS, or "
+      "lon/lat swapped?)\n",
+      dem_options.barrier_file.c_str());
 }
 
 void WarnIfBarrierSplits(const terrain::DemOptions& dem_options, uint64_t components) {
-  const bool barrier = std::isfinite(dem_options.barrier_below) || !dem_options.barrier_file.empty();
+  const bool barrier =
+      std::isfinite(dem_options.barrier_below) || !dem_options.barrier_file.empty();
   if (!barrier || components < 2) return;
-  std::fprintf(stderr,
-               "geodex: warning: with its barriers the surface is in %llu parts: a point in another part "
-               "than every source is unreachable (inf)\n",
-               static_cast<unsigned long long>(components));
+  std::fprintf(
+      stderr,
+      "geodex: warning: with its barriers the surface is in %llu parts: a point in another part "
+      "than every source is unreachable (inf)\n",
+      static_cast<unsigned long long>(components));
 }
 
 // Reads a mesh file, or a built-in sample ("sample:terrain").
@@ -86,7 +88,8 @@ absl::StatusOr<MeshData> LoadMeshData(const std::string& path,
   if (terrain::IsDemPath(path) && path.rfind("sample:", 0) != 0) {
     absl::StatusOr<terrain::Dem> read = terrain::Dem::Read(path, dem_options);
     if (!read.ok()) return read.status();
-    if (!dem_options.barrier_file.empty() && read->info().barrier_faces == 0) WarnBarrierMisses(dem_options);
+    if (!dem_options.barrier_file.empty() && read->info().barrier_faces == 0)
+      WarnBarrierMisses(dem_options);
     auto shared = std::make_shared<const terrain::Dem>(*std::move(read));
     MeshData data = shared->mesh();
     if (dem != nullptr) *dem = std::move(shared);
@@ -104,7 +107,8 @@ absl::StatusOr<MeshData> LoadMeshData(const std::string& path,
     terrain::CutStats cut_stats;
     data = terrain::CutBarrierPolygons(*data, *text, nullptr, dem_options.barrier_width,
                                        "--barrier " + dem_options.barrier_file, &cut_stats);
-    if (data.ok() && cut_stats.faces_removed + cut_stats.faces_cut == 0) WarnBarrierMisses(dem_options);
+    if (data.ok() && cut_stats.faces_removed + cut_stats.faces_cut == 0)
+      WarnBarrierMisses(dem_options);
   }
   return data;
 }
@@ -145,7 +149,8 @@ bool GetUint(const Args& args, const std::string& key, uint64_t* out, std::strin
   return true;
 }
 
-bool GetLevels(const Args& args, const std::string& count_flag, IsolineOptions* options, std::string* error) {
+bool GetLevels(const Args& args, const std::string& count_flag, IsolineOptions* options,
+               std::string* error) {
   if (args.options.count("levels")) {
     for (absl::string_view item : absl::StrSplit(args.options.at("levels"), ',')) {
       double level;
@@ -156,8 +161,10 @@ bool GetLevels(const Args& args, const std::string& count_flag, IsolineOptions* 
       options->levels.push_back(level);
     }
   } else if (args.options.count(count_flag) &&
-             (!absl::SimpleAtoi(args.options.at(count_flag), &options->count) || options->count < 2)) {
-    *error = absl::StrFormat("--%s: '%s' is not an integer >= 2", count_flag, args.options.at(count_flag));
+             (!absl::SimpleAtoi(args.options.at(count_flag), &options->count) ||
+              options->count < 2)) {
+    *error = absl::StrFormat("--%s: '%s' is not an integer >= 2", count_flag,
+                             args.options.at(count_flag));
     return false;
   }
   return true;
@@ -166,7 +173,8 @@ bool GetLevels(const Args& args, const std::string& count_flag, IsolineOptions* 
 bool CheckKnown(const Args& args, const std::set<std::string>& known, std::string* error) {
   for (const auto& [key, value] : args.options) {
     // --X-file (points from a file) goes with a command that takes --X.
-    const bool file_of_known = absl::EndsWith(key, "-file") && known.count(key.substr(0, key.size() - 5));
+    const bool file_of_known =
+        absl::EndsWith(key, "-file") && known.count(key.substr(0, key.size() - 5));
     if (!known.count(key) && !kMeshReadingFlags.count(key) && !file_of_known) {
       const std::string flag = args.options.count(key + "-file") ? key + "-file" : key;
       *error = absl::StrFormat("unknown option --%s (see geodex --help)", flag);

@@ -15,8 +15,8 @@
 #include "geodex/distance_matrix.h"
 #include "geodex/isolines.h"
 #include "geodex/locate.h"
-#include "geodex/shortest_path.h"
 #include "geodex/mesh_data.h"
+#include "geodex/shortest_path.h"
 #include "geodex/surface_point.h"
 #include "geodex/terrain.h"
 #include "geodex/triangle_mesh.h"
@@ -64,7 +64,8 @@ inline const std::set<std::string> kMeshReadingFlags = {"dem-step", "barrier-bel
 bool CheckKnown(const Args& args, const std::set<std::string>& known, std::string* error);
 // --levels L1,L2,... (finite numbers) or --COUNT_FLAG K (an integer >= 2; isolines' --count,
 // render's --isolines) into `options`; false with *error naming the flag.
-bool GetLevels(const Args& args, const std::string& count_flag, IsolineOptions* options, std::string* error);
+bool GetLevels(const Args& args, const std::string& count_flag, IsolineOptions* options,
+               std::string* error);
 
 // While alive, shows "geodex: WHAT... 3.4 s" on stderr, refreshed, once the work has taken more than
 // a second, and only when stderr is a terminal (scripts and pipes see nothing). Cleared at the end.

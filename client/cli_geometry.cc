@@ -2,9 +2,6 @@
 // geometry (paper section 6) and write it as JSON (default, stdout), OBJ lines or an SVG top view.
 // With a server the geometry is computed there and written here exactly the same way.
 
-#include "cli_common.h"
-#include "cli_backend.h"
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -16,10 +13,12 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "geodex/gis_formats.h"
 #include "absl/strings/str_split.h"
+#include "cli_backend.h"
+#include "cli_common.h"
 #include "geodex/delaunay.h"
 #include "geodex/geodesic_solver.h"
+#include "geodex/gis_formats.h"
 #include "geodex/isolines.h"
 #include "geodex/locate.h"
 #include "geodex/mesh_io.h"
@@ -81,8 +80,9 @@ bool OutputFormat(const Args& args, Format* format, std::string* error) {
     *format = Format::kSvg;
     return true;
   }
-  *error = absl::StrFormat("--output: '%s' must end in .json, .obj, .svg or, on a DEM, a vector file's %s", path,
-                           terrain::GisExtensions(terrain::GisFileKind::kVector));
+  *error = absl::StrFormat(
+      "--output: '%s' must end in .json, .obj, .svg or, on a DEM, a vector file's %s", path,
+      terrain::GisExtensions(terrain::GisFileKind::kVector));
   return false;
 }
 
@@ -271,7 +271,7 @@ int RunIsolines(Backend& backend, const Args& args) {
     absl::StatusOr<const DistanceField*> field = backend.Field({s.points, {}, false});
     if (!field.ok()) return FailQuery(field.status());
     return WriteVectorOutput(backend, args,
-                              terrain::IsochroneFeatures(*s.data, (*field)->distance, iso->levels));
+                             terrain::IsochroneFeatures(*s.data, (*field)->distance, iso->levels));
   }
   if (format == Format::kObj) return WriteOutput(args, Obj("isolines", lines));
   if (format == Format::kSvg) return WriteOutput(args, Svg("isolines", *s.data, lines, SitePositions(s)));

@@ -44,7 +44,8 @@ struct Layers {
 };
 
 // geodex render: its entry of `geodex --help`.
-constexpr char kRenderHelp[] = R"(  render MESH --sources SPEC [--isolines K | --levels L1,L2,...] [--voronoi] [--delaunay]
+constexpr char kRenderHelp[] =
+    R"(  render MESH --sources SPEC [--isolines K | --levels L1,L2,...] [--voronoi] [--delaunay]
          [--path A B] --output out.png|.ply|.gltf [--view auto|iso|top|bottom|front|back|left|right]
          [--size WxH]
       A picture of the field: the shaded mesh coloured by distance (viridis; grey where
@@ -60,8 +61,9 @@ constexpr char kRenderHelp[] = R"(  render MESH --sources SPEC [--isolines K | -
 
 int RunRender(Backend& backend, const Args& args) {
   std::string error;
-  if (!CheckKnown(args, {"sources", "isolines", "levels", "voronoi", "delaunay", "path", "output", "view",
-                         "size", "max-snap"},
+  if (!CheckKnown(args,
+                  {"sources", "isolines", "levels", "voronoi", "delaunay", "path", "output", "view",
+                   "size", "max-snap"},
                   &error)) {
     return Fail(kExitUsage, error);
   }
@@ -73,9 +75,11 @@ int RunRender(Backend& backend, const Args& args) {
     positional.pop_back();
   }
   if (positional.size() != 1 || !args.options.count("sources") || !args.options.count("output")) {
-    return Fail(kExitUsage,
-                "usage: geodex render MESH --sources SPEC [--isolines K | --levels L,...] [--voronoi] [--delaunay] "
-                "[--path A B] --output out.png|.ply|.gltf [--view auto|iso|top|front|...] [--size WxH]");
+    return Fail(
+        kExitUsage,
+        "usage: geodex render MESH --sources SPEC [--isolines K | --levels L,...] [--voronoi] "
+        "[--delaunay] "
+        "[--path A B] --output out.png|.ply|.gltf [--view auto|iso|top|front|...] [--size WxH]");
   }
   const std::string output = args.options.at("output");
   if (!EndsWith(output, ".png") && !EndsWith(output, ".ply") && !EndsWith(output, ".gltf")) {

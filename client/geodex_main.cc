@@ -18,7 +18,8 @@ namespace {
 
 // `geodex --help`: this header, each command's entry (kept with its code: QueryCommands), then
 // the point grammar, JSON and exit codes (kUsageTail).
-constexpr char kUsageHead[] = R"(geodex - exact geodesic distances on triangle meshes (improved Chen-Han)
+constexpr char kUsageHead[] =
+    R"(geodex - exact geodesic distances on triangle meshes (improved Chen-Han)
 
 usage: geodex [--server HOST:PORT] COMMAND MESH [options]
 

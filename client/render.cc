@@ -1,21 +1,20 @@
 #include "render.h"
 
-#include "output_file.h"
-
 #include <png.h>
 
 #include <algorithm>
-#include <tuple>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <tuple>
 
 #include "absl/strings/escaping.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "geodex/mesh_io.h"
+#include "output_file.h"
 
 namespace geodex::render {
 namespace {
@@ -289,7 +288,9 @@ void Text(Image* image, int x, int y, const std::string& text, int scale) {
 }
 
 // The width in pixels of `text` at `scale`.
-int TextWidth(const std::string& text, int scale) { return static_cast<int>(text.size()) * 6 * scale - scale; }
+int TextWidth(const std::string& text, int scale) {
+  return static_cast<int>(text.size()) * 6 * scale - scale;
+}
 
 // White under `text` (a label over the picture stays readable).
 void TextBackground(Image* image, int x, int y, const std::string& text, int scale) {
@@ -327,7 +328,7 @@ NiceScale NiceTicks(double max_value, const std::string& units, int most) {
   for (int k = 0; k * step <= top * (1 + 1e-12); ++k) {
     const double value = k * step;
     std::string label = decimals > 6 || value >= 1e9 ? absl::StrFormat("%.3g", value)
-                                                      : absl::StrFormat("%.*f", decimals, value);
+                                                     : absl::StrFormat("%.*f", decimals, value);
     out.ticks.push_back({value * out.divisor, label});
   }
   return out;
@@ -340,7 +341,8 @@ std::string NiceLabel(double value, const std::string& units) {
     value /= 1000;
   }
   // Three significant digits, no exponent.
-  const int digits = std::clamp(2 - static_cast<int>(std::floor(std::log10(std::max(std::abs(value), 1e-300)))), 0, 6);
+  const int digits = std::clamp(
+      2 - static_cast<int>(std::floor(std::log10(std::max(std::abs(value), 1e-300)))), 0, 6);
   std::string text = absl::StrFormat("%.*f", digits, value);
   if (text.find('.') != std::string::npos) {  // 12.50 -> 12.5, 3.00 -> 3
     while (text.back() == '0') text.pop_back();
@@ -371,13 +373,15 @@ void DrawColorBar(Image* image, double max_distance, const std::string& units) {
     if (TextWidth(tick.label, 2) > room) text_scale = 1;
   }
   for (const auto& tick : scale.ticks) {
-    const int y = bottom - 1 - static_cast<int>(std::lround((bottom - 1 - top) * (tick.value / max_distance)));
+    const int y = bottom - 1 -
+                  static_cast<int>(std::lround((bottom - 1 - top) * (tick.value / max_distance)));
     for (int x = x0 + bar; x < x0 + bar + 4; ++x) {  // a tick
       const size_t i = 3 * (size_t(y) * image->width + x);
       image->rgb[i] = image->rgb[i + 1] = image->rgb[i + 2] = 30;
     }
     std::string label = tick.label;
-    while (TextWidth(label, text_scale) > room && !label.empty()) label.pop_back();  // never past the edge
+    while (TextWidth(label, text_scale) > room && !label.empty())
+      label.pop_back();  // never past the edge
     Text(image, x0 + bar + 9, y - 7 * text_scale / 2, label, text_scale);
   }
   Text(image, x0 - 4, top - 40, "distance", 2);
@@ -487,7 +491,8 @@ Image Render(const Scene& scene, View view, int width, int height) {
     const int y = std::clamp(static_cast<int>(at[1]) - 3, 2, std::max(2, height - 10));
     const std::array<int, 4> box = {x - 2, y - 1, x + w + 2, y + 8};
     bool overlaps = false;
-    for (const auto& b : placed) overlaps |= box[0] < b[2] && b[0] < box[2] && box[1] < b[3] && b[1] < box[3];
+    for (const auto& b : placed)
+      overlaps |= box[0] < b[2] && b[0] < box[2] && box[1] < b[3] && b[1] < box[3];
     if (overlaps) continue;
     placed.push_back(box);
     labels.push_back({x, y, line.label});

@@ -107,8 +107,8 @@ absl::Status RunDeriveMesh(const QueryEnv& env, const v1::DeriveMeshRequest& req
   if (!barrier.polygons_geojson().empty()) {
     terrain::CutStats cut_stats;
     absl::StatusOr<MeshData> cut = terrain::CutBarrierPolygons(
-        derived, barrier.polygons_geojson(), from.terrain ? &*from.terrain : nullptr, barrier.width(),
-        "barrier.polygons_geojson", &cut_stats, env.limits->max_vertices);
+        derived, barrier.polygons_geojson(), from.terrain ? &*from.terrain : nullptr,
+        barrier.width(), "barrier.polygons_geojson", &cut_stats, env.limits->max_vertices);
     if (ExceededLimit(cut.status())) return cut.status();  // names --max_vertices on the way out
     if (!cut.ok()) return FieldError("barrier.polygons_geojson", cut.status().message());
     derived = *std::move(cut);
@@ -117,13 +117,15 @@ absl::Status RunDeriveMesh(const QueryEnv& env, const v1::DeriveMeshRequest& req
   if (derived.faces.empty()) return FieldError("barrier", "covers every face of the mesh");
   // A cut adds vertices and faces where the polygons cross the mesh: the mesh limits still hold.
   if (derived.vertex_count() > env.limits->max_vertices) {
-    return LimitExceededError(Limit::kVertices, absl::StrCat("the cut mesh has ", derived.vertex_count(),
-                                                             " vertices, more than --max_vertices ",
-                                                             env.limits->max_vertices));
+    return LimitExceededError(
+        Limit::kVertices,
+        absl::StrCat("the cut mesh has ", derived.vertex_count(),
+                     " vertices, more than --max_vertices ", env.limits->max_vertices));
   }
   if (derived.face_count() > env.limits->max_faces) {
-    return LimitExceededError(Limit::kFaces, absl::StrCat("the cut mesh has ", derived.face_count(),
-                                                          " faces, more than --max_faces ", env.limits->max_faces));
+    return LimitExceededError(
+        Limit::kFaces, absl::StrCat("the cut mesh has ", derived.face_count(),
+                                    " faces, more than --max_faces ", env.limits->max_faces));
   }
   if (env.cancel->IsCancelled()) return absl::CancelledError("derivation cancelled");
   const std::string id = ComputeMeshId(derived);

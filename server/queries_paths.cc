@@ -53,8 +53,9 @@ absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPath
     if (field != nullptr) {
       absl::StatusOr<GeodesicPath> path = TracePathFromVertex(*(*mesh)->mesh, *field, to->vertex);
       if (absl::IsNotFound(path.status())) {
-        return UnreachableError(absl::StrCat("to: unreachable from `from`: ",
-                                             UnreachableReason(*(*mesh)->mesh, *from, *to, solver->max_distance)));
+        return UnreachableError(
+            absl::StrCat("to: unreachable from `from`: ",
+                         UnreachableReason(*(*mesh)->mesh, *from, *to, solver->max_distance)));
       }
       if (!path.ok()) return path.status();
       std::reverse(path->points.begin(), path->points.end());  // traced from `to`

@@ -57,9 +57,10 @@ std::vector<uint32_t> TouchedVertices(const TriangleMesh& mesh, const SurfacePoi
 
 }  // namespace
 
-std::string UnreachableReason(const TriangleMesh& mesh, const SurfacePoint& from, const SurfacePoint& to,
-                              double max_distance) {
-  const std::vector<uint32_t> at_to = TouchedVertices(mesh, to), at_from = TouchedVertices(mesh, from);
+std::string UnreachableReason(const TriangleMesh& mesh, const SurfacePoint& from,
+                              const SurfacePoint& to, double max_distance) {
+  const std::vector<uint32_t> at_to = TouchedVertices(mesh, to),
+                              at_from = TouchedVertices(mesh, from);
   if (to.kind == SurfacePoint::Kind::kVertex && !at_to.empty() &&
       std::all_of(at_to.begin(), at_to.end(), [&](uint32_t v) { return mesh.IsIsolated(v); })) {
     return "it is a vertex no face uses";
@@ -70,15 +71,16 @@ std::string UnreachableReason(const TriangleMesh& mesh, const SurfacePoint& from
   }
   if (!shared && !at_to.empty() && !at_from.empty()) {
     return absl::StrFormat(
-        "it is on another part of the surface (a barrier, a hole or a gap parts them; the mesh has %d parts)",
+        "it is on another part of the surface (a barrier, a hole or a gap parts them; the mesh has "
+        "%d parts)",
         mesh.report().components);
   }
-  if (std::isfinite(max_distance)) return absl::StrFormat("it is farther than the max_distance limit (%.6g)", max_distance);
+  if (std::isfinite(max_distance))
+    return absl::StrFormat("it is farther than the max_distance limit (%.6g)", max_distance);
   return "no path reaches it";
 }
 
 namespace {
-
 
 absl::Status CheckOptions(const GeodesicOptions& options) {
   if (!IsExactMethod(options.method)) {
@@ -185,9 +187,9 @@ absl::StatusOr<PathQueryResult> ComputeShortestPath(const TriangleMesh& mesh,
   absl::StatusOr<PathsQueryResult> paths = ComputeShortestPaths(mesh, from, {to}, options);
   if (!paths.ok()) return paths.status();
   if (paths->distance[0] == kUnreachable) {
-    return absl::NotFoundError(absl::StrFormat("%s is unreachable from %s: %s", SurfacePointToString(to),
-                                               SurfacePointToString(from),
-                                               UnreachableReason(mesh, from, to, options.solver.max_distance)));
+    return absl::NotFoundError(absl::StrFormat(
+        "%s is unreachable from %s: %s", SurfacePointToString(to), SurfacePointToString(from),
+        UnreachableReason(mesh, from, to, options.solver.max_distance)));
   }
   PathQueryResult result;
   result.distance = paths->distance[0];

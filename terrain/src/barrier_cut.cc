@@ -55,7 +55,8 @@ class Geos {
   Ptr Polygon(const std::vector<std::vector<Point2>>& rings) const {
     std::vector<GEOSGeometry*> holes;
     for (size_t r = 1; r < rings.size(); ++r) holes.push_back(Ring(rings[r]));
-    return Own(GEOSGeom_createPolygon_r(h_, Ring(rings[0]), holes.data(), static_cast<unsigned>(holes.size())));
+    return Own(GEOSGeom_createPolygon_r(h_, Ring(rings[0]), holes.data(),
+                                        static_cast<unsigned>(holes.size())));
   }
   // The rings of every polygon in `g` (a Polygon, MultiPolygon or collection), each without its
   // closing point.
@@ -84,7 +85,8 @@ class Geos {
       rings.push_back(std::move(points));
     };
     read(GEOSGetExteriorRing_r(h_, g));
-    for (int i = 0; i < GEOSGetNumInteriorRings_r(h_, g); ++i) read(GEOSGetInteriorRingN_r(h_, g, i));
+    for (int i = 0; i < GEOSGetNumInteriorRings_r(h_, g); ++i)
+      read(GEOSGetInteriorRingN_r(h_, g, i));
     out.push_back(std::move(rings));
     return out;
   }
@@ -109,7 +111,6 @@ uint64_t EdgeKey(uint32_t a, uint32_t b) {
   return (uint64_t{std::min(a, b)} << 32) | std::max(a, b);
 }
 
-
 using Pieces = std::vector<std::vector<std::vector<RingVertex>>>;  // polygons, rings, vertices
 enum class Fate : uint8_t { kKeep, kRemove, kPieces };
 
@@ -118,9 +119,14 @@ enum class Fate : uint8_t { kKeep, kRemove, kPieces };
 // triangulated with every point their neighbours put on shared edges.
 class Surgery {
  public:
-  Surgery(const MeshData& mesh, const Geos& geos, const double origin[2], double reach, uint64_t max_vertices,
-          CutStats* stats)
-      : mesh_(mesh), geos_(geos), h_(geos.h()), reach_(reach), max_vertices_(max_vertices), stats_(stats),
+  Surgery(const MeshData& mesh, const Geos& geos, const double origin[2], double reach,
+          uint64_t max_vertices, CutStats* stats)
+      : mesh_(mesh),
+        geos_(geos),
+        h_(geos.h()),
+        reach_(reach),
+        max_vertices_(max_vertices),
+        stats_(stats),
         fate_(mesh.face_count(), Fate::kKeep) {
     origin_[0] = origin[0];
     origin_[1] = origin[1];
@@ -174,13 +180,16 @@ class Surgery {
             const Point2 &pl = local_[std::min(a, b)], &ph = local_[std::max(a, b)];
             const double dx = ph[0] - pl[0], dy = ph[1] - pl[1], length2 = dx * dx + dy * dy;
             const double t = ((q[0] - pl[0]) * dx + (q[1] - pl[1]) * dy) / length2;
-            const double off = std::abs((q[0] - pl[0]) * dy - (q[1] - pl[1]) * dx) / std::sqrt(length2);
+            const double off =
+                std::abs((q[0] - pl[0]) * dy - (q[1] - pl[1]) * dx) / std::sqrt(length2);
             if (off <= tolerance && t > 0 && t < 1) rv.id = EdgePoint(a, b, t);
           }
           if (rv.id != kInterior) rv.p = LocalOf(rv.id);
-          if (vertices.empty() || rv.id == kInterior || vertices.back().id != rv.id) vertices.push_back(rv);
+          if (vertices.empty() || rv.id == kInterior || vertices.back().id != rv.id)
+            vertices.push_back(rv);
         }
-        while (vertices.size() > 1 && vertices.back().id != kInterior && vertices.back().id == vertices.front().id) {
+        while (vertices.size() > 1 && vertices.back().id != kInterior &&
+               vertices.back().id == vertices.front().id) {
           vertices.pop_back();
         }
         if (vertices.size() >= 3) {
@@ -210,13 +219,15 @@ class Surgery {
   // Pass 2: the faces out, pieces (and whole faces with points on their edges) triangulated by
   // GEOS's constrained Delaunay triangulation with every edge point in their boundary, so that
   // neighbours share their edges piece for piece. `*pieces_made` lists the faces made from pieces.
-  // More vertices than the budget (or than 32-bit ids hold): ResourceExhausted naming --max_vertices.
+  // More vertices than the budget (or than 32-bit ids hold): ResourceExhausted naming
+  // --max_vertices.
   absl::Status CheckBudget() const {
     const uint64_t n = out_.positions.size() / 3;
     if ((max_vertices_ != 0 && n > max_vertices_) || n >= kInterior) {
-      return LimitExceededError(Limit::kVertices, absl::StrCat("the barrier's cut makes more than ",
-                                                               max_vertices_ != 0 ? max_vertices_ : uint64_t{kInterior},
-                                                               " vertices"));
+      return LimitExceededError(
+          Limit::kVertices,
+          absl::StrCat("the barrier's cut makes more than ",
+                       max_vertices_ != 0 ? max_vertices_ : uint64_t{kInterior}, " vertices"));
     }
     return absl::OkStatus();
   }
@@ -232,7 +243,8 @@ class Surgery {
       if (fate_[f] == Fate::kKeep) {
         bool has_points = false;
         if (Valid(c)) {
-          for (int k = 0; k < 3; ++k) has_points |= edge_points_.contains(EdgeKey(c[k], c[(k + 1) % 3]));
+          for (int k = 0; k < 3; ++k)
+            has_points |= edge_points_.contains(EdgeKey(c[k], c[(k + 1) % 3]));
         }
         if (!has_points) {
           out_.faces.insert(out_.faces.end(), c, c + 3);
@@ -244,7 +256,8 @@ class Surgery {
           FanFromCentre(f, pieces_made);  // edge-on from above: no triangulation in x-y
           continue;
         }
-        Pieces whole = {{{RingVertex{c[0], local_[c[0]]}, RingVertex{c[1], local_[c[1]]}, RingVertex{c[2], local_[c[2]]}}}};
+        Pieces whole = {{{RingVertex{c[0], local_[c[0]]}, RingVertex{c[1], local_[c[1]]},
+                          RingVertex{c[2], local_[c[2]]}}}};
         if (absl::Status s = Triangulate(f, whole, pieces_made); !s.ok()) return s;
         continue;
       }
@@ -255,7 +268,8 @@ class Surgery {
 
  private:
   Point2 LocalOf(uint32_t id) const {  // any mesh vertex, new ones too
-    return {out_.positions[3 * size_t{id}] - origin_[0], out_.positions[3 * size_t{id} + 1] - origin_[1]};
+    return {out_.positions[3 * size_t{id}] - origin_[0],
+            out_.positions[3 * size_t{id} + 1] - origin_[1]};
   }
   // A point on edge (a, b) at `t` from its lower id: the one already there within 1e-9, or new.
   uint32_t EdgePoint(uint32_t a, uint32_t b, double t) {
@@ -266,7 +280,8 @@ class Surgery {
     }
     const uint32_t id = static_cast<uint32_t>(out_.positions.size() / 3);
     for (int k = 0; k < 3; ++k) {
-      const double pl = mesh_.positions[3 * size_t{low} + k], ph = mesh_.positions[3 * size_t{high} + k];
+      const double pl = mesh_.positions[3 * size_t{low} + k],
+                   ph = mesh_.positions[3 * size_t{high} + k];
       out_.positions.push_back(pl + t * (ph - pl));
     }
     points.push_back({t, id});
@@ -302,15 +317,18 @@ class Surgery {
       if (it == edge_points_.end()) continue;
       std::vector<struct EdgePoint> along = it->second;
       const bool forward = a < b;  // t runs from the lower id
-      std::sort(along.begin(), along.end(), [&](const struct EdgePoint& x, const struct EdgePoint& y) {
-        return forward ? x.t < y.t : x.t > y.t;
-      });
+      std::sort(along.begin(), along.end(),
+                [&](const struct EdgePoint& x, const struct EdgePoint& y) {
+                  return forward ? x.t < y.t : x.t > y.t;
+                });
       for (const struct EdgePoint& e : along) ring.push_back(e.vertex);
     }
     const uint32_t centre = static_cast<uint32_t>(out_.positions.size() / 3);
     for (int d = 0; d < 3; ++d) {
-      out_.positions.push_back((mesh_.positions[3 * size_t{c[0]} + d] + mesh_.positions[3 * size_t{c[1]} + d] +
-                                mesh_.positions[3 * size_t{c[2]} + d]) / 3);
+      out_.positions.push_back((mesh_.positions[3 * size_t{c[0]} + d] +
+                                mesh_.positions[3 * size_t{c[1]} + d] +
+                                mesh_.positions[3 * size_t{c[2]} + d]) /
+                               3);
     }
     ++stats_->vertices_added;
     for (size_t i = 0; i < ring.size(); ++i) {
@@ -349,14 +367,18 @@ class Surgery {
             for (const struct EdgePoint& e : it->second) {
               if (e.t > std::min(tp, tq) && e.t < std::max(tp, tq)) between.push_back(e);
             }
-            std::sort(between.begin(), between.end(), [&](const struct EdgePoint& x, const struct EdgePoint& y) {
-              return tp < tq ? x.t < y.t : x.t > y.t;
-            });
-            for (const struct EdgePoint& e : between) grown.push_back({e.vertex, LocalOf(e.vertex)});
+            std::sort(between.begin(), between.end(),
+                      [&](const struct EdgePoint& x, const struct EdgePoint& y) {
+                        return tp < tq ? x.t < y.t : x.t > y.t;
+                      });
+            for (const struct EdgePoint& e : between)
+              grown.push_back({e.vertex, LocalOf(e.vertex)});
             break;
           }
         }
-        while (grown.size() > 1 && grown.back().id != kInterior && grown.back().id == grown.front().id) grown.pop_back();
+        while (grown.size() > 1 && grown.back().id != kInterior &&
+               grown.back().id == grown.front().id)
+          grown.pop_back();
         if (grown.size() < 3) continue;
         std::vector<Point2> points;
         for (const RingVertex& v : grown) {
@@ -367,8 +389,11 @@ class Surgery {
       }
       if (coordinates.empty()) continue;
       Geos::Ptr polygon = geos_.Polygon(coordinates);
-      Geos::Ptr triangles = geos_.Own(polygon != nullptr ? GEOSConstrainedDelaunayTriangulation_r(h_, polygon.get()) : nullptr);
-      if (triangles == nullptr) return absl::InternalError(absl::StrCat("GEOS cannot triangulate what is left of face ", f));
+      Geos::Ptr triangles = geos_.Own(
+          polygon != nullptr ? GEOSConstrainedDelaunayTriangulation_r(h_, polygon.get()) : nullptr);
+      if (triangles == nullptr)
+        return absl::InternalError(
+            absl::StrCat("GEOS cannot triangulate what is left of face ", f));
       for (const auto& t : geos_.Polygons(triangles.get())) {
         if (t.empty() || t[0].size() != 3) continue;
         std::array<uint32_t, 3> ids{};
@@ -393,7 +418,8 @@ class Surgery {
         const double turn = Cross(LocalOf(ids[0]), LocalOf(ids[1]), LocalOf(ids[2]));
         if (turn == 0) continue;
         if ((turn > 0) != (area2 > 0)) std::swap(ids[1], ids[2]);  // the face's own winding
-        if (pieces_made != nullptr) pieces_made->push_back(static_cast<uint32_t>(out_.face_count()));
+        if (pieces_made != nullptr)
+          pieces_made->push_back(static_cast<uint32_t>(out_.face_count()));
         out_.faces.insert(out_.faces.end(), ids.begin(), ids.end());
       }
     }
@@ -417,7 +443,8 @@ class Surgery {
 struct PreparedGeometry {
   GEOSContextHandle_t h;
   const GEOSPreparedGeometry* p;
-  PreparedGeometry(GEOSContextHandle_t context, const GEOSGeometry* g) : h(context), p(GEOSPrepare_r(context, g)) {}
+  PreparedGeometry(GEOSContextHandle_t context, const GEOSGeometry* g)
+      : h(context), p(GEOSPrepare_r(context, g)) {}
   ~PreparedGeometry() {
     if (p != nullptr) GEOSPreparedGeom_destroy_r(h, p);
   }
@@ -431,11 +458,13 @@ bool BoxesMiss(const Point2& A, const Point2& B, const Point2& C, const double b
 }
 
 // The polygons (valid, unioned) cut out of `mesh`.
-absl::StatusOr<MeshData> CutPolygons(const MeshData& mesh, const Geos& geos, const GEOSGeometry* barrier,
-                                     const double origin[2], double reach, uint64_t max_vertices, CutStats* stats) {
+absl::StatusOr<MeshData> CutPolygons(const MeshData& mesh, const Geos& geos,
+                                     const GEOSGeometry* barrier, const double origin[2],
+                                     double reach, uint64_t max_vertices, CutStats* stats) {
   GEOSContextHandle_t h = geos.h();
   double box[4];  // xmin ymin xmax ymax
-  if (GEOSisEmpty_r(h, barrier) == 1 || GEOSGeom_getExtent_r(h, barrier, &box[0], &box[1], &box[2], &box[3]) == 0) {
+  if (GEOSisEmpty_r(h, barrier) == 1 ||
+      GEOSGeom_getExtent_r(h, barrier, &box[0], &box[1], &box[2], &box[3]) == 0) {
     return mesh;
   }
   PreparedGeometry prepared(h, barrier);
@@ -447,8 +476,10 @@ absl::StatusOr<MeshData> CutPolygons(const MeshData& mesh, const Geos& geos, con
     const Point2 A = surgery.local(c[0]), B = surgery.local(c[1]), C = surgery.local(c[2]);
     if (BoxesMiss(A, B, C, box)) continue;
     const double area2 = Cross(A, B, C);
-    if (!(std::abs(area2) > 1e-12 * Surgery::SizeSquared(A, B, C))) {  // edge-on from above: by its centre
-      Geos::Ptr centre = geos.Own(GEOSGeom_createPointFromXY_r(h, (A[0] + B[0] + C[0]) / 3, (A[1] + B[1] + C[1]) / 3));
+    if (!(std::abs(area2) >
+          1e-12 * Surgery::SizeSquared(A, B, C))) {  // edge-on from above: by its centre
+      Geos::Ptr centre = geos.Own(
+          GEOSGeom_createPointFromXY_r(h, (A[0] + B[0] + C[0]) / 3, (A[1] + B[1] + C[1]) / 3));
       if (GEOSPreparedIntersects_r(h, prepared.p, centre.get()) == 1) surgery.Remove(f);
       continue;
     }
@@ -465,7 +496,8 @@ absl::StatusOr<MeshData> CutPolygons(const MeshData& mesh, const Geos& geos, con
       surgery.Remove(f);
       continue;
     }
-    if (surgery.Untouched(f, pieces)) continue;  // the barrier only touches it (or takes a sliver below rounding)
+    if (surgery.Untouched(f, pieces))
+      continue;  // the barrier only touches it (or takes a sliver below rounding)
     // Counted as cut when it loses area beyond rounding; a barrier along its edge only splits it.
     double left = 0;
     GEOSArea_r(h, rest.get(), &left);
@@ -484,12 +516,14 @@ struct LineEnd {
 // ends inside a face is joined to one of the face's corners there, by an ordinary edge), and
 // then every vertex on a line (but its ends) is split into one copy per side, so that the two
 // sides of a line share no vertex and no edge: paths go around the line's ends.
-absl::StatusOr<MeshData> SlitLines(const MeshData& mesh, const Geos& geos, const GEOSGeometry* lines,
-                                   const std::vector<LineEnd>& ends, const double origin[2], double reach,
-                                   uint64_t max_vertices, CutStats* stats) {
+absl::StatusOr<MeshData> SlitLines(const MeshData& mesh, const Geos& geos,
+                                   const GEOSGeometry* lines, const std::vector<LineEnd>& ends,
+                                   const double origin[2], double reach, uint64_t max_vertices,
+                                   CutStats* stats) {
   GEOSContextHandle_t h = geos.h();
   double box[4];
-  if (GEOSisEmpty_r(h, lines) == 1 || GEOSGeom_getExtent_r(h, lines, &box[0], &box[1], &box[2], &box[3]) == 0) {
+  if (GEOSisEmpty_r(h, lines) == 1 ||
+      GEOSGeom_getExtent_r(h, lines, &box[0], &box[1], &box[2], &box[3]) == 0) {
     return mesh;
   }
   PreparedGeometry prepared(h, lines);
@@ -505,7 +539,8 @@ absl::StatusOr<MeshData> SlitLines(const MeshData& mesh, const Geos& geos, const
     Geos::Ptr triangle = geos.Polygon({{A, B, C}});
     if (GEOSPreparedIntersects_r(h, prepared.p, triangle.get()) != 1) continue;
     Geos::Ptr inside = geos.Own(GEOSIntersection_r(h, lines, triangle.get()));
-    if (inside == nullptr) return absl::InternalError(absl::StrCat("GEOS cannot clip the lines to face ", f));
+    if (inside == nullptr)
+      return absl::InternalError(absl::StrCat("GEOS cannot clip the lines to face ", f));
     double length = 0;
     GEOSLength_r(h, inside.get(), &length);
     if (!(length > 0)) continue;  // touches at a point only
@@ -537,7 +572,8 @@ absl::StatusOr<MeshData> SlitLines(const MeshData& mesh, const Geos& geos, const
     std::function<void(const GEOSGeometry*)> add_pieces = [&](const GEOSGeometry* g) {
       const int type = GEOSGeomTypeId_r(h, g);
       if (type == GEOS_MULTILINESTRING || type == GEOS_GEOMETRYCOLLECTION) {
-        for (int i = 0; i < GEOSGetNumGeometries_r(h, g); ++i) add_pieces(GEOSGetGeometryN_r(h, g, i));
+        for (int i = 0; i < GEOSGetNumGeometries_r(h, g); ++i)
+          add_pieces(GEOSGetGeometryN_r(h, g, i));
         return;
       }
       if (type != GEOS_LINESTRING) return;
@@ -558,25 +594,29 @@ absl::StatusOr<MeshData> SlitLines(const MeshData& mesh, const Geos& geos, const
     std::vector<Point2> ring;
     for (int k = 0; k < 3; ++k) {
       ring.push_back(corners[k]);
-      std::sort(on_edge[k].begin(), on_edge[k].end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+      std::sort(on_edge[k].begin(), on_edge[k].end(),
+                [](const auto& x, const auto& y) { return x.first < y.first; });
       for (const auto& [t, q] : on_edge[k]) ring.push_back(q);
     }
     ring.push_back(corners[0]);
     GEOSCoordSequence* boundary = GEOSCoordSeq_create_r(h, static_cast<unsigned>(ring.size()), 2);
-    for (size_t i = 0; i < ring.size(); ++i) GEOSCoordSeq_setXY_r(h, boundary, static_cast<unsigned>(i), ring[i][0], ring[i][1]);
+    for (size_t i = 0; i < ring.size(); ++i)
+      GEOSCoordSeq_setXY_r(h, boundary, static_cast<unsigned>(i), ring[i][0], ring[i][1]);
     linework.push_back(GEOSGeom_createLineString_r(h, boundary));
     // A line ending inside the face is joined to the face's corner most across it by an ordinary
     // edge, so that the face splits there and its end is a vertex (a straight continuation would
     // leave the end a flat point of a longer edge, which GEOS drops).
     const double sign = area2 > 0 ? 1 : -1;
     for (const LineEnd& e : ends) {
-      const double inner = std::min({Cross(A, B, e.at) * sign, Cross(B, C, e.at) * sign, Cross(C, A, e.at) * sign});
+      const double inner =
+          std::min({Cross(A, B, e.at) * sign, Cross(B, C, e.at) * sign, Cross(C, A, e.at) * sign});
       if (!(inner > 1e-9 * std::abs(area2))) continue;  // not strictly inside this face
       const Point2* corner = nullptr;
       double across = -1;
       for (const Point2* q : {&A, &B, &C}) {
         const double dx = (*q)[0] - e.at[0], dy = (*q)[1] - e.at[1];
-        const double sine = std::abs(e.direction[0] * dy - e.direction[1] * dx) / std::hypot(dx, dy);
+        const double sine =
+            std::abs(e.direction[0] * dy - e.direction[1] * dx) / std::hypot(dx, dy);
         if (sine > across) {
           across = sine;
           corner = q;
@@ -587,14 +627,16 @@ absl::StatusOr<MeshData> SlitLines(const MeshData& mesh, const Geos& geos, const
       GEOSCoordSeq_setXY_r(h, seq, 1, (*corner)[0], (*corner)[1]);
       linework.push_back(GEOSGeom_createLineString_r(h, seq));
     }
-    Geos::Ptr all = geos.Own(GEOSGeom_createCollection_r(h, GEOS_GEOMETRYCOLLECTION, linework.data(),
-                                                         static_cast<unsigned>(linework.size())));
+    Geos::Ptr all = geos.Own(GEOSGeom_createCollection_r(
+        h, GEOS_GEOMETRYCOLLECTION, linework.data(), static_cast<unsigned>(linework.size())));
     Geos::Ptr noded = geos.Own(all != nullptr ? GEOSUnaryUnion_r(h, all.get()) : nullptr);
     const GEOSGeometry* noded_ptr = noded.get();
     Geos::Ptr parts = geos.Own(noded != nullptr ? GEOSPolygonize_r(h, &noded_ptr, 1) : nullptr);
-    if (parts == nullptr) return absl::InternalError(absl::StrCat("GEOS cannot split face ", f, " along the lines"));
+    if (parts == nullptr)
+      return absl::InternalError(absl::StrCat("GEOS cannot split face ", f, " along the lines"));
     Pieces pieces = surgery.Classify(f, geos.Polygons(parts.get()));
-    if (pieces.empty() || surgery.Untouched(f, pieces)) continue;  // along an edge: the slit is found below
+    if (pieces.empty() || surgery.Untouched(f, pieces))
+      continue;  // along an edge: the slit is found below
     ++stats->faces_cut;
     surgery.SetPieces(f, std::move(pieces));
   }
@@ -634,10 +676,12 @@ absl::StatusOr<MeshData> SlitLines(const MeshData& mesh, const Geos& geos, const
   // Around each vertex on a line, its faces fall into groups joined across edges that are not
   // slits: one group where the line ends (it stays whole), two where a line passes (or leaves the
   // mesh), more where lines cross. Each group past the first gets its own copy of the vertex.
-  absl::flat_hash_map<uint32_t, std::vector<std::pair<uint32_t, int>>> faces_at;  // vertex -> (face, corner)
+  absl::flat_hash_map<uint32_t, std::vector<std::pair<uint32_t, int>>>
+      faces_at;  // vertex -> (face, corner)
   for (size_t f = 0; f < out.face_count(); ++f) {
     for (int k = 0; k < 3; ++k) {
-      if (slit_neighbours.contains(out.faces[3 * f + k])) faces_at[out.faces[3 * f + k]].push_back({static_cast<uint32_t>(f), k});
+      if (slit_neighbours.contains(out.faces[3 * f + k]))
+        faces_at[out.faces[3 * f + k]].push_back({static_cast<uint32_t>(f), k});
     }
   }
   // In vertex order, so that the copies' ids (and the mesh's id) are the same in every process.
@@ -649,12 +693,16 @@ absl::StatusOr<MeshData> SlitLines(const MeshData& mesh, const Geos& geos, const
     const std::vector<uint32_t>& slits = slit_neighbours[v];
     std::vector<size_t> parent(around.size());
     for (size_t i = 0; i < parent.size(); ++i) parent[i] = i;
-    std::function<size_t(size_t)> root = [&](size_t i) { return parent[i] == i ? i : parent[i] = root(parent[i]); };
-    absl::flat_hash_map<uint32_t, size_t> first_across;  // other end of an edge at v -> a face on it
+    std::function<size_t(size_t)> root = [&](size_t i) {
+      return parent[i] == i ? i : parent[i] = root(parent[i]);
+    };
+    absl::flat_hash_map<uint32_t, size_t>
+        first_across;  // other end of an edge at v -> a face on it
     for (size_t i = 0; i < around.size(); ++i) {
       const uint32_t* c = &out.faces[3 * size_t{around[i].first}];
       for (uint32_t other : {c[(around[i].second + 1) % 3], c[(around[i].second + 2) % 3]}) {
-        if (std::find(slits.begin(), slits.end(), other) != slits.end()) continue;  // a slit parts them
+        if (std::find(slits.begin(), slits.end(), other) != slits.end())
+          continue;  // a slit parts them
         auto [it, fresh] = first_across.emplace(other, i);
         if (!fresh) parent[root(i)] = root(it->second);
       }
@@ -676,16 +724,18 @@ absl::StatusOr<MeshData> SlitLines(const MeshData& mesh, const Geos& geos, const
     }
   }
   if ((max_vertices != 0 && out.vertex_count() > max_vertices) || out.vertex_count() >= kInterior) {
-    return LimitExceededError(Limit::kVertices, absl::StrCat("the barrier's cut makes ", out.vertex_count(),
-                                                             " vertices, more than the ", max_vertices, " allowed"));
+    return LimitExceededError(Limit::kVertices,
+                              absl::StrCat("the barrier's cut makes ", out.vertex_count(),
+                                           " vertices, more than the ", max_vertices, " allowed"));
   }
   return split;
 }
 
 }  // namespace
 
-absl::StatusOr<MeshData> CutOutPolygons(const MeshData& mesh, const OGRGeometry& polygons, double scale,
-                                        double width, uint64_t max_vertices, CutStats* stats) {
+absl::StatusOr<MeshData> CutOutPolygons(const MeshData& mesh, const OGRGeometry& polygons,
+                                        double scale, double width, uint64_t max_vertices,
+                                        CutStats* stats) {
   *stats = CutStats{};
   const size_t n = mesh.vertex_count();
   Geos geos;
@@ -708,17 +758,20 @@ absl::StatusOr<MeshData> CutOutPolygons(const MeshData& mesh, const OGRGeometry&
   if (barrier == nullptr) return absl::InternalError("GEOS cannot take the barrier polygons");
   auto shift = [](double* x, double* y, void* data) {
     const double* o = static_cast<const double*>(data);  // scale, origin x, origin y
-    if (!std::isfinite(*x) || !std::isfinite(*y)) return 0;  // every coordinate, not only the extent's
+    if (!std::isfinite(*x) || !std::isfinite(*y))
+      return 0;  // every coordinate, not only the extent's
     *x = *x * o[0] - o[1];
     *y = *y * o[0] - o[2];
     return 1;
   };
   double frame[3] = {scale, origin[0], origin[1]};
   barrier = geos.Own(GEOSGeom_transformXY_r(h, barrier.get(), shift, frame));
-  if (barrier == nullptr) return absl::InvalidArgumentError("the polygons' coordinates are not finite numbers here");
+  if (barrier == nullptr)
+    return absl::InvalidArgumentError("the polygons' coordinates are not finite numbers here");
   double extent[4];
   if (GEOSisEmpty_r(h, barrier.get()) != 1 &&
-      (GEOSGeom_getExtent_r(h, barrier.get(), &extent[0], &extent[1], &extent[2], &extent[3]) == 0 ||
+      (GEOSGeom_getExtent_r(h, barrier.get(), &extent[0], &extent[1], &extent[2], &extent[3]) ==
+           0 ||
        !std::all_of(extent, extent + 4, [](double v) { return std::isfinite(v); }))) {
     return absl::InvalidArgumentError("the polygons' coordinates are not finite numbers here");
   }
@@ -733,8 +786,8 @@ absl::StatusOr<MeshData> CutOutPolygons(const MeshData& mesh, const OGRGeometry&
   std::vector<const GEOSGeometry*> flat;
   std::function<void(const GEOSGeometry*)> flatten = [&](const GEOSGeometry* g) {
     const int type = GEOSGeomTypeId_r(h, g);
-    if (type == GEOS_GEOMETRYCOLLECTION || type == GEOS_MULTIPOLYGON || type == GEOS_MULTILINESTRING ||
-        type == GEOS_MULTIPOINT) {
+    if (type == GEOS_GEOMETRYCOLLECTION || type == GEOS_MULTIPOLYGON ||
+        type == GEOS_MULTILINESTRING || type == GEOS_MULTIPOINT) {
       for (int i = 0; i < GEOSGetNumGeometries_r(h, g); ++i) flatten(GEOSGetGeometryN_r(h, g, i));
     } else {
       flat.push_back(g);
@@ -775,7 +828,8 @@ absl::StatusOr<MeshData> CutOutPolygons(const MeshData& mesh, const OGRGeometry&
       continue;
     } else {
       drop();
-      return absl::InvalidArgumentError("points are barriers with a width (metres): --barrier-width, barrier.width");
+      return absl::InvalidArgumentError(
+          "points are barriers with a width (metres): --barrier-width, barrier.width");
     }
     if (part == nullptr) {
       drop();
@@ -783,14 +837,18 @@ absl::StatusOr<MeshData> CutOutPolygons(const MeshData& mesh, const OGRGeometry&
     }
     areas.push_back(part);
   }
-  Geos::Ptr area_collection = geos.Own(GEOSGeom_createCollection_r(h, GEOS_GEOMETRYCOLLECTION, areas.data(),
-                                                                   static_cast<unsigned>(areas.size())));
-  Geos::Ptr line_collection = geos.Own(GEOSGeom_createCollection_r(h, GEOS_GEOMETRYCOLLECTION, lines.data(),
-                                                                   static_cast<unsigned>(lines.size())));
-  Geos::Ptr area = geos.Own(area_collection != nullptr ? GEOSUnaryUnion_r(h, area_collection.get()) : nullptr);
-  Geos::Ptr line = geos.Own(line_collection != nullptr ? GEOSUnaryUnion_r(h, line_collection.get()) : nullptr);
-  if (area == nullptr || line == nullptr) return absl::InternalError("GEOS cannot merge the barrier's parts");
-  absl::StatusOr<MeshData> cut = CutPolygons(mesh, geos, area.get(), origin, reach, max_vertices, stats);
+  Geos::Ptr area_collection = geos.Own(GEOSGeom_createCollection_r(
+      h, GEOS_GEOMETRYCOLLECTION, areas.data(), static_cast<unsigned>(areas.size())));
+  Geos::Ptr line_collection = geos.Own(GEOSGeom_createCollection_r(
+      h, GEOS_GEOMETRYCOLLECTION, lines.data(), static_cast<unsigned>(lines.size())));
+  Geos::Ptr area =
+      geos.Own(area_collection != nullptr ? GEOSUnaryUnion_r(h, area_collection.get()) : nullptr);
+  Geos::Ptr line =
+      geos.Own(line_collection != nullptr ? GEOSUnaryUnion_r(h, line_collection.get()) : nullptr);
+  if (area == nullptr || line == nullptr)
+    return absl::InternalError("GEOS cannot merge the barrier's parts");
+  absl::StatusOr<MeshData> cut =
+      CutPolygons(mesh, geos, area.get(), origin, reach, max_vertices, stats);
   if (!cut.ok() || lines.empty()) return cut;
   return SlitLines(*cut, geos, line.get(), ends, origin, reach, max_vertices, stats);
 }

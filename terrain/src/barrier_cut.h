@@ -32,7 +32,8 @@ namespace geodex::terrain {
 // width, or coordinates that are not finite; Internal only when GEOS fails.
 // `max_vertices` (0: none) bounds the mesh made: ResourceExhausted (geodex/limits.h kVertices)
 // beyond it, checked as the cut goes.
-absl::StatusOr<MeshData> CutOutPolygons(const MeshData& mesh, const OGRGeometry& barrier, double scale,
-                                        double width, uint64_t max_vertices, CutStats* stats);
+absl::StatusOr<MeshData> CutOutPolygons(const MeshData& mesh, const OGRGeometry& barrier,
+                                        double scale, double width, uint64_t max_vertices,
+                                        CutStats* stats);
 
 }  // namespace geodex::terrain

@@ -1,9 +1,7 @@
-#include "geodex/terrain.h"
-
 #include <algorithm>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
-#include <cerrno>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -19,16 +17,17 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
+#include "barrier_cut.h"
 #include "cpl_conv.h"
 #include "cpl_error.h"
 #include "cpl_json.h"
 #include "cpl_string.h"
 #include "gdal_priv.h"
-#include "barrier_cut.h"
 #include "gdal_quiet.h"
 #include "geodex/gis_formats.h"
-#include "mem_file.h"
 #include "geodex/limits.h"
+#include "geodex/terrain.h"
+#include "mem_file.h"
 #include "ogr_api.h"
 #include "ogr_geometry.h"
 #include "ogr_spatialref.h"
@@ -37,15 +36,15 @@
 namespace geodex::terrain {
 namespace {
 
-
 // The shortest text that reads back as `value` (500301.9, not 500301.90000000002): how a person
 // writes the coordinates that messages quote.
 std::string Shortest(double value) {
   char text[400];
   const double a = std::abs(value);
-  const auto end = (a == 0 || (a >= 1e-4 && a < 1e15))
-                       ? std::to_chars(text, text + sizeof(text), value, std::chars_format::fixed).ptr
-                       : std::to_chars(text, text + sizeof(text), value).ptr;
+  const auto end =
+      (a == 0 || (a >= 1e-4 && a < 1e15))
+          ? std::to_chars(text, text + sizeof(text), value, std::chars_format::fixed).ptr
+          : std::to_chars(text, text + sizeof(text), value).ptr;
   return std::string(text, end);
 }
 
@@ -161,7 +160,8 @@ namespace {
 bool IsCrsIdentifier(const std::string& name) {
   if (name.empty() || name.size() > 128 || name.find(':') == std::string::npos) return false;
   return std::all_of(name.begin(), name.end(), [](char c) {
-    return absl::ascii_isalnum(static_cast<unsigned char>(c)) || c == ':' || c == '_' || c == '.' || c == '-';
+    return absl::ascii_isalnum(static_cast<unsigned char>(c)) || c == ':' || c == '_' || c == '.' ||
+           c == '-';
   });
 }
 
@@ -190,7 +190,8 @@ absl::Status CheckGeoJsonCrs(const CPLJSONObject& node, const std::string& where
           R"({"type": "name", "properties": {"name": "EPSG:32633"}})"));
     };
     if (member.GetType() == CPLJSONObject::Type::Null) continue;
-    if (member.GetType() != CPLJSONObject::Type::Object) return refuse("its \"crs\" is not an object");
+    if (member.GetType() != CPLJSONObject::Type::Object)
+      return refuse("its \"crs\" is not an object");
     // GDAL reads the first member of a name in any case; this check would read another: refuse
     // names that differ only in case ("name" and "NAME").
     auto repeats = [](const CPLJSONObject& object) {
@@ -228,7 +229,8 @@ absl::Status CheckGeoJsonCrs(const CPLJSONObject& node, const std::string& where
                                    "\" is not a CRS identifier such as EPSG:32633"));
       }
     } else if (!(absl::EqualsIgnoreCase(type, "EPSG") && integer_code)) {
-      return refuse(absl::StrCat("its \"crs\" of type \"", type.substr(0, 40), "\" is not followed"));
+      return refuse(
+          absl::StrCat("its \"crs\" of type \"", type.substr(0, 40), "\" is not followed"));
     }
   }
   return absl::OkStatus();
@@ -241,7 +243,8 @@ CPLStringList SideCarsOf(const std::string& path) {
   const std::filesystem::path file(path);
   const std::string stem = absl::AsciiStrToLower(file.stem().string());
   std::error_code ec;
-  std::filesystem::directory_iterator dir(file.has_parent_path() ? file.parent_path() : ".", ec), end;
+  std::filesystem::directory_iterator dir(file.has_parent_path() ? file.parent_path() : ".", ec),
+      end;
   for (int seen = 0; !ec && dir != end && seen < 10000; dir.increment(ec), ++seen) {
     const std::string sibling = dir->path().filename().string();
     if (absl::StartsWith(absl::AsciiStrToLower(sibling), stem)) siblings.AddString(sibling.c_str());
@@ -252,7 +255,8 @@ CPLStringList SideCarsOf(const std::string& path) {
 // A barrier file the CLI's user names: GeoJSON (its "crs" checked as for text), a Shapefile,
 // GeoPackage or FlatGeobuf, each through its own driver only (no KML network links, GML schemas
 // or VRT sources).
-absl::StatusOr<GDALDatasetUniquePtr> OpenBarrierFile(const std::string& path, const std::string& name) {
+absl::StatusOr<GDALDatasetUniquePtr> OpenBarrierFile(const std::string& path,
+                                                     const std::string& name) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return absl::NotFoundError(absl::StrCat(name, ": cannot open: ", std::strerror(errno)));
   char first = ' ';
@@ -263,19 +267,21 @@ absl::StatusOr<GDALDatasetUniquePtr> OpenBarrierFile(const std::string& path, co
     std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     CPLJSONDocument document;
     if (!document.LoadMemory(text)) {
-      return absl::InvalidArgumentError(absl::StrCat(name, ": not GeoJSON (", QuietGdal::LastMessage(), ")"));
+      return absl::InvalidArgumentError(
+          absl::StrCat(name, ": not GeoJSON (", QuietGdal::LastMessage(), ")"));
     }
     if (absl::Status crs = CheckGeoJsonCrs(document.GetRoot(), name); !crs.ok()) return crs;
   }
   const char* const geojson[] = {"GeoJSON", nullptr};
   const char* const others[] = {"ESRI Shapefile", "GPKG", "FlatGeobuf", nullptr};
   CPLStringList siblings = SideCarsOf(path);
-  GDALDatasetUniquePtr ds(GDALDataset::FromHandle(GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY,
-                                                             first == '{' ? geojson : others, nullptr,
-                                                             siblings.List())));
+  GDALDatasetUniquePtr ds(GDALDataset::FromHandle(
+      GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, first == '{' ? geojson : others,
+                 nullptr, siblings.List())));
   if (ds == nullptr) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        name, ": not a GeoJSON, Shapefile, GeoPackage or FlatGeobuf file (", QuietGdal::LastMessage(), ")"));
+    return absl::InvalidArgumentError(
+        absl::StrCat(name, ": not a GeoJSON, Shapefile, GeoPackage or FlatGeobuf file (",
+                     QuietGdal::LastMessage(), ")"));
   }
   return ds;
 }
@@ -288,8 +294,9 @@ namespace {
 // reprojected into the mesh's plane first (a geographic DEM's UTM metres), where their edges are
 // straight.
 absl::StatusOr<MeshData> CutBarrier(const MeshData& mesh, OGRGeometry& polygons, const DemInfo* dem,
-                                    const OGRSpatialReference* file_crs, double width, uint64_t max_vertices,
-                                    const std::string& name, CutStats* stats) {
+                                    const OGRSpatialReference* file_crs, double width,
+                                    uint64_t max_vertices, const std::string& name,
+                                    CutStats* stats) {
   double scale = 1;
   if (dem != nullptr && dem->reprojected) {
     OGRSpatialReference mesh_crs;
@@ -299,8 +306,9 @@ absl::StatusOr<MeshData> CutBarrier(const MeshData& mesh, OGRGeometry& polygons,
     mesh_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
     TransformPtr to_mesh = MakeTransform(*file_crs, mesh_crs);
     if (to_mesh == nullptr || polygons.transform(to_mesh.get()) != OGRERR_NONE) {
-      return absl::InvalidArgumentError(absl::StrCat(name, ": the polygons do not project to the mesh's CRS (",
-                                                     QuietGdal::LastMessage(), ")"));
+      return absl::InvalidArgumentError(
+          absl::StrCat(name, ": the polygons do not project to the mesh's CRS (",
+                       QuietGdal::LastMessage(), ")"));
     }
   } else if (dem != nullptr) {
     scale = dem->horizontal_scale;
@@ -314,9 +322,12 @@ absl::StatusOr<MeshData> CutBarrier(const MeshData& mesh, OGRGeometry& polygons,
 
 }  // namespace
 
-absl::StatusOr<std::vector<FilePoint>> ReadPointsFile(const std::string& path, const std::string& name) {
+absl::StatusOr<std::vector<FilePoint>> ReadPointsFile(const std::string& path,
+                                                      const std::string& name) {
   QuietGdal quiet;
-  auto bad = [&](const std::string& why) { return absl::InvalidArgumentError(absl::StrCat(name, ": ", why)); };
+  auto bad = [&](const std::string& why) {
+    return absl::InvalidArgumentError(absl::StrCat(name, ": ", why));
+  };
   std::ifstream in(path, std::ios::binary);
   if (!in) return absl::NotFoundError(absl::StrCat(name, ": cannot open: ", std::strerror(errno)));
   char first = ' ';
@@ -328,50 +339,40 @@ absl::StatusOr<std::vector<FilePoint>> ReadPointsFile(const std::string& path, c
   if (csv) {
     // x,y columns (the DEM's CRS), or lon,lat / longitude,latitude (WGS 84).
     const char* const drivers[] = {"CSV", nullptr};
-    const char* const options[] = {"X_POSSIBLE_NAMES=x,lon,longitude,lng", "Y_POSSIBLE_NAMES=y,lat,latitude",
-                                   "KEEP_GEOM_COLUMNS=NO", nullptr};
+    const char* const options[] = {"X_POSSIBLE_NAMES=x,lon,longitude,lng",
+                                   "Y_POSSIBLE_NAMES=y,lat,latitude", "KEEP_GEOM_COLUMNS=NO",
+                                   nullptr};
     const char* const no_siblings[] = {nullptr};
-    ds.reset(GDALDataset::FromHandle(GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, drivers, options,
-                                                no_siblings)));
-    if (ds == nullptr) return bad(absl::StrCat("not a CSV file with x,y or lon,lat columns (", QuietGdal::LastMessage(), ")"));
+    ds.reset(GDALDataset::FromHandle(GDALOpenEx(path.c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY,
+                                                drivers, options, no_siblings)));
+    if (ds == nullptr)
+      return bad(absl::StrCat("not a CSV file with x,y or lon,lat columns (",
+                              QuietGdal::LastMessage(), ")"));
   } else {
     absl::StatusOr<GDALDatasetUniquePtr> file = OpenBarrierFile(path, name);
     if (!file.ok()) return file.status();
     ds = *std::move(file);
   }
   std::vector<FilePoint> points;
+  OGRSpatialReference wgs84;
+  wgs84.SetWellKnownGeogCS("WGS84");
   for (OGRLayer* layer : ds->GetLayers()) {
     const OGRSpatialReference* layer_crs = layer->GetSpatialRef();
     std::string wkt;
     if (layer_crs != nullptr) {
       wkt = WktOf(*layer_crs);
     } else if (csv) {
-      OGRFeatureDefn* defn = layer->GetLayerDefn();
+      // KEEP_GEOM_COLUMNS=NO drops the coordinate columns: the header says which they were.
+      std::ifstream header(path);
+      std::string line;
+      std::getline(header, line);
       bool lonlat = false;
-      for (int i = 0; i < defn->GetFieldCount(); ++i) {
-        const std::string field = absl::AsciiStrToLower(defn->GetFieldDefn(i)->GetNameRef());
-        lonlat |= field == "lon" || field == "longitude" || field == "lng";
+      for (absl::string_view cell : absl::StrSplit(absl::AsciiStrToLower(line), ',')) {
+        cell = absl::StripAsciiWhitespace(cell);
+        lonlat |= cell == "lon" || cell == "longitude" || cell == "lng";
       }
-      // KEEP_GEOM_COLUMNS=NO drops the coordinate columns: read the header for which they were.
-      if (!lonlat) {
-        std::ifstream header(path);
-        std::string line;
-        std::getline(header, line);
-        const std::string lower = absl::AsciiStrToLower(line);
-        for (const char* word : {"lon", "longitude", "lng"}) {
-          for (absl::string_view cell : absl::StrSplit(lower, ',')) {
-            lonlat |= absl::StripAsciiWhitespace(cell) == word;
-          }
-        }
-      }
-      if (lonlat) {
-        OGRSpatialReference wgs84;
-        wgs84.SetWellKnownGeogCS("WGS84");
-        wkt = WktOf(wgs84);
-      }
+      if (lonlat) wkt = WktOf(wgs84);
     } else if (first == '{') {  // GeoJSON without a crs: RFC 7946's WGS 84
-      OGRSpatialReference wgs84;
-      wgs84.SetWellKnownGeogCS("WGS84");
       wkt = WktOf(wgs84);
     }
     for (const auto& feature : *layer) {
@@ -389,7 +390,8 @@ absl::StatusOr<std::vector<FilePoint>> ReadPointsFile(const std::string& path, c
           for (const OGRPoint* p : *g->toMultiPoint()) add(p);
           break;
         default:
-          return bad(absl::StrCat("feature ", feature->GetFID(), " is a ", g->getGeometryName(), "; points are expected"));
+          return bad(absl::StrCat("feature ", feature->GetFID(), " is a ", g->getGeometryName(),
+                                  "; points are expected"));
       }
     }
   }
@@ -401,21 +403,24 @@ absl::StatusOr<std::string> FilePointSpec(const FilePoint& point) {
   if (point.crs_wkt.empty()) return absl::StrCat("g:", Shortest(point.x), ":", Shortest(point.y));
   QuietGdal quiet;
   OGRSpatialReference from, wgs84;
-  if (from.importFromWkt(point.crs_wkt.c_str()) != OGRERR_NONE) return absl::InvalidArgumentError("its CRS does not parse");
+  if (from.importFromWkt(point.crs_wkt.c_str()) != OGRERR_NONE)
+    return absl::InvalidArgumentError("its CRS does not parse");
   from.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
   wgs84.SetWellKnownGeogCS("WGS84");
   wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
   TransformPtr t = MakeTransform(from, wgs84);
   double x = point.x, y = point.y;
   if (t == nullptr || !t->Transform(1, &x, &y)) {
-    return absl::InvalidArgumentError(absl::StrCat("cannot project it to WGS 84 (", QuietGdal::LastMessage(), ")"));
+    return absl::InvalidArgumentError(
+        absl::StrCat("cannot project it to WGS 84 (", QuietGdal::LastMessage(), ")"));
   }
   return absl::StrCat("ll:", Shortest(x), ":", Shortest(y));
 }
 
 absl::StatusOr<MeshData> CutBarrierPolygons(const MeshData& mesh, const std::string& geojson,
-                                            const DemInfo* dem, double width, const std::string& name,
-                                            CutStats* stats, uint64_t max_vertices) {
+                                            const DemInfo* dem, double width,
+                                            const std::string& name, CutStats* stats,
+                                            uint64_t max_vertices) {
   QuietGdal quiet;
   auto bad = [&](const std::string& why) {
     return absl::InvalidArgumentError(absl::StrCat(name, ": ", why));
@@ -433,7 +438,8 @@ absl::StatusOr<MeshData> CutBarrierPolygons(const MeshData& mesh, const std::str
     return bad("not GeoJSON (a JSON object, starting with '{')");
   }
   CPLJSONDocument document;
-  if (!document.LoadMemory(geojson)) return bad(absl::StrCat("not GeoJSON (", QuietGdal::LastMessage(), ")"));
+  if (!document.LoadMemory(geojson))
+    return bad(absl::StrCat("not GeoJSON (", QuietGdal::LastMessage(), ")"));
   if (absl::Status crs = CheckGeoJsonCrs(document.GetRoot(), name); !crs.ok()) return crs;
   MemFile text(".geojson", geojson);
   if (!text.ok()) return absl::InternalError("GDAL cannot make an in-memory file");
@@ -465,14 +471,16 @@ absl::StatusOr<Dem> Dem::Read(const std::string& path, const DemOptions& options
   }
   QuietGdal quiet;
   // The user's own file, through the drivers of the formats IsDemPath names, with its own side-cars
-  // (.prj, .hdr, .aux.xml: the files beside it whose names start with its stem) given by name, since
-  // PrepareGdal stops GDAL listing directories.
-  // Not VRT: its sources name files and URLs of their own, opened by any driver.
-  const char* const drivers[] = {"GTiff", "AAIGrid", "HFA", "SRTMHGT", "USGSDEM", "EHdr", "netCDF", nullptr};
+  // (.prj, .hdr, .aux.xml: the files beside it whose names start with its stem) given by name,
+  // since PrepareGdal stops GDAL listing directories. Not VRT: its sources name files and URLs of
+  // their own, opened by any driver.
+  const char* const drivers[] = {"GTiff",   "AAIGrid", "HFA",    "SRTMHGT",
+                                 "USGSDEM", "EHdr",    "netCDF", nullptr};
   if (absl::EndsWithIgnoreCase(path, ".vrt")) {
     return absl::InvalidArgumentError(absl::StrCat(
-        path, ": a VRT is not read (its sources may name other files or URLs); make it a GeoTIFF "
-              "(gdal_translate in.vrt out.tif)"));
+        path,
+        ": a VRT is not read (its sources may name other files or URLs); make it a GeoTIFF "
+        "(gdal_translate in.vrt out.tif)"));
   }
   CPLStringList siblings = SideCarsOf(path);
   GDALDatasetUniquePtr ds(GDALDataset::FromHandle(GDALOpenEx(
@@ -497,12 +505,13 @@ absl::StatusOr<Dem> Dem::ReadGeoTiffBytes(const std::string& bytes, const std::s
   MemFile tiff(".tif", bytes);
   if (!tiff.ok()) return absl::InternalError("GDAL cannot make an in-memory file");
   // Only the GTiff driver parses untrusted bytes; its georeferencing comes from the file alone
-  // (no world file or .aux.xml), and no side-car is listed (PrepareGdal, and an empty sibling list).
+  // (no world file or .aux.xml), and no side-car is listed (PrepareGdal, and an empty sibling
+  // list).
   const char* const drivers[] = {"GTiff", nullptr};
   const char* const open_options[] = {"GEOREF_SOURCES=INTERNAL", nullptr};
   const char* const no_siblings[] = {nullptr};
-  GDALDatasetUniquePtr ds(GDALDataset::FromHandle(GDALOpenEx(tiff.path().c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY,
-                                                             drivers, open_options, no_siblings)));
+  GDALDatasetUniquePtr ds(GDALDataset::FromHandle(GDALOpenEx(
+      tiff.path().c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, drivers, open_options, no_siblings)));
   if (ds == nullptr) {
     return absl::InvalidArgumentError(
         absl::StrCat(name, ": not a GeoTIFF GDAL reads (", QuietGdal::LastMessage(), ")"));
@@ -523,9 +532,9 @@ absl::StatusOr<Dem> Dem::ReadGeoTiffBytes(const std::string& bytes, const std::s
         }
       }
       if (names_file) {
-        return absl::InvalidArgumentError(absl::StrCat(name, ": its CRS names files (",
-                                                       std::string(token.substr(0, 60)),
-                                                       "); geodex reads no file or URL an upload names"));
+        return absl::InvalidArgumentError(
+            absl::StrCat(name, ": its CRS names files (", std::string(token.substr(0, 60)),
+                         "); geodex reads no file or URL an upload names"));
       }
     }
   }
@@ -533,8 +542,10 @@ absl::StatusOr<Dem> Dem::ReadGeoTiffBytes(const std::string& bytes, const std::s
   // which GDAL opens, path or URL, when overviews are asked for. geodex never asks, and refuses
   // the indirection outright.
   if (CSLCount(ds->GetMetadata("OVERVIEWS")) > 0) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        name, ": its metadata names an external overview file; geodex reads no file or URL an upload names"));
+    return absl::InvalidArgumentError(
+        absl::StrCat(name,
+                     ": its metadata names an external overview file; geodex reads no file or URL "
+                     "an upload names"));
   }
   return ReadDataset(*ds, name, options);
 }
@@ -716,7 +727,8 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
   if (!options.barrier_file.empty()) {
     absl::StatusOr<GDALDatasetUniquePtr> file = OpenBarrierFile(options.barrier_file, barrier_name);
     if (!file.ok()) return file.status();
-    absl::StatusOr<std::unique_ptr<OGRGeometry>> polygons = BarrierPolygonsOf(file->get(), barrier_name, &file_crs);
+    absl::StatusOr<std::unique_ptr<OGRGeometry>> polygons =
+        BarrierPolygonsOf(file->get(), barrier_name, &file_crs);
     if (!polygons.ok()) return polygons.status();
     barrier = *std::move(polygons);
   }
@@ -748,7 +760,8 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
   if (barrier == nullptr) return dem;
   CutStats stats;
   absl::StatusOr<MeshData> cut =
-      CutBarrier(dem.mesh_, *barrier, &info, &file_crs, options.barrier_width, options.max_vertices, barrier_name, &stats);
+      CutBarrier(dem.mesh_, *barrier, &info, &file_crs, options.barrier_width, options.max_vertices,
+                 barrier_name, &stats);
   if (!cut.ok()) return cut.status();
   if (cut->faces.empty()) return bad("the barrier covers every face: nothing is left");
   info.barrier_faces = stats.faces_removed + stats.faces_cut;
@@ -808,7 +821,8 @@ absl::StatusOr<Dem> Dem::FromMesh(MeshData mesh, DemInfo info) {
     const double u = (xs[v] - gt[0]) / gt[1] - 0.5, w = (ys[v] - gt[3]) / gt[5] - 0.5;
     const double i = std::round(u), j = std::round(w);
     // A cell centre to far better than a cell (projections round-trip to ~1e-9 of one).
-    const bool centre = std::abs(u - i) < 1e-6 && std::abs(w - j) < 1e-6 && i >= 0 && j >= 0 && i < W && j < H;
+    const bool centre =
+        std::abs(u - i) < 1e-6 && std::abs(w - j) < 1e-6 && i >= 0 && j >= 0 && i < W && j < H;
     const size_t cell = centre ? static_cast<size_t>(j) * W + static_cast<size_t>(i) : 0;
     if (!centre || (v > 0 && cell <= previous)) {
       if (v == 0) return bad("vertex 0 is not at a cell centre");
@@ -826,10 +840,12 @@ absl::StatusOr<Dem> Dem::FromMesh(MeshData mesh, DemInfo info) {
     }
     if (std::abs(u - std::round(u)) < 1e-6 && std::abs(w - std::round(w)) < 1e-6) {
       // At a cell centre only as a copy of that cell's vertex (a line barrier's two sides).
-      const size_t cell = static_cast<size_t>(std::round(w)) * W + static_cast<size_t>(std::round(u));
-      const uint32_t original = std::round(u) < W && std::round(w) < H ? dem.vertex_of_cell_[cell] : kNoVertex;
-      if (original == kNoVertex ||
-          !std::equal(&mesh.positions[3 * v], &mesh.positions[3 * v] + 3, &mesh.positions[3 * size_t{original}])) {
+      const size_t cell =
+          static_cast<size_t>(std::round(w)) * W + static_cast<size_t>(std::round(u));
+      const uint32_t original =
+          std::round(u) < W && std::round(w) < H ? dem.vertex_of_cell_[cell] : kNoVertex;
+      if (original == kNoVertex || !std::equal(&mesh.positions[3 * v], &mesh.positions[3 * v] + 3,
+                                               &mesh.positions[3 * size_t{original}])) {
         return bad(absl::StrCat("vertex ", v, " is out of row order"));
       }
     }
@@ -914,13 +930,14 @@ absl::StatusOr<std::array<double, 4>> Dem::LonLatExtent() const {
   if (t == nullptr) return absl::InternalError("the DEM's CRS does not project to WGS 84");
   // The used cells' centres around the grid's edge (a projection bends straight lines).
   const std::array<double, 6>& gt = info_.geotransform;
-  std::array<double, 4> box = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
-                               -std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
+  std::array<double, 4> box = {
+      std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+      -std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
   const uint32_t W = info_.grid_width, H = info_.grid_height;
   for (int k = 0; k <= 64; ++k) {
     const double f = k / 64.0;
-    for (auto [u, v] : {std::pair{f * (W - 1), 0.0}, std::pair{f * (W - 1), H - 1.0}, std::pair{0.0, f * (H - 1)},
-                        std::pair{W - 1.0, f * (H - 1)}}) {
+    for (auto [u, v] : {std::pair{f * (W - 1), 0.0}, std::pair{f * (W - 1), H - 1.0},
+                        std::pair{0.0, f * (H - 1)}, std::pair{W - 1.0, f * (H - 1)}}) {
       double x = gt[0] + (u + 0.5) * gt[1], y = gt[3] + (v + 0.5) * gt[5];
       if (!t->Transform(1, &x, &y)) continue;
       box = {std::min(box[0], x), std::min(box[1], y), std::max(box[2], x), std::max(box[3], y)};
@@ -930,16 +947,19 @@ absl::StatusOr<std::array<double, 4>> Dem::LonLatExtent() const {
 }
 
 absl::StatusOr<SurfacePoint> Dem::DropMapPoint(double x, double y) const {
-  absl::StatusOr<SurfacePoint> p = DropNamed(x, y, absl::StrCat("g:", Shortest(x), ":", Shortest(y)));
+  absl::StatusOr<SurfacePoint> p =
+      DropNamed(x, y, absl::StrCat("g:", Shortest(x), ":", Shortest(y)));
   if (!OutsideTheDem(p.status())) return p;
   // Where the DEM is, in the same coordinates, and whether x and y were given the other way round.
   const std::array<double, 6>& gt = info_.geotransform;
   const double x0 = gt[0] + 0.5 * gt[1], x1 = gt[0] + (info_.grid_width - 0.5) * gt[1];
   const double y0 = gt[3] + 0.5 * gt[5], y1 = gt[3] + (info_.grid_height - 0.5) * gt[5];
-  std::string message = absl::StrFormat("%s (it covers x %.10g to %.10g, y %.10g to %.10g in %s)", p.status().message(),
-                                        std::min(x0, x1), std::max(x0, x1), std::min(y0, y1), std::max(y0, y1),
-                                        info_.file_crs_name);
-  if (InGrid(y, x)) absl::StrAppend(&message, "; g:", Shortest(y), ":", Shortest(x), " would be inside (x and y swapped?)");
+  std::string message = absl::StrFormat("%s (it covers x %.10g to %.10g, y %.10g to %.10g in %s)",
+                                        p.status().message(), std::min(x0, x1), std::max(x0, x1),
+                                        std::min(y0, y1), std::max(y0, y1), info_.file_crs_name);
+  if (InGrid(y, x))
+    absl::StrAppend(&message, "; g:", Shortest(y), ":", Shortest(x),
+                    " would be inside (x and y swapped?)");
   return absl::InvalidArgumentError(message);
 }
 
@@ -979,12 +999,13 @@ absl::StatusOr<SurfacePoint> Dem::DropLonLat(double lon, double lat) const {
   if (!OutsideTheDem(p.status())) return p;
   std::string message(p.status().message());
   if (absl::StatusOr<std::array<double, 4>> box = LonLatExtent(); box.ok()) {
-    absl::StrAppendFormat(&message, " (it covers longitude %.8g to %.8g, latitude %.8g to %.8g)", (*box)[0],
-                          (*box)[2], (*box)[1], (*box)[3]);
+    absl::StrAppendFormat(&message, " (it covers longitude %.8g to %.8g, latitude %.8g to %.8g)",
+                          (*box)[0], (*box)[2], (*box)[1], (*box)[3]);
   }
   double sx = lat, sy = lon;  // longitude and latitude the other way round
   if (std::abs(lat) <= 180 && std::abs(lon) <= 90 && t->Transform(1, &sx, &sy) && InGrid(sx, sy)) {
-    absl::StrAppend(&message, "; ll:", Shortest(lat), ":", Shortest(lon), " would be inside (longitude first: ll:LON:LAT)");
+    absl::StrAppend(&message, "; ll:", Shortest(lat), ":", Shortest(lon),
+                    " would be inside (longitude first: ll:LON:LAT)");
   }
   return absl::InvalidArgumentError(message);
 }
@@ -1012,19 +1033,23 @@ absl::StatusOr<SurfacePoint> Dem::DropMeshPoint(double mx, double my, double u, 
         // The block triangle's face, or the pieces a barrier cut left of it.
         std::vector<uint32_t> candidates;
         if (face_of_block_[triangle] != kNoVertex) candidates.push_back(face_of_block_[triangle]);
-        for (auto it = std::lower_bound(pieces_.begin(), pieces_.end(), std::make_pair(triangle, uint32_t{0}));
+        for (auto it = std::lower_bound(pieces_.begin(), pieces_.end(),
+                                        std::make_pair(triangle, uint32_t{0}));
              it != pieces_.end() && it->first == triangle; ++it) {
           candidates.push_back(it->second);
         }
         for (const uint32_t f : candidates) {
           const double* p[3];
-          for (int c = 0; c < 3; ++c) p[c] = &mesh_.positions[3 * size_t{mesh_.faces[3 * size_t{f} + c]}];
+          for (int c = 0; c < 3; ++c)
+            p[c] = &mesh_.positions[3 * size_t{mesh_.faces[3 * size_t{f} + c]}];
           // Barycentrics of (mx, my) in the face's projection onto the map plane.
-          const double det = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) -
-                             (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]);
+          const double det =
+              (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]);
           if (det == 0) continue;
-          const double b1 = ((mx - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (my - p[0][1])) / det;
-          const double b2 = ((p[1][0] - p[0][0]) * (my - p[0][1]) - (mx - p[0][0]) * (p[1][1] - p[0][1])) / det;
+          const double b1 =
+              ((mx - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (my - p[0][1])) / det;
+          const double b2 =
+              ((p[1][0] - p[0][0]) * (my - p[0][1]) - (mx - p[0][0]) * (p[1][1] - p[0][1])) / det;
           const std::array<double, 3> b = {1 - b1 - b2, b1, b2};
           const double lowest = std::min({b[0], b[1], b[2]});
           if (lowest > best_min) {
@@ -1047,8 +1072,8 @@ absl::StatusOr<SurfacePoint> Dem::DropMeshPoint(double mx, double my, double u, 
 namespace {
 
 // One band on the used grid, made in memory and copied out by the format the path's extension
-// names (GisFormatOf): a cell without a vertex, or whose vertex no face uses (inside a barrier), has
-// no surface (kRasterNoSurface, the band's nodata); `value_of_vertex` gives the others.
+// names (GisFormatOf): a cell without a vertex, or whose vertex no face uses (inside a barrier),
+// has no surface (kRasterNoSurface, the band's nodata); `value_of_vertex` gives the others.
 absl::Status WriteRaster(const DemInfo& info, const std::vector<uint32_t>& vertex_of_cell,
                          const MeshData& mesh, const std::string& path, GDALDataType type,
                          const char* description, const char* unit,
@@ -1061,14 +1086,16 @@ absl::Status WriteRaster(const DemInfo& info, const std::vector<uint32_t>& verte
   }
   GDALDriver* mem = GetGDALDriverManager()->GetDriverByName("MEM");
   GDALDriver* driver = GetGDALDriverManager()->GetDriverByName(format->driver);
-  if (mem == nullptr || driver == nullptr || driver->GetMetadataItem(GDAL_DCAP_CREATECOPY) == nullptr) {
-    return absl::InvalidArgumentError(absl::StrCat("cannot write ", path, ": this GDAL writes no ", format->description));
+  if (mem == nullptr || driver == nullptr ||
+      driver->GetMetadataItem(GDAL_DCAP_CREATECOPY) == nullptr) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("cannot write ", path, ": this GDAL writes no ", format->description));
   }
   auto failed = [&] {
     return absl::PermissionDeniedError(absl::StrCat("cannot write ", path, ": ", QuietGdal::LastMessage()));
   };
-  GDALDatasetUniquePtr ds(mem->Create("", static_cast<int>(info.grid_width), static_cast<int>(info.grid_height),
-                                      1, type, nullptr));
+  GDALDatasetUniquePtr ds(mem->Create("", static_cast<int>(info.grid_width),
+                                      static_cast<int>(info.grid_height), 1, type, nullptr));
   if (ds == nullptr) return failed();
   double gt[6];
   std::copy(info.geotransform.begin(), info.geotransform.end(), gt);
@@ -1101,7 +1128,8 @@ absl::Status WriteRaster(const DemInfo& info, const std::vector<uint32_t>& verte
     options.AddString("COMPRESS=DEFLATE");
     options.AddString("TILED=YES");
   }
-  GDALDatasetUniquePtr out(driver->CreateCopy(path.c_str(), ds.get(), FALSE, options.List(), nullptr, nullptr));
+  GDALDatasetUniquePtr out(
+      driver->CreateCopy(path.c_str(), ds.get(), FALSE, options.List(), nullptr, nullptr));
   if (out == nullptr) return failed();
   out.reset();  // closes the file: a late write error shows in GDAL's last error
   if (CPLGetLastErrorType() >= CE_Failure) return failed();
@@ -1112,16 +1140,17 @@ absl::Status WriteRaster(const DemInfo& info, const std::vector<uint32_t>& verte
 
 absl::Status Dem::WriteFloatRaster(const std::string& path, const std::vector<double>& values) const {
   if (values.size() < mesh_.vertex_count()) return absl::InternalError("one value per vertex expected");
-  return WriteRaster(info_, vertex_of_cell_, mesh_, path, GDT_Float32, "geodesic distance", "m", [&](uint32_t v) {
-    return std::isfinite(values[v]) ? values[v] : kRasterUnreachable;
-  });
+  return WriteRaster(
+      info_, vertex_of_cell_, mesh_, path, GDT_Float32, "geodesic distance", "m",
+      [&](uint32_t v) { return std::isfinite(values[v]) ? values[v] : kRasterUnreachable; });
 }
 
 absl::Status Dem::WriteIndexRaster(const std::string& path, const std::vector<uint32_t>& values) const {
   if (values.size() < mesh_.vertex_count()) return absl::InternalError("one value per vertex expected");
-  return WriteRaster(info_, vertex_of_cell_, mesh_, path, GDT_Int32, "nearest source", nullptr, [&](uint32_t v) {
-    return values[v] >= 0x80000000u ? kRasterUnreachable : static_cast<double>(values[v]);
-  });
+  return WriteRaster(
+      info_, vertex_of_cell_, mesh_, path, GDT_Int32, "nearest source", nullptr, [&](uint32_t v) {
+        return values[v] >= 0x80000000u ? kRasterUnreachable : static_cast<double>(values[v]);
+      });
 }
 
 

@@ -163,17 +163,19 @@ absl::Status WriteVectorFile(const DemInfo& dem, const std::vector<GeoFeature>& 
   };
   const GisFormat* format = GisFormatOf(path);
   if (format == nullptr || format->kind != GisFileKind::kVector) {
-    return absl::InvalidArgumentError(absl::StrCat("cannot write ", path, ": a vector file is one of ",
-                                                   GisExtensions(GisFileKind::kVector)));
+    return absl::InvalidArgumentError(absl::StrCat(
+        "cannot write ", path, ": a vector file is one of ", GisExtensions(GisFileKind::kVector)));
   }
   if (!OGRGeometryFactory::haveGEOS()) return absl::InternalError("GDAL was built without GEOS");
   GDALDriver* driver = GetGDALDriverManager()->GetDriverByName(format->driver);
   if (driver == nullptr) {
-    return absl::InvalidArgumentError(absl::StrCat("cannot write ", path, ": this GDAL writes no ", format->description));
+    return absl::InvalidArgumentError(
+        absl::StrCat("cannot write ", path, ": this GDAL writes no ", format->description));
   }
   const bool geojson = std::string(format->driver) == "GeoJSON";
-  native_crs = native_crs || !geojson;  // RFC 7946 is GeoJSON's; every other format keeps the DEM's CRS
-  RemoveOldOutput(path);  // the driver will not overwrite
+  native_crs =
+      native_crs || !geojson;  // RFC 7946 is GeoJSON's; every other format keeps the DEM's CRS
+  RemoveOldOutput(path);       // the driver will not overwrite
   GDALDatasetUniquePtr ds(driver->Create(path.c_str(), 0, 0, 0, GDT_Unknown, nullptr));
   if (ds == nullptr) return failed(QuietGdal::LastMessage());
   // Geometries are built in the mesh's CRS when it was reprojected, else in the file's.
@@ -184,8 +186,9 @@ absl::Status WriteVectorFile(const DemInfo& dem, const std::vector<GeoFeature>& 
   file.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
   const char* rfc[] = {"RFC7946=YES", "WRITE_NAME=NO", nullptr};
   const char* native[] = {"WRITE_NAME=NO", nullptr};
-  OGRLayer* layer = ds->CreateLayer("geodex", native_crs ? &file : &built, wkbUnknown,
-                                    geojson ? const_cast<char**>(native_crs ? native : rfc) : nullptr);
+  OGRLayer* layer =
+      ds->CreateLayer("geodex", native_crs ? &file : &built, wkbUnknown,
+                      geojson ? const_cast<char**>(native_crs ? native : rfc) : nullptr);
   if (layer == nullptr) return failed(QuietGdal::LastMessage());
   std::unique_ptr<OGRCoordinateTransformation, decltype(&OGRCoordinateTransformation::DestroyCT)>
       to_file(nullptr, &OGRCoordinateTransformation::DestroyCT);
@@ -204,7 +207,9 @@ absl::Status WriteVectorFile(const DemInfo& dem, const std::vector<GeoFeature>& 
     for (const auto& [name, value] : f.properties) {
       auto [at, added] = field_of.emplace(name, fields.size());
       if (added) fields.push_back({name, OFTReal});
-      if (std::holds_alternative<std::monostate>(value) || (!added && fields[at->second].second != OFTReal)) continue;
+      if (std::holds_alternative<std::monostate>(value) ||
+          (!added && fields[at->second].second != OFTReal))
+        continue;
       fields[at->second].second = std::holds_alternative<double>(value)    ? OFTReal
                                   : std::holds_alternative<int64_t>(value) ? OFTInteger64
                                                                            : OFTString;
@@ -259,11 +264,11 @@ absl::Status WriteVectorFile(const DemInfo& dem, const std::vector<GeoFeature>& 
   return absl::OkStatus();
 }
 
-
 absl::StatusOr<std::string> GeoJsonText(const DemInfo& dem, const std::vector<GeoFeature>& features,
                                         bool native_crs) {
   MemFile file(".geojson");
-  if (absl::Status written = WriteVectorFile(dem, features, file.path(), native_crs); !written.ok()) {
+  if (absl::Status written = WriteVectorFile(dem, features, file.path(), native_crs);
+      !written.ok()) {
     return absl::InternalError(written.message());
   }
   return file.Take();

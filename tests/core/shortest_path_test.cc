@@ -254,17 +254,26 @@ TEST(UnreachableReasonTest, SaysWhy) {
   absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(data);
   ASSERT_TRUE(mesh.ok()) << mesh.status();
   PathQueryOptions options;
-  absl::StatusOr<PathQueryResult> apart = ComputeShortestPath(*mesh, SurfacePoint::AtVertex(0), SurfacePoint::AtVertex(4), options);
+  absl::StatusOr<PathQueryResult> apart =
+      ComputeShortestPath(*mesh, SurfacePoint::AtVertex(0), SurfacePoint::AtVertex(4), options);
   EXPECT_EQ(apart.status().code(), absl::StatusCode::kNotFound);
-  EXPECT_NE(apart.status().message().find("it is on another part of the surface"), std::string::npos) << apart.status();
-  EXPECT_NE(apart.status().message().find("the mesh has 2 parts"), std::string::npos) << apart.status();
-  EXPECT_EQ(UnreachableReason(*mesh, SurfacePoint::AtVertex(0), SurfacePoint::AtVertex(6), kUnreachable),
-            "it is a vertex no face uses");
+  EXPECT_NE(apart.status().message().find("it is on another part of the surface"),
+            std::string::npos)
+      << apart.status();
+  EXPECT_NE(apart.status().message().find("the mesh has 2 parts"), std::string::npos)
+      << apart.status();
+  EXPECT_EQ(
+      UnreachableReason(*mesh, SurfacePoint::AtVertex(0), SurfacePoint::AtVertex(6), kUnreachable),
+      "it is a vertex no face uses");
   options.solver.max_distance = 0.5;
-  absl::StatusOr<PathQueryResult> far = ComputeShortestPath(*mesh, SurfacePoint::AtVertex(0), SurfacePoint::AtVertex(1), options);
+  absl::StatusOr<PathQueryResult> far =
+      ComputeShortestPath(*mesh, SurfacePoint::AtVertex(0), SurfacePoint::AtVertex(1), options);
   EXPECT_EQ(far.status().code(), absl::StatusCode::kNotFound);
-  EXPECT_NE(far.status().message().find("farther than the max_distance limit (0.5)"), std::string::npos) << far.status();
-  EXPECT_EQ(UnreachableReason(*mesh, SurfacePoint::OnEdge(0, 1, 0.5), SurfacePoint::InFace(1, 0.2, 0.3, 0.5), kUnreachable)
+  EXPECT_NE(far.status().message().find("farther than the max_distance limit (0.5)"),
+            std::string::npos)
+      << far.status();
+  EXPECT_EQ(UnreachableReason(*mesh, SurfacePoint::OnEdge(0, 1, 0.5),
+                              SurfacePoint::InFace(1, 0.2, 0.3, 0.5), kUnreachable)
                 .rfind("it is on another part", 0),
             0u);
 }

@@ -21,17 +21,17 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "geodex/distance_field.h"
-#include "geodex/geodesic_solver.h"
-#include "geodex/triangle_mesh.h"
 #include "cpl_vsi.h"
 #include "gdal_priv.h"
+#include "geodex/distance_field.h"
+#include "geodex/geodesic_solver.h"
 #include "geodex/mesh_id.h"
 #include "geodex/mesh_io.h"
 #include "geodex/terrain.h"
+#include "geodex/triangle_mesh.h"
+#include "geodex_client.h"
 #include "gtest/gtest.h"
 #include "ogr_spatialref.h"
-#include "geodex_client.h"
 #include "server_test_util.h"
 
 namespace geodex::server {
@@ -41,7 +41,6 @@ namespace fs = std::filesystem;
 
 using testing::BadField;
 using testing::Contains;
-
 
 // A TCP listener on 127.0.0.1, on a port the kernel picks, that counts the connections made to it
 // (each accepted and closed at once) until it is destroyed: what geodexd must never reach.
@@ -55,7 +54,8 @@ class ConnectionCounter {
     address.sin_port = 0;
     socklen_t size = sizeof(address);
     if (fd_ < 0 || bind(fd_, reinterpret_cast<sockaddr*>(&address), sizeof(address)) != 0 ||
-        listen(fd_, 16) != 0 || getsockname(fd_, reinterpret_cast<sockaddr*>(&address), &size) != 0) {
+        listen(fd_, 16) != 0 ||
+        getsockname(fd_, reinterpret_cast<sockaddr*>(&address), &size) != 0) {
       ADD_FAILURE() << "cannot listen on 127.0.0.1";
       return;
     }
@@ -78,7 +78,9 @@ class ConnectionCounter {
     if (thread_.joinable()) thread_.join();
     if (fd_ >= 0) close(fd_);
   }
-  std::string Url(const std::string& path) const { return absl::StrCat("http://127.0.0.1:", port_, path); }
+  std::string Url(const std::string& path) const {
+    return absl::StrCat("http://127.0.0.1:", port_, path);
+  }
   int connections() const { return connections_; }
 
  private:
@@ -456,10 +458,10 @@ TEST_F(TerrainServiceTest, DeriveMeshByABarrier) {
   }
 }
 
-
 // geodexd never reaches out (issue 30): no URL, file or driver that a request names is followed.
 // Each hostile input is refused as INVALID_ARGUMENT naming its field, quickly (a followed link
-// waited 10 s on a silent peer), no connection reaches the listener, and the server goes on serving.
+// waited 10 s on a silent peer), no connection reaches the listener, and the server goes on
+// serving.
 TEST_F(TerrainServiceTest, NoRequestMakesTheServerReachOut) {
   ConnectionCounter listener;
   StartServer();
@@ -468,30 +470,37 @@ TEST_F(TerrainServiceTest, NoRequestMakesTheServerReachOut) {
       R"("type": "Polygon", "coordinates": [[[500100, 4999900], [500200, 4999900], [500200, 4999800], [500100, 4999900]]])";
   auto collection = [&](const std::string& crs) {
     return absl::StrCat(R"({"type": "FeatureCollection", "crs": )", crs,
-                        R"(, "features": [{"type": "Feature", "properties": {}, "geometry": {)", polygon, "}}]}");
+                        R"(, "features": [{"type": "Feature", "properties": {}, "geometry": {)",
+                        polygon, "}}]}");
   };
   const std::vector<std::string> texts = {
-      collection(absl::StrCat(R"({"type": "link", "properties": {"href": ")", listener.Url("/crs"), R"(", "type": "proj4"}})")),
-      collection(absl::StrCat(R"({"type": "url", "properties": {"url": ")", listener.Url("/crs"), R"("}})")),
-      collection(absl::StrCat(R"({"type": "name", "properties": {"name": ")", listener.Url("/crs"), R"("}})")),
-      collection(absl::StrCat(R"({"type": "LINK", "properties": {"href": ")", listener.Url("/crs"), R"("}})")),
+      collection(absl::StrCat(R"({"type": "link", "properties": {"href": ")", listener.Url("/crs"),
+                              R"(", "type": "proj4"}})")),
+      collection(absl::StrCat(R"({"type": "url", "properties": {"url": ")", listener.Url("/crs"),
+                              R"("}})")),
+      collection(absl::StrCat(R"({"type": "name", "properties": {"name": ")", listener.Url("/crs"),
+                              R"("}})")),
+      collection(absl::StrCat(R"({"type": "LINK", "properties": {"href": ")", listener.Url("/crs"),
+                              R"("}})")),
       collection(R"({"type": "name", "properties": {"name": "/etc/passwd"}})"),
       collection(R"({"type": "OGC", "properties": {"urn": "urn:ogc:def:crs:EPSG::32633"}})"),
       // GDAL reads the first "name" in any case, a check reading the last would pass a PROJ string
       // naming a local grid file: names differing only in case are refused.
-      collection(R"({"type": "name", "properties": {"NAME": "+proj=longlat +datum=WGS84 +nadgrids=/etc/passwd +type=crs", "name": "EPSG:4326"}})"),
+      collection(
+          R"({"type": "name", "properties": {"NAME": "+proj=longlat +datum=WGS84 +nadgrids=/etc/passwd +type=crs", "name": "EPSG:4326"}})"),
       collection(R"({"TYPE": "link", "type": "name", "properties": {"name": "EPSG:4326"}})"),
       // A crs on a geometry, and a member spelled in capitals: GDAL follows both.
-      absl::StrCat(R"({"type": "Feature", "properties": {}, "geometry": {"CRS": {"type": "link", "properties": {"href": ")",
-                   listener.Url("/geometry-crs"), R"("}}, )", polygon, "}}"),
+      absl::StrCat(
+          R"({"type": "Feature", "properties": {}, "geometry": {"CRS": {"type": "link", "properties": {"href": ")",
+          listener.Url("/geometry-crs"), R"("}}, )", polygon, "}}"),
       absl::StrCat("/vsicurl/", listener.Url("/x.geojson")),
       "/vsimem/geodex-0.geojson",
       "file:///etc/passwd",
       "/etc/passwd",
       "barrier.geojson",
       listener.Url("/x.geojson"),
-      absl::StrCat(R"(<OGRVRTDataSource><OGRVRTLayer name="x"><SrcDataSource>/vsicurl/)", listener.Url("/v.geojson"),
-                   "</SrcDataSource></OGRVRTLayer></OGRVRTDataSource>"),
+      absl::StrCat(R"(<OGRVRTDataSource><OGRVRTLayer name="x"><SrcDataSource>/vsicurl/)",
+                   listener.Url("/v.geojson"), "</SrcDataSource></OGRVRTLayer></OGRVRTDataSource>"),
   };
   for (const std::string& text : texts) {
     v1::DeriveMeshRequest request;
@@ -502,9 +511,11 @@ TEST_F(TerrainServiceTest, NoRequestMakesTheServerReachOut) {
     context.set_deadline(testing::In(60));
     const auto start = std::chrono::steady_clock::now();
     grpc::Status status = stub_->DeriveMesh(&context, request, &derived);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << text;
-    EXPECT_EQ(BadField(status), "barrier.polygons_geojson") << text << ": " << status.error_message();
+    EXPECT_EQ(BadField(status), "barrier.polygons_geojson")
+        << text << ": " << status.error_message();
     EXPECT_LT(seconds, 5) << text;  // generous; a followed link waits 10 s
   }
   // A crs named by an identifier is still read (and reprojected): the same wall as without it.
@@ -523,7 +534,8 @@ TEST_F(TerrainServiceTest, NoRequestMakesTheServerReachOut) {
   auto tiff_with = [&](const std::string& key, const std::string& value, const char* domain) {
     const std::string path = (dir_ / "in" / absl::StrCat("meta-", key, ".tif")).string();
     GDALDataset* ds = GetGDALDriverManager()->GetDriverByName("GTiff")->CreateCopy(
-        path.c_str(), GDALDataset::FromHandle(GDALOpen(tif_.c_str(), GA_ReadOnly)), FALSE, nullptr, nullptr, nullptr);
+        path.c_str(), GDALDataset::FromHandle(GDALOpen(tif_.c_str(), GA_ReadOnly)), FALSE, nullptr,
+        nullptr, nullptr);
     EXPECT_NE(ds, nullptr);
     ds->SetMetadataItem(key.c_str(), value.c_str(), domain);
     GDALClose(ds);
@@ -532,23 +544,28 @@ TEST_F(TerrainServiceTest, NoRequestMakesTheServerReachOut) {
   };
   const std::string local_overview = (dir_ / "in" / "secret.tif").string();
   fs::copy_file(tif_, local_overview);
-  for (const std::string& target : {absl::StrCat("/vsicurl/", listener.Url("/o.tif")), local_overview}) {
+  for (const std::string& target :
+       {absl::StrCat("/vsicurl/", listener.Url("/o.tif")), local_overview}) {
     const auto start = std::chrono::steady_clock::now();
     testing::UploadResult refused = UploadDem(tiff_with("OVERVIEW_FILE", target, "OVERVIEWS"), "");
     EXPECT_EQ(refused.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << target;
     EXPECT_EQ(BadField(refused.status), "chunk") << refused.status.error_message();
-    EXPECT_TRUE(Contains(refused.status.error_message(), "external overview file")) << refused.status.error_message();
+    EXPECT_TRUE(Contains(refused.status.error_message(), "external overview file"))
+        << refused.status.error_message();
     EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5);
   }
-  testing::UploadResult harmless = UploadDem(tiff_with("SOURCE", listener.Url("/meta"), nullptr), "");
+  testing::UploadResult harmless =
+      UploadDem(tiff_with("SOURCE", listener.Url("/meta"), nullptr), "");
   EXPECT_TRUE(harmless.status.ok()) << harmless.status.error_message();
   const std::string vrt = absl::StrCat(
       R"(<VRTDataset rasterXSize="30" rasterYSize="30"><VRTRasterBand dataType="Float32" band="1"><SimpleSource>)",
-      "<SourceFilename>/vsicurl/", listener.Url("/src.tif"), "</SourceFilename><SourceBand>1</SourceBand>",
+      "<SourceFilename>/vsicurl/", listener.Url("/src.tif"),
+      "</SourceFilename><SourceBand>1</SourceBand>",
       "</SimpleSource></VRTRasterBand></VRTDataset>");
   for (v1::MeshFormat format : {v1::MESH_FORMAT_GEOTIFF, v1::MESH_FORMAT_UNSPECIFIED}) {
     testing::UploadResult refused = UploadDem(vrt, "", format, "dem.vrt");
-    EXPECT_EQ(refused.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << refused.status.error_message();
+    EXPECT_EQ(refused.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT)
+        << refused.status.error_message();
   }
 
   // Nothing reached the listener, and geodexd still serves.
@@ -640,7 +657,8 @@ TEST_F(TerrainServiceTest, ExportGisMakesTheCliFiles) {
   // Beyond max_distance: distance and source are null, not left out.
   request.mutable_options()->set_max_distance(20);
   const std::string near_only = run(request, &media);
-  EXPECT_TRUE(Contains(near_only, "\"distance\": null, \"source\": null")) << near_only.substr(0, 800);
+  EXPECT_TRUE(Contains(near_only, "\"distance\": null, \"source\": null"))
+      << near_only.substr(0, 800);
   request.clear_options();
 
   // Not a DEM's mesh, no product: INVALID_ARGUMENT naming the field.

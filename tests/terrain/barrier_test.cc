@@ -35,7 +35,8 @@ constexpr double kSlopeX = 0.3, kSlopeY = -0.2;  // the plane z = 0.3 x - 0.2 y
 MeshData TiltedGrid(int n) {
   MeshData mesh;
   for (int j = 0; j <= n; ++j) {
-    for (int i = 0; i <= n; ++i) mesh.positions.insert(mesh.positions.end(), {1.0 * i, 1.0 * j, kSlopeX * i + kSlopeY * j});
+    for (int i = 0; i <= n; ++i)
+      mesh.positions.insert(mesh.positions.end(), {1.0 * i, 1.0 * j, kSlopeX * i + kSlopeY * j});
   }
   auto id = [n](int i, int j) { return static_cast<uint32_t>(j * (n + 1) + i); };
   for (int j = 0; j < n; ++j) {
@@ -55,7 +56,9 @@ double Cross(const Point2& o, const Point2& a, const Point2& b) {
   return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
 }
 
-std::array<double, 3> OnPlane(const Point2& p) { return {p[0], p[1], kSlopeX * p[0] + kSlopeY * p[1]}; }
+std::array<double, 3> OnPlane(const Point2& p) {
+  return {p[0], p[1], kSlopeX * p[0] + kSlopeY * p[1]};
+}
 double Length3(const Point2& p, const Point2& q) {
   const auto a = OnPlane(p), b = OnPlane(q);
   return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
@@ -74,7 +77,10 @@ bool Blocked(const Point2& p, const Point2& q, const std::vector<Point2>& polygo
       continue;
     }
     const double t = -at_p / slope;
-    if (slope > 0) lo = std::max(lo, t); else hi = std::min(hi, t);
+    if (slope > 0)
+      lo = std::max(lo, t);
+    else
+      hi = std::min(hi, t);
   }
   return hi - lo > 1e-9;
 }
@@ -84,7 +90,9 @@ double TautString(const Point2& s, const Point2& t, const std::vector<std::vecto
   std::vector<Point2> nodes = {s, t};
   for (const auto& h : holes) nodes.insert(nodes.end(), h.begin(), h.end());
   std::vector<double> best(nodes.size(), std::numeric_limits<double>::infinity());
-  std::priority_queue<std::pair<double, size_t>, std::vector<std::pair<double, size_t>>, std::greater<>> queue;
+  std::priority_queue<std::pair<double, size_t>, std::vector<std::pair<double, size_t>>,
+                      std::greater<>>
+      queue;
   best[0] = 0;
   queue.push({0, 0});
   while (!queue.empty()) {
@@ -108,8 +116,8 @@ std::string PolygonJson(const std::vector<std::vector<Point2>>& polygons) {
   for (const auto& ring : polygons) {
     std::string coordinates;
     for (size_t k = 0; k <= ring.size(); ++k) {
-      absl::StrAppendFormat(&coordinates, "%s[%.17g, %.17g]", k == 0 ? "" : ", ", ring[k % ring.size()][0],
-                            ring[k % ring.size()][1]);
+      absl::StrAppendFormat(&coordinates, "%s[%.17g, %.17g]", k == 0 ? "" : ", ",
+                            ring[k % ring.size()][0], ring[k % ring.size()][1]);
     }
     absl::StrAppend(&parts, parts.empty() ? "" : ", ", "[[", coordinates, "]]");
   }
@@ -123,7 +131,9 @@ double Area3(const MeshData& m) {
     for (int c = 0; c < 3; ++c) p[c] = &m.positions[3 * size_t{m.faces[3 * f + c]}];
     const double u[3] = {p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]};
     const double v[3] = {p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]};
-    total += std::hypot(u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]) / 2;
+    total += std::hypot(u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
+                        u[0] * v[1] - u[1] * v[0]) /
+             2;
   }
   return total;
 }
@@ -142,7 +152,8 @@ double DistanceToBoundary(const Point2& p, const std::vector<Point2>& ring) {
   for (size_t k = 0; k < ring.size(); ++k) {
     const Point2 &a = ring[k], &b = ring[(k + 1) % ring.size()];
     const double dx = b[0] - a[0], dy = b[1] - a[1];
-    const double t = std::clamp(((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / (dx * dx + dy * dy), 0.0, 1.0);
+    const double t =
+        std::clamp(((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / (dx * dx + dy * dy), 0.0, 1.0);
     best = std::min(best, std::hypot(p[0] - a[0] - t * dx, p[1] - a[1] - t * dy));
   }
   return best;
@@ -150,7 +161,8 @@ double DistanceToBoundary(const Point2& p, const std::vector<Point2>& ring) {
 
 // Conforming: each directed edge once; an edge with one face lies on the grid's outer boundary or
 // on a polygon's boundary (a T-junction would leave one inside). Every vertex on the plane.
-void ExpectConforming(const MeshData& cut, int n, const std::vector<std::vector<Point2>>& polygons) {
+void ExpectConforming(const MeshData& cut, int n,
+                      const std::vector<std::vector<Point2>>& polygons) {
   std::map<std::pair<uint32_t, uint32_t>, int> directed;
   for (size_t f = 0; f < cut.face_count(); ++f) {
     for (int c = 0; c < 3; ++c) ++directed[{cut.faces[3 * f + c], cut.faces[3 * f + (c + 1) % 3]}];
@@ -163,11 +175,12 @@ void ExpectConforming(const MeshData& cut, int n, const std::vector<std::vector<
     const double* a = &cut.positions[3 * size_t{edge.first}];
     const double* b = &cut.positions[3 * size_t{edge.second}];
     const Point2 mid = {(a[0] + b[0]) / 2, (a[1] + b[1]) / 2};
-    bool ok = std::abs(mid[0]) < 1e-12 || std::abs(mid[1]) < 1e-12 || std::abs(mid[0] - n) < 1e-12 ||
-              std::abs(mid[1] - n) < 1e-12;
+    bool ok = std::abs(mid[0]) < 1e-12 || std::abs(mid[1]) < 1e-12 ||
+              std::abs(mid[0] - n) < 1e-12 || std::abs(mid[1] - n) < 1e-12;
     for (const auto& ring : polygons) {
-      ok = ok || (DistanceToBoundary(mid, ring) < 1e-9 && DistanceToBoundary({a[0], a[1]}, ring) < 1e-9 &&
-                  DistanceToBoundary({b[0], b[1]}, ring) < 1e-9);
+      ok = ok ||
+           (DistanceToBoundary(mid, ring) < 1e-9 && DistanceToBoundary({a[0], a[1]}, ring) < 1e-9 &&
+            DistanceToBoundary({b[0], b[1]}, ring) < 1e-9);
     }
     bad += ok ? 0 : 1;
   }
@@ -187,11 +200,13 @@ TEST(BarrierCutTest, SquareHoleGivesTheTautString) {
   const double angle = 20 * M_PI / 180;
   for (int k = 0; k < 4; ++k) {
     const double a = angle + k * M_PI / 2;
-    hole.push_back({10.13 + 4.3 * std::cos(a) * std::sqrt(2.0), 9.87 + 4.3 * std::sin(a) * std::sqrt(2.0)});
+    hole.push_back(
+        {10.13 + 4.3 * std::cos(a) * std::sqrt(2.0), 9.87 + 4.3 * std::sin(a) * std::sqrt(2.0)});
   }
   ASSERT_GT(Shoelace(hole), 0);
   CutStats stats;
-  absl::StatusOr<MeshData> cut = CutBarrierPolygons(grid, PolygonJson({hole}), nullptr, 0, "hole", &stats);
+  absl::StatusOr<MeshData> cut =
+      CutBarrierPolygons(grid, PolygonJson({hole}), nullptr, 0, "hole", &stats);
   ASSERT_TRUE(cut.ok()) << cut.status();
   EXPECT_GT(stats.faces_cut, 0u);
   EXPECT_GT(stats.faces_removed, 0u);
@@ -235,14 +250,17 @@ TEST(BarrierCutTest, AWallNarrowerThanACellSeparates) {
   const MeshData grid = TiltedGrid(n);
   // 0.3 wide, across the whole grid at 17 degrees off its columns.
   const double angle = 17 * M_PI / 180, cx = 8.4, cy = 8;
-  const Point2 along = {std::sin(angle), std::cos(angle)}, across = {std::cos(angle), -std::sin(angle)};
+  const Point2 along = {std::sin(angle), std::cos(angle)},
+               across = {std::cos(angle), -std::sin(angle)};
   std::vector<Point2> wall;
-  for (auto [u, w] : std::vector<std::pair<double, double>>{{-20, -0.15}, {-20, 0.15}, {20, 0.15}, {20, -0.15}}) {
+  for (auto [u, w] :
+       std::vector<std::pair<double, double>>{{-20, -0.15}, {-20, 0.15}, {20, 0.15}, {20, -0.15}}) {
     wall.push_back({cx + u * along[0] + w * across[0], cy + u * along[1] + w * across[1]});
   }
   if (Shoelace(wall) < 0) std::reverse(wall.begin(), wall.end());
   CutStats stats;
-  absl::StatusOr<MeshData> cut = CutBarrierPolygons(grid, PolygonJson({wall}), nullptr, 0, "wall", &stats);
+  absl::StatusOr<MeshData> cut =
+      CutBarrierPolygons(grid, PolygonJson({wall}), nullptr, 0, "wall", &stats);
   ASSERT_TRUE(cut.ok()) << cut.status();
   ExpectConforming(*cut, n, {wall});
   absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(*cut);
@@ -274,11 +292,14 @@ TEST(BarrierCutTest, LinesAreWallsOfTheirWidth) {
   const MeshData grid = TiltedGrid(n);
   const std::string fence = R"({"type": "LineString", "coordinates": [[4.37, -1], [6.11, 11]]})";
   CutStats stats;
-  absl::Status refused =
-      CutBarrierPolygons(grid, R"({"type": "Point", "coordinates": [3, 3]})", nullptr, 0, "--barrier f", &stats).status();
+  absl::Status refused = CutBarrierPolygons(grid, R"({"type": "Point", "coordinates": [3, 3]})",
+                                            nullptr, 0, "--barrier f", &stats)
+                             .status();
   EXPECT_EQ(refused.code(), absl::StatusCode::kInvalidArgument);
-  EXPECT_EQ(refused.message().rfind("--barrier f: points are barriers with a width", 0), 0u) << refused;
-  absl::StatusOr<MeshData> cut = CutBarrierPolygons(grid, fence, nullptr, 0.25, "--barrier f", &stats);
+  EXPECT_EQ(refused.message().rfind("--barrier f: points are barriers with a width", 0), 0u)
+      << refused;
+  absl::StatusOr<MeshData> cut =
+      CutBarrierPolygons(grid, fence, nullptr, 0.25, "--barrier f", &stats);
   ASSERT_TRUE(cut.ok()) << cut.status();
   // The wall's area is its length times its width plus its two round ends (GEOS's buffer: 8
   // segments a quarter circle, so a little less than pi r^2).
@@ -301,8 +322,10 @@ using Segment = std::array<Point2, 2>;
 // Does p-q cross segment a-b (each passing through the other's inside)? Touching an end is not.
 bool Crosses(const Point2& p, const Point2& q, const Segment& s) {
   const double eps = 1e-12;
-  const double o1 = Cross(s[0], s[1], p), o2 = Cross(s[0], s[1], q), o3 = Cross(p, q, s[0]), o4 = Cross(p, q, s[1]);
-  return ((o1 > eps && o2 < -eps) || (o1 < -eps && o2 > eps)) && ((o3 > eps && o4 < -eps) || (o3 < -eps && o4 > eps));
+  const double o1 = Cross(s[0], s[1], p), o2 = Cross(s[0], s[1], q), o3 = Cross(p, q, s[0]),
+               o4 = Cross(p, q, s[1]);
+  return ((o1 > eps && o2 < -eps) || (o1 < -eps && o2 > eps)) &&
+         ((o3 > eps && o4 < -eps) || (o3 < -eps && o4 > eps));
 }
 
 // The shortest path from s to t on the plane around the slits, through their ends inside the grid.
@@ -332,13 +355,15 @@ double AroundSlits(const Point2& s, const Point2& t, const std::vector<Segment>&
   return best[1];
 }
 
-double DistanceToSegment(const Point2& p, const Segment& s) { return DistanceToBoundary(p, {s[0], s[1]}); }
+double DistanceToSegment(const Point2& p, const Segment& s) {
+  return DistanceToBoundary(p, {s[0], s[1]});
+}
 
 std::string LinesJson(const std::vector<Segment>& lines) {
   std::string parts;
   for (const Segment& l : lines) {
-    absl::StrAppendFormat(&parts, "%s[[%.17g, %.17g], [%.17g, %.17g]]", parts.empty() ? "" : ", ", l[0][0], l[0][1],
-                          l[1][0], l[1][1]);
+    absl::StrAppendFormat(&parts, "%s[[%.17g, %.17g], [%.17g, %.17g]]", parts.empty() ? "" : ", ",
+                          l[0][0], l[0][1], l[1][0], l[1][1]);
   }
   return absl::StrCat(R"({"type": "MultiLineString", "coordinates": [)", parts, "]}");
 }
@@ -352,7 +377,8 @@ TEST(BarrierCutTest, LinesWithoutAWidthAreExactSlits) {
                                       Segment{Point2{8.55, 9.3}, Point2{10.4, 17}},
                                       Segment{Point2{12, 2}, Point2{15, 5}}};
   CutStats stats;
-  absl::StatusOr<MeshData> cut = CutBarrierPolygons(grid, LinesJson(slits), nullptr, 0, "slits", &stats);
+  absl::StatusOr<MeshData> cut =
+      CutBarrierPolygons(grid, LinesJson(slits), nullptr, 0, "slits", &stats);
   ASSERT_TRUE(cut.ok()) << cut.status();
   EXPECT_GT(stats.faces_cut, 0u);
   EXPECT_EQ(stats.faces_removed, 0u);
@@ -392,8 +418,8 @@ TEST(BarrierCutTest, LinesWithoutAWidthAreExactSlits) {
   }
 
   // A line across the whole grid separates.
-  absl::StatusOr<MeshData> across = CutBarrierPolygons(grid, LinesJson({Segment{Point2{-1, 4.37}, Point2{17, 5.91}}}),
-                                                       nullptr, 0, "across", &stats);
+  absl::StatusOr<MeshData> across = CutBarrierPolygons(
+      grid, LinesJson({Segment{Point2{-1, 4.37}, Point2{17, 5.91}}}), nullptr, 0, "across", &stats);
   ASSERT_TRUE(across.ok()) << across.status();
   absl::StatusOr<TriangleMesh> halves = TriangleMesh::Build(*across);
   ASSERT_TRUE(halves.ok());
@@ -411,27 +437,35 @@ TEST(BarrierCutTest, BadBarriersAreClearErrorsOrRepaired) {
   const int n = 8;
   const MeshData grid = TiltedGrid(n);
   CutStats stats;
-  absl::Status nan = CutBarrierPolygons(grid, R"({"type": "LineString", "coordinates": [[1, 1], [2, NaN]]})", nullptr, 0,
-                                        "--barrier f", &stats).status();
+  absl::Status nan =
+      CutBarrierPolygons(grid, R"({"type": "LineString", "coordinates": [[1, 1], [2, NaN]]})",
+                         nullptr, 0, "--barrier f", &stats)
+          .status();
   EXPECT_EQ(nan.code(), absl::StatusCode::kInvalidArgument) << nan;
   // A bow tie (self-intersecting ring): its two triangles are cut.
   absl::StatusOr<MeshData> bowtie = CutBarrierPolygons(
-      grid, R"({"type": "Polygon", "coordinates": [[[1.3, 1.2], [4.7, 4.6], [4.7, 1.2], [1.3, 4.6], [1.3, 1.2]]]})", nullptr,
-      0, "bowtie", &stats);
+      grid,
+      R"({"type": "Polygon", "coordinates": [[[1.3, 1.2], [4.7, 4.6], [4.7, 1.2], [1.3, 4.6], [1.3, 1.2]]]})",
+      nullptr, 0, "bowtie", &stats);
   ASSERT_TRUE(bowtie.ok()) << bowtie.status();
   const double sec = std::sqrt(1 + kSlopeX * kSlopeX + kSlopeY * kSlopeY);
   EXPECT_NEAR(Area3(*bowtie), (n * n - 2 * (3.4 * 1.7 / 2)) * sec, 1e-9 * n * n);
   // A line whose last point repeats still ends where it ends (the slit reaches it).
   absl::StatusOr<MeshData> repeated = CutBarrierPolygons(
-      grid, R"({"type": "LineString", "coordinates": [[-1, 3.3], [4.55, 3.3], [4.55, 3.3]]})", nullptr, 0, "line", &stats);
-  absl::StatusOr<MeshData> plain = CutBarrierPolygons(
-      grid, R"({"type": "LineString", "coordinates": [[-1, 3.3], [4.55, 3.3]]})", nullptr, 0, "line", &stats);
+      grid, R"({"type": "LineString", "coordinates": [[-1, 3.3], [4.55, 3.3], [4.55, 3.3]]})",
+      nullptr, 0, "line", &stats);
+  absl::StatusOr<MeshData> plain =
+      CutBarrierPolygons(grid, R"({"type": "LineString", "coordinates": [[-1, 3.3], [4.55, 3.3]]})",
+                         nullptr, 0, "line", &stats);
   ASSERT_TRUE(repeated.ok() && plain.ok());
   EXPECT_EQ(repeated->faces, plain->faces) << repeated->face_count() << " " << plain->face_count();
-  EXPECT_EQ(repeated->positions, plain->positions) << repeated->vertex_count() << " " << plain->vertex_count();
+  EXPECT_EQ(repeated->positions, plain->positions)
+      << repeated->vertex_count() << " " << plain->vertex_count();
   // The vertex budget.
-  absl::Status budget = CutBarrierPolygons(grid, R"({"type": "LineString", "coordinates": [[-1, 3.3], [9, 4.1]]})", nullptr,
-                                           0, "line", &stats, grid.vertex_count() + 2).status();
+  absl::Status budget =
+      CutBarrierPolygons(grid, R"({"type": "LineString", "coordinates": [[-1, 3.3], [9, 4.1]]})",
+                         nullptr, 0, "line", &stats, grid.vertex_count() + 2)
+          .status();
   EXPECT_EQ(budget.code(), absl::StatusCode::kResourceExhausted) << budget;
 }
 
@@ -451,7 +485,8 @@ TEST(BarrierCutTest, TwoHolesAndAPolygonAlongGridLines) {
   const std::vector<Point2> ledge = {{6.5, 2}, {8.5, 2}, {8.5, 3.7}, {6.5, 3.7}};
   const std::vector<std::vector<Point2>> all = {square, triangle, tip, ledge, hair};
   CutStats stats;
-  absl::StatusOr<MeshData> cut = CutBarrierPolygons(grid, PolygonJson(all), nullptr, 0, "holes", &stats);
+  absl::StatusOr<MeshData> cut =
+      CutBarrierPolygons(grid, PolygonJson(all), nullptr, 0, "holes", &stats);
   ASSERT_TRUE(cut.ok()) << cut.status();
   ExpectConforming(*cut, n, all);
   EXPECT_GT(stats.faces_split, 0u);
@@ -464,12 +499,14 @@ TEST(BarrierCutTest, TwoHolesAndAPolygonAlongGridLines) {
   ASSERT_TRUE(mesh.ok()) << mesh.status();
   absl::StatusOr<DistanceField> field = ComputeDistanceField(*mesh, {SurfacePoint::AtVertex(0)});
   ASSERT_TRUE(field.ok());
-  for (const Point2 target : {Point2{12, 12}, Point2{6, 3}, Point2{3, 12}, Point2{11, 9}, Point2{9, 4}, Point2{4, 10}}) {
+  for (const Point2 target :
+       {Point2{12, 12}, Point2{6, 3}, Point2{3, 12}, Point2{11, 9}, Point2{9, 4}, Point2{4, 10}}) {
     const double d = field->distance[static_cast<size_t>(target[1] * (n + 1) + target[0])];
     EXPECT_NEAR(d, TautString({0, 0}, target, all), 1e-9 * d) << target[0] << " " << target[1];
   }
   // A polygon that misses the mesh changes nothing.
-  absl::StatusOr<MeshData> away = CutBarrierPolygons(grid, PolygonJson({{{30, 30}, {31, 30}, {31, 31}}}), nullptr, 0, "away", &stats);
+  absl::StatusOr<MeshData> away = CutBarrierPolygons(
+      grid, PolygonJson({{{30, 30}, {31, 30}, {31, 31}}}), nullptr, 0, "away", &stats);
   ASSERT_TRUE(away.ok());
   EXPECT_EQ(away->faces, grid.faces);
   EXPECT_EQ(away->positions, grid.positions);
@@ -480,11 +517,13 @@ TEST(BarrierCutTest, TwoHolesAndAPolygonAlongGridLines) {
 // to map point, the distance is the taut string around the hole's corners to 1e-9.
 TEST(BarrierCutTest, DemHoleGivesTheTautString) {
   GDALAllRegister();
-  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "geodex-barrier-dem-hole";
+  const std::filesystem::path dir =
+      std::filesystem::path(::testing::TempDir()) / "geodex-barrier-dem-hole";
   std::filesystem::create_directories(dir);
   const std::string tif = (dir / "plane.tif").string(), hole_file = (dir / "hole.geojson").string();
   const double ax = 0.12, ay = -0.07;  // z = ax (x - 500000) + ay (y - 5000000)
-  GDALDataset* ds = GetGDALDriverManager()->GetDriverByName("GTiff")->Create(tif.c_str(), 40, 30, 1, GDT_Float64, nullptr);
+  GDALDataset* ds = GetGDALDriverManager()->GetDriverByName("GTiff")->Create(tif.c_str(), 40, 30, 1,
+                                                                             GDT_Float64, nullptr);
   double gt[6] = {500000, 10, 0, 5000000, 0, -10};
   ds->SetGeoTransform(gt);
   OGRSpatialReference utm;
@@ -493,7 +532,9 @@ TEST(BarrierCutTest, DemHoleGivesTheTautString) {
   std::vector<double> row(40);
   for (int j = 0; j < 30; ++j) {
     for (int i = 0; i < 40; ++i) row[i] = ax * (i + 0.5) * 10 + ay * -(j + 0.5) * 10;
-    ASSERT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Write, 0, j, 40, 1, row.data(), 40, 1, GDT_Float64, 0, 0), CE_None);
+    ASSERT_EQ(
+        ds->GetRasterBand(1)->RasterIO(GF_Write, 0, j, 40, 1, row.data(), 40, 1, GDT_Float64, 0, 0),
+        CE_None);
   }
   GDALClose(ds);
   std::vector<Point2> hole;
@@ -503,10 +544,12 @@ TEST(BarrierCutTest, DemHoleGivesTheTautString) {
   }
   std::string ring;
   for (size_t k = 0; k <= hole.size(); ++k) {
-    absl::StrAppendFormat(&ring, "%s[%.17g, %.17g]", k == 0 ? "" : ", ", hole[k % 4][0], hole[k % 4][1]);
+    absl::StrAppendFormat(&ring, "%s[%.17g, %.17g]", k == 0 ? "" : ", ", hole[k % 4][0],
+                          hole[k % 4][1]);
   }
-  std::ofstream(hole_file) << R"({"type": "Polygon", "crs": {"type": "name", "properties": {"name": "EPSG:32633"}}, "coordinates": [[)"
-                           << ring << "]]}";
+  std::ofstream(hole_file)
+      << R"({"type": "Polygon", "crs": {"type": "name", "properties": {"name": "EPSG:32633"}}, "coordinates": [[)"
+      << ring << "]]}";
   DemOptions options;
   options.barrier_file = hole_file;
   absl::StatusOr<Dem> dem = Dem::Read(tif, options);
@@ -539,14 +582,17 @@ TEST(BarrierCutTest, DemHoleGivesTheTautString) {
         continue;
       }
       // The taut string: straight, or through one or two of the hole's corners.
-      double expected = Blocked(source, target, hole) ? std::numeric_limits<double>::infinity() : length(source, target);
+      double expected = Blocked(source, target, hole) ? std::numeric_limits<double>::infinity()
+                                                      : length(source, target);
       for (size_t a = 0; a < 4; ++a) {
         if (!Blocked(source, hole[a], hole) && !Blocked(hole[a], target, hole)) {
           expected = std::min(expected, length(source, hole[a]) + length(hole[a], target));
         }
         for (size_t b = 0; b < 4; ++b) {
-          if (a != b && !Blocked(source, hole[a], hole) && !Blocked(hole[a], hole[b], hole) && !Blocked(hole[b], target, hole)) {
-            expected = std::min(expected, length(source, hole[a]) + length(hole[a], hole[b]) + length(hole[b], target));
+          if (a != b && !Blocked(source, hole[a], hole) && !Blocked(hole[a], hole[b], hole) &&
+              !Blocked(hole[b], target, hole)) {
+            expected = std::min(expected, length(source, hole[a]) + length(hole[a], hole[b]) +
+                                              length(hole[b], target));
           }
         }
       }
@@ -563,8 +609,10 @@ TEST(BarrierCutTest, DemHoleGivesTheTautString) {
 // same cut; the stored mesh (Dem::FromMesh) drops map points as the read one does.
 TEST(BarrierCutTest, DemBarrierInEitherCrsAndStoredAgain) {
   GDALAllRegister();
-  const std::string path = (std::filesystem::path(::testing::TempDir()) / "geodex-barrier-plane.tif").string();
-  GDALDataset* ds = GetGDALDriverManager()->GetDriverByName("GTiff")->Create(path.c_str(), 30, 20, 1, GDT_Float64, nullptr);
+  const std::string path =
+      (std::filesystem::path(::testing::TempDir()) / "geodex-barrier-plane.tif").string();
+  GDALDataset* ds = GetGDALDriverManager()->GetDriverByName("GTiff")->Create(
+      path.c_str(), 30, 20, 1, GDT_Float64, nullptr);
   double gt[6] = {500000, 10, 0, 5000000, 0, -10};
   ds->SetGeoTransform(gt);
   OGRSpatialReference utm, wgs84;
@@ -576,13 +624,16 @@ TEST(BarrierCutTest, DemBarrierInEitherCrsAndStoredAgain) {
   std::vector<double> row(30);
   for (int j = 0; j < 20; ++j) {
     for (int i = 0; i < 30; ++i) row[i] = 0.1 * i - 0.05 * j;
-    ASSERT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Write, 0, j, 30, 1, row.data(), 30, 1, GDT_Float64, 0, 0), CE_None);
+    ASSERT_EQ(
+        ds->GetRasterBand(1)->RasterIO(GF_Write, 0, j, 30, 1, row.data(), 30, 1, GDT_Float64, 0, 0),
+        CE_None);
   }
   GDALClose(ds);
   absl::StatusOr<Dem> dem = Dem::Read(path);
   ASSERT_TRUE(dem.ok()) << dem.status();
 
-  const std::vector<Point2> ring = {{500083.3, 4999912.1}, {500191.7, 4999897.4}, {500172.2, 4999832.6}, {500101.9, 4999851.5}};
+  const std::vector<Point2> ring = {
+      {500083.3, 4999912.1}, {500191.7, 4999897.4}, {500172.2, 4999832.6}, {500101.9, 4999851.5}};
   std::string native, lonlat;
   OGRCoordinateTransformation* to_ll = OGRCreateCoordinateTransformation(&utm, &wgs84);
   for (size_t k = 0; k <= ring.size(); ++k) {
@@ -595,17 +646,20 @@ TEST(BarrierCutTest, DemBarrierInEitherCrsAndStoredAgain) {
   CutStats a_stats, b_stats;
   absl::StatusOr<MeshData> a = CutBarrierPolygons(
       dem->mesh(),
-      absl::StrCat(R"({"type": "Polygon", "crs": {"type": "name", "properties": {"name": "EPSG:32633"}}, "coordinates": [[)",
-                   native, "]]}"),
+      absl::StrCat(
+          R"({"type": "Polygon", "crs": {"type": "name", "properties": {"name": "EPSG:32633"}}, "coordinates": [[)",
+          native, "]]}"),
       &dem->info(), 0, "native", &a_stats);
   absl::StatusOr<MeshData> b = CutBarrierPolygons(
-      dem->mesh(), absl::StrCat(R"({"type": "Polygon", "coordinates": [[)", lonlat, "]]}"), &dem->info(), 0, "lonlat", &b_stats);
+      dem->mesh(), absl::StrCat(R"({"type": "Polygon", "coordinates": [[)", lonlat, "]]}"),
+      &dem->info(), 0, "lonlat", &b_stats);
   ASSERT_TRUE(a.ok()) << a.status();
   ASSERT_TRUE(b.ok()) << b.status();
   EXPECT_EQ(a->faces, b->faces);
   ASSERT_EQ(a->positions.size(), b->positions.size());
   double worst = 0;
-  for (size_t k = 0; k < a->positions.size(); ++k) worst = std::max(worst, std::abs(a->positions[k] - b->positions[k]));
+  for (size_t k = 0; k < a->positions.size(); ++k)
+    worst = std::max(worst, std::abs(a->positions[k] - b->positions[k]));
   EXPECT_LT(worst, 1e-6);
   EXPECT_GT(a_stats.faces_cut, 0u);
 
@@ -619,7 +673,8 @@ TEST(BarrierCutTest, DemBarrierInEitherCrsAndStoredAgain) {
       std::vector<Point2> local;
       for (const Point2& q : ring) local.push_back({q[0], q[1]});
       bool inside = true;
-      for (size_t k = 0; k < 4; ++k) inside &= Shoelace({local[k], local[(k + 1) % 4], Point2{x, y}}) < 0;
+      for (size_t k = 0; k < 4; ++k)
+        inside &= Shoelace({local[k], local[(k + 1) % 4], Point2{x, y}}) < 0;
       if (inside) {
         EXPECT_FALSE(p.ok()) << x << " " << y;
         continue;
@@ -627,7 +682,8 @@ TEST(BarrierCutTest, DemBarrierInEitherCrsAndStoredAgain) {
       ASSERT_TRUE(p.ok()) << x << " " << y << ": " << p.status();
       double pos[3] = {0, 0, 0};
       for (int c = 0; c < 3; ++c) {
-        for (int d = 0; d < 3; ++d) pos[d] += p->bary[c] * a->positions[3 * size_t{a->faces[3 * size_t{p->face} + c]} + d];
+        for (int d = 0; d < 3; ++d)
+          pos[d] += p->bary[c] * a->positions[3 * size_t{a->faces[3 * size_t{p->face} + c]} + d];
       }
       EXPECT_NEAR(pos[0], x, 1e-6);
       EXPECT_NEAR(pos[1], y, 1e-6);
@@ -649,7 +705,8 @@ TEST(BarrierCutTest, DemBarrierInEitherCrsAndStoredAgain) {
   absl::StatusOr<TriangleMesh> halves = TriangleMesh::Build(*slit);
   ASSERT_TRUE(halves.ok());
   EXPECT_EQ(halves->report().components, 2u);
-  absl::StatusOr<SurfacePoint> west = slit_dem->DropMapPoint(500051, 4999901), east = slit_dem->DropMapPoint(500161, 4999901);
+  absl::StatusOr<SurfacePoint> west = slit_dem->DropMapPoint(500051, 4999901),
+                               east = slit_dem->DropMapPoint(500161, 4999901);
   ASSERT_TRUE(west.ok() && east.ok());
   absl::StatusOr<DistanceField> field = ComputeDistanceField(*halves, {*west});
   ASSERT_TRUE(field.ok());

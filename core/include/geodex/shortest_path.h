@@ -75,8 +75,8 @@ struct PathQueryOptions {
 // Why `to` is unreachable from `from`, in words for an error ("it is on another part of the
 // surface (...)"): a vertex no face uses, a point on another part of the surface (split off by a
 // barrier or a hole, or a separate piece of the mesh), or beyond the max_distance limit.
-std::string UnreachableReason(const TriangleMesh& mesh, const SurfacePoint& from, const SurfacePoint& to,
-                              double max_distance);
+std::string UnreachableReason(const TriangleMesh& mesh, const SurfacePoint& from,
+                              const SurfacePoint& to, double max_distance);
 
 struct PathQueryResult {
   double distance = kUnreachable;

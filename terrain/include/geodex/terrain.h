@@ -97,8 +97,9 @@ struct CutStats {
 // `max_vertices` (0: none) bounds the cut mesh: ResourceExhausted (geodex/limits.h kVertices)
 // beyond it, checked as the cut goes (a barrier crossing many faces adds vertices at each).
 absl::StatusOr<MeshData> CutBarrierPolygons(const MeshData& mesh, const std::string& geojson,
-                                            const DemInfo* dem, double width, const std::string& name,
-                                            CutStats* stats, uint64_t max_vertices = 0);
+                                            const DemInfo* dem, double width,
+                                            const std::string& name, CutStats* stats,
+                                            uint64_t max_vertices = 0);
 
 // A point read from a file (--sources-file, --targets-file): its coordinates in the file's CRS
 // (crs_wkt; "" when the file names none: then in the DEM's CRS) and how messages name it.
@@ -111,7 +112,8 @@ struct FilePoint {
 // its "crs" names another by an identifier), GeoPackage, Shapefile or FlatGeobuf (each its own
 // driver only; their CRS, none: the DEM's), or CSV with x,y columns (the DEM's CRS) or lon,lat
 // (WGS 84). InvalidArgument starting with `name` for anything else.
-absl::StatusOr<std::vector<FilePoint>> ReadPointsFile(const std::string& path, const std::string& name);
+absl::StatusOr<std::vector<FilePoint>> ReadPointsFile(const std::string& path,
+                                                      const std::string& name);
 // The point as a SPEC item: ll:LON:LAT when its CRS is known, else g:X:Y.
 absl::StatusOr<std::string> FilePointSpec(const FilePoint& point);
 
