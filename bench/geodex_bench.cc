@@ -128,7 +128,7 @@ const std::vector<std::string>& MatrixMeshes() {
   return names;
 }
 const std::vector<std::string>& EstimateMeshes() {
-  static const std::vector<std::string> names = {"gargoyle", "armadillo", "fertility", "kitten",
+  static const std::vector<std::string> names = {"gargoyle",  "armadillo", "fertility", "kitten",
                                                  "bunny-npm", "camelhead", "face"};
   return names;
 }
@@ -175,7 +175,8 @@ constexpr char kUsage[] =
     "                      target's distance (default meshes: gargoyle, armadillo)\n"
     "  --matrix            instead of the main table: a 16 x 16 distance matrix between random\n"
     "                      points vs 16 full fields vs 256 A* queries (default mesh: armadillo)\n"
-    "  --estimate          instead of the main table: the unfolding estimate at random face points\n"
+    "  --estimate          instead of the main table: the unfolding estimate at random face "
+    "points\n"
     "                      (section 4) vs the exact distance, the straight line and Dijkstra\n"
     "                      (default meshes: gargoyle armadillo fertility kitten bunny-npm\n"
     "                      camelhead face)\n"
@@ -228,8 +229,8 @@ absl::StatusOr<Config> ParseArgs(int argc, char** argv) {
     } else if (arg == "--meshes" || arg == "--mesh" || arg == "--sources" || arg == "--repeat" ||
                arg == "--cgal-max-faces" || arg == "--methods" || arg == "--markdown" ||
                arg == "--timeout-s" || arg == "--wait-idle" || arg == "--seed" ||
-               arg == "--per-group" || arg == "--points" || arg == "--batch" ||
-               arg == "--peer" || arg == "--terrain-dir") {
+               arg == "--per-group" || arg == "--points" || arg == "--batch" || arg == "--peer" ||
+               arg == "--terrain-dir") {
       absl::StatusOr<std::string> v = next();
       if (!v.ok()) return v.status();
       if (arg == "--meshes") {
@@ -469,13 +470,13 @@ enum class Task : int32_t {
   kInfo,
   kGeodex,
   kCgal,
-  kPlanTargets,  // --astar: the full field from sources[0], then target points by distance group
+  kPlanTargets,   // --astar: the full field from sources[0], then target points by distance group
   kSamplePoints,  // `count` random points (seeded), sent back packed
-  kPathPair,     // --astar: from[0] -> to[0], A* and full field, `repeat` times each
-  kMatrix,       // --matrix: ComputeDistanceMatrix(from, to)
-  kFields,       // --matrix: ComputeDistanceField per point of `from`
-  kPathQueries,  // --matrix: ComputeShortestPath for every (from, to) pair
-  kEstimate,     // --estimate: estimate vs exact vs straight line vs Dijkstra at random face points
+  kPathPair,      // --astar: from[0] -> to[0], A* and full field, `repeat` times each
+  kMatrix,        // --matrix: ComputeDistanceMatrix(from, to)
+  kFields,        // --matrix: ComputeDistanceField per point of `from`
+  kPathQueries,   // --matrix: ComputeShortestPath for every (from, to) pair
+  kEstimate,  // --estimate: estimate vs exact vs straight line vs Dijkstra at random face points
 };
 
 // What a child does. `options` is used by kGeodex (its method picks ICH or Dijkstra).
@@ -744,8 +745,8 @@ std::array<double, 3> PointPosition(const MeshData& data, const SurfacePoint& p)
 // uniform over the component's area (a face picked by area, then a uniform point inside it).
 class PointSampler {
  public:
-  PointSampler(const MeshData& data, const TriangleMesh& mesh, uint32_t anchor,
-               double vertex_share, uint64_t seed)
+  PointSampler(const MeshData& data, const TriangleMesh& mesh, uint32_t anchor, double vertex_share,
+               uint64_t seed)
       : rng_(seed), vertex_share_(vertex_share) {
     const uint32_t component = mesh.Component(anchor);
     for (uint32_t v = 0; v < mesh.file_vertex_count(); ++v) {
@@ -776,10 +777,10 @@ class PointSampler {
       return SurfacePoint::AtVertex(vertices_[rng_.Below(vertices_.size())]);
     }
     const double x = rng_.Uniform() * cumulative_area_.back();
-    const size_t i = std::min<size_t>(
-        std::upper_bound(cumulative_area_.begin(), cumulative_area_.end(), x) -
-            cumulative_area_.begin(),
-        faces_.size() - 1);
+    const size_t i =
+        std::min<size_t>(std::upper_bound(cumulative_area_.begin(), cumulative_area_.end(), x) -
+                             cumulative_area_.begin(),
+                         faces_.size() - 1);
     const double r1 = std::sqrt(rng_.Uniform()), r2 = rng_.Uniform();
     return SurfacePoint::InFace(faces_[i], 1 - r1, r1 * (1 - r2), r1 * r2);
   }
@@ -839,8 +840,7 @@ int64_t PeakRssKb() {
   while (std::getline(in, line)) {
     if (absl::StartsWith(line, "VmHWM:")) {
       int64_t kb = 0;
-      std::vector<std::string> parts =
-          absl::StrSplit(line.substr(6), ' ', absl::SkipWhitespace());
+      std::vector<std::string> parts = absl::StrSplit(line.substr(6), ' ', absl::SkipWhitespace());
       if (!parts.empty() && absl::SimpleAtoi(parts[0], &kb)) return kb;
     }
   }
@@ -1722,7 +1722,8 @@ Section MainSection(const Config& config, const std::vector<MeshInfo>& meshes) {
         cells.push_back(Ms(r.wall_ms));
         cells.push_back(Ms(r.cpu_ms));
         cells.push_back(Ratio(r.solve_ms / dijkstra_ms));
-        cells.push_back(method != "Dijkstra" && method != "CGAL" ? Ratio(cgal_ms / r.solve_ms) : "");
+        cells.push_back(method != "Dijkstra" && method != "CGAL" ? Ratio(cgal_ms / r.solve_ms)
+                                                                 : "");
         cells.push_back(windows ? Count(r.stats.windows_created) : "");
         cells.push_back(windows ? Count(FilteredWindows(r.stats)) : "");
         cells.push_back(windows ? Count(r.stats.windows_processed) : "");
@@ -1741,9 +1742,9 @@ Section MainSection(const Config& config, const std::vector<MeshInfo>& meshes) {
       // default engine) and a check against Dijkstra's upper bound.
       auto exact_row = [&](const std::string& method, const Outcome& o) {
         std::vector<std::string> cells = row(method, o);
-        const Outcome* reference = cgal_run && cgal_run->ok() ? &*cgal_run
+        const Outcome* reference = cgal_run && cgal_run->ok()        ? &*cgal_run
                                    : ich && ich->ok() && &o != &*ich ? &*ich
-                                                                      : nullptr;
+                                                                     : nullptr;
         if (o.ok() && reference != nullptr && o.distance.size() == reference->distance.size()) {
           const FieldDiff d = Compare(o.distance, reference->distance);
           cells[cells.size() - 3] = Sci(d.max_abs);
@@ -1775,8 +1776,8 @@ Section MainSection(const Config& config, const std::vector<MeshInfo>& meshes) {
         exact_row(name, o);
         if (o.ok() && ich && ich->ok()) {
           s.notes.push_back(absl::StrFormat(
-              "%s source %u: geodex exact / %s = %.2f in time, %.2f in peak RSS", mesh.name,
-              source, name, ich->report.solve_ms / o.report.solve_ms,
+              "%s source %u: geodex exact / %s = %.2f in time, %.2f in peak RSS", mesh.name, source,
+              name, ich->report.solve_ms / o.report.solve_ms,
               static_cast<double>(ich->maxrss_kb) / std::max<int64_t>(1, o.maxrss_kb)));
         }
       }
@@ -2017,7 +2018,7 @@ struct PairResult {
   double fraction = 0;  // the exact (full-field) distance / the source's largest distance
   int group = 0;
   double full_ms = 0, astar_ms = 0;
-  double speedup = 0;  // full_ms / astar_ms
+  double speedup = 0;   // full_ms / astar_ms
   double rel_diff = 0;  // |A* - full| / full
 };
 
@@ -2065,8 +2066,8 @@ std::vector<Section> AstarSections(const Config& config, const std::vector<MeshI
     const Outcome plan = RunPointJob(*mesh, plan_job, config);
     Progress("choose the targets", plan);
     if (!plan.ok()) {
-      groups.notes.push_back(absl::StrCat(mesh->name, ": choosing the targets failed: ",
-                                          plan.StatusText(), " ", plan.message));
+      groups.notes.push_back(absl::StrCat(
+          mesh->name, ": choosing the targets failed: ", plan.StatusText(), " ", plan.message));
       continue;
     }
     const double largest = plan.report.max_distance;
@@ -2082,8 +2083,8 @@ std::vector<Section> AstarSections(const Config& config, const std::vector<MeshI
       r.target = targets[i];
       r.outcome = RunPointJob(*mesh, job, config);
       const ChildReport& c = r.outcome.report;
-      Progress(absl::StrFormat("pair %d/%d (%s): A* %.1f ms, full %.1f ms", i + 1,
-                               targets.size(), ShortPoint(targets[i]), c.wall_ms, c.full_wall_ms),
+      Progress(absl::StrFormat("pair %d/%d (%s): A* %.1f ms, full %.1f ms", i + 1, targets.size(),
+                               ShortPoint(targets[i]), c.wall_ms, c.full_wall_ms),
                r.outcome);
       if (r.outcome.ok()) {
         r.fraction = c.full_distance / largest;
@@ -2165,12 +2166,11 @@ std::vector<Section> AstarSections(const Config& config, const std::vector<MeshI
         cells.push_back(r.outcome.StatusText());
       } else {
         cells.insert(cells.end(),
-                     {absl::StrFormat("%.6g", c.full_distance), Percent(r.fraction),
-                      Ms(r.full_ms), Ms(r.astar_ms), Ms(c.full_solve_ms), Ms(c.solve_ms),
-                      Ratio(r.speedup), Count(c.full_stats.windows_created),
-                      Count(c.stats.windows_created),
-                      MiBOfBytes(static_cast<double>(c.stats.peak_bytes)),
-                      MiBOfKb(c.astar_peak_kb), Sci(r.rel_diff), OtherLoad(r.outcome)});
+                     {absl::StrFormat("%.6g", c.full_distance), Percent(r.fraction), Ms(r.full_ms),
+                      Ms(r.astar_ms), Ms(c.full_solve_ms), Ms(c.solve_ms), Ratio(r.speedup),
+                      Count(c.full_stats.windows_created), Count(c.stats.windows_created),
+                      MiBOfBytes(static_cast<double>(c.stats.peak_bytes)), MiBOfKb(c.astar_peak_kb),
+                      Sci(r.rel_diff), OtherLoad(r.outcome)});
       }
       pairs.table.AddRow(cells);
     }
@@ -2212,8 +2212,8 @@ Section MatrixSection(const Config& config, const std::vector<MeshInfo>& meshes)
     const Outcome points = RunPointJob(*mesh, sample, config);
     const std::vector<SurfacePoint> all = UnpackPoints(points.distance);
     if (!points.ok() || all.size() != 2 * kSide) {
-      s.notes.push_back(absl::StrCat(mesh->name, ": sampling the points failed: ",
-                                     points.StatusText(), " ", points.message));
+      s.notes.push_back(absl::StrCat(
+          mesh->name, ": sampling the points failed: ", points.StatusText(), " ", points.message));
       continue;
     }
     Job job;
@@ -2243,31 +2243,30 @@ Section MatrixSection(const Config& config, const std::vector<MeshInfo>& meshes)
     }
     auto row = [&](const std::string& method, const Outcome& o, int solves, int r,
                    const std::string& vs) {
-      std::vector<std::string> out = {mesh->name, Count(mesh->report.faces), method,
-                                      Count(solves), Count(r)};
+      std::vector<std::string> out = {mesh->name, Count(mesh->report.faces), method, Count(solves),
+                                      Count(r)};
       if (!o.ok()) {
         out.push_back(o.StatusText());
-        if (!o.message.empty()) s.notes.push_back(absl::StrCat(mesh->name, " ", method, ": ",
-                                                               o.message));
+        if (!o.message.empty())
+          s.notes.push_back(absl::StrCat(mesh->name, " ", method, ": ", o.message));
         return out;
       }
       const ChildReport& c = o.report;
-      out.insert(out.end(), {Ms(c.wall_ms), Ms(c.solve_ms), Ms(c.wall_ms / solves),
-                             absl::StrFormat("%.2fx", c.wall_ms / matrix_ms),
-                             Count(c.stats.windows_created),
-                             MiBOfBytes(static_cast<double>(c.stats.peak_bytes)),
-                             DeltaMiB(o, *mesh), vs, OtherLoad(o)});
+      out.insert(out.end(),
+                 {Ms(c.wall_ms), Ms(c.solve_ms), Ms(c.wall_ms / solves),
+                  absl::StrFormat("%.2fx", c.wall_ms / matrix_ms), Count(c.stats.windows_created),
+                  MiBOfBytes(static_cast<double>(c.stats.peak_bytes)), DeltaMiB(o, *mesh), vs,
+                  OtherLoad(o)});
       return out;
     };
     s.table.AddRow(row("distance matrix 16 x 16", matrix, kSide, repeat, "0"));
     s.table.AddRow(row("16 full fields", fields, kSide, repeat, ""));
-    s.table.AddRow(row("256 A* queries", queries, static_cast<int>(cells), query_repeat,
-                       Sci(query_rel)));
+    s.table.AddRow(
+        row("256 A* queries", queries, static_cast<int>(cells), query_repeat, Sci(query_rel)));
     int vertex_points = 0;
     for (const SurfacePoint& p : all) vertex_points += p.kind == SurfacePoint::Kind::kVertex;
     if (queries.ok() && queries.distance.size() == 2 * cells) {
-      const std::vector<double> per_query(queries.distance.begin() + cells,
-                                          queries.distance.end());
+      const std::vector<double> per_query(queries.distance.begin() + cells, queries.distance.end());
       s.notes.push_back(absl::StrFormat(
           "%s: the 256 A* queries took %s ms each at the median (%s-%s ms)", mesh->name,
           Ms(Median(per_query)), Ms(MinOf(per_query)), Ms(MaxOf(per_query))));
@@ -2291,10 +2290,10 @@ Section MatrixSection(const Config& config, const std::vector<MeshInfo>& meshes)
       sources.push_back(ShortPoint(all[k]));
       targets.push_back(ShortPoint(all[kSide + k]));
     }
-    s.notes.push_back(absl::StrFormat("%s: %d of the 32 points are vertices; sources: %s; "
-                                      "targets: %s",
-                                      mesh->name, vertex_points, absl::StrJoin(sources, ", "),
-                                      absl::StrJoin(targets, ", ")));
+    s.notes.push_back(absl::StrFormat(
+        "%s: %d of the 32 points are vertices; sources: %s; "
+        "targets: %s",
+        mesh->name, vertex_points, absl::StrJoin(sources, ", "), absl::StrJoin(targets, ", ")));
   }
   return s;
 }
@@ -2311,10 +2310,10 @@ Section EstimateSection(const Config& config, const std::vector<MeshInfo>& meshe
                 "the estimate is within 0.1%%, below = the share where it is below d_exact. "
                 "est us = per point (the field computed once: field ms); exact ms = per call.",
                 config.points, config.seed, config.batch),
-            Table({"mesh", "faces", "points", "line med", "line p90", "line max",
-                   "Dijkstra med", "Dijkstra p90", "Dijkstra max", "estimate med",
-                   "estimate p90", "estimate max", "estimate <= 0.1%", "estimate <= 0.01%",
-                   "estimate below", "field ms", "est us", "exact ms", "other load"},
+            Table({"mesh", "faces", "points", "line med", "line p90", "line max", "Dijkstra med",
+                   "Dijkstra p90", "Dijkstra max", "estimate med", "estimate p90", "estimate max",
+                   "estimate <= 0.1%", "estimate <= 0.01%", "estimate below", "field ms", "est us",
+                   "exact ms", "other load"},
                   "lrr"),
             {}};
   for (const MeshInfo* mesh : ModeMeshes(config, meshes, EstimateMeshes())) {
@@ -2328,8 +2327,7 @@ Section EstimateSection(const Config& config, const std::vector<MeshInfo>& meshe
     const Outcome o = RunPointJob(*mesh, job, config);
     Progress("estimate vs exact", o);
     if (!o.ok() || o.distance.size() != 4 * static_cast<size_t>(config.points)) {
-      s.table.AddRow({mesh->name, Count(mesh->report.faces), Count(config.points),
-                      o.StatusText()});
+      s.table.AddRow({mesh->name, Count(mesh->report.faces), Count(config.points), o.StatusText()});
       if (!o.message.empty()) s.notes.push_back(absl::StrCat(mesh->name, ": ", o.message));
       continue;
     }
@@ -2369,8 +2367,8 @@ Section EstimateSection(const Config& config, const std::vector<MeshInfo>& meshe
                     Ms(c.solve_ms), absl::StrFormat("%.2f", 1000 * c.estimate_ms / n),
                     Ms(c.exact_ms / std::max(1, c.exact_solves)), OtherLoad(o)});
     s.notes.push_back(absl::StrFormat(
-        "%s: the worst estimate is off by %s at a point %s of D = %.6g from the source%s", mesh->name,
-        Percent(worst), Percent(worst_exact / c.max_distance), c.max_distance,
+        "%s: the worst estimate is off by %s at a point %s of D = %.6g from the source%s",
+        mesh->name, Percent(worst), Percent(worst_exact / c.max_distance), c.max_distance,
         skipped > 0 ? absl::StrCat(" (", skipped, " points at distance 0 or unreachable skipped)")
                     : ""));
     if (inconsistent > 0) {

@@ -110,9 +110,9 @@ class Child : public testing_support::GeodexdChild {
  private:
   static std::vector<std::string> Args(const fs::path& dir, const std::string& binary,
                                        std::vector<std::string> flags) {
-    std::vector<std::string> args = {binary, "--listen", "127.0.0.1:0", "--metrics_listen",
-                                     "127.0.0.1:0", "--data-dir", (dir / "data").string(),
-                                     "--samples=false"};
+    std::vector<std::string> args = {
+        binary,        "--listen",   "127.0.0.1:0",           "--metrics_listen",
+        "127.0.0.1:0", "--data-dir", (dir / "data").string(), "--samples=false"};
     args.insert(args.end(), flags.begin(), flags.end());
     return args;
   }
@@ -205,15 +205,24 @@ int Main(int argc, char** argv) {
   uint32_t seed = 1;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string flag = argv[i], value = argv[i + 1];
-    if (flag == "--geodexd") geodexd = value;
-    else if (flag == "--mesh") mesh_paths.push_back(value);
-    else if (flag == "--seconds") seconds = std::stod(value);
-    else if (flag == "--workers") workers = std::stoi(value);
-    else if (flag == "--queue") queue = std::stoi(value);
-    else if (flag == "--overload") overload = std::stod(value);
-    else if (flag == "--mesh_budget_mib") mesh_budget_mib = std::stod(value);
-    else if (flag == "--cache_mib") cache_mib = std::stod(value);
-    else if (flag == "--seed") seed = static_cast<uint32_t>(std::stoul(value));
+    if (flag == "--geodexd")
+      geodexd = value;
+    else if (flag == "--mesh")
+      mesh_paths.push_back(value);
+    else if (flag == "--seconds")
+      seconds = std::stod(value);
+    else if (flag == "--workers")
+      workers = std::stoi(value);
+    else if (flag == "--queue")
+      queue = std::stoi(value);
+    else if (flag == "--overload")
+      overload = std::stod(value);
+    else if (flag == "--mesh_budget_mib")
+      mesh_budget_mib = std::stod(value);
+    else if (flag == "--cache_mib")
+      cache_mib = std::stod(value);
+    else if (flag == "--seed")
+      seed = static_cast<uint32_t>(std::stoul(value));
     else {
       std::fprintf(stderr, "unknown flag %s (see the comment at the top of load_bench.cc)\n",
                    flag.c_str());
@@ -225,7 +234,8 @@ int Main(int argc, char** argv) {
     if (fs::exists(source + "/../shared/meshes/armadillo.off")) {
       mesh_paths.push_back(source + "/../shared/meshes/armadillo.off");
     }
-    for (const char* name : {"fertility", "bump-domain", "kitten", "bunny-npm", "three-peaks", "knight"}) {
+    for (const char* name :
+         {"fertility", "bump-domain", "kitten", "bunny-npm", "three-peaks", "knight"}) {
       mesh_paths.push_back(absl::StrCat(source, "/tests/data/", name, ".off"));
     }
   }
@@ -261,7 +271,8 @@ int Main(int argc, char** argv) {
       grpc::Status s = Upload(*stub, files[i], fs::path(mesh_paths[i]).filename(),
                               absl::StrCat("probe", i), &created);
       if (!s.ok()) {
-        std::fprintf(stderr, "upload of %s: %s\n", mesh_paths[i].c_str(), s.error_message().c_str());
+        std::fprintf(stderr, "upload of %s: %s\n", mesh_paths[i].c_str(),
+                     s.error_message().c_str());
         return 1;
       }
       mesh_memory += created.memory_bytes();
@@ -287,24 +298,27 @@ int Main(int argc, char** argv) {
   {
     auto stub = v1::Geodex::NewStub(OwnChannel(child.port(), "upload"));
     for (size_t i = 0; i < files.size(); ++i) {
-      grpc::Status s = Upload(*stub, files[i], fs::path(mesh_paths[i]).filename(),
-                              absl::StrCat("load", i));
+      grpc::Status s =
+          Upload(*stub, files[i], fs::path(mesh_paths[i]).filename(), absl::StrCat("load", i));
       if (!s.ok()) {
-        std::fprintf(stderr, "upload of %s: %s\n", mesh_paths[i].c_str(), s.error_message().c_str());
+        std::fprintf(stderr, "upload of %s: %s\n", mesh_paths[i].c_str(),
+                     s.error_message().c_str());
         return 1;
       }
     }
   }
-  std::printf("geodexd pid %d: %d workers, queue %d, mesh budget %.1f MiB (meshes need %.1f MiB), "
-              "result cache %.0f MiB; idle RSS %.0f MiB; hardware threads %u\n",
-              child.pid(), workers, queue, mesh_budget / 1048576.0, mesh_memory / 1048576.0,
-              cache_mib, idle_rss_kb / 1024.0, std::thread::hardware_concurrency());
+  std::printf(
+      "geodexd pid %d: %d workers, queue %d, mesh budget %.1f MiB (meshes need %.1f MiB), "
+      "result cache %.0f MiB; idle RSS %.0f MiB; hardware threads %u\n",
+      child.pid(), workers, queue, mesh_budget / 1048576.0, mesh_memory / 1048576.0, cache_mib,
+      idle_rss_kb / 1024.0, std::thread::hardware_concurrency());
   std::printf("meshes:");
   for (size_t i = 0; i < meshes.size(); ++i) {
     std::printf(" %s (%u faces)", fs::path(mesh_paths[i]).filename().c_str(), meshes[i].faces);
   }
-  std::printf("\nquery mix: 40%% A* paths, 20%% fields, 20%% point distances x16, 10%% locate x64, "
-              "10%% isolines; a random mesh per query\n");
+  std::printf(
+      "\nquery mix: 40%% A* paths, 20%% fields, 20%% point distances x16, 10%% locate x64, "
+      "10%% isolines; a random mesh per query\n");
 
   const int overload_clients = static_cast<int>(overload * (workers + queue) + 0.5);
   std::vector<PhaseReport> phases;
@@ -328,18 +342,21 @@ int Main(int argc, char** argv) {
     health_failures += r.health_failures;
     worst_health_p99 = std::max(worst_health_p99, Percentile(r.health_ms, 0.99));
   }
-  std::printf("\nmeshes evicted from RAM %.0f, loaded back from disk %.0f; cache hits %.0f, "
-              "misses %.0f\n",
-              MetricValue(metrics, "geodex_mesh_store_evictions_total"),
-              MetricValue(metrics, "geodex_mesh_store_disk_loads_total"),
-              MetricValue(metrics, "geodex_result_cache_hits_total"),
-              MetricValue(metrics, "geodex_result_cache_misses_total"));
-  std::printf("geodexd peak RSS (VmHWM) %.0f MiB = idle %.0f + mesh budget %.1f + cache budget %.0f "
-              "+ %.0f MiB of solver working memory and gRPC buffers for %d workers\n",
-              hwm_kb / 1024.0, idle_rss_kb / 1024.0, mesh_budget / 1048576.0, cache_mib,
-              (static_cast<double>(hwm_kb) * 1024 - static_cast<double>(idle_rss_kb) * 1024 -
-               static_cast<double>(mesh_budget) - static_cast<double>(cache_budget)) / 1048576.0,
-              workers);
+  std::printf(
+      "\nmeshes evicted from RAM %.0f, loaded back from disk %.0f; cache hits %.0f, "
+      "misses %.0f\n",
+      MetricValue(metrics, "geodex_mesh_store_evictions_total"),
+      MetricValue(metrics, "geodex_mesh_store_disk_loads_total"),
+      MetricValue(metrics, "geodex_result_cache_hits_total"),
+      MetricValue(metrics, "geodex_result_cache_misses_total"));
+  std::printf(
+      "geodexd peak RSS (VmHWM) %.0f MiB = idle %.0f + mesh budget %.1f + cache budget %.0f "
+      "+ %.0f MiB of solver working memory and gRPC buffers for %d workers\n",
+      hwm_kb / 1024.0, idle_rss_kb / 1024.0, mesh_budget / 1048576.0, cache_mib,
+      (static_cast<double>(hwm_kb) * 1024 - static_cast<double>(idle_rss_kb) * 1024 -
+       static_cast<double>(mesh_budget) - static_cast<double>(cache_budget)) /
+          1048576.0,
+      workers);
   const int exit_code = child.Terminate(60);
 
   bool pass = true;
@@ -353,7 +370,8 @@ int Main(int argc, char** argv) {
   check(refused_outside_overload == 0,
         absl::StrCat("RESOURCE_EXHAUSTED before the overload phase: ", refused_outside_overload));
   check(health_failures == 0, absl::StrCat("failed health checks: ", health_failures));
-  check(worst_health_p99 < 50, absl::StrFormat("worst health p99 %.2f ms < 50 ms", worst_health_p99));
+  check(worst_health_p99 < 50,
+        absl::StrFormat("worst health p99 %.2f ms < 50 ms", worst_health_p99));
   check(peak_store <= static_cast<double>(mesh_budget),
         absl::StrFormat("mesh store peak %.1f MiB <= budget %.1f MiB", peak_store / 1048576.0,
                         mesh_budget / 1048576.0));
@@ -361,8 +379,10 @@ int Main(int argc, char** argv) {
         absl::StrFormat("result cache peak %.1f MiB <= budget %.0f MiB", peak_cache / 1048576.0,
                         cache_mib));
   check(exit_code == 0, absl::StrCat("geodexd exit status after SIGTERM: ", exit_code));
-  if (pass) fs::remove_all(dir);
-  else std::printf("geodexd log kept in %s\n", dir.c_str());
+  if (pass)
+    fs::remove_all(dir);
+  else
+    std::printf("geodexd log kept in %s\n", dir.c_str());
   return pass ? 0 : 1;
 }
 

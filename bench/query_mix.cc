@@ -65,12 +65,23 @@ void MixResult::Merge(const MixResult& other) {
 }
 
 std::string StatusName(grpc::StatusCode code) {
-  static const char* const kNames[] = {
-      "OK",           "CANCELLED",         "UNKNOWN",        "INVALID_ARGUMENT",
-      "DEADLINE_EXCEEDED", "NOT_FOUND",    "ALREADY_EXISTS", "PERMISSION_DENIED",
-      "RESOURCE_EXHAUSTED", "FAILED_PRECONDITION", "ABORTED", "OUT_OF_RANGE",
-      "UNIMPLEMENTED", "INTERNAL",         "UNAVAILABLE",    "DATA_LOSS",
-      "UNAUTHENTICATED"};
+  static const char* const kNames[] = {"OK",
+                                       "CANCELLED",
+                                       "UNKNOWN",
+                                       "INVALID_ARGUMENT",
+                                       "DEADLINE_EXCEEDED",
+                                       "NOT_FOUND",
+                                       "ALREADY_EXISTS",
+                                       "PERMISSION_DENIED",
+                                       "RESOURCE_EXHAUSTED",
+                                       "FAILED_PRECONDITION",
+                                       "ABORTED",
+                                       "OUT_OF_RANGE",
+                                       "UNIMPLEMENTED",
+                                       "INTERNAL",
+                                       "UNAVAILABLE",
+                                       "DATA_LOSS",
+                                       "UNAUTHENTICATED"};
   const int i = static_cast<int>(code);
   return i >= 0 && i <= 16 ? kNames[i] : "code " + std::to_string(i);
 }
@@ -86,7 +97,9 @@ MixResult RunMixClient(const std::shared_ptr<grpc::Channel>& channel,
   MixResult result;
   while (!stop.load()) {
     const MixMesh& mesh = meshes[which(rng)];
-    auto vertex = [&] { return std::uniform_int_distribution<uint32_t>(0, mesh.vertices - 1)(rng); };
+    auto vertex = [&] {
+      return std::uniform_int_distribution<uint32_t>(0, mesh.vertices - 1)(rng);
+    };
     auto face_point = [&](v1::SurfacePoint* p) {
       const double a = unit(rng), b = unit(rng) * (1 - a);
       auto* f = p->mutable_face();

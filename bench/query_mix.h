@@ -35,16 +35,16 @@ grpc::Status HealthCheck(grpc::GenericStub& stub);
 
 // A mesh the mix queries: its resource name and what the client needs to pick valid inputs.
 struct MixMesh {
-  std::string name;               // "meshes/<alias>"
-  uint32_t vertices = 0;          // file vertices
+  std::string name;       // "meshes/<alias>"
+  uint32_t vertices = 0;  // file vertices
   uint32_t faces = 0;
   std::vector<double> positions;  // file coordinates, 3 per vertex (for LocatePoints)
 };
 
 struct MixResult {
-  std::vector<double> latencies_ms;                        // every query
-  std::map<std::string, std::vector<double>> kind_ms;      // OK queries, by kind ("path", ...)
-  std::map<std::string, int> statuses;                     // "OK", "RESOURCE_EXHAUSTED", ...
+  std::vector<double> latencies_ms;                    // every query
+  std::map<std::string, std::vector<double>> kind_ms;  // OK queries, by kind ("path", ...)
+  std::map<std::string, int> statuses;                 // "OK", "RESOURCE_EXHAUSTED", ...
   int queries = 0;
   void Merge(const MixResult& other);
 };

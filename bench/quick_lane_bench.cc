@@ -63,9 +63,12 @@ int Main(int argc, char** argv) {
   int workers = 2, calls = 100;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string flag = argv[i], value = argv[i + 1];
-    if (flag == "--mesh") mesh_path = value;
-    else if (flag == "--workers") workers = std::stoi(value);
-    else if (flag == "--calls") calls = std::stoi(value);
+    if (flag == "--mesh")
+      mesh_path = value;
+    else if (flag == "--workers")
+      workers = std::stoi(value);
+    else if (flag == "--calls")
+      calls = std::stoi(value);
     else {
       std::fprintf(stderr, "unknown flag %s\n", flag.c_str());
       return 2;
@@ -82,8 +85,9 @@ int Main(int argc, char** argv) {
   }
   const uint32_t vertices = static_cast<uint32_t>(data->vertex_count());
   const auto& pos = data->positions;
-  std::printf("mesh %s: %u vertices; %d solve workers busy with uncached fields; %d calls per kind\n",
-              mesh_path.c_str(), vertices, workers, calls);
+  std::printf(
+      "mesh %s: %u vertices; %d solve workers busy with uncached fields; %d calls per kind\n",
+      mesh_path.c_str(), vertices, workers, calls);
 
   std::vector<Setting> settings = {{"no quick lane (--quick_threads=0)", 0, {}},
                                    {"quick lane (--quick_threads=2)", 2, {}}};
@@ -99,7 +103,8 @@ int Main(int argc, char** argv) {
       return 1;
     }
     const std::string address = absl::StrCat("127.0.0.1:", (*server)->port());
-    auto stub = v1::Geodex::NewStub(grpc::CreateChannel(address, grpc::InsecureChannelCredentials()));
+    auto stub =
+        v1::Geodex::NewStub(grpc::CreateChannel(address, grpc::InsecureChannelCredentials()));
     v1::Mesh mesh;
     if (grpc::Status s = Upload(*stub, file, mesh_path, "", &mesh); !s.ok()) {
       std::fprintf(stderr, "upload: %s\n", s.error_message().c_str());
@@ -150,7 +155,9 @@ int Main(int argc, char** argv) {
         stub->FindShortestPath(&context, request, &response);
       }
       auto t3 = Clock::now();
-      auto ms = [](Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); };
+      auto ms = [](Clock::duration d) {
+        return std::chrono::duration<double, std::milli>(d).count();
+      };
       locate_ms.push_back(ms(t1 - t0));
       field_ms.push_back(ms(t2 - t1));
       path_ms.push_back(ms(t3 - t2));

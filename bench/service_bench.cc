@@ -143,9 +143,11 @@ int MatrixSection(const TriangleMesh& mesh, const std::string& bytes, const std:
   }
   std::shuffle(near.begin(), near.end(), rng);
   local.assign(near.begin(), near.begin() + std::min<size_t>(64, near.size()));
-  std::printf("\n4. planner matrices, result cache off (median of 3; field: one full field "
-              "through the same server)\n");
-  std::printf("   matrix          workers   field ms   matrix ms   / field   speed-up   first row ms\n");
+  std::printf(
+      "\n4. planner matrices, result cache off (median of 3; field: one full field "
+      "through the same server)\n");
+  std::printf(
+      "   matrix          workers   field ms   matrix ms   / field   speed-up   first row ms\n");
   std::map<std::string, double> one_worker;
   for (int workers : {1, threads}) {
     BenchServer bench_server = StartBenchServer(workers, /*result_cache=*/false, bytes, mesh_path);
@@ -260,9 +262,10 @@ int Main(int argc, char** argv) {
   std::shared_ptr<grpc::Channel> channel = bench_server.channel;
   const std::vector<bench::MixMesh> mix_meshes = {
       {"meshes/bench", mesh.file_vertex_count(), mesh.face_count(), data->positions}};
-  std::printf("\n2. query mix for %.0f s per row (40%% A* paths, 20%% fields, 20%% point "
-              "distances x16, 10%% locate x64, 10%% isolines)\n",
-              seconds);
+  std::printf(
+      "\n2. query mix for %.0f s per row (40%% A* paths, 20%% fields, 20%% point "
+      "distances x16, 10%% locate x64, 10%% isolines)\n",
+      seconds);
   std::printf("   clients  queries  queries/s   p50 ms   p99 ms   statuses\n");
   for (int clients : {1, 2, 4}) {
     if (!want('2')) break;
@@ -313,9 +316,10 @@ int Main(int argc, char** argv) {
     }
     stop = true;
     for (auto& t : load) t.join();
-    std::printf("\n3. health checks while all %d workers compute full fields (300 checks, all busy "
-                "at %d of them)\n",
-                threads, busy_samples);
+    std::printf(
+        "\n3. health checks while all %d workers compute full fields (300 checks, all busy "
+        "at %d of them)\n",
+        threads, busy_samples);
     std::printf("   p50 %.2f ms   p99 %.2f ms   max %.2f ms   failures %d\n",
                 Percentile(health, 0.5), Percentile(health, 0.99),
                 *std::max_element(health.begin(), health.end()), failures);

@@ -19,12 +19,12 @@
 #include "geodex/distance_field.h"
 #include "geodex/distance_matrix.h"
 #include "geodex/geodesic_solver.h"
+#include "geodex/geojson.h"
 #include "geodex/isolines.h"
 #include "geodex/locate.h"
 #include "geodex/mesh_data.h"
 #include "geodex/shortest_path.h"
 #include "geodex/surface_point.h"
-#include "geodex/geojson.h"
 #include "geodex/terrain.h"
 #include "geodex/voronoi.h"
 
@@ -99,7 +99,8 @@ absl::Status ResolvePoints(Backend& backend, const Args& args, const std::string
 // Parses a SPEC list given as --`option`; `g:X:Y` and `ll:LON:LAT` items are dropped onto the
 // backend's DEM (without a backend, before MESH is open, only their syntax is checked).
 // InvalidArgument naming the option.
-absl::StatusOr<std::vector<SurfacePoint>> ParseSpec(const Backend* backend, const std::string& option,
+absl::StatusOr<std::vector<SurfacePoint>> ParseSpec(const Backend* backend,
+                                                    const std::string& option,
                                                     const std::string& spec);
 // Parses --`option` (which must be present), then ResolvePoints.
 absl::Status ResolveOption(Backend& backend, const Args& args, const std::string& option,

@@ -169,8 +169,8 @@ absl::StatusOr<std::string> DropMapPoints(const Backend* backend, const std::str
     double a = 0, b = 0;
     if (parts.size() != 3 || !absl::SimpleAtod(parts[1], &a) || !absl::SimpleAtod(parts[2], &b) ||
         !std::isfinite(a) || !std::isfinite(b)) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "bad point '%s' (expected %s)", item, native ? "g:X:Y" : "ll:LON:LAT"));
+      return absl::InvalidArgumentError(
+          absl::StrFormat("bad point '%s' (expected %s)", item, native ? "g:X:Y" : "ll:LON:LAT"));
     }
     if (backend == nullptr) {
       item = "0";
@@ -178,8 +178,8 @@ absl::StatusOr<std::string> DropMapPoints(const Backend* backend, const std::str
     }
     const terrain::Dem* dem = backend->Terrain();
     if (dem == nullptr) {
-      return absl::InvalidArgumentError(
-          absl::StrFormat("point %s: map coordinates need a DEM as MESH (a raster such as .tif)", item));
+      return absl::InvalidArgumentError(absl::StrFormat(
+          "point %s: map coordinates need a DEM as MESH (a raster such as .tif)", item));
     }
     absl::StatusOr<SurfacePoint> p = native ? dem->DropMapPoint(a, b) : dem->DropLonLat(a, b);
     if (!p.ok()) {
@@ -196,11 +196,13 @@ absl::StatusOr<std::string> DropMapPoints(const Backend* backend, const std::str
   return absl::StrJoin(items, ",");
 }
 
-absl::StatusOr<std::vector<SurfacePoint>> ParseSpec(const Backend* backend, const std::string& option,
+absl::StatusOr<std::vector<SurfacePoint>> ParseSpec(const Backend* backend,
+                                                    const std::string& option,
                                                     const std::string& spec) {
   absl::StatusOr<std::string> dropped = DropMapPoints(backend, spec);
   if (!dropped.ok()) {
-    return absl::InvalidArgumentError(absl::StrFormat("--%s: %s", option, dropped.status().message()));
+    return absl::InvalidArgumentError(
+        absl::StrFormat("--%s: %s", option, dropped.status().message()));
   }
   absl::StatusOr<std::vector<SurfacePoint>> p = ParseSurfacePoints(*dropped);
   if (!p.ok()) {
@@ -211,7 +213,8 @@ absl::StatusOr<std::vector<SurfacePoint>> ParseSpec(const Backend* backend, cons
 
 absl::Status ResolveOption(Backend& backend, const Args& args, const std::string& option,
                            std::vector<SurfacePoint>* points, SnapReport* report) {
-  absl::StatusOr<std::vector<SurfacePoint>> p = ParseSpec(&backend, option, args.options.at(option));
+  absl::StatusOr<std::vector<SurfacePoint>> p =
+      ParseSpec(&backend, option, args.options.at(option));
   if (!p.ok()) return p.status();
   if (absl::Status s = ResolvePoints(backend, args, option, &*p, report); !s.ok()) return s;
   *points = *std::move(p);
@@ -350,8 +353,10 @@ std::string FormatInfo(const InfoValues& v, bool json) {
       {"internal_vertices", absl::StrFormat("%d", v.internal_vertices)},
       {"mean_edge_length", absl::StrFormat("%.17g", v.mean_edge_length)},
       {"max_edge_length", absl::StrFormat("%.17g", v.max_edge_length)},
-      {"bbox_min", absl::StrFormat("%.17g %.17g %.17g", v.bbox_min[0], v.bbox_min[1], v.bbox_min[2])},
-      {"bbox_max", absl::StrFormat("%.17g %.17g %.17g", v.bbox_max[0], v.bbox_max[1], v.bbox_max[2])},
+      {"bbox_min",
+       absl::StrFormat("%.17g %.17g %.17g", v.bbox_min[0], v.bbox_min[1], v.bbox_min[2])},
+      {"bbox_max",
+       absl::StrFormat("%.17g %.17g %.17g", v.bbox_max[0], v.bbox_max[1], v.bbox_max[2])},
       {"bytes", absl::StrFormat("%d", v.bytes)},
       {"load_ms", absl::StrFormat("%.3f", v.load_ms)},
       {"build_ms", absl::StrFormat("%.3f", v.build_ms)},
@@ -384,19 +389,20 @@ std::string FormatInfo(const InfoValues& v, bool json) {
   for (size_t i = 0; i < rows.size(); ++i) {
     // A bounding-box corner is an array of three numbers in JSON.
     const bool triple = rows[i].first.rfind("bbox_", 0) == 0;
-    out += absl::StrFormat("%s\"%s\": %s%s%s", i ? ", " : "", rows[i].first, triple ? "[" : "",
-                           triple ? absl::StrJoin(absl::StrSplit(rows[i].second, ' '), ", ")
-                                  : rows[i].second,
-                           triple ? "]" : "");
+    out += absl::StrFormat(
+        "%s\"%s\": %s%s%s", i ? ", " : "", rows[i].first, triple ? "[" : "",
+        triple ? absl::StrJoin(absl::StrSplit(rows[i].second, ' '), ", ") : rows[i].second,
+        triple ? "]" : "");
   }
   for (const auto& [k, value] : dem_rows) {
     const bool pair = k == "raster" || k == "grid";
     const bool number =
         k == "dem_step" || k == "nodata_cells" || k == "barrier_cells" || k == "barrier_faces";
-    out += absl::StrFormat(", \"%s\": %s", k,
-                           pair     ? absl::StrCat("[", absl::StrJoin(absl::StrSplit(value, ' '), ", "), "]")
-                           : number ? value
-                                    : JsonString(value));
+    out += absl::StrFormat(
+        ", \"%s\": %s", k,
+        pair     ? absl::StrCat("[", absl::StrJoin(absl::StrSplit(value, ' '), ", "), "]")
+        : number ? value
+                 : JsonString(value));
   }
   return out + "}\n";
 }
@@ -509,8 +515,8 @@ std::string FormatAt(const std::vector<SurfacePoint>& points, const AtValues& v,
     const uint32_t source = v.exact.source[i];
     if (json) {
       text += absl::StrFormat(
-          "%s{\"point\": \"%s\", \"estimate\": %s, \"exact\": %s, \"source\": %s",
-          i ? ", " : "", SurfacePointToString(points[i]), JsonNumber(v.estimate[i]),
+          "%s{\"point\": \"%s\", \"estimate\": %s, \"exact\": %s, \"source\": %s", i ? ", " : "",
+          SurfacePointToString(points[i]), JsonNumber(v.estimate[i]),
           JsonNumber(v.exact.distance[i]), source == kNoIndex ? "null" : absl::StrCat(source));
       if (!direction.empty()) {
         absl::StrAppend(&text, ", \"direction\": ",
@@ -573,12 +579,11 @@ constexpr char kDistancesHelp[] =
 int RunDistances(Backend& backend, const Args& args) {
   std::string error;
   bool json = false;
-  if (!CheckKnown(
-          args,
-          {"sources", "method", "lambda", "lambda-scale", "max-distance", "max-windows", "stats",
-           "output", "no-filter", "no-one-split", "at", "max-snap", "format", "directions",
-           "labels-output"},
-          &error) ||
+  if (!CheckKnown(args,
+                  {"sources", "method", "lambda", "lambda-scale", "max-distance", "max-windows",
+                   "stats", "output", "no-filter", "no-one-split", "at", "max-snap", "format",
+                   "directions", "labels-output"},
+                  &error) ||
       !GetFormat(args, &json, &error) || !backend.Supports(args, &error)) {
     return Fail(kExitUsage, error);
   }
@@ -604,7 +609,8 @@ int RunDistances(Backend& backend, const Args& args) {
   }
   query.options.use_filter = !args.options.count("no-filter");
   query.options.use_one_angle_one_split = !args.options.count("no-one-split");
-  absl::StatusOr<std::vector<SurfacePoint>> parsed = ParseSpec(nullptr, "sources", args.options.at("sources"));
+  absl::StatusOr<std::vector<SurfacePoint>> parsed =
+      ParseSpec(nullptr, "sources", args.options.at("sources"));
   if (!parsed.ok()) return Fail(kExitUsage, std::string(parsed.status().message()));
   // Rasters (GeoTIFF, aligned with the DEM's grid): the distances with --output X.tif, the
   // nearest source's index with --labels-output X.tif.
@@ -708,8 +714,8 @@ int RunDistances(Backend& backend, const Args& args) {
     if (int code = WriteOutput(args, text); code != kExitOk) return code;
   }
   if (args.options.count("stats")) {
-    const std::string leading = absl::StrFormat("\"method\": \"%s\", \"sources\": %d, %s",
-                                                method, sources.size(), SnapJson(snap));
+    const std::string leading = absl::StrFormat("\"method\": \"%s\", \"sources\": %d, %s", method,
+                                                sources.size(), SnapJson(snap));
     const std::string trailing = absl::StrFormat("\"output_ms\": %.3f, ", MsSince(t_out));
     std::fputs(StatsJson(backend, leading, stats, trailing).c_str(), stderr);
   }
@@ -849,7 +855,8 @@ std::string FormatMatrixJson(const DistanceMatrix& m) {
 }
 
 // geodex matrix: its entry of `geodex --help`.
-constexpr char kMatrixHelp[] = R"(  matrix MESH --sources SPEC --targets SPEC [--stats] [--lambda L] [--max-distance D]
+constexpr char kMatrixHelp[] =
+    R"(  matrix MESH --sources SPEC --targets SPEC [--stats] [--lambda L] [--max-distance D]
          [--k-nearest K] [--threads N] [--format json]
       Exact distances, one row per source, tab-separated. Rows run in parallel on every usable
       core (--threads N to limit). The same points as sources and targets give a symmetric
@@ -996,7 +1003,9 @@ int RunLocate(Backend& backend, const Args& args) {
 const std::vector<Command>& QueryCommands() {
   static const std::vector<Command>* commands = new std::vector<Command>{
       {"info", kInfoHelp, {"strict"}, RunInfo},
-      {"distances", kDistancesHelp, {"stats", "no-filter", "no-one-split", "directions"},
+      {"distances",
+       kDistancesHelp,
+       {"stats", "no-filter", "no-one-split", "directions"},
        RunDistances},
       {"path", kPathHelp, {"stats"}, RunPath},
       {"matrix", kMatrixHelp, {"stats"}, RunMatrix},

@@ -49,9 +49,9 @@ struct Command {
 // Every query command, in the order `geodex --help` lists them (cli_commands.cc).
 const std::vector<Command>& QueryCommands();
 // The commands of the other files, listed by QueryCommands.
-const Command& IsolinesCommand();   // cli_geometry.cc
-const Command& VoronoiCommand();    // cli_geometry.cc
-const Command& DelaunayCommand();   // cli_geometry.cc
-const Command& RenderCommand();     // cli_render.cc
+const Command& IsolinesCommand();  // cli_geometry.cc
+const Command& VoronoiCommand();   // cli_geometry.cc
+const Command& DelaunayCommand();  // cli_geometry.cc
+const Command& RenderCommand();    // cli_render.cc
 
 }  // namespace geodex::cli

@@ -251,10 +251,7 @@ void RowProgress::Update(size_t done, size_t total) {
   std::fflush(stderr);
 }
 
-
-std::string JsonNumber(double x) {
-  return std::isfinite(x) ? absl::StrFormat("%.17g", x) : "null";
-}
+std::string JsonNumber(double x) { return std::isfinite(x) ? absl::StrFormat("%.17g", x) : "null"; }
 
 std::string JsonXyz(const std::array<double, 3>& p) {
   return absl::StrFormat("[%.17g, %.17g, %.17g]", p[0], p[1], p[2]);
@@ -276,7 +273,6 @@ std::string PathPointJson(const PathPoint& p) {
   }
   return s + "\"position\": true}";
 }
-
 
 bool GetFormat(const Args& args, bool* json, std::string* error) {
   const std::string format = args.options.count("format") ? args.options.at("format") : "text";

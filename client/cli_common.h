@@ -67,8 +67,9 @@ bool CheckKnown(const Args& args, const std::set<std::string>& known, std::strin
 bool GetLevels(const Args& args, const std::string& count_flag, IsolineOptions* options,
                std::string* error);
 
-// While alive, shows "geodex: WHAT... 3.4 s" on stderr, refreshed, once the work has taken more than
-// a second, and only when stderr is a terminal (scripts and pipes see nothing). Cleared at the end.
+// While alive, shows "geodex: WHAT... 3.4 s" on stderr, refreshed, once the work has taken more
+// than a second, and only when stderr is a terminal (scripts and pipes see nothing). Cleared at the
+// end.
 class Progress {
  public:
   explicit Progress(std::string what);

@@ -99,9 +99,9 @@ std::string PointsJson(const std::vector<PathPoint>& points) {
 std::string SitesJson(const Solved& s) {
   std::string json = "[";
   for (size_t i = 0; i < s.points.size(); ++i) {
-    json +=
-        absl::StrFormat("%s{\"site\": %d, \"spec\": \"%s\", \"p\": %s}", i ? ", " : "", i,
-                        SurfacePointToString(s.points[i]), JsonXyz(PositionOf(*s.data, s.points[i])));
+    json += absl::StrFormat("%s{\"site\": %d, \"spec\": \"%s\", \"p\": %s}", i ? ", " : "", i,
+                            SurfacePointToString(s.points[i]),
+                            JsonXyz(PositionOf(*s.data, s.points[i])));
   }
   return json + "]";
 }
@@ -229,7 +229,8 @@ int Usage(const std::string& command, const std::string& key, const std::string&
 }
 
 // geodex isolines: its entry of `geodex --help`.
-constexpr char kIsolinesHelp[] = R"(  isolines MESH --sources SPEC (--levels L1,L2,... | --count K) [--output FILE.json|.obj|.svg]
+constexpr char kIsolinesHelp[] =
+    R"(  isolines MESH --sources SPEC (--levels L1,L2,... | --count K) [--output FILE.json|.obj|.svg]
       Approximate geodesic offsets (paper section 6.1; linear along edges): polylines of edge
       points per level. --count K: the levels D*j/K, j = 1..K-1, D the largest distance.
 )";
@@ -274,7 +275,8 @@ int RunIsolines(Backend& backend, const Args& args) {
                              terrain::IsochroneFeatures(*s.data, (*field)->distance, iso->levels));
   }
   if (format == Format::kObj) return WriteOutput(args, Obj("isolines", lines));
-  if (format == Format::kSvg) return WriteOutput(args, Svg("isolines", *s.data, lines, SitePositions(s)));
+  if (format == Format::kSvg)
+    return WriteOutput(args, Svg("isolines", *s.data, lines, SitePositions(s)));
   return WriteOutput(args, json);
 }
 
@@ -337,7 +339,8 @@ int RunVoronoi(Backend& backend, const Args& args) {
     return WriteVectorOutput(backend, args, terrain::VoronoiFeatures(*s.data, *vd));
   }
   if (format == Format::kObj) return WriteOutput(args, Obj("voronoi", lines));
-  if (format == Format::kSvg) return WriteOutput(args, Svg("voronoi", *s.data, lines, SitePositions(s)));
+  if (format == Format::kSvg)
+    return WriteOutput(args, Svg("voronoi", *s.data, lines, SitePositions(s)));
   return WriteOutput(args, json);
 }
 
@@ -399,7 +402,8 @@ int RunDelaunay(Backend& backend, const Args& args) {
     json += absl::StrFormat(
         "%s\n{\"edge\": [%d, %d], \"sites\": [%d, %d], \"witness\": %d, "
         "\"point\": %s}",
-        i ? "," : "", x.vertex_a, x.vertex_b, x.site_a, x.site_b, x.witness, PathPointJson(x.point));
+        i ? "," : "", x.vertex_a, x.vertex_b, x.site_a, x.site_b, x.witness,
+        PathPointJson(x.point));
     const Point3 a = PositionOf(*s.data, SurfacePoint::AtVertex(x.vertex_a));
     const Point3 b = PositionOf(*s.data, SurfacePoint::AtVertex(x.vertex_b));
     lines.push_back(
@@ -411,7 +415,8 @@ int RunDelaunay(Backend& backend, const Args& args) {
     return WriteVectorOutput(backend, args, terrain::DelaunayFeatures(*dt));
   }
   if (format == Format::kObj) return WriteOutput(args, Obj("delaunay", lines));
-  if (format == Format::kSvg) return WriteOutput(args, Svg("delaunay", *s.data, lines, SitePositions(s)));
+  if (format == Format::kSvg)
+    return WriteOutput(args, Svg("delaunay", *s.data, lines, SitePositions(s)));
   return WriteOutput(args, json);
 }
 

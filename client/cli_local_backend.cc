@@ -18,10 +18,9 @@ namespace geodex::cli {
 namespace {
 
 std::string Key(const std::vector<SurfacePoint>& sources, const GeodesicOptions& o) {
-  std::string key =
-      absl::StrFormat("%d|%.17g|%d|%.17g|%d|%d|%d|", static_cast<int>(o.method), o.lambda,
-                      static_cast<int>(o.lambda_scale), o.max_distance, o.max_windows,
-                      o.use_filter, o.use_one_angle_one_split);
+  std::string key = absl::StrFormat("%d|%.17g|%d|%.17g|%d|%d|%d|", static_cast<int>(o.method),
+                                    o.lambda, static_cast<int>(o.lambda_scale), o.max_distance,
+                                    o.max_windows, o.use_filter, o.use_one_angle_one_split);
   for (const SurfacePoint& p : sources) absl::StrAppend(&key, SurfacePointToString(p), ",");
   return key;
 }

@@ -17,8 +17,8 @@
 #include "api_convert.h"
 #include "cli_backend.h"
 #include "cli_common.h"
-#include "geodex_client.h"
 #include "geodex/surface_point.h"
+#include "geodex_client.h"
 
 namespace geodex::cli {
 namespace {
@@ -27,7 +27,6 @@ using client::FieldViolation;
 using client::FieldViolationOf;
 using client::GeodexClient;
 using client::MeshRef;
-
 
 // A progress bar on stderr for uploads, only when stderr is a terminal.
 void UploadProgress(uint64_t done, uint64_t total) {
@@ -64,8 +63,9 @@ std::unique_ptr<GeodexClient> Connect(const std::string& target) {
 // "sources[0].vertex: ..." from geodexd becomes "--sources: point 7: ..." (the field's head is
 // looked up in `flags`, request field -> CLI flag). Other errors pass unchanged.
 template <typename T>
-absl::StatusOr<T> Flagged(absl::StatusOr<T> result,
-                          std::initializer_list<std::pair<absl::string_view, absl::string_view>> flags) {
+absl::StatusOr<T> Flagged(
+    absl::StatusOr<T> result,
+    std::initializer_list<std::pair<absl::string_view, absl::string_view>> flags) {
   if (result.ok()) return result;
   std::optional<FieldViolation> violation = FieldViolationOf(result.status());
   if (!violation.has_value()) return result;
@@ -111,8 +111,9 @@ class RemoteBackend final : public Backend {
     absl::StatusOr<MeshRef> ref;
     const bool barrier =
         std::isfinite(dem_options.barrier_below) || !dem_options.barrier_file.empty();
-    const bool here = (std::filesystem::exists(mesh, ec) && !std::filesystem::is_directory(mesh, ec)) ||
-                      mesh.rfind("sample:", 0) == 0;
+    const bool here =
+        (std::filesystem::exists(mesh, ec) && !std::filesystem::is_directory(mesh, ec)) ||
+        mesh.rfind("sample:", 0) == 0;
     if (barrier && !here) return OpenDerivedOnServer(mesh, dem_options);
     if (DerivedHere(mesh, dem_options) && here) {
       absl::StatusOr<MeshData> data = LoadMeshData(mesh, dem_options, &dem_);
@@ -180,7 +181,8 @@ class RemoteBackend final : public Backend {
     if (args.options.count("method")) {
       const std::string& m = args.options.at("method");
       if (m == "dijkstra") {
-        *error = "--method dijkstra: local only (geodexd computes exact fields; use --lambda for speed)";
+        *error =
+            "--method dijkstra: local only (geodexd computes exact fields; use --lambda for speed)";
         return false;
       }
       if (m == "full") {
@@ -272,8 +274,8 @@ class RemoteBackend final : public Backend {
     }
     if (out.estimate.size() != n || out.exact.distance.size() != n ||
         out.exact.source.size() != n) {
-      return absl::InternalError(absl::StrFormat(
-          "the server answered %d points for %d asked", out.exact.distance.size(), n));
+      return absl::InternalError(absl::StrFormat("the server answered %d points for %d asked",
+                                                 out.exact.distance.size(), n));
     }
     return out;
   }
@@ -318,8 +320,8 @@ class RemoteBackend final : public Backend {
   mutable std::shared_ptr<const terrain::Dem> dem_;
   mutable bool dem_fetched_ = false;
   std::optional<terrain::DemInfo> terrain_info_;  // a server DEM's map, for info
-  DistanceField field_;             // the last Field answer (Backend::Field hands out a pointer)
-  bool cached_ = false;             // the last field came from the server's result cache
+  DistanceField field_;  // the last Field answer (Backend::Field hands out a pointer)
+  bool cached_ = false;  // the last field came from the server's result cache
 };
 
 std::string MeshLine(const v1::Mesh& m) {
@@ -375,13 +377,13 @@ int RemoteMesh(GeodexClient& client, const Args& args) {
     absl::StatusOr<MeshData> data = LoadMeshData(p[1], *dem);
     if (!data.ok()) return Fail(kExitInput, std::string(data.status().message()));
     absl::StatusOr<MeshRef> ref =  // uploads only if missing
-        DerivedHere(p[1], *dem) ? UploadDerived(client, p[1], *dem, *data) : client.ResolveMesh(p[1]);
+        DerivedHere(p[1], *dem) ? UploadDerived(client, p[1], *dem, *data)
+                                : client.ResolveMesh(p[1]);
     if (!ref.ok()) return FailQuery(ref.status());
-    absl::StatusOr<v1::Mesh> m =
-        args.options.count("name")
-            ? client.Upload(ref->file_name, ref->file_bytes, args.options.at("name"), ref->id,
-                            ref->dem)
-            : client.GetMesh(ref->name);
+    absl::StatusOr<v1::Mesh> m = args.options.count("name")
+                                     ? client.Upload(ref->file_name, ref->file_bytes,
+                                                     args.options.at("name"), ref->id, ref->dem)
+                                     : client.GetMesh(ref->name);
     if (!m.ok()) return FailQuery(m.status());
     std::fputs((json ? MeshJson(*m) + "\n" : MeshLine(*m)).c_str(), stdout);
     return kExitOk;

@@ -10,8 +10,8 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
-#include "cli_common.h"
 #include "cli_backend.h"
+#include "cli_common.h"
 #include "geodex/delaunay.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/isolines.h"
@@ -31,7 +31,8 @@ std::vector<render::Point3> Positions(const std::vector<PathPoint>& points) {
 }
 
 bool EndsWith(const std::string& s, const std::string& suffix) {
-  return s.size() > suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+  return s.size() > suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
 // What the picture shows, computed locally or by a server.
@@ -83,7 +84,8 @@ int RunRender(Backend& backend, const Args& args) {
   }
   const std::string output = args.options.at("output");
   if (!EndsWith(output, ".png") && !EndsWith(output, ".ply") && !EndsWith(output, ".gltf")) {
-    return Fail(kExitUsage, absl::StrFormat("--output: '%s' must end in .png, .ply or .gltf", output));
+    return Fail(kExitUsage,
+                absl::StrFormat("--output: '%s' must end in .png, .ply or .gltf", output));
   }
   absl::StatusOr<render::View> view =
       render::ParseView(args.options.count("view") ? args.options.at("view") : "auto");
@@ -103,9 +105,11 @@ int RunRender(Backend& backend, const Args& args) {
   }
   if (!GetLevels(args, "isolines", &levels, &error)) return Fail(kExitUsage, error);
   const bool isolines = levels.count > 0 || !levels.levels.empty();
-  const bool voronoi = args.options.count("voronoi") > 0, delaunay = args.options.count("delaunay") > 0;
+  const bool voronoi = args.options.count("voronoi") > 0,
+             delaunay = args.options.count("delaunay") > 0;
 
-  absl::StatusOr<std::vector<SurfacePoint>> sources = ParseSpec(nullptr, "sources", args.options.at("sources"));
+  absl::StatusOr<std::vector<SurfacePoint>> sources =
+      ParseSpec(nullptr, "sources", args.options.at("sources"));
   if (!sources.ok()) return Fail(kExitUsage, std::string(sources.status().message()));
   std::vector<SurfacePoint> ends;
   if (!path_spec.empty()) {

@@ -8,20 +8,20 @@
 #include <thread>
 #include <utility>
 
+#include "absl/strings/cord.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "api_convert.h"
-#include "geometry_convert.h"
+#include "geodex/mesh_id.h"
 #include "geodex/mesh_io.h"
 #include "geodex/samples.h"
-#include "absl/strings/cord.h"
+#include "geometry_convert.h"
 #include "google/rpc/error_details.pb.h"
 #include "google/rpc/status.pb.h"
 #include "grpcpp/create_channel.h"
 #include "grpcpp/generic/generic_stub.h"
 #include "grpcpp/security/credentials.h"
 #include "grpcpp/support/byte_buffer.h"
-#include "geodex/mesh_id.h"
 
 namespace geodex::client {
 namespace {
@@ -120,9 +120,9 @@ grpc::Status GeodexClient::Call(const std::string& mesh_id,
       backoff *= 2;
     }
     grpc::ClientContext context;
-    context.set_deadline(std::chrono::system_clock::now() +
-                         std::chrono::microseconds(
-                             static_cast<int64_t>(options_.deadline_seconds * 1e6)));
+    context.set_deadline(
+        std::chrono::system_clock::now() +
+        std::chrono::microseconds(static_cast<int64_t>(options_.deadline_seconds * 1e6)));
     if (!mesh_id.empty()) context.AddMetadata("x-mesh-id", mesh_id);
     if (!options_.token.empty()) context.AddMetadata("authorization", "Bearer " + options_.token);
     ++calls_;
@@ -146,7 +146,8 @@ grpc::Status GeodexClient::MeshCall(MeshRef& mesh,
   if (status.error_code() == grpc::StatusCode::NOT_FOUND && !mesh.file_bytes.empty() &&
       ErrorReason(status) == "MESH_NOT_FOUND") {
     // The server lost (or never had) the mesh: upload it again and retry once.
-    absl::StatusOr<v1::Mesh> uploaded = Upload(mesh.file_name, mesh.file_bytes, "", mesh.id, mesh.dem);
+    absl::StatusOr<v1::Mesh> uploaded =
+        Upload(mesh.file_name, mesh.file_bytes, "", mesh.id, mesh.dem);
     if (!uploaded.ok()) {
       return grpc::Status(static_cast<grpc::StatusCode>(uploaded.status().code()),
                           std::string(uploaded.status().message()));
@@ -225,9 +226,8 @@ absl::StatusOr<v1::Mesh> GeodexClient::GetMesh(const std::string& name) {
   request.set_name(name);
   v1::Mesh mesh;
   const std::string id = IdOfName(name);
-  grpc::Status status = Call(id, [&](grpc::ClientContext* context) {
-    return stub_->GetMesh(context, request, &mesh);
-  });
+  grpc::Status status = Call(
+      id, [&](grpc::ClientContext* context) { return stub_->GetMesh(context, request, &mesh); });
   if (!status.ok()) return ToAbsl(status);
   return mesh;
 }
@@ -347,8 +347,8 @@ absl::StatusOr<MeshRef> GeodexClient::ResolveMesh(const std::string& mesh) {
       if (directory) {
         return absl::InvalidArgumentError(absl::StrCat(mesh, ": is a directory, not a mesh file"));
       }
-      return absl::NotFoundError(absl::StrCat(
-          mesh, ": no such file, and the server has no mesh with that id or name"));
+      return absl::NotFoundError(
+          absl::StrCat(mesh, ": no such file, and the server has no mesh with that id or name"));
     }
     return found.status();
   }
@@ -391,8 +391,7 @@ absl::StatusOr<MeshData> GeodexClient::GetMeshGeometry(MeshRef& mesh) {
   return std::move(out.result());
 }
 
-absl::StatusOr<PathQueryResult> GeodexClient::ShortestPath(MeshRef& mesh,
-                                                           const PathQuery& query) {
+absl::StatusOr<PathQueryResult> GeodexClient::ShortestPath(MeshRef& mesh, const PathQuery& query) {
   v1::FindShortestPathRequest request;
   request.set_mesh(mesh.name);
   api::PathQueryToProto(query, &request);

@@ -31,8 +31,8 @@
 #include "geodex/mesh_data.h"
 #include "geodex/shortest_path.h"
 #include "geodex/surface_point.h"
-#include "geodex/voronoi.h"
 #include "geodex/v1/geodex.grpc.pb.h"
+#include "geodex/voronoi.h"
 
 namespace geodex::client {
 
@@ -46,10 +46,10 @@ std::optional<FieldViolation> FieldViolationOf(const absl::Status& status);
 
 struct ClientOptions {
   std::string target = "127.0.0.1:50051";  // HOST:PORT
-  double deadline_seconds = 600;            // per call
-  int max_attempts = 4;                     // tries on UNAVAILABLE or a full queue
-  double initial_backoff_seconds = 0.2;     // doubled after each retry
-  bool retry_queue_full = true;             // retry RESOURCE_EXHAUSTED reason QUEUE_FULL
+  double deadline_seconds = 600;           // per call
+  int max_attempts = 4;                    // tries on UNAVAILABLE or a full queue
+  double initial_backoff_seconds = 0.2;    // doubled after each retry
+  bool retry_queue_full = true;            // retry RESOURCE_EXHAUSTED reason QUEUE_FULL
   size_t upload_chunk_bytes = 1 << 20;
   // TLS: `tls` on, with `ca_pem` the PEM roots to trust ("" = the system's roots).
   bool tls = false;
@@ -153,7 +153,8 @@ class GeodexClient {
                     const std::function<grpc::Status(grpc::ClientContext*)>& call);
   // Runs a mesh-scoped query; on NOT_FOUND for a mesh this client has the file of, uploads it
   // again and retries once.
-  grpc::Status MeshCall(MeshRef& mesh, const std::function<grpc::Status(grpc::ClientContext*)>& call);
+  grpc::Status MeshCall(MeshRef& mesh,
+                        const std::function<grpc::Status(grpc::ClientContext*)>& call);
 
   ClientOptions options_;
   std::shared_ptr<grpc::Channel> channel_;

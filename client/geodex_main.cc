@@ -148,9 +148,10 @@ int main(int argc, char** argv) {
     break;
   }
   if (first >= argc) {
-    std::fputs("geodex: usage: geodex [--server HOST:PORT [--tls] [--ca FILE] [--token-file FILE]] "
-               "COMMAND ...\n",
-               stderr);
+    std::fputs(
+        "geodex: usage: geodex [--server HOST:PORT [--tls] [--ca FILE] [--token-file FILE]] "
+        "COMMAND ...\n",
+        stderr);
     return kExitUsage;
   }
   SetRemoteOptions(remote);
@@ -183,7 +184,8 @@ int main(int argc, char** argv) {
   // Every query command is written once against a backend: this process, or the server.
   for (const Command& c : QueryCommands()) {
     if (command != c.name) continue;
-    std::unique_ptr<Backend> backend = server.empty() ? MakeLocalBackend() : MakeRemoteBackend(server);
+    std::unique_ptr<Backend> backend =
+        server.empty() ? MakeLocalBackend() : MakeRemoteBackend(server);
     if (backend == nullptr) return RunServerCommand(server, command, args);  // built without gRPC
     return c.run(*backend, args);
   }

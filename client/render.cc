@@ -76,7 +76,9 @@ Point3 VertexOf(const MeshData& m, uint32_t v) {
 class Canvas {
  public:
   Canvas(int width, int height)
-      : width_(width), height_(height), depth_(size_t(width) * height, -kInf),
+      : width_(width),
+        height_(height),
+        depth_(size_t(width) * height, -kInf),
         image_{width, height, std::vector<uint8_t>(size_t(width) * height * 3, 255)} {}
 
   // A triangle with per-vertex colours, shaded by `light` (0..1).
@@ -85,8 +87,8 @@ class Canvas {
     const double max_x = std::min(width_ - 1.0, std::ceil(std::max({p[0][0], p[1][0], p[2][0]})));
     const double min_y = std::max(0.0, std::floor(std::min({p[0][1], p[1][1], p[2][1]})));
     const double max_y = std::min(height_ - 1.0, std::ceil(std::max({p[0][1], p[1][1], p[2][1]})));
-    const double area = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) -
-                        (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]);
+    const double area =
+        (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]);
     if (std::abs(area) < 1e-12) return;
     for (int y = static_cast<int>(min_y); y <= max_y; ++y) {
       for (int x = static_cast<int>(min_x); x <= max_x; ++x) {
@@ -131,8 +133,8 @@ class Canvas {
     const int steps = std::max(1, static_cast<int>(std::ceil(length * 2)));
     for (int s = 0; s <= steps; ++s) {
       const double t = double(s) / steps;
-      Dot(a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2]),
-          width / 2, color, bias);
+      Dot(a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2]), width / 2,
+          color, bias);
     }
   }
 
@@ -154,16 +156,16 @@ class Canvas {
 
 Rgb ColorMap(double t) {
   // Ten evenly spaced samples of the viridis colour map, interpolated linearly.
-  static constexpr uint8_t kStops[10][3] = {{68, 1, 84},    {72, 40, 120},  {62, 73, 137},
-                                            {49, 104, 142}, {38, 130, 142}, {31, 158, 137},
-                                            {53, 183, 121}, {110, 206, 88}, {181, 222, 43},
-                                            {253, 231, 37}};
+  static constexpr uint8_t kStops[10][3] = {
+      {68, 1, 84},    {72, 40, 120},  {62, 73, 137},  {49, 104, 142}, {38, 130, 142},
+      {31, 158, 137}, {53, 183, 121}, {110, 206, 88}, {181, 222, 43}, {253, 231, 37}};
   t = std::clamp(std::isnan(t) ? 0.0 : t, 0.0, 1.0) * 9;
   const int i = std::min(8, static_cast<int>(t));
   const double f = t - i;
   Rgb out;
   for (int ch = 0; ch < 3; ++ch) {
-    out[ch] = static_cast<uint8_t>(std::lround(kStops[i][ch] + f * (kStops[i + 1][ch] - kStops[i][ch])));
+    out[ch] =
+        static_cast<uint8_t>(std::lround(kStops[i][ch] + f * (kStops[i + 1][ch] - kStops[i][ch])));
   }
   return out;
 }
@@ -209,7 +211,8 @@ Projector Frame(const MeshData& m, View view, int width, int height) {
     lo[1] = std::min(lo[1], sy), hi[1] = std::max(hi[1], sy);
   }
   if (!(lo[0] <= hi[0])) lo[0] = lo[1] = 0, hi[0] = hi[1] = 1;
-  const double extent_x = std::max(hi[0] - lo[0], 1e-300), extent_y = std::max(hi[1] - lo[1], 1e-300);
+  const double extent_x = std::max(hi[0] - lo[0], 1e-300),
+               extent_y = std::max(hi[1] - lo[1], 1e-300);
   project.scale = 0.9 * std::min(width / extent_x, height / extent_y);
   project.offset_x = width / 2.0 - (lo[0] + hi[0]) / 2 * project.scale;
   project.offset_y = height / 2.0 - (lo[1] + hi[1]) / 2 * project.scale;
@@ -219,10 +222,9 @@ Projector Frame(const MeshData& m, View view, int width, int height) {
 // Rasterises the mesh's faces (shaded, or flat grey when only the depth matters).
 void DrawMesh(const Scene& scene, const Projector& project, Canvas* canvas) {
   const MeshData& m = *scene.mesh;
-  const Point3 light_dir = Normalize(
-      {project.camera.toward[0] + 0.3 * project.camera.up[0],
-       project.camera.toward[1] + 0.3 * project.camera.up[1],
-       project.camera.toward[2] + 0.3 * project.camera.up[2]});
+  const Point3 light_dir = Normalize({project.camera.toward[0] + 0.3 * project.camera.up[0],
+                                      project.camera.toward[1] + 0.3 * project.camera.up[1],
+                                      project.camera.toward[2] + 0.3 * project.camera.up[2]});
   const Rgb grey{128, 128, 128};
   for (size_t f = 0; f < m.face_count(); ++f) {
     const uint32_t v[3] = {m.faces[3 * f], m.faces[3 * f + 1], m.faces[3 * f + 2]};
@@ -358,7 +360,8 @@ namespace {
 // (drawn smaller when needed), the caption "distance" and the units.
 void DrawColorBar(Image* image, double max_distance, const std::string& units) {
   const int x0 = image->width - kColorBarWidth + 8, bar = 16;
-  const int top = static_cast<int>(0.15 * image->height), bottom = static_cast<int>(0.85 * image->height);
+  const int top = static_cast<int>(0.15 * image->height),
+            bottom = static_cast<int>(0.85 * image->height);
   for (int y = top; y < bottom; ++y) {
     const Rgb c = ColorMap(double(bottom - 1 - y) / std::max(1, bottom - 1 - top));
     for (int x = x0; x < x0 + bar; ++x) {
@@ -539,7 +542,8 @@ absl::Status WriteColoredPly(const std::string& path, const MeshData& mesh,
   return WriteMeshPly(path, mesh, attributes);
 }
 
-absl::Status WriteGltf(const std::string& path, const MeshData& mesh, const std::vector<Rgb>& colors) {
+absl::Status WriteGltf(const std::string& path, const MeshData& mesh,
+                       const std::vector<Rgb>& colors) {
   // Buffer: float32 positions, normalized uint8 RGBA colours, uint32 indices (4-byte aligned).
   std::string buffer;
   auto put = [&](const void* p, size_t n) { buffer.append(static_cast<const char*>(p), n); };

@@ -1,9 +1,9 @@
 #pragma once
 
 // A small software renderer for `geodex render`: the mesh shaded and coloured by distance (a
-// perceptual colour map), with isolines, Voronoi boundaries, Delaunay edges, paths and sources drawn
-// over it, seen from a named direction and framed automatically; written as PNG (libpng). Also
-// coloured PLY and glTF 2.0 exports of the same colours for 3D viewers.
+// perceptual colour map), with isolines, Voronoi boundaries, Delaunay edges, paths and sources
+// drawn over it, seen from a named direction and framed automatically; written as PNG (libpng).
+// Also coloured PLY and glTF 2.0 exports of the same colours for 3D viewers.
 //
 // Orthographic projection, a z-buffer, Lambert shading (two-sided) plus an ambient term; lines are
 // depth-tested against the surface with a small bias so they show on it but not through it.
@@ -40,7 +40,7 @@ struct Scene {
   const MeshData* mesh = nullptr;
   std::vector<Rgb> vertex_colors;  // one per mesh vertex
   std::vector<Polyline> lines;
-  std::vector<Point3> markers;     // sources: black dots with a white ring
+  std::vector<Point3> markers;  // sources: black dots with a white ring
   // The colour bar at the right (when max_distance > 0 and the image is at least kColorBarMinWidth
   // wide): the colour map from 0 (bottom) to max_distance (top), labelled, with `units`.
   double max_distance = 0;
@@ -92,6 +92,7 @@ absl::Status WriteColoredPly(const std::string& path, const MeshData& mesh,
                              const std::vector<Rgb>& colors, const std::vector<double>& distances);
 // glTF 2.0 (one .gltf JSON file with the buffer embedded as a base64 data URI): positions,
 // COLOR_0 and indices.
-absl::Status WriteGltf(const std::string& path, const MeshData& mesh, const std::vector<Rgb>& colors);
+absl::Status WriteGltf(const std::string& path, const MeshData& mesh,
+                       const std::vector<Rgb>& colors);
 
 }  // namespace geodex::render

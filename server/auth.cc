@@ -20,7 +20,8 @@ bool ConstantTimeEqual(const std::string& a, const std::string& b) {
 
 absl::StatusOr<std::vector<std::string>> ReadTokenFile(const std::string& path) {
   std::ifstream in(path);
-  if (!in) return absl::InvalidArgumentError(absl::StrCat("--auth_token_file ", path, ": cannot read"));
+  if (!in)
+    return absl::InvalidArgumentError(absl::StrCat("--auth_token_file ", path, ": cannot read"));
   std::vector<std::string> tokens;
   for (std::string line; std::getline(in, line);) {
     std::string token(absl::StripAsciiWhitespace(line));
@@ -39,7 +40,8 @@ bool TokenAuthenticator::Allows(const grpc::CallbackServerContext& context) cons
   if (it == metadata.end()) return false;
   const std::string kBearer = "Bearer ";
   const std::string value(it->second.data(), it->second.size());
-  if (value.size() <= kBearer.size() || value.compare(0, kBearer.size(), kBearer) != 0) return false;
+  if (value.size() <= kBearer.size() || value.compare(0, kBearer.size(), kBearer) != 0)
+    return false;
   const std::string presented = value.substr(kBearer.size());
   bool ok = false;
   for (const std::string& token : tokens_) ok |= ConstantTimeEqual(presented, token);

@@ -1,8 +1,8 @@
 #pragma once
 
 // Bearer-token authentication of geodex.v1 calls. Every call must carry `authorization: Bearer
-// TOKEN` metadata with one of the tokens of --auth_token_file; health and reflection stay open (they
-// are other services), and so does the metrics endpoint. The check runs in the service's own
+// TOKEN` metadata with one of the tokens of --auth_token_file; health and reflection stay open
+// (they are other services), and so does the metrics endpoint. The check runs in the service's own
 // handlers rather than in a grpc::AuthMetadataProcessor, which aborts the process on insecure
 // credentials (gRPC 1.51): it works with and without TLS and can only ever answer UNAUTHENTICATED.
 
@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
-#include "grpcpp/support/server_callback.h"
 #include "grpcpp/server_context.h"
+#include "grpcpp/support/server_callback.h"
 
 namespace geodex::server {
 

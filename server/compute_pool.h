@@ -4,15 +4,14 @@
 // threads. TrySubmit refuses work at once when the queue is full (the caller answers
 // RESOURCE_EXHAUSTED) instead of letting requests pile up.
 
+#include <condition_variable>
 #include <cstddef>
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <mutex>
 #include <thread>
 #include <vector>
-
-#include <condition_variable>
-#include <mutex>
 
 namespace geodex::server {
 
@@ -53,11 +52,11 @@ class ComputePool {
   // std::mutex rather than absl::Mutex: Debian's Abseil is not built for ThreadSanitizer, so its
   // mutexes would be invisible to the sanitizer tier.
   mutable std::mutex mu_;
-  std::condition_variable work_;                // a task arrived, or stopping
-  std::deque<std::function<void()>> queue_;     // guarded by mu_
-  size_t busy_ = 0;                             // guarded by mu_
-  uint64_t rejected_ = 0;                       // guarded by mu_
-  bool stopping_ = false;                       // guarded by mu_
+  std::condition_variable work_;             // a task arrived, or stopping
+  std::deque<std::function<void()>> queue_;  // guarded by mu_
+  size_t busy_ = 0;                          // guarded by mu_
+  uint64_t rejected_ = 0;                    // guarded by mu_
+  bool stopping_ = false;                    // guarded by mu_
   std::vector<std::thread> workers_;
 };
 

@@ -52,7 +52,8 @@ class FieldCache {
     std::list<std::string>::iterator lru;
   };
   const uint64_t budget_bytes_;
-  mutable std::mutex mu_;  // (std::mutex: visible to ThreadSanitizer; members below are guarded by it)
+  mutable std::mutex
+      mu_;  // (std::mutex: visible to ThreadSanitizer; members below are guarded by it)
   absl::flat_hash_map<std::string, Entry> entries_;
   std::list<std::string> lru_;  // most recent first
   uint64_t bytes_ = 0;

@@ -8,13 +8,13 @@
 
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
+#include "geodex/mesh_id.h"
+#include "geodex/mesh_io.h"
+#include "geodex/samples.h"
 #include "grpcpp/ext/proto_server_reflection_plugin.h"
 #include "grpcpp/security/server_credentials.h"
 #include "grpcpp/server_builder.h"
-#include "geodex/mesh_io.h"
-#include "geodex/samples.h"
 #include "listen_address.h"
-#include "geodex/mesh_id.h"
 
 namespace geodex::server {
 
@@ -47,8 +47,8 @@ absl::Status ValidateServerOptions(const ServerOptions& options) {
         "serve TLS, or pass --allow_plaintext_tokens when a TLS-terminating proxy is in front");
   }
   if (options.queue_capacity > kMaxQueueCapacity) {
-    return absl::InvalidArgumentError(absl::StrCat("--queue_capacity=", options.queue_capacity,
-                                                   ": at most ", kMaxQueueCapacity));
+    return absl::InvalidArgumentError(
+        absl::StrCat("--queue_capacity=", options.queue_capacity, ": at most ", kMaxQueueCapacity));
   }
   const ServiceLimits& l = options.limits;
   const uint64_t stream_chunk = l.stream_chunk_bytes;
@@ -141,11 +141,11 @@ absl::StatusOr<std::unique_ptr<GeodexServer>> GeodexServer::Start(const ServerOp
   }
   if (!options.import_dir.empty()) s->ImportDirectory(options.import_dir);
 
-  absl::StatusOr<std::unique_ptr<ServerMetrics>> metrics = ServerMetrics::Start(
-      options.metrics_listen,
-      MetricSources{s->pool_.get(), s->store_.get(), s->cache_.get(), &s->service_->counters(),
-                    &s->descriptions_},
-      options.log_requests, options.replica_name);
+  absl::StatusOr<std::unique_ptr<ServerMetrics>> metrics =
+      ServerMetrics::Start(options.metrics_listen,
+                           MetricSources{s->pool_.get(), s->store_.get(), s->cache_.get(),
+                                         &s->service_->counters(), &s->descriptions_},
+                           options.log_requests, options.replica_name);
   if (!metrics.ok()) return metrics.status();
   s->metrics_ = *std::move(metrics);
 
@@ -184,7 +184,8 @@ absl::StatusOr<std::string> ReadSmallFile(const std::string& path, const std::st
   if (!in.good() && !in.eof()) {
     return absl::InvalidArgumentError(absl::StrCat(flag, " ", path, ": cannot read"));
   }
-  if (bytes.empty()) return absl::InvalidArgumentError(absl::StrCat(flag, " ", path, ": empty or missing"));
+  if (bytes.empty())
+    return absl::InvalidArgumentError(absl::StrCat(flag, " ", path, ": empty or missing"));
   return bytes;
 }
 
@@ -225,8 +226,8 @@ void GeodexServer::ImportDirectory(const std::string& dir) {
     // The alias is the file name up to its first dot, when it is a valid, unused alias.
     std::string alias = path.filename().string();
     alias = alias.substr(0, alias.find('.'));
-    bool valid = !alias.empty() && alias.size() <= 63 && !IsMeshId(alias) &&
-                 !store_->GetRecord(alias).ok();
+    bool valid =
+        !alias.empty() && alias.size() <= 63 && !IsMeshId(alias) && !store_->GetRecord(alias).ok();
     for (char c : alias) {
       valid = valid && (std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-');
     }

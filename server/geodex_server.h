@@ -13,8 +13,8 @@
 #include "absl/time/time.h"
 #include "compute_pool.h"
 #include "geodex_service.h"
-#include "health_service.h"
 #include "grpcpp/server.h"
+#include "health_service.h"
 #include "mesh_store.h"
 #include "metrics.h"
 
@@ -22,27 +22,27 @@ namespace geodex::server {
 
 // What happened at start, for geodexd to log.
 struct StartupReport {
-  size_t indexed = 0;                              // meshes found in the data directory
-  std::vector<MeshDisk::Skipped> skipped;          // corrupt/truncated files (left in place)
-  std::vector<std::string> removed_temporaries;    // writes interrupted by a crash
-  std::vector<std::string> samples;                // built-in samples added
-  std::vector<std::string> imported;               // "file -> meshes/id"
-  std::vector<std::string> import_errors;          // "file: reason"
+  size_t indexed = 0;                            // meshes found in the data directory
+  std::vector<MeshDisk::Skipped> skipped;        // corrupt/truncated files (left in place)
+  std::vector<std::string> removed_temporaries;  // writes interrupted by a crash
+  std::vector<std::string> samples;              // built-in samples added
+  std::vector<std::string> imported;             // "file -> meshes/id"
+  std::vector<std::string> import_errors;        // "file: reason"
 };
 
 struct ServerOptions {
   std::string listen = "127.0.0.1:50051";  // HOST:PORT; port 0 picks a free port
-  std::string data_dir;     // persisted meshes (mesh_disk.h); empty = RAM only
-  bool samples = false;     // offer the built-in samples on a fresh data directory (or RAM only);
-                            // geodexd turns this on by default (--samples)
-  std::string import_dir;   // meshes to import at start (server-side files; never request paths)
+  std::string data_dir;                    // persisted meshes (mesh_disk.h); empty = RAM only
+  bool samples = false;    // offer the built-in samples on a fresh data directory (or RAM only);
+                           // geodexd turns this on by default (--samples)
+  std::string import_dir;  // meshes to import at start (server-side files; never request paths)
   uint64_t mesh_budget_bytes = uint64_t{4} << 30;
-  size_t pool_threads = 0;    // 0 = hardware concurrency
+  size_t pool_threads = 0;  // 0 = hardware concurrency
   // Workers of the quick lane: calls that need no solve (locate, cached fields and traces) never
   // wait behind full solves (query_reactors.h). 0 = no quick lane (the behaviour before it).
   size_t quick_threads = 2;
   size_t queue_capacity = 64;
-  int max_receive_message_bytes = 4 << 20;  // per message; uploads are chunked below this
+  int max_receive_message_bytes = 4 << 20;            // per message; uploads are chunked below this
   uint64_t result_cache_bytes = uint64_t{256} << 20;  // finished fields kept for reuse; 0 = off
   std::string metrics_listen;  // HOST:PORT of the Prometheus /metrics endpoint; "" = none
   bool log_requests = false;   // one spdlog line per call (geodexd: on)
@@ -70,7 +70,8 @@ inline constexpr size_t kMaxQuickThreads = 64;
 inline constexpr size_t kMaxQueueCapacity = 1'000'000;
 inline constexpr uint64_t kMaxStreamChunkBytes = 3 << 20;
 
-// A whole (small) file, e.g. a PEM certificate; InvalidArgument naming `flag` when unreadable/empty.
+// A whole (small) file, e.g. a PEM certificate; InvalidArgument naming `flag` when
+// unreadable/empty.
 absl::StatusOr<std::string> ReadSmallFile(const std::string& path, const std::string& flag);
 
 class GeodexServer {
@@ -105,7 +106,7 @@ class GeodexServer {
   // its workers), the service and the store.
   std::unique_ptr<MeshStore> store_;
   std::unique_ptr<FieldCache> cache_;
-  CallDescriptions descriptions_;  // written by the service, read by the interceptor
+  CallDescriptions descriptions_;           // written by the service, read by the interceptor
   std::unique_ptr<ServerMetrics> metrics_;  // the interceptor records into it: outlives server_
   std::unique_ptr<GeodexService> service_;
   std::unique_ptr<HealthService> health_;

@@ -11,11 +11,11 @@
 #include "absl/strings/str_cat.h"
 #include "geodex/cancel.h"
 #include "geodex/limits.h"
+#include "geodex/mesh_id.h"
 #include "geodex/mesh_io.h"
 #include "geodex/terrain.h"
 #include "google/protobuf/descriptor.h"
 #include "grpcpp/support/server_callback.h"
-#include "geodex/mesh_id.h"
 #include "proto_convert.h"
 #include "queries.h"
 #include "query_reactors.h"
@@ -113,7 +113,9 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
       if (env_.descriptions != nullptr) {
         env_.descriptions->SetMesh(context_, metadata_.display_name());
       }
-      if (absl::Status valid = ValidateDisplayName(metadata_.display_name(), "metadata.display_name"); !valid.ok()) {
+      if (absl::Status valid =
+              ValidateDisplayName(metadata_.display_name(), "metadata.display_name");
+          !valid.ok()) {
         return valid;
       }
       absl::StatusOr<MeshFormat> format = FormatFromProto(metadata_.format());
@@ -126,9 +128,11 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
       if (metadata_.has_dem()) {
         if (metadata_.format() != v1::MESH_FORMAT_GEOTIFF &&
             metadata_.format() != v1::MESH_FORMAT_UNSPECIFIED) {
-          return FieldError("metadata.dem", "DEM options are for a GeoTIFF upload (format MESH_FORMAT_GEOTIFF)");
+          return FieldError("metadata.dem",
+                            "DEM options are for a GeoTIFF upload (format MESH_FORMAT_GEOTIFF)");
         }
-        if (metadata_.dem().has_barrier_below() && !std::isfinite(metadata_.dem().barrier_below())) {
+        if (metadata_.dem().has_barrier_below() &&
+            !std::isfinite(metadata_.dem().barrier_below())) {
           return FieldError("metadata.dem.barrier_below", "must be finite");
         }
       }
@@ -142,25 +146,32 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
       return absl::OkStatus();
     }
     if (request.has_metadata()) {
-      return FieldError("metadata", absl::StrCat("message ", messages_, " carries metadata again; only the first CreateMeshRequest may"));
+      return FieldError(
+          "metadata",
+          absl::StrCat("message ", messages_,
+                       " carries metadata again; only the first CreateMeshRequest may"));
     }
     if (request.payload_case() != v1::CreateMeshRequest::kChunk) {
-      return FieldError("chunk", absl::StrCat("message ", messages_, " of the upload stream carries neither metadata nor a chunk"));
+      return FieldError("chunk",
+                        absl::StrCat("message ", messages_,
+                                     " of the upload stream carries neither metadata nor a chunk"));
     }
     const std::string& chunk = request.chunk();
     const uint64_t total = bytes_.size() + chunk.size();
     if (total > limits.max_upload_bytes) return TooLarge(total);
     if (metadata_.total_bytes() != 0 && total > metadata_.total_bytes()) {
-      return FieldError("metadata.total_bytes", absl::StrCat("declared ", metadata_.total_bytes(), " bytes, but message ", messages_, " brings the upload to ", total));
+      return FieldError("metadata.total_bytes",
+                        absl::StrCat("declared ", metadata_.total_bytes(), " bytes, but message ",
+                                     messages_, " brings the upload to ", total));
     }
     bytes_.append(chunk);
     return absl::OkStatus();
   }
 
   absl::Status TooLarge(uint64_t bytes) const {
-    return ServerLimitError("max_upload_bytes", absl::StrCat("upload of ", bytes,
-                                                     " bytes exceeds --max_upload_bytes=",
-                                                     env_.limits->max_upload_bytes));
+    return ServerLimitError("max_upload_bytes",
+                            absl::StrCat("upload of ", bytes, " bytes exceeds --max_upload_bytes=",
+                                         env_.limits->max_upload_bytes));
   }
 
   void EndOfUpload() {
@@ -174,9 +185,13 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
       if (!have_metadata_) {
         complete = FieldError("metadata", "the upload stream was empty");
       } else if (metadata_.total_bytes() != 0 && bytes_.size() != metadata_.total_bytes()) {
-        complete = FieldError("metadata.total_bytes", absl::StrCat("declared ", metadata_.total_bytes(), " bytes, but ", bytes_.size(), " arrived; nothing was stored"));
+        complete = FieldError("metadata.total_bytes",
+                              absl::StrCat("declared ", metadata_.total_bytes(), " bytes, but ",
+                                           bytes_.size(), " arrived; nothing was stored"));
       } else if (bytes_.empty()) {
-        complete = FieldError("chunk", absl::StrCat("the upload stream ended after the metadata without any bytes (", messages_, " messages)"));
+        complete = FieldError(
+            "chunk", absl::StrCat("the upload stream ended after the metadata without any bytes (",
+                                  messages_, " messages)"));
       }
     }
     if (!complete.ok()) {
@@ -212,7 +227,8 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
   absl::StatusOr<terrain::Dem> ReadDem(const std::string& file_name) const {
     terrain::DemOptions options;
     options.step = std::max<uint32_t>(1, metadata_.dem().step());
-    if (metadata_.dem().has_barrier_below()) options.barrier_below = metadata_.dem().barrier_below();
+    if (metadata_.dem().has_barrier_below())
+      options.barrier_below = metadata_.dem().barrier_below();
     options.max_cells = env_.limits->max_dem_cells;
     options.max_vertices = env_.limits->max_vertices;
     options.max_faces = env_.limits->max_faces;
@@ -233,38 +249,44 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
     read_limits.max_faces = limits.max_faces;
     // A gzip upload inflates at most to the upload limit (checked while inflating).
     read_limits.max_decompressed_bytes = limits.max_upload_bytes;
-    const std::string file_name =
-        metadata_.file_name().empty()
-            ? "upload"
-            : std::string(metadata_.file_name().substr(0, kMaxEchoBytes));
+    const std::string file_name = metadata_.file_name().empty()
+                                      ? "upload"
+                                      : std::string(metadata_.file_name().substr(0, kMaxEchoBytes));
     std::shared_ptr<const terrain::Dem> dem;
-    if (dem_ || (metadata_.format() == v1::MESH_FORMAT_UNSPECIFIED && terrain::LooksLikeTiff(bytes_))) {
+    if (dem_ ||
+        (metadata_.format() == v1::MESH_FORMAT_UNSPECIFIED && terrain::LooksLikeTiff(bytes_))) {
       absl::StatusOr<terrain::Dem> read = ReadDem(file_name);
       if (!read.ok()) return read.status();
       dem = std::make_shared<const terrain::Dem>(*std::move(read));
     } else if (metadata_.has_dem()) {
-      return FieldError("metadata.dem", "DEM options are for a GeoTIFF upload, and this upload is not one");
+      return FieldError("metadata.dem",
+                        "DEM options are for a GeoTIFF upload, and this upload is not one");
     }
     // A DEM's mesh is its grid's (not copied); a mesh file's is read here.
-    absl::StatusOr<MeshData> read = dem != nullptr ? MeshData()
-                                                   : ReadMeshFromBuffer(absl::string_view(bytes_),
-                                                                        format_, file_name, read_limits);
+    absl::StatusOr<MeshData> read =
+        dem != nullptr
+            ? MeshData()
+            : ReadMeshFromBuffer(absl::string_view(bytes_), format_, file_name, read_limits);
     if (!read.ok()) {
       if (read.status().code() == absl::StatusCode::kResourceExhausted) return read.status();
       return FieldError("chunk", read.status().message());
     }
     const MeshData* data = dem != nullptr ? &dem->mesh() : &*read;
     if (data->vertex_count() > limits.max_vertices) {
-      return ServerLimitError("max_vertices", absl::StrCat("mesh has ", data->vertex_count(),
-                       " vertices, over --max_vertices=", limits.max_vertices));
+      return ServerLimitError("max_vertices",
+                              absl::StrCat("mesh has ", data->vertex_count(),
+                                           " vertices, over --max_vertices=", limits.max_vertices));
     }
     if (data->face_count() > limits.max_faces) {
-      return ServerLimitError("max_faces", absl::StrCat(
-          "mesh has ", data->face_count(), " faces, over --max_faces=", limits.max_faces));
+      return ServerLimitError("max_faces",
+                              absl::StrCat("mesh has ", data->face_count(),
+                                           " faces, over --max_faces=", limits.max_faces));
     }
     std::string id = ComputeMeshId(*data);
     if (!metadata_.expected_mesh_id().empty() && metadata_.expected_mesh_id() != id) {
-      return FieldError("metadata.expected_mesh_id", absl::StrCat(metadata_.expected_mesh_id(), " differs from the uploaded mesh's id ", id));
+      return FieldError(
+          "metadata.expected_mesh_id",
+          absl::StrCat(metadata_.expected_mesh_id(), " differs from the uploaded mesh's id ", id));
     }
     std::shared_ptr<StoredMesh> candidate;
     // A stored mesh that is this DEM's but was uploaded as a mesh file gains its map: build it.
@@ -285,9 +307,9 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
       candidate->pinned = metadata_.pin();
     }
     candidate->display_name = metadata_.display_name();
-    const std::string canonical =
-        env_.store->has_disk() && candidate->mesh != nullptr ? CanonicalMeshEncoding(*data)
-                                                             : std::string();
+    const std::string canonical = env_.store->has_disk() && candidate->mesh != nullptr
+                                      ? CanonicalMeshEncoding(*data)
+                                      : std::string();
     absl::StatusOr<std::shared_ptr<const StoredMesh>> stored =
         env_.store->Insert(std::move(candidate), canonical, limits.max_names_per_mesh);
     if (!stored.ok()) return stored.status();
@@ -404,23 +426,23 @@ const std::vector<MethodRow>& MethodTable() {
       StreamRow<v1::GetMeshGeometryRequest, v1::MeshGeometry, &RunGetMeshGeometry>(
           "GetMeshGeometry", Lane::kQuick),
       UnaryRow<v1::ListMeshesRequest, v1::ListMeshesResponse, &RunListMeshes>("ListMeshes",
-                                                                               Lane::kInline),
+                                                                              Lane::kInline),
       UnaryRow<v1::DeleteMeshRequest, v1::DeleteMeshResponse, &RunDeleteMesh>("DeleteMesh",
-                                                                               Lane::kInline),
+                                                                              Lane::kInline),
       UnaryRow<v1::DeriveMeshRequest, v1::Mesh, &RunDeriveMesh>("DeriveMesh", Lane::kSolve),
       StreamRow<v1::ComputeDistanceFieldRequest, v1::ComputeDistanceFieldResponse,
                 &RunComputeDistanceField>("ComputeDistanceField", Lane::kQuick),
       UnaryRow<v1::FindShortestPathRequest, v1::FindShortestPathResponse, &RunFindShortestPath>(
           "FindShortestPath", Lane::kQuick),
-      UnaryRow<v1::FindShortestPathsRequest, v1::FindShortestPathsResponse,
-               &RunFindShortestPaths>("FindShortestPaths", Lane::kSolve),
+      UnaryRow<v1::FindShortestPathsRequest, v1::FindShortestPathsResponse, &RunFindShortestPaths>(
+          "FindShortestPaths", Lane::kSolve),
       // A repeated matrix is a cache hit.
       StreamRow<v1::ComputeDistanceMatrixRequest, v1::ComputeDistanceMatrixResponse,
                 &RunComputeDistanceMatrix>("ComputeDistanceMatrix", Lane::kQuick),
-      UnaryRow<v1::EstimateDistancesRequest, v1::EstimateDistancesResponse,
-               &RunEstimateDistances>("EstimateDistances", Lane::kQuick),
-      UnaryRow<v1::LocatePointsRequest, v1::LocatePointsResponse, &RunLocatePoints>(
-          "LocatePoints", Lane::kQuick),
+      UnaryRow<v1::EstimateDistancesRequest, v1::EstimateDistancesResponse, &RunEstimateDistances>(
+          "EstimateDistances", Lane::kQuick),
+      UnaryRow<v1::LocatePointsRequest, v1::LocatePointsResponse, &RunLocatePoints>("LocatePoints",
+                                                                                    Lane::kQuick),
       StreamRow<v1::ComputeIsolinesRequest, v1::ComputeIsolinesResponse, &RunComputeIsolines>(
           "ComputeIsolines", Lane::kQuick),
       StreamRow<v1::ComputeVoronoiRequest, v1::ComputeVoronoiResponse, &RunComputeVoronoi>(

@@ -1,15 +1,15 @@
 // geodexd: the geodex gRPC server. `geodexd --help` lists every flag.
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <csignal>
-#include <cstring>
 #include <cstdio>
+#include <cstring>
 #include <string>
 #include <thread>
 #include <vector>
-
-#include <unistd.h>
 
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
@@ -18,7 +18,8 @@
 #include "geodex_server.h"
 #include "spdlog/spdlog.h"
 
-ABSL_FLAG(std::string, listen, "127.0.0.1:50051", "HOST:PORT to listen on (port 0 = any free port)");
+ABSL_FLAG(std::string, listen, "127.0.0.1:50051",
+          "HOST:PORT to listen on (port 0 = any free port)");
 ABSL_FLAG(std::string, data_dir, "",
           "Directory for persisted meshes (created if missing; empty = keep meshes in RAM only)");
 ABSL_FLAG(bool, samples, true,
@@ -34,7 +35,8 @@ ABSL_FLAG(std::string, metrics_listen, "127.0.0.1:9464",
           "HOST:PORT of the Prometheus /metrics HTTP endpoint (empty = off)");
 ABSL_FLAG(std::string, replica_name, "",
           "Name sent to clients as x-geodex-replica metadata (default: the host name)");
-ABSL_FLAG(std::string, tls_cert, "", "PEM certificate (chain) of the server: serve TLS (with --tls_key)");
+ABSL_FLAG(std::string, tls_cert, "",
+          "PEM certificate (chain) of the server: serve TLS (with --tls_key)");
 ABSL_FLAG(std::string, tls_key, "", "PEM private key of --tls_cert");
 ABSL_FLAG(std::string, auth_token_file, "",
           "File of bearer tokens, one per line: geodex.v1 calls need 'authorization: Bearer TOKEN' "
@@ -49,16 +51,19 @@ ABSL_FLAG(uint32_t, quick_threads, 2,
           "estimates from them), so that they never wait behind full solves (0 = no quick lane)");
 ABSL_FLAG(uint32_t, queue_capacity, 64,
           "Queries that may wait for a worker; beyond that calls get RESOURCE_EXHAUSTED at once");
-ABSL_FLAG(uint64_t, max_upload_bytes, uint64_t{1} << 30, "Largest mesh file accepted by CreateMesh");
+ABSL_FLAG(uint64_t, max_upload_bytes, uint64_t{1} << 30,
+          "Largest mesh file accepted by CreateMesh");
 ABSL_FLAG(uint64_t, max_vertices, 20'000'000, "Most vertices in an uploaded mesh");
 ABSL_FLAG(uint64_t, max_faces, 40'000'000, "Most faces in an uploaded mesh");
 ABSL_FLAG(uint64_t, max_dem_cells, 25'000'000,
           "Most cells (width x height) in an uploaded GeoTIFF DEM, checked before GDAL reads them");
-ABSL_FLAG(uint32_t, max_names_per_mesh, 16,
-          "Most names (display name and aliases from re-uploads under other names) one mesh may have");
+ABSL_FLAG(
+    uint32_t, max_names_per_mesh, 16,
+    "Most names (display name and aliases from re-uploads under other names) one mesh may have");
 ABSL_FLAG(uint32_t, max_sources, 100'000, "Most sources in one query");
-ABSL_FLAG(uint32_t, max_targets, 50'000,
-          "Most targets (matrix columns, EstimateDistances points, LocatePoints positions) per query");
+ABSL_FLAG(
+    uint32_t, max_targets, 50'000,
+    "Most targets (matrix columns, EstimateDistances points, LocatePoints positions) per query");
 ABSL_FLAG(uint32_t, max_levels, 1'000, "Most isoline levels per ComputeIsolines query");
 ABSL_FLAG(uint64_t, max_output_values, 100'000'000,
           "Most values one query may return (field vertices, matrix cells)");
@@ -172,17 +177,19 @@ int main(int argc, char** argv) {
   for (const auto& line : report.import_errors) spdlog::warn("import failed: {}", line);
   // The effective configuration, one line.
   spdlog::info(
-      "config replica={} listen={} data_dir={} samples={} mesh_budget_bytes={} result_cache_bytes={} "
+      "config replica={} listen={} data_dir={} samples={} mesh_budget_bytes={} "
+      "result_cache_bytes={} "
       "pool_threads={} quick_threads={} "
-      "queue_capacity={} max_upload_bytes={} max_vertices={} max_faces={} max_dem_cells={} max_sources={} "
+      "queue_capacity={} max_upload_bytes={} max_vertices={} max_faces={} max_dem_cells={} "
+      "max_sources={} "
       "max_targets={} max_levels={} max_output_values={} max_windows={} "
       "max_unary_response_bytes={} stream_chunk_bytes={} shutdown_grace_seconds={}",
       options.replica_name, options.listen, options.data_dir.empty() ? "(none)" : options.data_dir,
-      options.samples,
-      options.mesh_budget_bytes, options.result_cache_bytes, (*server)->pool().threads(),
-      options.quick_threads, options.queue_capacity, options.limits.max_upload_bytes, options.limits.max_vertices, options.limits.max_faces,
-      options.limits.max_dem_cells, options.limits.max_sources, options.limits.max_targets, options.limits.max_levels,
-      options.limits.max_output_values, options.limits.max_windows,
+      options.samples, options.mesh_budget_bytes, options.result_cache_bytes,
+      (*server)->pool().threads(), options.quick_threads, options.queue_capacity,
+      options.limits.max_upload_bytes, options.limits.max_vertices, options.limits.max_faces,
+      options.limits.max_dem_cells, options.limits.max_sources, options.limits.max_targets,
+      options.limits.max_levels, options.limits.max_output_values, options.limits.max_windows,
       options.limits.max_unary_response_bytes, options.limits.stream_chunk_bytes,
       absl::GetFlag(FLAGS_shutdown_grace_seconds));
   if ((*server)->metrics().port() != 0) {

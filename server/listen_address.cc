@@ -1,11 +1,11 @@
 #include "listen_address.h"
 
-#include <cerrno>
-#include <cstdlib>
-
 #include <netdb.h>
 #include <sys/socket.h>
 #include <unistd.h>
+
+#include <cerrno>
+#include <cstdlib>
 
 #include "absl/strings/ascii.h"
 #include "absl/strings/match.h"

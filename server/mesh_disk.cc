@@ -79,7 +79,8 @@ struct Parsed {
 absl::StatusOr<Parsed> ParseFile(const std::string& bytes, bool verify) {
   Parsed out;
   if (bytes.size() < 8 + 4 + 4 + 8 + 32) return absl::DataLossError("truncated (too short)");
-  if (std::memcmp(bytes.data(), kMagic, 8) != 0) return absl::DataLossError("not a geodex mesh file");
+  if (std::memcmp(bytes.data(), kMagic, 8) != 0)
+    return absl::DataLossError("not a geodex mesh file");
   const uint32_t version = static_cast<uint32_t>(GetLE(bytes.data() + 8, 4));
   const uint64_t header_size = GetLE(bytes.data() + 12, 4);
   if (header_size > kMaxHeaderBytes || 16 + header_size + 8 + 32 > bytes.size()) {
@@ -199,8 +200,10 @@ absl::Status MeshDisk::Write(const MeshRecord& header, const std::string& canoni
   const int fd = ::open(temp_path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
   if (fd < 0) return ErrnoStatus(errno, absl::StrCat("creating ", temp_path));
   absl::Status status = WriteAll(fd, bytes, temp_path);
-  if (status.ok() && ::fsync(fd) != 0) status = ErrnoStatus(errno, absl::StrCat("fsync ", temp_path));
-  if (::close(fd) != 0 && status.ok()) status = ErrnoStatus(errno, absl::StrCat("closing ", temp_path));
+  if (status.ok() && ::fsync(fd) != 0)
+    status = ErrnoStatus(errno, absl::StrCat("fsync ", temp_path));
+  if (::close(fd) != 0 && status.ok())
+    status = ErrnoStatus(errno, absl::StrCat("closing ", temp_path));
   if (status.ok() && ::rename(temp_path.c_str(), final_path.c_str()) != 0) {
     status = ErrnoStatus(errno, absl::StrCat("renaming ", temp_path));
   }
@@ -217,7 +220,8 @@ absl::Status MeshDisk::Write(const MeshRecord& header, const std::string& canoni
   return absl::OkStatus();
 }
 
-absl::Status MeshDisk::Read(const std::string& id, MeshRecord* header, std::string* canonical) const {
+absl::Status MeshDisk::Read(const std::string& id, MeshRecord* header,
+                            std::string* canonical) const {
   // Messages name the mesh, never the server's paths (they reach clients).
   const std::string path = PathOf(id);
   const std::string mesh = absl::StrCat("stored mesh meshes/", id);

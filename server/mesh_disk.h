@@ -38,9 +38,9 @@ class MeshDisk {
   };
   struct Index {
     std::vector<IndexEntry> meshes;
-    std::vector<Skipped> skipped;        // corrupt, truncated or misnamed files (left in place)
+    std::vector<Skipped> skipped;  // corrupt, truncated or misnamed files (left in place)
     std::vector<std::string> removed_temporaries;
-    bool fresh = false;                  // the directory had never been initialised
+    bool fresh = false;  // the directory had never been initialised
   };
 
   // Creates DIR/meshes if needed, removes stale temporaries and reads every file's header

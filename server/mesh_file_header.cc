@@ -68,11 +68,11 @@ class Reader {
 // MeshReport's counts, in declaration order: the one list both directions walk.
 template <typename Report, typename F>
 void ForEachCount(Report& r, F&& f) {
-  for (auto* p : {&r.file_vertices, &r.file_faces, &r.boundary_edges, &r.boundary_loops,
-                  &r.components, &r.vertex_connected_components, &r.isolated_vertices,
-                  &r.non_manifold_edges, &r.non_manifold_vertices, &r.degenerate_faces,
-                  &r.flipped_faces, &r.orientation_cuts, &r.saddle_vertices,
-                  &r.boundary_vertices}) {
+  for (auto* p :
+       {&r.file_vertices, &r.file_faces, &r.boundary_edges, &r.boundary_loops, &r.components,
+        &r.vertex_connected_components, &r.isolated_vertices, &r.non_manifold_edges,
+        &r.non_manifold_vertices, &r.degenerate_faces, &r.flipped_faces, &r.orientation_cuts,
+        &r.saddle_vertices, &r.boundary_vertices}) {
     f(*p);
   }
 }
@@ -125,7 +125,8 @@ std::string EncodeMeshFileHeader(const MeshRecord& record) {
   if (record.terrain) {
     const terrain::DemInfo& t = *record.terrain;
     w.Str(t.driver);
-    for (uint32_t v : {t.raster_width, t.raster_height, t.step, t.grid_width, t.grid_height}) w.U32(v);
+    for (uint32_t v : {t.raster_width, t.raster_height, t.step, t.grid_width, t.grid_height})
+      w.U32(v);
     for (uint64_t v : {t.nodata_cells, t.barrier_cells, t.barrier_faces}) w.U64(v);
     w.Str(t.file_crs_name);
     w.Str(t.file_crs_wkt);
@@ -168,7 +169,8 @@ absl::StatusOr<MeshRecord> DecodeMeshFileHeader(uint32_t version, absl::string_v
   if (version >= 3 && r.U8() != 0) {
     terrain::DemInfo& t = record.terrain.emplace();
     t.driver = r.Str();
-    for (uint32_t* v : {&t.raster_width, &t.raster_height, &t.step, &t.grid_width, &t.grid_height}) {
+    for (uint32_t* v :
+         {&t.raster_width, &t.raster_height, &t.step, &t.grid_width, &t.grid_height}) {
       *v = r.U32();
     }
     for (uint64_t* v : {&t.nodata_cells, &t.barrier_cells, &t.barrier_faces}) *v = r.U64();

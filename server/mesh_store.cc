@@ -70,7 +70,9 @@ void MeshStore::AttachDisk(MeshDisk disk, const MeshDisk::Index& index) {
 
 absl::StatusOr<std::vector<std::string>> MeshStore::VictimsLocked(uint64_t bytes) const {
   if (bytes > budget_bytes_) {
-    return ServerLimitError("mesh_budget_bytes", absl::StrCat("mesh needs ", bytes, " bytes of memory, more than the whole ",
+    return ServerLimitError(
+        "mesh_budget_bytes",
+        absl::StrCat("mesh needs ", bytes, " bytes of memory, more than the whole ",
                      "mesh budget (--mesh_budget_bytes=", budget_bytes_, ")"));
   }
   std::vector<std::string> victims;
@@ -83,9 +85,11 @@ absl::StatusOr<std::vector<std::string>> MeshStore::VictimsLocked(uint64_t bytes
     freed += slot.mesh->memory_bytes;
   }
   if (used_bytes_ - freed + bytes > budget_bytes_) {
-    return ServerLimitError("mesh_budget_bytes", absl::StrCat(
-        "mesh needs ", bytes, " bytes of memory but pinned meshes hold ", used_bytes_ - freed,
-        " of the ", budget_bytes_, " byte budget (--mesh_budget_bytes)"));
+    return ServerLimitError(
+        "mesh_budget_bytes",
+        absl::StrCat("mesh needs ", bytes, " bytes of memory but pinned meshes hold ",
+                     used_bytes_ - freed, " of the ", budget_bytes_,
+                     " byte budget (--mesh_budget_bytes)"));
   }
   return victims;
 }
@@ -110,7 +114,8 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::Insert(
     if (!mesh->display_name.empty()) {
       auto alias = aliases_.find(mesh->display_name);
       if (alias != aliases_.end() && alias->second != mesh->id) {
-        return FieldError(name_field, absl::StrCat("\"", mesh->display_name, "\" already names mesh ", alias->second));
+        return FieldError(name_field, absl::StrCat("\"", mesh->display_name,
+                                                   "\" already names mesh ", alias->second));
       }
     }
     auto existing = meshes_.find(mesh->id);
@@ -119,8 +124,9 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::Insert(
       if (slot.resident) lru_.splice(lru_.begin(), lru_, slot.lru);
       const std::string& name = mesh->display_name;
       const StoredMesh& old = *slot.mesh;
-      const bool known = name.empty() || old.display_name == name ||
-                         std::find(old.aliases.begin(), old.aliases.end(), name) != old.aliases.end();
+      const bool known =
+          name.empty() || old.display_name == name ||
+          std::find(old.aliases.begin(), old.aliases.end(), name) != old.aliases.end();
       // The same mesh uploaded as its DEM: the record gains the map (and, resident, the grid).
       const bool gains_terrain = !old.terrain && mesh->terrain && mesh->dem != nullptr;
       if (gains_terrain) {
@@ -150,9 +156,11 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::Insert(
       if (!known) {
         const size_t names = (current.display_name.empty() ? 0 : 1) + current.aliases.size();
         if (names >= max_names) {
-          return ServerLimitError("max_names_per_mesh", absl::StrCat(
-              name_field, ": mesh ", mesh->id, " already has ", names,
-              " names, the most a mesh may have (--max_names_per_mesh=", max_names, ")"));
+          return ServerLimitError(
+              "max_names_per_mesh",
+              absl::StrCat(name_field, ": mesh ", mesh->id, " already has ", names,
+                           " names, the most a mesh may have (--max_names_per_mesh=", max_names,
+                           ")"));
         }
         auto updated = std::make_shared<StoredMesh>(current);
         if (updated->display_name.empty()) {
@@ -169,7 +177,8 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::Insert(
       return slot.mesh;
     }
     if (mesh->mesh == nullptr) {  // a re-upload whose stored mesh was deleted meanwhile
-      return absl::AbortedError(absl::StrCat("mesh ", mesh->id, " was deleted during the upload; retry"));
+      return absl::AbortedError(
+          absl::StrCat("mesh ", mesh->id, " was deleted during the upload; retry"));
     }
     // Fail early, before writing anything, when the mesh can never fit.
     if (absl::StatusOr<std::vector<std::string>> victims = VictimsLocked(mesh->memory_bytes);
@@ -182,7 +191,8 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::Insert(
     if (absl::Status s = disk_->Write(*mesh, canonical); !s.ok()) return s;
   }
   std::lock_guard<std::mutex> lock(mu_);
-  if (auto existing = meshes_.find(mesh->id); existing != meshes_.end() && existing->second.resident) {
+  if (auto existing = meshes_.find(mesh->id);
+      existing != meshes_.end() && existing->second.resident) {
     return existing->second.mesh;  // a concurrent upload of the same mesh won
   }
   absl::StatusOr<std::vector<std::string>> victims = VictimsLocked(mesh->memory_bytes);
@@ -269,7 +279,8 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> MeshStore::Get(const std::stri
     }
     dem = std::make_shared<const terrain::Dem>(*std::move(grid));
   }
-  std::shared_ptr<StoredMesh> loaded = MakeStoredMesh(record->id, *std::move(built), std::move(dem));
+  std::shared_ptr<StoredMesh> loaded =
+      MakeStoredMesh(record->id, *std::move(built), std::move(dem));
   loaded->display_name = record->display_name;
   loaded->aliases = record->aliases;
   loaded->pinned = record->pinned;

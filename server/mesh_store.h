@@ -86,7 +86,7 @@ class MeshStore {
 
   uint64_t used_bytes() const;  // resident meshes
   uint64_t budget_bytes() const { return budget_bytes_; }
-  size_t size() const;           // all meshes (resident or on disk)
+  size_t size() const;  // all meshes (resident or on disk)
   size_t resident_count() const;
   uint64_t evictions() const;
   uint64_t disk_loads() const;
@@ -112,8 +112,9 @@ class MeshStore {
 
   const uint64_t budget_bytes_;
   std::optional<MeshDisk> disk_;
-  mutable std::mutex mu_;  // (std::mutex: visible to ThreadSanitizer; members below are guarded by it)
-  std::map<std::string, Slot> meshes_;  // ordered by id for List
+  mutable std::mutex
+      mu_;  // (std::mutex: visible to ThreadSanitizer; members below are guarded by it)
+  std::map<std::string, Slot> meshes_;                     // ordered by id for List
   absl::flat_hash_map<std::string, std::string> aliases_;  // alias -> id
   std::list<std::string> lru_;  // resident meshes, most recently used first
   uint64_t used_bytes_ = 0;

@@ -36,7 +36,8 @@ struct MessageStream {
       : next([p = std::move(producer)](Response* out) {
           return p(out) ? Produced::kMessage : Produced::kEnd;
         }) {}
-  MessageStream(Next next_message, Work run) : next(std::move(next_message)), work(std::move(run)) {}
+  MessageStream(Next next_message, Work run)
+      : next(std::move(next_message)), work(std::move(run)) {}
 
   Next next;
   Work work;  // empty: nothing to wait for

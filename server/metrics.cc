@@ -1,7 +1,5 @@
 #include "metrics.h"
 
-#include "listen_address.h"
-
 #include <algorithm>
 #include <cctype>
 #include <exception>
@@ -12,6 +10,7 @@
 #include "absl/time/clock.h"
 #include "google/protobuf/descriptor.h"
 #include "google/protobuf/message.h"
+#include "listen_address.h"
 #include "prometheus/collectable.h"
 #include "prometheus/counter.h"
 #include "prometheus/exposer.h"
@@ -89,12 +88,23 @@ class GaugeCollector final : public prometheus::Collectable {
 namespace {
 
 const char* CodeName(int code) {
-  static const char* const kNames[] = {
-      "OK",           "CANCELLED",          "UNKNOWN",           "INVALID_ARGUMENT",
-      "DEADLINE_EXCEEDED", "NOT_FOUND",     "ALREADY_EXISTS",    "PERMISSION_DENIED",
-      "RESOURCE_EXHAUSTED", "FAILED_PRECONDITION", "ABORTED",    "OUT_OF_RANGE",
-      "UNIMPLEMENTED", "INTERNAL",          "UNAVAILABLE",       "DATA_LOSS",
-      "UNAUTHENTICATED"};
+  static const char* const kNames[] = {"OK",
+                                       "CANCELLED",
+                                       "UNKNOWN",
+                                       "INVALID_ARGUMENT",
+                                       "DEADLINE_EXCEEDED",
+                                       "NOT_FOUND",
+                                       "ALREADY_EXISTS",
+                                       "PERMISSION_DENIED",
+                                       "RESOURCE_EXHAUSTED",
+                                       "FAILED_PRECONDITION",
+                                       "ABORTED",
+                                       "OUT_OF_RANGE",
+                                       "UNIMPLEMENTED",
+                                       "INTERNAL",
+                                       "UNAVAILABLE",
+                                       "DATA_LOSS",
+                                       "UNAUTHENTICATED"};
   return code >= 0 && code <= 16 ? kNames[code] : "UNKNOWN";
 }
 
@@ -111,8 +121,10 @@ std::string Sanitize(absl::string_view text) {
 class RequestInterceptor final : public grpc::experimental::Interceptor {
  public:
   RequestInterceptor(grpc::experimental::ServerRpcInfo* info, ServerMetrics* metrics)
-      : metrics_(metrics), call_(info->server_context()),
-        method_(info->method() != nullptr ? info->method() : ""), start_(absl::Now()) {
+      : metrics_(metrics),
+        call_(info->server_context()),
+        method_(info->method() != nullptr ? info->method() : ""),
+        start_(absl::Now()) {
     if (!method_.empty() && method_[0] == '/') method_.erase(0, 1);
     // geodex's own methods are raw (bytes): the service describes each call once it has parsed
     // the request (CallDescriptions), after the token check.
@@ -148,9 +160,10 @@ class RequestInterceptor final : public grpc::experimental::Interceptor {
       const double seconds = absl::ToDoubleSeconds(absl::Now() - start_);
       metrics_->RecordRequest(method_, status.error_code(), seconds);
       if (metrics_->log_requests()) {
-        spdlog::info("request method={} mesh={} sources={} duration_ms={:.3f} status={} request_id={}",
-                     method_, mesh_.empty() ? "-" : Sanitize(mesh_), sources_, seconds * 1e3,
-                     CodeName(status.error_code()), request_id_);
+        spdlog::info(
+            "request method={} mesh={} sources={} duration_ms={:.3f} status={} request_id={}",
+            method_, mesh_.empty() ? "-" : Sanitize(mesh_), sources_, seconds * 1e3,
+            CodeName(status.error_code()), request_id_);
       }
     }
     methods->Proceed();
@@ -183,9 +196,9 @@ class RequestInterceptorFactory final
 }  // namespace
 
 absl::StatusOr<std::unique_ptr<ServerMetrics>> ServerMetrics::Start(const std::string& listen,
-                                                                     const MetricSources& sources,
-                                                                     bool log_requests,
-                                                                     const std::string& replica) {
+                                                                    const MetricSources& sources,
+                                                                    bool log_requests,
+                                                                    const std::string& replica) {
   std::unique_ptr<ServerMetrics> m(new ServerMetrics());
   m->log_requests_ = log_requests;
   m->replica_ = replica;

@@ -5,8 +5,8 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "geodex/mesh_id.h"
-#include "status_convert.h"
 #include "google/protobuf/util/time_util.h"
+#include "status_convert.h"
 
 namespace geodex::server {
 namespace {
@@ -33,7 +33,9 @@ absl::StatusOr<std::string> ParseMeshName(const std::string& name, const std::st
   constexpr absl::string_view kPrefix = "meshes/";
   if (!absl::StartsWith(name, kPrefix) || name.size() == kPrefix.size() ||
       name.find('/', kPrefix.size()) != std::string::npos) {
-    return FieldError(field, absl::StrCat("expected \"meshes/{mesh_id}\" or \"meshes/{display_name}\", got ", QuoteInput(name)));
+    return FieldError(
+        field, absl::StrCat("expected \"meshes/{mesh_id}\" or \"meshes/{display_name}\", got ",
+                            QuoteInput(name)));
   }
   return name.substr(kPrefix.size());
 }
@@ -46,7 +48,10 @@ absl::Status ValidateDisplayName(const std::string& name, const std::string& fie
                 c == '.' || c == '_' || c == '-');
   }
   if (!ok) {
-    return FieldError(field, absl::StrCat(QuoteInput(name), " must be 1-63 characters of [A-Za-z0-9._-] and not a 64-digit hex id"));
+    return FieldError(
+        field,
+        absl::StrCat(QuoteInput(name),
+                     " must be 1-63 characters of [A-Za-z0-9._-] and not a 64-digit hex id"));
   }
   return absl::OkStatus();
 }
@@ -107,7 +112,8 @@ absl::StatusOr<SurfacePoint> ResolvePoint(const StoredMesh& mesh, const v1::Surf
       const bool map = point.point_case() == v1::SurfacePoint::kMapPoint;
       const std::string where = absl::StrCat(field, map ? ".map_point" : ".lon_lat");
       if (mesh.dem == nullptr) {
-        return FieldError(where, "the mesh is not a DEM's (upload a GeoTIFF): map points need its map");
+        return FieldError(where,
+                          "the mesh is not a DEM's (upload a GeoTIFF): map points need its map");
       }
       absl::StatusOr<SurfacePoint> dropped =
           map ? mesh.dem->DropMapPoint(point.map_point().x(), point.map_point().y())
@@ -124,13 +130,12 @@ absl::StatusOr<SurfacePoint> ResolvePoint(const StoredMesh& mesh, const v1::Surf
                       valid.message());
   }
   if (p.kind == SurfacePoint::Kind::kEdge && !HasFileEdge(*mesh.mesh, p.edge_from, p.edge_to)) {
-    return FieldError(absl::StrCat(field, ".edge"), absl::StrCat("the mesh has no edge between ", "vertices ", p.edge_from, " and ", p.edge_to));
+    return FieldError(absl::StrCat(field, ".edge"),
+                      absl::StrCat("the mesh has no edge between ", "vertices ", p.edge_from,
+                                   " and ", p.edge_to));
   }
   return p;
 }
-
-
-
 
 absl::StatusOr<GeodesicOptions> SolverOptionsFromProto(const v1::SolverOptions& options,
                                                        uint64_t max_windows,
@@ -156,6 +161,5 @@ absl::StatusOr<GeodesicOptions> SolverOptionsFromProto(const v1::SolverOptions& 
   out.max_windows = max_windows;
   return out;
 }
-
 
 }  // namespace geodex::server

@@ -43,5 +43,4 @@ absl::StatusOr<GeodesicOptions> SolverOptionsFromProto(const v1::SolverOptions& 
                                                        uint64_t max_windows,
                                                        const std::string& field);
 
-
 }  // namespace geodex::server

@@ -9,10 +9,10 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
-#include "geodex/cancel.h"
-#include "geodex/v1/geodex.pb.h"
 #include "call_descriptions.h"
 #include "compute_pool.h"
+#include "geodex/cancel.h"
+#include "geodex/v1/geodex.pb.h"
 #include "mesh_store.h"
 #include "message_stream.h"
 

@@ -41,7 +41,8 @@ absl::StatusOr<MessageStream<v1::ComputeIsolinesResponse>> RunComputeIsolines(
   absl::StatusOr<SolvedField> solved =
       SolveField(env, request.mesh(), request.sources(), request.options());
   if (!solved.ok()) return solved.status();
-  absl::StatusOr<Isolines> isolines = ExtractIsolines(*solved->mesh->mesh, *solved->field, *options);
+  absl::StatusOr<Isolines> isolines =
+      ExtractIsolines(*solved->mesh->mesh, *solved->field, *options);
   if (!isolines.ok()) return isolines.status();
 
   std::vector<v1::ComputeIsolinesResponse> messages =

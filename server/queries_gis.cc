@@ -56,9 +56,10 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> FileStream(const std::strin
                                                                 uint32_t chunk_bytes,
                                                                 uint64_t max_output_values) {
   if (bytes.size() / 8 > max_output_values) {
-    return ServerLimitError("max_output_values",
-                            absl::StrCat("the file would be ", bytes.size(), " bytes, over 8 per value of --max_output_values=",
-                                         max_output_values));
+    return ServerLimitError(
+        "max_output_values",
+        absl::StrCat("the file would be ", bytes.size(),
+                     " bytes, over 8 per value of --max_output_values=", max_output_values));
   }
   std::vector<v1::ExportGisResponse> messages;
   for (size_t offset = 0; offset < bytes.size() || messages.empty(); offset += chunk_bytes) {
@@ -88,7 +89,8 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
   auto geojson_of = [&](const terrain::Dem& on, const std::vector<terrain::GeoFeature>& features)
       -> absl::StatusOr<MessageStream<v1::ExportGisResponse>> {
     if (env.cancel->IsCancelled()) return absl::CancelledError("export cancelled");
-    absl::StatusOr<std::string> text = terrain::GeoJsonText(on.info(), features, request.native_crs());
+    absl::StatusOr<std::string> text =
+        terrain::GeoJsonText(on.info(), features, request.native_crs());
     if (!text.ok()) return text.status();
     return FileStream(*text, kGeoJson, chunk, env.limits->max_output_values);
   };
@@ -112,11 +114,13 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
       PathQueryOptions options;
       options.solver = *solver;
       absl::StatusOr<PathQueryResult> path = ComputeShortestPath(*mesh.mesh, *from, *to, options);
-      if (absl::IsNotFound(path.status())) return UnreachableError("points[0]: unreachable from sources[0]");
+      if (absl::IsNotFound(path.status()))
+        return UnreachableError("points[0]: unreachable from sources[0]");
       if (!path.ok()) return NameSolveError(path.status(), "sources");
       return geojson({terrain::PathFeature(path->path.points, path->distance)});
     }
-    absl::StatusOr<std::vector<SurfacePoint>> sources = ResolveSources(env, mesh, request.sources());
+    absl::StatusOr<std::vector<SurfacePoint>> sources =
+        ResolveSources(env, mesh, request.sources());
     if (!sources.ok()) return sources.status();
     absl::StatusOr<std::vector<SurfacePoint>> points =
         ResolvePoints(mesh, request.points(), "points", env.limits->max_targets, "max_targets");
@@ -127,7 +131,8 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
     std::vector<terrain::PointValue> values;
     for (size_t i = 0; i < points->size(); ++i) {
       const auto& [distance, label] = (*exact)[i];
-      values.push_back({PositionOf(dem.mesh(), (*points)[i]), SpecOf(request.points(static_cast<int>(i))),
+      values.push_back({PositionOf(dem.mesh(), (*points)[i]),
+                        SpecOf(request.points(static_cast<int>(i))),
                         SurfacePointToString((*points)[i]), distance,
                         std::isfinite(distance) ? int64_t{label} : -1});
     }

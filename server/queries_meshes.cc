@@ -80,7 +80,6 @@ absl::StatusOr<MessageStream<v1::MeshGeometry>> RunGetMeshGeometry(
       api::MeshGeometryToProto((*mesh)->mesh->ToMeshData(), env.limits->stream_chunk_bytes));
 }
 
-
 absl::Status RunDeriveMesh(const QueryEnv& env, const v1::DeriveMeshRequest& request,
                            v1::Mesh* response) {
   const v1::Barrier& barrier = request.barrier();
@@ -93,7 +92,8 @@ absl::Status RunDeriveMesh(const QueryEnv& env, const v1::DeriveMeshRequest& req
   if (!(barrier.width() >= 0) || !std::isfinite(barrier.width())) {
     return FieldError("barrier.width", "must be a finite number of metres, 0 or more");
   }
-  if (absl::Status valid = ValidateDisplayName(request.display_name(), "display_name"); !valid.ok()) {
+  if (absl::Status valid = ValidateDisplayName(request.display_name(), "display_name");
+      !valid.ok()) {
     return valid;
   }
   absl::StatusOr<std::shared_ptr<const StoredMesh>> base = LookupMesh(env, request.mesh(), "mesh");

@@ -33,9 +33,8 @@
 namespace geodex::server {
 
 inline absl::Status PoolFullError(const ComputePool& pool, const char* flags) {
-  return QueueFullError(
-      absl::StrCat("compute queue full (", pool.threads(), " workers busy, ", pool.queue_capacity(),
-                   " queued; ", flags, "); retry later"));
+  return QueueFullError(absl::StrCat("compute queue full (", pool.threads(), " workers busy, ",
+                                     pool.queue_capacity(), " queued; ", flags, "); retry later"));
 }
 
 inline grpc::Status PoolFullStatus(const ComputePool& pool, const char* flags) {
@@ -54,10 +53,11 @@ absl::Status ParseRequest(const grpc::ByteBuffer& bytes, Message* message, const
   grpc::ByteBuffer copy(bytes);  // shares the slices; the reader needs a mutable buffer
   grpc::ProtoBufferReader reader(&copy);
   if (!reader.status().ok() || !message->ParseFromZeroCopyStream(&reader)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        what, ": the request could not be parsed as ", Message::descriptor()->full_name(), " (",
-        bytes.Length(), " bytes: invalid wire format, invalid UTF-8 in a string field, or nesting "
-        "too deep)"));
+    return absl::InvalidArgumentError(
+        absl::StrCat(what, ": the request could not be parsed as ",
+                     Message::descriptor()->full_name(), " (", bytes.Length(),
+                     " bytes: invalid wire format, invalid UTF-8 in a string field, or nesting "
+                     "too deep)"));
   }
   return absl::OkStatus();
 }
@@ -147,8 +147,8 @@ class UnaryQueryReactor final : public grpc::ServerUnaryReactor {
 
   void Submit(ComputePool* pool, bool quick) {
     if (!pool->TrySubmit([this, pool, quick] { Compute(quick, pool); })) {
-      Finish(PoolFullStatus(*pool, quick ? "--quick_threads/--queue_capacity"
-                                         : "--pool_threads/--queue_capacity"));
+      Finish(PoolFullStatus(
+          *pool, quick ? "--quick_threads/--queue_capacity" : "--pool_threads/--queue_capacity"));
     }
   }
 
@@ -226,8 +226,8 @@ class StreamQueryReactor final : public grpc::ServerWriteReactor<grpc::ByteBuffe
 
   void Submit(ComputePool* pool, bool quick) {
     if (!pool->TrySubmit([this, pool, quick] { Compute(pool, quick); })) {
-      this->Finish(PoolFullStatus(*pool, quick ? "--quick_threads/--queue_capacity"
-                                               : "--pool_threads/--queue_capacity"));
+      this->Finish(PoolFullStatus(
+          *pool, quick ? "--quick_threads/--queue_capacity" : "--pool_threads/--queue_capacity"));
     }
   }
 
@@ -304,10 +304,10 @@ class StreamQueryReactor final : public grpc::ServerWriteReactor<grpc::ByteBuffe
   Request request_;
   CancelToken cancel_;
   MessageStream<Response> stream_;  // set by Compute before any write, then used under mu_
-  std::mutex mu_;  // orders the writer's state between the compute thread and gRPC's threads
-  bool writing_ = false;     // a StartWrite is outstanding
-  bool finishing_ = false;   // Finish was decided; nothing more happens
-  bool work_done_ = false;   // the query (and its work, if any) returned
+  std::mutex mu_;         // orders the writer's state between the compute thread and gRPC's threads
+  bool writing_ = false;  // a StartWrite is outstanding
+  bool finishing_ = false;  // Finish was decided; nothing more happens
+  bool work_done_ = false;  // the query (and its work, if any) returned
   bool client_gone_ = false;
   absl::Status work_status_ = absl::OkStatus();
   grpc::Status final_status_ = grpc::Status::OK;

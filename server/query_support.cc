@@ -17,10 +17,10 @@
 #include "geodex/distance_matrix.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/isolines.h"
+#include "geodex/mesh_id.h"
 #include "geodex/point_distance.h"
 #include "geodex/shortest_path.h"
 #include "geodex/voronoi.h"
-#include "geodex/mesh_id.h"
 #include "proto_convert.h"
 #include "service_limits.h"
 #include "status_convert.h"
@@ -164,7 +164,6 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> LookupMesh(const QueryEnv& env
   return mesh;  // or DataLoss (a corrupt file), ResourceExhausted (cannot be loaded back)
 }
 
-
 absl::StatusOr<IsolineOptions> IsolineLevels(const QueryEnv& env,
                                              const google::protobuf::RepeatedField<double>& levels,
                                              int32_t count) {
@@ -183,13 +182,12 @@ absl::StatusOr<IsolineOptions> IsolineLevels(const QueryEnv& env,
   }
   if (options.levels.empty()) {
     if (count < 2) {
-      return FieldError("count",
-                        absl::StrCat("give levels, or a count >= 2 (got ", count, ")"));
+      return FieldError("count", absl::StrCat("give levels, or a count >= 2 (got ", count, ")"));
     }
     if (static_cast<uint64_t>(count) > uint64_t{max_levels} + 1) {
-      return ServerLimitError(
-          "max_levels", absl::StrCat("count: ", count, " gives ", count - 1,
-                                     " levels, over --max_levels=", max_levels));
+      return ServerLimitError("max_levels",
+                              absl::StrCat("count: ", count, " gives ", count - 1,
+                                           " levels, over --max_levels=", max_levels));
     }
     options.count = count;
   }

@@ -12,15 +12,15 @@ namespace geodex::server {
 
 struct ServiceLimits {
   uint64_t max_upload_bytes = uint64_t{1} << 30;  // --max_upload_bytes
-  uint64_t max_vertices = 20'000'000;              // --max_vertices
-  uint64_t max_faces = 40'000'000;                 // --max_faces
-  uint64_t max_dem_cells = 25'000'000;             // --max_dem_cells (a GeoTIFF upload's cells)
-  uint32_t max_names_per_mesh = 16;                // --max_names_per_mesh (display name + aliases)
-  uint32_t max_sources = 100'000;                  // --max_sources
-  uint32_t max_targets = 50'000;                   // --max_targets (matrix columns, points)
-  uint32_t max_levels = 1'000;                     // --max_levels (isolines)
-  uint64_t max_output_values = 100'000'000;        // --max_output_values
-  uint64_t max_windows = 0;                        // --max_windows (per solve; 0 = unlimited)
+  uint64_t max_vertices = 20'000'000;             // --max_vertices
+  uint64_t max_faces = 40'000'000;                // --max_faces
+  uint64_t max_dem_cells = 25'000'000;            // --max_dem_cells (a GeoTIFF upload's cells)
+  uint32_t max_names_per_mesh = 16;               // --max_names_per_mesh (display name + aliases)
+  uint32_t max_sources = 100'000;                 // --max_sources
+  uint32_t max_targets = 50'000;                  // --max_targets (matrix columns, points)
+  uint32_t max_levels = 1'000;                    // --max_levels (isolines)
+  uint64_t max_output_values = 100'000'000;       // --max_output_values
+  uint64_t max_windows = 0;                       // --max_windows (per solve; 0 = unlimited)
   // Largest unary response (LocatePoints, EstimateDistances, FindShortestPath): clients keep
   // gRPC's default 4 MiB receive limit. --max_unary_response_bytes
   uint64_t max_unary_response_bytes = 4 << 20;

@@ -27,8 +27,8 @@ std::string PayloadOf(const absl::Status& status, absl::string_view url) {
 
 std::string CapMessage(absl::string_view message) {
   if (message.size() <= kMaxStatusMessageBytes) return std::string(message);
-  return absl::StrCat(message.substr(0, kMaxStatusMessageBytes - 60), "... (message cut: ",
-                      message.size(), " bytes)");
+  return absl::StrCat(message.substr(0, kMaxStatusMessageBytes - 60),
+                      "... (message cut: ", message.size(), " bytes)");
 }
 
 }  // namespace

@@ -31,8 +31,9 @@ grpc::Status ToGrpcStatus(const absl::Status& status);
 // ("\"abc...\" (cut: 1048576 bytes)").
 std::string QuoteInput(absl::string_view input);
 
-// Typed errors. What a client acts on (the field, the flag, the reason) travels as data: absl::Status
-// payloads that ToGrpcStatus turns into google.rpc details, never parsed back out of a message.
+// Typed errors. What a client acts on (the field, the flag, the reason) travels as data:
+// absl::Status payloads that ToGrpcStatus turns into google.rpc details, never parsed back out of a
+// message.
 //
 // INVALID_ARGUMENT "FIELD: DESCRIPTION", with a BadRequest naming FIELD ("sources[2].edge.t").
 absl::Status FieldError(absl::string_view field, absl::string_view description);

@@ -1,6 +1,7 @@
 #pragma once
 
-// Dijkstra on the edge graph: the baseline for tests and benchmarks, and what lambda = 1 reproduces.
+// Dijkstra on the edge graph: the baseline for tests and benchmarks, and what lambda = 1
+// reproduces.
 
 #include <vector>
 

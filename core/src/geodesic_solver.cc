@@ -54,8 +54,8 @@ absl::StatusOr<DistanceField> ComputeDistanceField(const TriangleMesh& mesh,
   }
   DistanceField field;
   if (options.method == Method::kDijkstra) {
-    if (absl::Status s = RunDijkstra(mesh, SeedsForDijkstra(mesh, resolver.sources()), options,
-                                     &field);
+    if (absl::Status s =
+            RunDijkstra(mesh, SeedsForDijkstra(mesh, resolver.sources()), options, &field);
         !s.ok()) {
       return s;
     }
@@ -67,8 +67,8 @@ absl::StatusOr<DistanceField> ComputeDistanceField(const TriangleMesh& mesh,
       DistanceField bound;
       GeodesicOptions dijkstra = options;
       dijkstra.method = Method::kDijkstra;
-      if (absl::Status s = RunDijkstra(mesh, SeedsForDijkstra(mesh, resolver.sources()), dijkstra,
-                                       &bound);
+      if (absl::Status s =
+              RunDijkstra(mesh, SeedsForDijkstra(mesh, resolver.sources()), dijkstra, &bound);
           !s.ok()) {
         return s;
       }

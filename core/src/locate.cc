@@ -410,10 +410,10 @@ uint64_t SurfaceLocator::MemoryBytes() const {
 absl::Status CheckSnapDistance(const std::array<double, 3>& query, const LocatedPoint& located,
                                double max_snap) {
   if (!(located.distance > max_snap)) return absl::OkStatus();
-  return absl::InvalidArgumentError(absl::StrFormat(
-      "%s is %.6g from the surface, farther than the maximum snap distance %.6g",
-      SurfacePointToString(SurfacePoint::AtPosition(query[0], query[1], query[2])),
-      located.distance, max_snap));
+  return absl::InvalidArgumentError(
+      absl::StrFormat("%s is %.6g from the surface, farther than the maximum snap distance %.6g",
+                      SurfacePointToString(SurfacePoint::AtPosition(query[0], query[1], query[2])),
+                      located.distance, max_snap));
 }
 
 }  // namespace geodex

@@ -92,9 +92,8 @@ std::string Sha256Hex(absl::string_view bytes) {
 std::string CanonicalMeshEncoding(const MeshData& mesh) {
   std::string out;
   out.reserve(12 + 8 * mesh.positions.size() + 4 * mesh.faces.size());
-  EncodeCanonical(mesh, [&](const uint8_t* p, size_t n) {
-    out.append(reinterpret_cast<const char*>(p), n);
-  });
+  EncodeCanonical(
+      mesh, [&](const uint8_t* p, size_t n) { out.append(reinterpret_cast<const char*>(p), n); });
   return out;
 }
 

@@ -35,7 +35,8 @@ absl::Status PlacePoint(const TriangleMesh& mesh, const SurfacePoint& p,
   std::vector<uint32_t> half_edges;
   HalfEdgesOfFileEdge(mesh, p.edge_from, p.edge_to, &half_edges);
   for (const uint32_t h : half_edges) {
-    const double x = (mesh.FileVertex(mesh.From(h)) == p.edge_from ? p.t : 1 - p.t) * mesh.Length(h);
+    const double x =
+        (mesh.FileVertex(mesh.From(h)) == p.edge_from ? p.t : 1 - p.t) * mesh.Length(h);
     const uint32_t f = TriangleMesh::FaceOf(h);
     if (mesh.FaceDegenerate(f)) continue;
     const int k = static_cast<int>(h % 3);
@@ -46,9 +47,9 @@ absl::Status PlacePoint(const TriangleMesh& mesh, const SurfacePoint& p,
     out->push_back({f, x0 + (x1 - x0) * x / len, y0 + (y1 - y0) * x / len});
   }
   if (out->empty()) {
-    return absl::InvalidArgumentError(absl::StrFormat(
-        "point %s: no non-degenerate face has the edge %d-%d", SurfacePointToString(p),
-        p.edge_from, p.edge_to));
+    return absl::InvalidArgumentError(
+        absl::StrFormat("point %s: no non-degenerate face has the edge %d-%d",
+                        SurfacePointToString(p), p.edge_from, p.edge_to));
   }
   return absl::OkStatus();
 }

@@ -84,7 +84,8 @@ namespace {
 
 absl::Status CheckOptions(const GeodesicOptions& options) {
   if (!IsExactMethod(options.method)) {
-    return absl::InvalidArgumentError("point queries and paths need an exact method (exact or ich)");
+    return absl::InvalidArgumentError(
+        "point queries and paths need an exact method (exact or ich)");
   }
   return ValidateGeodesicOptions(options);
 }
@@ -246,7 +247,8 @@ void WorkRows(const std::shared_ptr<RowQueue>& q) {
 }
 
 // Runs run(0..total-1) on the calling thread and up to threads - 1 helpers; returns when all ran.
-void RunRows(size_t total, unsigned threads, const std::function<void(std::function<void()>)>& spawn,
+void RunRows(size_t total, unsigned threads,
+             const std::function<void(std::function<void()>)>& spawn,
              std::function<void(size_t)> run) {
   auto q = std::make_shared<RowQueue>();
   q->total = total;
@@ -321,7 +323,8 @@ absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
   if (!resolved.ok()) return resolved.status();
   std::vector<std::vector<ich::ResolvedSource>> row_sources(distinct.size());
   for (size_t r = 0; r < distinct.size(); ++r) {
-    absl::StatusOr<std::vector<ich::ResolvedSource>> src = ResolveSources(mesh, {sources[distinct[r]]});
+    absl::StatusOr<std::vector<ich::ResolvedSource>> src =
+        ResolveSources(mesh, {sources[distinct[r]]});
     if (!src.ok()) return src.status();
     row_sources[r] = *std::move(src);
   }
@@ -401,11 +404,12 @@ absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
       try {
         ich::IchSolver solver(mesh, options.solver);
         solver.set_final_needed(k);
-        status = solver.SolveForTargets(row_sources[r], *row_targets, /*use_heuristic=*/true,
-                                        true, &results, &stats);
+        status = solver.SolveForTargets(row_sources[r], *row_targets, /*use_heuristic=*/true, true,
+                                        &results, &stats);
       } catch (const std::bad_alloc&) {
         status = absl::ResourceExhaustedError(
-            "out of memory for geodesic windows; set a window budget, a max_distance or lambda > 0");
+            "out of memory for geodesic windows; set a window budget, a max_distance or lambda > "
+            "0");
       }
       if (status.ok()) {
         double* row = &solved[r * cols];
@@ -436,7 +440,8 @@ absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
   m.cols = targets.size();
   m.values.resize(m.rows * m.cols);
   for (size_t i = 0; i < m.rows; ++i) {
-    for (size_t j = 0; j < m.cols; ++j) m.values[i * m.cols + j] = cell(source_row[i], column_of[j]);
+    for (size_t j = 0; j < m.cols; ++j)
+      m.values[i * m.cols + j] = cell(source_row[i], column_of[j]);
   }
   m.stats = total_stats;
   return m;

@@ -42,9 +42,9 @@ MeshData Torus() {
   for (int i = 0; i < kU; ++i) {
     for (int j = 0; j < kV; ++j) {
       const double u = 2 * kPi * i / kU, v = 2 * kPi * j / kV;
-      m.positions.insert(m.positions.end(), {(kR + kr * std::cos(v)) * std::cos(u),
-                                             (kR + kr * std::cos(v)) * std::sin(u),
-                                             kr * std::sin(v)});
+      m.positions.insert(m.positions.end(),
+                         {(kR + kr * std::cos(v)) * std::cos(u),
+                          (kR + kr * std::cos(v)) * std::sin(u), kr * std::sin(v)});
     }
   }
   auto id = [](int i, int j) { return static_cast<uint32_t>((i % kU) * kV + (j % kV)); };
@@ -60,11 +60,11 @@ MeshData Torus() {
 MeshData Sphere() {
   const double t = (1 + std::sqrt(5.0)) / 2;
   MeshData m;
-  m.positions = {-1, t, 0, 1, t, 0, -1, -t, 0, 1, -t, 0, 0, -1, t, 0, 1, t,
-                 0, -1, -t, 0, 1, -t, t, 0, -1, t, 0, 1, -t, 0, -1, -t, 0, 1};
-  m.faces = {0, 11, 5, 0, 5, 1, 0, 1, 7, 0, 7, 10, 0, 10, 11, 1, 5, 9, 5, 11, 4,
-             11, 10, 2, 10, 7, 6, 7, 1, 8, 3, 9, 4, 3, 4, 2, 3, 2, 6, 3, 6, 8,
-             3, 8, 9, 4, 9, 5, 2, 4, 11, 6, 2, 10, 8, 6, 7, 9, 8, 1};
+  m.positions = {-1, t,  0,  1, t, 0,  -1, -t, 0,  1, -t, 0, 0,  -1, t,  0,  1, t,
+                 0,  -1, -t, 0, 1, -t, t,  0,  -1, t, 0,  1, -t, 0,  -1, -t, 0, 1};
+  m.faces = {0, 11, 5,  0, 5,  1, 0, 1, 7, 0, 7,  10, 0, 10, 11, 1, 5, 9, 5, 11,
+             4, 11, 10, 2, 10, 7, 6, 7, 1, 8, 3,  9,  4, 3,  4,  2, 3, 2, 6, 3,
+             6, 8,  3,  8, 9,  4, 9, 5, 2, 4, 11, 6,  2, 10, 8,  6, 7, 9, 8, 1};
   for (int level = 0; level < 3; ++level) {
     std::map<std::pair<uint32_t, uint32_t>, uint32_t> midpoint;
     auto mid = [&](uint32_t a, uint32_t b) {
@@ -87,9 +87,9 @@ MeshData Sphere() {
     m.faces = std::move(faces);
   }
   for (size_t v = 0; v < m.positions.size(); v += 3) {
-    const double n = std::sqrt(m.positions[v] * m.positions[v] +
-                               m.positions[v + 1] * m.positions[v + 1] +
-                               m.positions[v + 2] * m.positions[v + 2]);
+    const double n =
+        std::sqrt(m.positions[v] * m.positions[v] + m.positions[v + 1] * m.positions[v + 1] +
+                  m.positions[v + 2] * m.positions[v + 2]);
     for (int k = 0; k < 3; ++k) m.positions[v + k] /= n;
   }
   return m;

@@ -163,7 +163,7 @@ class Tracer {
     // Triangle (0,0), (len,0), c with c.y > 0; a small tolerance relative to the edge.
     const double tol = 1e-12 * len;
     if (q.y < -tol) return false;
-    const double right = (c.x - len) * (q.y) - (c.y) * (q.x - len);  // edge (len,0) -> c
+    const double right = (c.x - len) * (q.y) - (c.y) * (q.x - len);         // edge (len,0) -> c
     const double left = (0 - c.x) * (q.y - c.y) - (0 - c.y) * (q.x - c.x);  // edge c -> (0,0)
     return right >= -tol * len && left >= -tol * len;
   }
@@ -260,12 +260,14 @@ absl::StatusOr<GeodesicPath> TracePathFromVertex(const TriangleMesh& mesh,
   // A split vertex: start from its best copy.
   uint32_t start = vertex;
   for (uint32_t v = mesh.file_vertex_count(); v < mesh.vertex_count(); ++v) {
-    if (mesh.FileVertex(v) == vertex && field.internal_distance[v] < field.internal_distance[start]) {
+    if (mesh.FileVertex(v) == vertex &&
+        field.internal_distance[v] < field.internal_distance[start]) {
       start = v;
     }
   }
   if (!std::isfinite(field.internal_distance[start])) {
-    return absl::NotFoundError(absl::StrFormat("vertex %d is unreachable from every source", vertex));
+    return absl::NotFoundError(
+        absl::StrFormat("vertex %d is unreachable from every source", vertex));
   }
   GeodesicPath path;
   path.source = field.internal_source[start];

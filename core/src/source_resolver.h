@@ -76,22 +76,21 @@ class SourceResolver {
       placed = true;
     }
     if (!found) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "point %s: the mesh has no edge between vertices %d and %d", SurfacePointToString(p), a,
-          b));
+      return absl::InvalidArgumentError(
+          absl::StrFormat("point %s: the mesh has no edge between vertices %d and %d",
+                          SurfacePointToString(p), a, b));
     }
     if (!placed) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "point %s: the edge %d-%d belongs only to degenerate (zero-area) faces",
-          SurfacePointToString(p), a, b));
+      return absl::InvalidArgumentError(
+          absl::StrFormat("point %s: the edge %d-%d belongs only to degenerate (zero-area) faces",
+                          SurfacePointToString(p), a, b));
     }
     return absl::OkStatus();
   }
 
   absl::Status AddFacePoint(const SurfacePoint& p, uint32_t label) {
     const uint32_t f = p.face;
-    double bary[3] = {std::max(0.0, p.bary[0]), std::max(0.0, p.bary[1]),
-                      std::max(0.0, p.bary[2])};
+    double bary[3] = {std::max(0.0, p.bary[0]), std::max(0.0, p.bary[1]), std::max(0.0, p.bary[2])};
     const double sum = bary[0] + bary[1] + bary[2];
     for (double& b : bary) b = b / sum < kSnap ? 0 : b / sum;
     // File corners of the face (internal order may have corners 1 and 2 swapped).
@@ -107,8 +106,7 @@ class SourceResolver {
     if (zeros == 1) {
       const int z = bary[0] == 0 ? 0 : (bary[1] == 0 ? 1 : 2);
       const int i = (z + 1) % 3, j = (z + 2) % 3;
-      return AddEdgePoint(p, file_corner[i], file_corner[j], bary[j] / (bary[i] + bary[j]),
-                          label);
+      return AddEdgePoint(p, file_corner[i], file_corner[j], bary[j] / (bary[i] + bary[j]), label);
     }
     if (mesh_.FaceDegenerate(f)) {
       return absl::InvalidArgumentError(absl::StrFormat(
@@ -141,7 +139,7 @@ class SourceResolver {
 };
 
 inline std::vector<VertexSeed> SeedsForDijkstra(const TriangleMesh& mesh,
-                                         const std::vector<ich::ResolvedSource>& sources) {
+                                                const std::vector<ich::ResolvedSource>& sources) {
   std::vector<VertexSeed> seeds;
   for (const ich::ResolvedSource& s : sources) {
     if (s.is_vertex) {
@@ -156,6 +154,5 @@ inline std::vector<VertexSeed> SeedsForDijkstra(const TriangleMesh& mesh,
   }
   return seeds;
 }
-
 
 }  // namespace geodex

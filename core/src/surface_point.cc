@@ -40,7 +40,8 @@ absl::StatusOr<std::vector<SurfacePoint>> ParseSurfacePoints(absl::string_view s
     std::vector<absl::string_view> parts = absl::StrSplit(item, ':');
     if (parts.size() == 1) {
       uint32_t v;
-      if (!ParseUint(parts[0], &v)) return bad("expected a vertex id, e:V1:V2:T or f:FACE:B0:B1:B2");
+      if (!ParseUint(parts[0], &v))
+        return bad("expected a vertex id, e:V1:V2:T or f:FACE:B0:B1:B2");
       points.push_back(SurfacePoint::AtVertex(v));
     } else if (parts[0] == "e") {
       uint32_t a, b;
@@ -97,9 +98,9 @@ absl::Status ValidateSurfacePoint(const TriangleMesh& mesh, const SurfacePoint& 
     }
     case SurfacePoint::Kind::kFace: {
       if (p.face >= mesh.face_count()) {
-        return absl::InvalidArgumentError(absl::StrFormat(
-            "point %s: face %d does not exist (the mesh has %d faces)", name, p.face,
-            mesh.face_count()));
+        return absl::InvalidArgumentError(
+            absl::StrFormat("point %s: face %d does not exist (the mesh has %d faces)", name,
+                            p.face, mesh.face_count()));
       }
       double sum = 0;
       for (double b : p.bary) {
@@ -110,8 +111,8 @@ absl::Status ValidateSurfacePoint(const TriangleMesh& mesh, const SurfacePoint& 
         sum += b;
       }
       if (std::abs(sum - 1) > kBarycentricSumTolerance) {
-        return absl::InvalidArgumentError(absl::StrFormat(
-            "point %s: barycentric coordinates sum to %.17g, not 1", name, sum));
+        return absl::InvalidArgumentError(
+            absl::StrFormat("point %s: barycentric coordinates sum to %.17g, not 1", name, sum));
       }
       return absl::OkStatus();
     }

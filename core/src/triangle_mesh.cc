@@ -137,8 +137,8 @@ class MeshBuilder {
         }
       }
       if (c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) {
-        return absl::InvalidArgumentError(absl::StrFormat(
-            "face %d repeats a vertex (%d %d %d)", f, c[0], c[1], c[2]));
+        return absl::InvalidArgumentError(
+            absl::StrFormat("face %d repeats a vertex (%d %d %d)", f, c[0], c[1], c[2]));
       }
     }
     m_.file_vertex_count_ = static_cast<uint32_t>(nv);
@@ -425,8 +425,7 @@ class MeshBuilder {
     m_.neighbor_length_.resize(m_.neighbors_.size());
     for (uint32_t v = 0; v < nv; ++v) {
       for (uint32_t i = m_.neighbor_offsets_[v]; i < m_.neighbor_offsets_[v + 1]; ++i) {
-        m_.neighbor_length_[i] =
-            Dist3(&m_.positions_[3 * v], &m_.positions_[3 * m_.neighbors_[i]]);
+        m_.neighbor_length_[i] = Dist3(&m_.positions_[3 * v], &m_.positions_[3 * m_.neighbors_[i]]);
       }
     }
   }
@@ -438,8 +437,8 @@ class MeshBuilder {
     m_.corner_start_angle_.assign(m_.corner_angle_.size(), 0.0);
     for (uint32_t v = 0; v < nv; ++v) {
       const uint8_t fl = m_.vertex_flags_[v];
-      if (fl & (TriangleMesh::kBoundary | TriangleMesh::kIsolated |
-                TriangleMesh::kTouchesDegenerate)) {
+      if (fl &
+          (TriangleMesh::kBoundary | TriangleMesh::kIsolated | TriangleMesh::kTouchesDegenerate)) {
         continue;
       }
       const uint32_t degree = m_.corner_offsets_[v + 1] - m_.corner_offsets_[v];

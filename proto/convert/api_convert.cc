@@ -155,9 +155,8 @@ MeshSummary MeshSummaryFromProto(const v1::Mesh& m) {
 
 void SolverOptionsToProto(const GeodesicOptions& options, v1::SolverOptions* out) {
   out->set_lambda(options.lambda);
-  out->set_lambda_scale(options.lambda_scale == LambdaScale::kMeanEdge
-                            ? v1::LAMBDA_SCALE_MEAN_EDGE
-                            : v1::LAMBDA_SCALE_MAX_EDGE);
+  out->set_lambda_scale(options.lambda_scale == LambdaScale::kMeanEdge ? v1::LAMBDA_SCALE_MEAN_EDGE
+                                                                       : v1::LAMBDA_SCALE_MAX_EDGE);
   if (std::isfinite(options.max_distance)) out->set_max_distance(options.max_distance);
 }
 
@@ -256,8 +255,7 @@ void FieldQueryToProto(const FieldQuery& query, v1::ComputeDistanceFieldRequest*
 }
 
 size_t FieldBytesPerVertex(const FieldEncoding& encoding, const DistanceField& products) {
-  return (encoding.f32 ? 4 : 8) + (encoding.labels ? 4 : 0) +
-         (products.direction.empty() ? 0 : 24);
+  return (encoding.f32 ? 4 : 8) + (encoding.labels ? 4 : 0) + (products.direction.empty() ? 0 : 24);
 }
 
 void FieldChunkToProto(const DistanceField& field, const DistanceField& products, size_t begin,
@@ -275,8 +273,7 @@ void FieldChunkToProto(const DistanceField& field, const DistanceField& products
       values->AddAlreadyReserved(static_cast<float>(field.distance[i]));
     }
   } else {
-    out->mutable_distances_f64()->Add(field.distance.begin() + begin,
-                                      field.distance.begin() + end);
+    out->mutable_distances_f64()->Add(field.distance.begin() + begin, field.distance.begin() + end);
   }
   if (encoding.labels) {
     out->mutable_labels()->Add(field.source.begin() + begin, field.source.begin() + end);

@@ -8,9 +8,9 @@
 
 #include "geodex/distance_field.h"
 #include "geodex/distance_matrix.h"
+#include "geodex/geodesic_solver.h"
 #include "geodex/locate.h"
 #include "geodex/point_distance.h"
-#include "geodex/geodesic_solver.h"
 #include "geodex/shortest_path.h"
 #include "geodex/surface_point.h"
 #include "geodex/terrain.h"

@@ -56,8 +56,8 @@ std::string WktOf(const OGRSpatialReference& srs) {
   return out;
 }
 
-using TransformPtr = std::unique_ptr<OGRCoordinateTransformation,
-                                     decltype(&OGRCoordinateTransformation::DestroyCT)>;
+using TransformPtr =
+    std::unique_ptr<OGRCoordinateTransformation, decltype(&OGRCoordinateTransformation::DestroyCT)>;
 TransformPtr MakeTransform(const OGRSpatialReference& from, const OGRSpatialReference& to) {
   PrepareGdal();  // PROJ's network off before any transformation is made
   return TransformPtr(OGRCreateCoordinateTransformation(&from, &to),
@@ -71,7 +71,8 @@ double MetresPerHeightUnit(std::string unit) {
       unit == "meters") {
     return 1;
   }
-  if (unit == "ft" || unit == "foot" || unit == "feet" || unit == "international foot") return 0.3048;
+  if (unit == "ft" || unit == "foot" || unit == "feet" || unit == "international foot")
+    return 0.3048;
   if (unit == "us survey foot" || unit == "us-ft" || unit == "ftus") return 1200.0 / 3937.0;
   return 0;
 }
@@ -84,7 +85,8 @@ absl::StatusOr<std::unique_ptr<OGRGeometry>> BarrierPolygonsOf(GDALDataset* ds,
   auto bad = [&](const std::string& why) {
     return absl::InvalidArgumentError(absl::StrCat(name, ": ", why));
   };
-  if (ds == nullptr) return bad(absl::StrCat("not a vector file GDAL reads (", QuietGdal::LastMessage(), ")"));
+  if (ds == nullptr)
+    return bad(absl::StrCat("not a vector file GDAL reads (", QuietGdal::LastMessage(), ")"));
   OGRSpatialReference wgs84;
   wgs84.SetWellKnownGeogCS("WGS84");
   wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
@@ -96,14 +98,17 @@ absl::StatusOr<std::unique_ptr<OGRGeometry>> BarrierPolygonsOf(GDALDataset* ds,
     TransformPtr to_dem(nullptr, &OGRCoordinateTransformation::DestroyCT);
     if (crs != nullptr) {
       to_dem = MakeTransform(from, *crs);
-      if (to_dem == nullptr) return bad(absl::StrCat("cannot project it to the DEM's CRS (", QuietGdal::LastMessage(), ")"));
+      if (to_dem == nullptr)
+        return bad(
+            absl::StrCat("cannot project it to the DEM's CRS (", QuietGdal::LastMessage(), ")"));
     }
     for (const auto& feature : *layer) {
       const OGRGeometry* g = feature->GetGeometryRef();
       if (g == nullptr) continue;
       std::unique_ptr<OGRGeometry> copy(g->clone());
       if (to_dem != nullptr && copy->transform(to_dem.get()) != OGRERR_NONE) {
-        return bad(absl::StrCat("cannot project a feature to the DEM's CRS (", QuietGdal::LastMessage(), ")"));
+        return bad(absl::StrCat("cannot project a feature to the DEM's CRS (",
+                                QuietGdal::LastMessage(), ")"));
       }
       switch (wkbFlatten(copy->getGeometryType())) {
         case wkbPolygon:
@@ -147,7 +152,8 @@ MeshData RemoveFacesBelow(const MeshData& mesh, double z) {
 
 bool IsDemPath(const std::string& path) {
   std::string ext = absl::AsciiStrToLower(std::filesystem::path(path).extension().string());
-  for (const char* known : {".tif", ".tiff", ".vrt", ".asc", ".img", ".hgt", ".dem", ".bil", ".nc"}) {
+  for (const char* known :
+       {".tif", ".tiff", ".vrt", ".asc", ".img", ".hgt", ".dem", ".bil", ".nc"}) {
     if (ext == known) return true;
   }
   return false;
@@ -427,7 +433,8 @@ absl::StatusOr<MeshData> CutBarrierPolygons(const MeshData& mesh, const std::str
   };
   OGRSpatialReference file_crs;
   if (dem != nullptr) {
-    if (file_crs.importFromWkt(dem->file_crs_wkt.c_str()) != OGRERR_NONE) return bad("the DEM's CRS does not parse");
+    if (file_crs.importFromWkt(dem->file_crs_wkt.c_str()) != OGRERR_NONE)
+      return bad("the DEM's CRS does not parse");
     file_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
   }
   // The text goes into an in-memory file of its own that GDAL's GeoJSON driver alone opens. (Given
@@ -444,8 +451,8 @@ absl::StatusOr<MeshData> CutBarrierPolygons(const MeshData& mesh, const std::str
   MemFile text(".geojson", geojson);
   if (!text.ok()) return absl::InternalError("GDAL cannot make an in-memory file");
   const char* const drivers[] = {"GeoJSON", nullptr};
-  GDALDatasetUniquePtr ds(GDALDataset::FromHandle(
-      GDALOpenEx(text.path().c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, drivers, nullptr, nullptr)));
+  GDALDatasetUniquePtr ds(GDALDataset::FromHandle(GDALOpenEx(
+      text.path().c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, drivers, nullptr, nullptr)));
   absl::StatusOr<std::unique_ptr<OGRGeometry>> polygons =
       ds == nullptr ? bad(absl::StrCat("not GeoJSON polygons (", QuietGdal::LastMessage(), ")"))
                     : BarrierPolygonsOf(ds.get(), name, dem != nullptr ? &file_crs : nullptr);
@@ -459,8 +466,10 @@ bool IsGeoTiffPath(const std::string& path) {
 }
 
 bool LooksLikeTiff(const std::string& bytes) {
-  return bytes.size() >= 4 && ((bytes[0] == 'I' && bytes[1] == 'I' && (bytes[2] == 42 || bytes[2] == 43) && bytes[3] == 0) ||
-                               (bytes[0] == 'M' && bytes[1] == 'M' && bytes[2] == 0 && (bytes[3] == 42 || bytes[3] == 43)));
+  return bytes.size() >= 4 && ((bytes[0] == 'I' && bytes[1] == 'I' &&
+                                (bytes[2] == 42 || bytes[2] == 43) && bytes[3] == 0) ||
+                               (bytes[0] == 'M' && bytes[1] == 'M' && bytes[2] == 0 &&
+                                (bytes[3] == 42 || bytes[3] == 43)));
 }
 
 absl::StatusOr<Dem> Dem::Read(const std::string& path, const DemOptions& options) {
@@ -566,9 +575,10 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
   info.raster_height = static_cast<uint32_t>(ds->GetRasterYSize());
   if (options.max_cells != 0 &&
       uint64_t{info.raster_width} * info.raster_height > options.max_cells) {
-    return LimitExceededError(Limit::kDemCells, absl::StrFormat(
-        "%s: %ux%u cells, more than the %u a DEM may have here", path, info.raster_width,
-        info.raster_height, options.max_cells));
+    return LimitExceededError(
+        Limit::kDemCells,
+        absl::StrFormat("%s: %ux%u cells, more than the %u a DEM may have here", path,
+                        info.raster_width, info.raster_height, options.max_cells));
   }
   info.step = options.step;
   info.grid_width = (info.raster_width + options.step - 1) / options.step;
@@ -580,19 +590,24 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
   const uint64_t most_vertices = uint64_t{info.grid_width} * info.grid_height;
   const uint64_t most_faces = 2 * uint64_t{info.grid_width - 1} * (info.grid_height - 1);
   if (options.max_vertices != 0 && most_vertices > options.max_vertices) {
-    return LimitExceededError(Limit::kVertices, absl::StrFormat(
-        "%s: %ux%u used cells can make %d vertices, more than the %d a mesh may have here", path,
-        info.grid_width, info.grid_height, most_vertices, options.max_vertices));
+    return LimitExceededError(
+        Limit::kVertices,
+        absl::StrFormat(
+            "%s: %ux%u used cells can make %d vertices, more than the %d a mesh may have here",
+            path, info.grid_width, info.grid_height, most_vertices, options.max_vertices));
   }
   if (options.max_faces != 0 && most_faces > options.max_faces) {
-    return LimitExceededError(Limit::kFaces, absl::StrFormat(
-        "%s: %ux%u used cells can make %d faces, more than the %d a mesh may have here", path,
-        info.grid_width, info.grid_height, most_faces, options.max_faces));
+    return LimitExceededError(
+        Limit::kFaces,
+        absl::StrFormat(
+            "%s: %ux%u used cells can make %d faces, more than the %d a mesh may have here", path,
+            info.grid_width, info.grid_height, most_faces, options.max_faces));
   }
   double gt[6];
   if (ds->GetGeoTransform(gt) != CE_None) return bad("no geotransform (not georeferenced)");
   if (gt[2] != 0 || gt[4] != 0) return bad("a rotated grid (geotransform terms 2 and 4 not 0)");
-  if (!std::all_of(gt, gt + 6, [](double v) { return std::isfinite(v); }) || gt[1] == 0 || gt[5] == 0) {
+  if (!std::all_of(gt, gt + 6, [](double v) { return std::isfinite(v); }) || gt[1] == 0 ||
+      gt[5] == 0) {
     return bad("its geotransform is not a grid (a cell size of 0, or not finite)");
   }
   // Cells that doubles cannot tell apart at these coordinates (or, geographic, finer than a
@@ -620,16 +635,19 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
     if (std::min(std::abs(gt[1]), std::abs(gt[5])) < 1e-7) {
       return bad("cells finer than 1e-7 degrees (about a centimetre)");
     }
-    double lon = gt[0] + gt[1] * info.raster_width / 2.0, lat = gt[3] + gt[5] * info.raster_height / 2.0;
+    double lon = gt[0] + gt[1] * info.raster_width / 2.0,
+           lat = gt[3] + gt[5] * info.raster_height / 2.0;
     OGRSpatialReference wgs84;
     wgs84.SetWellKnownGeogCS("WGS84");
     wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
     TransformPtr to_wgs84 = MakeTransform(file_crs, wgs84);
     if (to_wgs84 == nullptr || !to_wgs84->Transform(1, &lon, &lat)) {
-      return bad(absl::StrCat("cannot find the DEM's centre in WGS 84 (", QuietGdal::LastMessage(), ")"));
+      return bad(
+          absl::StrCat("cannot find the DEM's centre in WGS 84 (", QuietGdal::LastMessage(), ")"));
     }
     if (!(std::abs(lon) <= 180 && std::abs(lat) <= 90)) {
-      return bad(absl::StrFormat("its centre (%.9g, %.9g) is not a longitude and latitude", lon, lat));
+      return bad(
+          absl::StrFormat("its centre (%.9g, %.9g) is not a longitude and latitude", lon, lat));
     }
     const int zone = std::clamp(static_cast<int>(std::floor((lon + 180) / 6)) + 1, 1, 60);
     OGRSpatialReference utm;
@@ -658,7 +676,8 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
   info.vertical_unit = band->GetUnitType() != nullptr ? band->GetUnitType() : "";
   const double unit = MetresPerHeightUnit(info.vertical_unit);
   if (unit == 0) {
-    return bad(absl::StrCat("height unit '", info.vertical_unit, "' is not m, ft or US survey foot"));
+    return bad(
+        absl::StrCat("height unit '", info.vertical_unit, "' is not m, ft or US survey foot"));
   }
   int has_scale = 0, has_offset = 0;
   double scale = band->GetScale(&has_scale), offset = band->GetOffset(&has_offset);
@@ -704,9 +723,9 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
       const double py = (j + 0.5) * info.geotransform[5] + info.geotransform[3];
       xs.push_back(px);
       ys.push_back(py);
-      dem.mesh_.positions.insert(dem.mesh_.positions.end(),
-                                 {px * info.horizontal_scale, py * info.horizontal_scale,
-                                  (raw * scale + offset) * unit});
+      dem.mesh_.positions.insert(
+          dem.mesh_.positions.end(),
+          {px * info.horizontal_scale, py * info.horizontal_scale, (raw * scale + offset) * unit});
     }
   }
   if (to_mesh != nullptr && next > 0) {
@@ -801,8 +820,9 @@ absl::StatusOr<Dem> Dem::FromMesh(MeshData mesh, DemInfo info) {
     mesh_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
     TransformPtr back = MakeTransform(mesh_crs, file_crs);
     std::vector<int> ok(n);
-    if (back == nullptr || (n > 0 && !back->Transform(static_cast<int>(n), xs.data(), ys.data(),
-                                                       nullptr, ok.data())) ||
+    if (back == nullptr ||
+        (n > 0 &&
+         !back->Transform(static_cast<int>(n), xs.data(), ys.data(), nullptr, ok.data())) ||
         std::find(ok.begin(), ok.end(), 0) != ok.end()) {
       return bad("its vertices do not project back to the file's CRS");
     }
@@ -976,8 +996,8 @@ absl::StatusOr<SurfacePoint> Dem::DropNamed(double x, double y, const std::strin
     utm.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
     TransformPtr t = MakeTransform(file_crs, utm);
     if (t == nullptr || !t->Transform(1, &mx, &my)) {
-      return absl::InvalidArgumentError(absl::StrCat(name, ": cannot project it (",
-                                                     QuietGdal::LastMessage(), ")"));
+      return absl::InvalidArgumentError(
+          absl::StrCat(name, ": cannot project it (", QuietGdal::LastMessage(), ")"));
     }
   }
   return DropMeshPoint(mx, my, u, v, name);
@@ -986,14 +1006,15 @@ absl::StatusOr<SurfacePoint> Dem::DropNamed(double x, double y, const std::strin
 absl::StatusOr<SurfacePoint> Dem::DropLonLat(double lon, double lat) const {
   const std::string name = absl::StrCat("ll:", Shortest(lon), ":", Shortest(lat));
   if (!(std::abs(lon) <= 180 && std::abs(lat) <= 90)) {
-    return absl::InvalidArgumentError(absl::StrCat(name, ": longitude must be in [-180, 180] and latitude in [-90, 90]"));
+    return absl::InvalidArgumentError(
+        absl::StrCat(name, ": longitude must be in [-180, 180] and latitude in [-90, 90]"));
   }
   QuietGdal quiet;
   TransformPtr t = Wgs84Transform(info_, /*from_wgs84=*/true);
   double x = lon, y = lat;
   if (t == nullptr || !t->Transform(1, &x, &y)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat(name, ": cannot project it to the DEM's CRS (", QuietGdal::LastMessage(), ")"));
+    return absl::InvalidArgumentError(absl::StrCat(name, ": cannot project it to the DEM's CRS (",
+                                                   QuietGdal::LastMessage(), ")"));
   }
   absl::StatusOr<SurfacePoint> p = DropNamed(x, y, name);
   if (!OutsideTheDem(p.status())) return p;
@@ -1011,7 +1032,7 @@ absl::StatusOr<SurfacePoint> Dem::DropLonLat(double lon, double lat) const {
 }
 
 absl::StatusOr<SurfacePoint> Dem::DropMeshPoint(double mx, double my, double u, double v,
-                                               const std::string& name) const {
+                                                const std::string& name) const {
   const uint32_t W = info_.grid_width, H = info_.grid_height;
   constexpr double kEdge = 1e-9;  // grid units: a point on the outer boundary is inside
   if (!(u >= -kEdge && u <= W - 1 + kEdge && v >= -kEdge && v <= H - 1 + kEdge)) {
@@ -1026,7 +1047,12 @@ absl::StatusOr<SurfacePoint> Dem::DropMeshPoint(double mx, double my, double u, 
   double best_min = -std::numeric_limits<double>::infinity();
   for (int dj = 0; dj <= 2; ++dj) {
     for (int di = 0; di <= 2; ++di) {
-      const int i = bi + (di == 2 ? -1 : di == 1 ? 1 : 0), j = bj + (dj == 2 ? -1 : dj == 1 ? 1 : 0);
+      const int i = bi + (di == 2   ? -1
+                          : di == 1 ? 1
+                                    : 0),
+                j = bj + (dj == 2   ? -1
+                          : dj == 1 ? 1
+                                    : 0);
       if (i < 0 || j < 0 || i > static_cast<int>(W) - 2 || j > static_cast<int>(H) - 2) continue;
       for (int k = 0; k < 2; ++k) {
         const uint64_t triangle = 2 * (uint64_t(j) * (W - 1) + i) + k;
@@ -1062,7 +1088,8 @@ absl::StatusOr<SurfacePoint> Dem::DropMeshPoint(double mx, double my, double u, 
     }
   }
   if (best_face == kNoVertex || best_min < -1e-7) {
-    return absl::InvalidArgumentError(absl::StrCat(name, ": in a hole of the DEM (nodata or a barrier)"));
+    return absl::InvalidArgumentError(
+        absl::StrCat(name, ": in a hole of the DEM (nodata or a barrier)"));
   }
   double sum = 0;
   for (double& b : best) sum += (b = b > 0 ? b : 0.0);  // also turns -0 into 0
@@ -1092,7 +1119,8 @@ absl::Status WriteRaster(const DemInfo& info, const std::vector<uint32_t>& verte
         absl::StrCat("cannot write ", path, ": this GDAL writes no ", format->description));
   }
   auto failed = [&] {
-    return absl::PermissionDeniedError(absl::StrCat("cannot write ", path, ": ", QuietGdal::LastMessage()));
+    return absl::PermissionDeniedError(
+        absl::StrCat("cannot write ", path, ": ", QuietGdal::LastMessage()));
   };
   GDALDatasetUniquePtr ds(mem->Create("", static_cast<int>(info.grid_width),
                                       static_cast<int>(info.grid_height), 1, type, nullptr));
@@ -1118,7 +1146,8 @@ absl::Status WriteRaster(const DemInfo& info, const std::vector<uint32_t>& verte
       row[i] = v == kNoVertex || !on_surface[v] ? kRasterNoSurface : value_of_vertex(v);
     }
     if (band->RasterIO(GF_Write, 0, static_cast<int>(j), static_cast<int>(info.grid_width), 1,
-                       row.data(), static_cast<int>(info.grid_width), 1, GDT_Float64, 0, 0) != CE_None) {
+                       row.data(), static_cast<int>(info.grid_width), 1, GDT_Float64, 0,
+                       0) != CE_None) {
       return failed();
     }
   }
@@ -1138,25 +1167,29 @@ absl::Status WriteRaster(const DemInfo& info, const std::vector<uint32_t>& verte
 
 }  // namespace
 
-absl::Status Dem::WriteFloatRaster(const std::string& path, const std::vector<double>& values) const {
-  if (values.size() < mesh_.vertex_count()) return absl::InternalError("one value per vertex expected");
+absl::Status Dem::WriteFloatRaster(const std::string& path,
+                                   const std::vector<double>& values) const {
+  if (values.size() < mesh_.vertex_count())
+    return absl::InternalError("one value per vertex expected");
   return WriteRaster(
       info_, vertex_of_cell_, mesh_, path, GDT_Float32, "geodesic distance", "m",
       [&](uint32_t v) { return std::isfinite(values[v]) ? values[v] : kRasterUnreachable; });
 }
 
-absl::Status Dem::WriteIndexRaster(const std::string& path, const std::vector<uint32_t>& values) const {
-  if (values.size() < mesh_.vertex_count()) return absl::InternalError("one value per vertex expected");
+absl::Status Dem::WriteIndexRaster(const std::string& path,
+                                   const std::vector<uint32_t>& values) const {
+  if (values.size() < mesh_.vertex_count())
+    return absl::InternalError("one value per vertex expected");
   return WriteRaster(
       info_, vertex_of_cell_, mesh_, path, GDT_Int32, "nearest source", nullptr, [&](uint32_t v) {
         return values[v] >= 0x80000000u ? kRasterUnreachable : static_cast<double>(values[v]);
       });
 }
 
-
 namespace {
 // What `write` writes to an in-memory GeoTIFF, as bytes.
-absl::StatusOr<std::string> RasterBytes(const std::function<absl::Status(const std::string&)>& write) {
+absl::StatusOr<std::string> RasterBytes(
+    const std::function<absl::Status(const std::string&)>& write) {
   MemFile tiff(".tif");
   if (absl::Status written = write(tiff.path()); !written.ok()) {
     return absl::InternalError(written.message());

@@ -18,7 +18,6 @@
 namespace geodex::terrain {
 namespace {
 
-
 // Mesh x y back to the CRS the geometry is built in: the mesh's when reprojected (UTM), else the
 // file's (whose unit may be feet: the mesh is in metres).
 std::array<double, 2> ToCrs(const DemInfo& dem, double x, double y) {
@@ -144,8 +143,8 @@ std::vector<Polygon2> SublevelPieces(const MeshData& mesh, const std::vector<dou
         const double da = value[a], db = value[b];
         const double* pa = &mesh.positions[3 * a];
         const double* pb = &mesh.positions[3 * b];
-        double t = std::isinf(da) || std::isinf(db) ? (da <= level ? 0.0 : 1.0)
-                                                    : (level - da) / (db - da);
+        double t =
+            std::isinf(da) || std::isinf(db) ? (da <= level ? 0.0 : 1.0) : (level - da) / (db - da);
         t = std::clamp(t, 0.0, 1.0);
         piece.push_back({pa[0] + t * (pb[0] - pa[0]), pa[1] + t * (pb[1] - pa[1])});
       }
@@ -195,7 +194,8 @@ absl::Status WriteVectorFile(const DemInfo& dem, const std::vector<GeoFeature>& 
   if (native_crs && dem.reprojected) {
     to_file.reset(OGRCreateCoordinateTransformation(&built, &file));
     if (to_file == nullptr) {
-      return failed(absl::StrCat("cannot project to the DEM's CRS (", QuietGdal::LastMessage(), ")"));
+      return failed(
+          absl::StrCat("cannot project to the DEM's CRS (", QuietGdal::LastMessage(), ")"));
     }
   }
 
@@ -241,8 +241,10 @@ absl::Status WriteVectorFile(const DemInfo& dem, const std::vector<GeoFeature>& 
         break;
       }
     }
-    if (to_file != nullptr && !geometry->IsEmpty() && geometry->transform(to_file.get()) != OGRERR_NONE) {
-      return failed(absl::StrCat("cannot project to the DEM's CRS (", QuietGdal::LastMessage(), ")"));
+    if (to_file != nullptr && !geometry->IsEmpty() &&
+        geometry->transform(to_file.get()) != OGRERR_NONE) {
+      return failed(
+          absl::StrCat("cannot project to the DEM's CRS (", QuietGdal::LastMessage(), ")"));
     }
     OGRFeatureUniquePtr feature(OGRFeature::CreateFeature(layer->GetLayerDefn()));
     for (const auto& [name, value] : f.properties) {
@@ -318,7 +320,8 @@ std::vector<GeoFeature> DelaunayFeatures(const DelaunayTriangulation& delaunay) 
     GeoFeature f;
     f.kind = GeoFeature::Kind::kLine;
     for (const PathPoint& q : e.points) f.points.push_back(q.position);
-    f.properties = {{"site_a", int64_t{e.site_a}}, {"site_b", int64_t{e.site_b}}, {"length", e.length}};
+    f.properties = {
+        {"site_a", int64_t{e.site_a}}, {"site_b", int64_t{e.site_b}}, {"length", e.length}};
     features.push_back(std::move(f));
   }
   return features;

@@ -23,8 +23,9 @@ class MemFile {
   }
   // A file over `bytes`; ok() is false when GDAL cannot make it.
   MemFile(const char* extension, const std::string& bytes) : MemFile(extension) {
-    VSILFILE* file = VSIFileFromMemBuffer(
-        path_.c_str(), reinterpret_cast<GByte*>(const_cast<char*>(bytes.data())), bytes.size(), FALSE);
+    VSILFILE* file = VSIFileFromMemBuffer(path_.c_str(),
+                                          reinterpret_cast<GByte*>(const_cast<char*>(bytes.data())),
+                                          bytes.size(), FALSE);
     ok_ = file != nullptr;
     if (ok_) VSIFCloseL(file);
   }
@@ -38,7 +39,8 @@ class MemFile {
   std::string Take() {
     vsi_l_offset length = 0;
     GByte* data = VSIGetMemFileBuffer(path_.c_str(), &length, TRUE);
-    std::string out = data != nullptr ? std::string(reinterpret_cast<const char*>(data), length) : "";
+    std::string out =
+        data != nullptr ? std::string(reinterpret_cast<const char*>(data), length) : "";
     CPLFree(data);
     return out;
   }

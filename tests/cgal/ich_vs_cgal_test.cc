@@ -151,14 +151,15 @@ TEST_P(IchVsCgalTest, LocalMatrixEntriesMatchCgal) {
   std::sort(by_distance.begin(), by_distance.end());
   const size_t step = std::max<size_t>(1, data->vertex_count() / 90);
   std::vector<SurfacePoint> points;
-  for (size_t i = 0; i < 9; ++i) points.push_back(SurfacePoint::AtVertex(by_distance[i * step].second));
+  for (size_t i = 0; i < 9; ++i)
+    points.push_back(SurfacePoint::AtVertex(by_distance[i * step].second));
   // Symmetric (each pair solved by one row) and not (every row solves every target).
   const std::vector<SurfacePoint> sources(points.begin(), points.begin() + 4);
   std::map<uint32_t, std::vector<double>> cgal_from;  // by source vertex
   for (const SurfacePoint& p : points) cgal_from[p.vertex] = CgalDistances(*data, {p});
   using Points = const std::vector<SurfacePoint>*;
-  for (const auto& [rows, cols] :
-       {std::pair<Points, Points>{&points, &points}, std::pair<Points, Points>{&sources, &points}}) {
+  for (const auto& [rows, cols] : {std::pair<Points, Points>{&points, &points},
+                                   std::pair<Points, Points>{&sources, &points}}) {
     absl::StatusOr<DistanceMatrix> m = ComputeDistanceMatrix(*mesh, *rows, *cols);
     ASSERT_TRUE(m.ok()) << m.status();
     for (size_t i = 0; i < rows->size(); ++i) {

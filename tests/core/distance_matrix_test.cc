@@ -2,6 +2,8 @@
 // pair, k nearest, max_distance, lambda, progress and cancellation, checked against single
 // ComputeShortestPath queries (exact either way).
 
+#include "geodex/distance_matrix.h"
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -12,7 +14,6 @@
 #include <vector>
 
 #include "geodex/cancel.h"
-#include "geodex/distance_matrix.h"
 #include "geodex/shortest_path.h"
 #include "gtest/gtest.h"
 #include "util/test_meshes.h"
@@ -34,7 +35,8 @@ std::vector<SurfacePoint> LocalWaypoints(const TriangleMesh& mesh, size_t n, dou
   const uint32_t centre = rng() % mesh.file_vertex_count();
   std::vector<uint32_t> near;
   for (uint32_t v = 0; v < mesh.file_vertex_count(); ++v) {
-    if (Distance(mesh.Position(v), mesh.Position(centre)) <= radius_rel * diagonal) near.push_back(v);
+    if (Distance(mesh.Position(v), mesh.Position(centre)) <= radius_rel * diagonal)
+      near.push_back(v);
   }
   std::shuffle(near.begin(), near.end(), rng);
   std::vector<SurfacePoint> out;
@@ -54,7 +56,8 @@ std::vector<SurfacePoint> LocalWaypoints(const TriangleMesh& mesh, size_t n, dou
 std::vector<SurfacePoint> SpreadPoints(const TriangleMesh& mesh, size_t n, uint32_t seed) {
   std::mt19937 rng(seed);
   std::vector<SurfacePoint> out;
-  for (size_t i = 0; i < n; ++i) out.push_back(SurfacePoint::AtVertex(rng() % mesh.file_vertex_count()));
+  for (size_t i = 0; i < n; ++i)
+    out.push_back(SurfacePoint::AtVertex(rng() % mesh.file_vertex_count()));
   return out;
 }
 

@@ -193,9 +193,8 @@ TEST(CancellationTest, CancelFromAnotherThreadEndsTheSolve) {
   GeodesicOptions o;
   o.cancel = &token;
   absl::Status status;
-  std::thread worker([&] {
-    status = ComputeDistanceField(*mesh, {SurfacePoint::AtVertex(0)}, o).status();
-  });
+  std::thread worker(
+      [&] { status = ComputeDistanceField(*mesh, {SurfacePoint::AtVertex(0)}, o).status(); });
   token.Cancel();
   worker.join();
   EXPECT_TRUE(status.ok() || status.code() == absl::StatusCode::kCancelled) << status;

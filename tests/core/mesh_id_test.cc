@@ -20,7 +20,8 @@ TEST(Sha256Test, IncrementalEqualsOneShot) {
   std::string data;
   for (int i = 0; i < 1000; ++i) data.push_back(static_cast<char>(i * 7));
   Sha256 sha;
-  for (size_t i = 0; i < data.size(); i += 37) sha.Update(data.data() + i, std::min<size_t>(37, data.size() - i));
+  for (size_t i = 0; i < data.size(); i += 37)
+    sha.Update(data.data() + i, std::min<size_t>(37, data.size() - i));
   std::array<uint8_t, 32> digest = sha.Finish();
   std::string hex;
   for (uint8_t b : digest) {

@@ -1,8 +1,6 @@
 // Tests of the mesh readers and writers: every format and variant on good input (files under
 // tests/data/io, binary files built here), gzip, format detection, malformed and hostile input
 // (the error must name the file and the position), and write/read round trips.
-#include "geodex/limits.h"
-#include "util/gzip.h"
 #include "geodex/mesh_io.h"
 
 #include <stdlib.h>
@@ -24,7 +22,9 @@
 #include "absl/status/status.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "geodex/limits.h"
 #include "gtest/gtest.h"
+#include "util/gzip.h"
 
 namespace geodex {
 namespace {
@@ -421,7 +421,8 @@ TEST(PlyReaderTest, MalformedHeaderAndAsciiNamesFileAndLine) {
   ExpectError(Parse(ascii + "5\n", "more.ply"), kInvalid, {"more.ply: line 29", "'5'"});
   ReadLimits limits;
   limits.max_faces = 3;
-  ExpectError(Parse(ascii, "lim.ply", limits), Code::kResourceExhausted, {"lim.ply", "faces exceed the limit of 3"});
+  ExpectError(Parse(ascii, "lim.ply", limits), Code::kResourceExhausted,
+              {"lim.ply", "faces exceed the limit of 3"});
 }
 
 // ---------------------------------------------------------------------------------------------

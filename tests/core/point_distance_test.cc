@@ -1,13 +1,14 @@
 // The paper's unfolding estimate (section 4) at surface points, against exact values obtained by
 // symmetry (a solve from the point itself, read at the source vertex).
 
+#include "geodex/point_distance.h"
+
 #include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
 
 #include "geodex/geodesic_solver.h"
-#include "geodex/point_distance.h"
 #include "gtest/gtest.h"
 #include "util/test_meshes.h"
 
@@ -69,7 +70,8 @@ TEST(PointEstimateTest, VerticesAndSameFaceSourcesAreExact) {
   absl::StatusOr<DistanceField> field = ComputeDistanceField(*mesh, {src});
   ASSERT_TRUE(field.ok());
   // A vertex: the field's own value.
-  absl::StatusOr<PointEstimate> at_vertex = EstimateDistanceAt(*mesh, *field, SurfacePoint::AtVertex(9));
+  absl::StatusOr<PointEstimate> at_vertex =
+      EstimateDistanceAt(*mesh, *field, SurfacePoint::AtVertex(9));
   ASSERT_TRUE(at_vertex.ok());
   EXPECT_EQ(at_vertex->distance, field->distance[9]);
   // Another point of the source's face: a straight line.
@@ -89,14 +91,15 @@ TEST(PointEstimateTest, VerticesAndSameFaceSourcesAreExact) {
 TEST(PointEstimateTest, SeveralSourcesPickTheNearerLabel) {
   absl::StatusOr<TriangleMesh> mesh = LoadTestMesh("bump-domain.off");
   ASSERT_TRUE(mesh.ok());
-  absl::StatusOr<DistanceField> field = ComputeDistanceField(
-      *mesh, {SurfacePoint::AtVertex(0), SurfacePoint::AtVertex(2086)});
+  absl::StatusOr<DistanceField> field =
+      ComputeDistanceField(*mesh, {SurfacePoint::AtVertex(0), SurfacePoint::AtVertex(2086)});
   ASSERT_TRUE(field.ok());
   // At the corner vertices of a face the labels agree with the field; the estimate inside a face
   // whose vertices all belong to one source carries that label.
   for (uint32_t f = 0; f < mesh->face_count(); f += 97) {
     const uint32_t l0 = field->source[mesh->FaceVertex(f, 0)];
-    if (l0 != field->source[mesh->FaceVertex(f, 1)] || l0 != field->source[mesh->FaceVertex(f, 2)]) {
+    if (l0 != field->source[mesh->FaceVertex(f, 1)] ||
+        l0 != field->source[mesh->FaceVertex(f, 2)]) {
       continue;
     }
     absl::StatusOr<PointEstimate> e =

@@ -188,8 +188,8 @@ TEST(PointDirectionTest, OnAPlaneEachPointHeadsStraightAtItsNearestSource) {
   // Edge points on each of a face's three edges (the solver places them in either face).
   for (uint32_t f : {7u, 90u, 150u, 251u}) {
     for (int k = 0; k < 3; ++k) {
-      query.points.push_back(SurfacePoint::OnEdge(data.faces[3 * f + k],
-                                                  data.faces[3 * f + (k + 1) % 3], 0.375));
+      query.points.push_back(
+          SurfacePoint::OnEdge(data.faces[3 * f + k], data.faces[3 * f + (k + 1) % 3], 0.375));
     }
   }
   query.points.push_back(query.sources[1]);

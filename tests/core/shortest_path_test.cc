@@ -1,11 +1,12 @@
 // Path backtracing: the polyline's length equals the field's distance, it is straight across every
 // edge it crosses (unfolds to a line), and it bends only at saddle or boundary vertices.
 
+#include "geodex/shortest_path.h"
+
 #include <cmath>
 #include <string>
 
 #include "geodex/geodesic_solver.h"
-#include "geodex/shortest_path.h"
 #include "gtest/gtest.h"
 #include "util/mesh_factory.h"
 #include "util/test_meshes.h"
@@ -56,8 +57,8 @@ void CheckPath(const MeshData& data, const TriangleMesh& mesh, const DistanceFie
       const auto ahead = Sub(pts[i + 1].position, pts[i].position);
       if (Norm(back) > 1e-9 * el && Norm(ahead) > 1e-9 * el) {
         const double c1 = Dot(back, e) / (Norm(back) * el), c2 = Dot(ahead, e) / (Norm(ahead) * el);
-        EXPECT_NEAR(c1 + c2, 0, 1e-7) << "path bends on edge " << w.edge_from << "-" << w.edge_to
-                                      << " (vertex " << v << ")";
+        EXPECT_NEAR(c1 + c2, 0, 1e-7)
+            << "path bends on edge " << w.edge_from << "-" << w.edge_to << " (vertex " << v << ")";
       }
     }
   }
@@ -108,7 +109,8 @@ TEST_P(PathTest, DirectionFieldIsTheFirstStepOfEveryPath) {
   const uint32_t n = mesh->file_vertex_count();
   for (const std::vector<SurfacePoint>& sources :
        {std::vector<SurfacePoint>{SurfacePoint::AtVertex(0)},
-        std::vector<SurfacePoint>{SurfacePoint::InFace(7, 0.2, 0.3, 0.5), SurfacePoint::AtVertex(n / 2)}}) {
+        std::vector<SurfacePoint>{SurfacePoint::InFace(7, 0.2, 0.3, 0.5),
+                                  SurfacePoint::AtVertex(n / 2)}}) {
     absl::StatusOr<DistanceField> field = ComputeDistanceField(*mesh, sources);
     ASSERT_TRUE(field.ok());
     const std::vector<std::array<double, 3>> dir = ComputeDirectionField(*mesh, *field);
@@ -121,9 +123,9 @@ TEST_P(PathTest, DirectionFieldIsTheFirstStepOfEveryPath) {
       // The first point of the path away from v (an edge crossing may repeat v's position).
       size_t k = 1;
       const double scale = 1e-9 * (1 + field->distance[v]);
-      while (k < p.size() && std::hypot(p[k].position[0] - p[0].position[0],
-                                        p[k].position[1] - p[0].position[1],
-                                        p[k].position[2] - p[0].position[2]) <= scale) {
+      while (k < p.size() &&
+             std::hypot(p[k].position[0] - p[0].position[0], p[k].position[1] - p[0].position[1],
+                        p[k].position[2] - p[0].position[2]) <= scale) {
         ++k;
       }
       if (k == p.size()) {  // v is a source
@@ -206,7 +208,7 @@ TEST(PathTest, DirectionFieldOnAPlanePointsAtTheSource) {
 TEST(PathTest, DirectionFieldStepsIntoTheFaceAcrossTheEdge) {
   MeshData data;
   data.positions = {0, 0, 0, 1, 0, 0, 0.5, 1, 0, 0.5, -1, 0.5};  // A B C D
-  data.faces = {0, 1, 2, 1, 0, 3};                                // ABC, BAD (fold along AB)
+  data.faces = {0, 1, 2, 1, 0, 3};                               // ABC, BAD (fold along AB)
   absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(data);
   ASSERT_TRUE(mesh.ok());
   ASSERT_EQ(mesh->From(0), 0u);  // half-edge 0 runs A -> B in face ABC

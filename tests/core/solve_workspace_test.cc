@@ -3,6 +3,8 @@
 // would change answers, so every query here runs on a mesh that has already answered others and
 // on a freshly built copy, and the two must agree bit for bit, counters included.
 
+#include "ich/solve_workspace.h"
+
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -13,7 +15,6 @@
 #include "geodex/geodesic_solver.h"
 #include "geodex/shortest_path.h"
 #include "gtest/gtest.h"
-#include "ich/solve_workspace.h"
 #include "util/test_meshes.h"
 
 namespace geodex {
@@ -139,10 +140,12 @@ TEST_P(SolveWorkspaceTest, AnswersOnAWarmMeshEqualThoseOnAFreshOne) {
   {
     absl::StatusOr<TriangleMesh> cold = LoadTestMesh(GetParam());
     ASSERT_TRUE(cold.ok());
-    const PathQueryResult a = *ComputeShortestPath(*cold, SurfacePoint::AtVertex(0),
-                                                   SurfacePoint::AtVertex(104729u % warm->file_vertex_count()));
-    const PathQueryResult b = *ComputeShortestPath(*warm, SurfacePoint::AtVertex(0),
-                                                   SurfacePoint::AtVertex(104729u % warm->file_vertex_count()));
+    const PathQueryResult a =
+        *ComputeShortestPath(*cold, SurfacePoint::AtVertex(0),
+                             SurfacePoint::AtVertex(104729u % warm->file_vertex_count()));
+    const PathQueryResult b =
+        *ComputeShortestPath(*warm, SurfacePoint::AtVertex(0),
+                             SurfacePoint::AtVertex(104729u % warm->file_vertex_count()));
     EXPECT_EQ(a.distance, b.distance);
     EXPECT_EQ(a.stats.windows_created, b.stats.windows_created);
     EXPECT_EQ(a.path.points.size(), b.path.points.size());

@@ -20,9 +20,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   ReadLimits limits;
   limits.max_vertices = 20000;
   limits.max_faces = 40000;
-  absl::StatusOr<MeshData> mesh = ReadMeshFromBuffer(
-      absl::string_view(reinterpret_cast<const char*>(data) + 1, size - 1), format, "fuzz.mesh",
-      limits);
+  absl::StatusOr<MeshData> mesh =
+      ReadMeshFromBuffer(absl::string_view(reinterpret_cast<const char*>(data) + 1, size - 1),
+                         format, "fuzz.mesh", limits);
   if (!mesh.ok() || mesh->vertex_count() == 0 || mesh->vertex_count() > 2000) return 0;
   absl::StatusOr<TriangleMesh> built = TriangleMesh::Build(*mesh);
   if (!built.ok()) return 0;

@@ -13,11 +13,11 @@
 
 #include "absl/strings/str_cat.h"
 #include "field_cache.h"
-#include "geodex_service.h"
 #include "geodex/cancel.h"
-#include "geodex/mesh_io.h"
 #include "geodex/mesh_id.h"
+#include "geodex/mesh_io.h"
 #include "geodex/terrain.h"
+#include "geodex_service.h"
 #include "mesh_store.h"
 #include "ogr_spatialref.h"
 #include "queries.h"
@@ -65,7 +65,8 @@ struct World {
     MeshData grid;
     for (int j = 0; j < 6; ++j) {
       for (int i = 0; i < 6; ++i) {
-        grid.positions.insert(grid.positions.end(), {500005.0 + 10 * i, 4999995.0 - 10 * j, 0.5 * i * j});
+        grid.positions.insert(grid.positions.end(),
+                              {500005.0 + 10 * i, 4999995.0 - 10 * j, 0.5 * i * j});
       }
     }
     for (uint32_t j = 0; j < 5; ++j) {

@@ -16,9 +16,9 @@
 #include <fstream>
 #include <string>
 
+#include "geodex/mesh_id.h"
 #include "geodex/triangle_mesh.h"
 #include "mesh_disk.h"
-#include "geodex/mesh_id.h"
 
 namespace {
 

@@ -326,8 +326,8 @@ TEST(ApiConvertTest, FieldRoundTripsThroughManyMessages) {
     const DistanceField& back = assembler.result();
     ASSERT_EQ(back.distance.size(), n);
     for (size_t v = 0; v < n; ++v) {
-      const double want = f32 ? static_cast<double>(static_cast<float>(field->distance[v]))
-                              : field->distance[v];
+      const double want =
+          f32 ? static_cast<double>(static_cast<float>(field->distance[v])) : field->distance[v];
       ASSERT_EQ(std::memcmp(&back.distance[v], &want, sizeof want), 0) << v;
       for (int c = 0; c < 3; ++c) {
         ASSERT_EQ(std::memcmp(&back.direction[v][c], &products.direction[v][c], sizeof(double)), 0);
@@ -376,8 +376,8 @@ TEST(ApiConvertTest, MatrixRoundTripsThroughManyMessages) {
     api::MatrixAssembler assembler;
     for (size_t begin = 0; begin < m.values.size(); begin += 3) {
       v1::ComputeDistanceMatrixResponse message;
-      api::MatrixChunkToProto(m.rows, m.cols, m.values, begin,
-                              std::min(m.values.size(), begin + 3), f32, &message);
+      api::MatrixChunkToProto(m.rows, m.cols, m.values, begin, std::min(m.values.size(), begin + 3),
+                              f32, &message);
       assembler.Add(message);
       EXPECT_EQ(assembler.rows_done(), std::min(m.values.size(), begin + 3) / m.cols);
     }
@@ -386,8 +386,8 @@ TEST(ApiConvertTest, MatrixRoundTripsThroughManyMessages) {
     EXPECT_EQ(back.cols, m.cols);
     ASSERT_EQ(back.values.size(), m.values.size());
     for (size_t i = 0; i < m.values.size(); ++i) {
-      EXPECT_EQ(back.values[i], f32 ? static_cast<double>(static_cast<float>(m.values[i]))
-                                    : m.values[i]);
+      EXPECT_EQ(back.values[i],
+                f32 ? static_cast<double>(static_cast<float>(m.values[i])) : m.values[i]);
     }
   }
 }

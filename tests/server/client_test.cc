@@ -8,9 +8,9 @@
 
 #include "absl/time/clock.h"
 #include "geodex/geodesic_solver.h"
+#include "geodex/mesh_id.h"
 #include "geodex/samples.h"
 #include "geodex_client.h"
-#include "geodex/mesh_id.h"
 #include "server_test_util.h"
 
 namespace geodex::server {
@@ -120,7 +120,8 @@ TEST_F(ClientTest, QueueFullIsRetriedWithBackoffButALimitIsNot) {
 
   testing::Notification release;
   ASSERT_TRUE(server_->pool().TrySubmit([&release] { release.WaitForNotification(); }));
-  for (int i = 0; i < 6000 && server_->pool().busy() == 0; ++i) absl::SleepFor(absl::Milliseconds(5));
+  for (int i = 0; i < 6000 && server_->pool().busy() == 0; ++i)
+    absl::SleepFor(absl::Milliseconds(5));
   ASSERT_EQ(server_->pool().busy(), 1u);
   const uint64_t rejected_before = server_->pool().rejected();
   std::thread releaser([&] {
@@ -141,9 +142,10 @@ TEST_F(ClientTest, QueueFullIsRetriedWithBackoffButALimitIsNot) {
 
   // Two targets with --max_targets=1: RESOURCE_EXHAUSTED (reason LIMIT) at once, no retry.
   const int retries_mid = client.retries();
-  absl::StatusOr<DistanceMatrix> matrix = client.Matrix(
-      mesh, {{SurfacePoint::AtVertex(0)}, {SurfacePoint::AtVertex(1), SurfacePoint::AtVertex(2)},
-             MatrixOptions{}});
+  absl::StatusOr<DistanceMatrix> matrix =
+      client.Matrix(mesh, {{SurfacePoint::AtVertex(0)},
+                           {SurfacePoint::AtVertex(1), SurfacePoint::AtVertex(2)},
+                           MatrixOptions{}});
   EXPECT_EQ(matrix.status().code(), absl::StatusCode::kResourceExhausted) << matrix.status();
   EXPECT_EQ(client.retries(), retries_mid);
 }

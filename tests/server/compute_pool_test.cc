@@ -1,11 +1,10 @@
 #include "compute_pool.h"
-#include "server_test_util.h"
 
 #include <atomic>
 
 #include "absl/time/clock.h"
-
 #include "gtest/gtest.h"
+#include "server_test_util.h"
 
 namespace geodex::server {
 namespace {

@@ -39,9 +39,9 @@ class Geodexd {
 
  private:
   static std::vector<std::string> Args(const fs::path& dir, std::vector<std::string> extra) {
-    std::vector<std::string> args = {GEODEXD_BINARY, "--listen", "127.0.0.1:0", "--data-dir",
-                                     (dir / "data").string(), "--metrics_listen", "127.0.0.1:0",
-                                     "--pool_threads", "1"};
+    std::vector<std::string> args = {
+        GEODEXD_BINARY,     "--listen",    "127.0.0.1:0",    "--data-dir", (dir / "data").string(),
+        "--metrics_listen", "127.0.0.1:0", "--pool_threads", "1"};
     args.insert(args.end(), extra.begin(), extra.end());
     return args;
   }

@@ -241,9 +241,9 @@ TEST_F(HostileClientTest, LambdaAndUnknownEnumsNameTheirFields) {
   EXPECT_EQ(BadField(s), "options.lambda") << s.error_message();
   EXPECT_TRUE(Contains(s.error_message(), "[0, 1]"));
 
-  RawResult r = RawCall(channel_, "/geodex.v1.Geodex/CreateMesh",
-                        {Metadata("enum", 0, static_cast<v1::MeshFormat>(42)),
-                         Chunk(GridOff(3, 3, false))});
+  RawResult r =
+      RawCall(channel_, "/geodex.v1.Geodex/CreateMesh",
+              {Metadata("enum", 0, static_cast<v1::MeshFormat>(42)), Chunk(GridOff(3, 3, false))});
   EXPECT_EQ(r.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_EQ(BadField(r.status), "metadata.format") << r.status.error_message();
 }

@@ -46,7 +46,8 @@ TEST_F(LifecycleTest, ErrorsCarryBadRequestAndErrorInfoDetails) {
   ASSERT_TRUE(details.details(0).UnpackTo(&bad_request));
   ASSERT_EQ(bad_request.field_violations_size(), 1);
   EXPECT_EQ(bad_request.field_violations(0).field(), "sources[1].vertex");
-  EXPECT_NE(bad_request.field_violations(0).description().find("vertex 99 does not exist"), std::string::npos);
+  EXPECT_NE(bad_request.field_violations(0).description().find("vertex 99 does not exist"),
+            std::string::npos);
 
   s = ReadField(*stub_, FieldRequest(up.mesh.name(), {0, 1, 2}), 30).status;
   ASSERT_EQ(s.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
@@ -118,9 +119,8 @@ TEST_F(LifecycleTest, ShutdownLetsAQueuedCallFinishWithinTheGracePeriod) {
   }));
   blocking->WaitForNotification();
   // A field request waits in the queue behind the blocked worker.
-  std::future<testing::FieldResult> call = std::async(std::launch::async, [&] {
-    return ReadField(*stub_, FieldRequest(up.mesh.name(), {0}), 60);
-  });
+  std::future<testing::FieldResult> call = std::async(
+      std::launch::async, [&] { return ReadField(*stub_, FieldRequest(up.mesh.name(), {0}), 60); });
   for (int i = 0; i < 6000 && server_->pool().queued() == 0; ++i) {
     absl::SleepFor(absl::Milliseconds(5));
   }
@@ -185,7 +185,8 @@ TEST(ServerOptionsTest, SettingsThatCannotWorkFailToStartNamingTheFlag) {
       {"--max_targets", [](ServerOptions& o) { o.limits.max_targets = 0; }},
       {"--max_levels", [](ServerOptions& o) { o.limits.max_levels = 0; }},
       {"--max_output_values", [](ServerOptions& o) { o.limits.max_output_values = 0; }},
-      {"--max_unary_response_bytes", [](ServerOptions& o) { o.limits.max_unary_response_bytes = 0; }},
+      {"--max_unary_response_bytes",
+       [](ServerOptions& o) { o.limits.max_unary_response_bytes = 0; }},
       {"--stream_chunk_bytes", [](ServerOptions& o) { o.limits.stream_chunk_bytes = 0; }},
       {"--stream_chunk_bytes", [](ServerOptions& o) { o.limits.stream_chunk_bytes = 64u << 20; }},
   };

@@ -1,7 +1,7 @@
 #include "mesh_store.h"
 
-#include "gtest/gtest.h"
 #include "geodex/mesh_id.h"
+#include "gtest/gtest.h"
 #include "server_test_util.h"
 
 namespace geodex::server {
@@ -40,7 +40,8 @@ TEST(MeshStoreTest, InsertGetDeleteAndAlias) {
 
 TEST(MeshStoreTest, LruEvictionUnderBudgetSparesPinnedAndRecentlyUsed) {
   auto m1 = Make(10), m2 = Make(11), m3 = Make(12), m4 = Make(13);
-  uint64_t most = std::max({m1->memory_bytes, m2->memory_bytes, m3->memory_bytes, m4->memory_bytes});
+  uint64_t most =
+      std::max({m1->memory_bytes, m2->memory_bytes, m3->memory_bytes, m4->memory_bytes});
   MeshStore store(3 * most);
   m1->pinned = true;
   ASSERT_TRUE(store.Insert(m1).ok());

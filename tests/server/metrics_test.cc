@@ -73,13 +73,15 @@ TEST_F(MetricsTest, ScrapeCountsRequestsCacheHitsAndWindows) {
   }
   ASSERT_NE(text.find("200 OK"), std::string::npos) << text.substr(0, 200);
   EXPECT_EQ(Sample(text, field_ok), 2);
-  EXPECT_EQ(Sample(text, "geodex_requests_total{code=\"INVALID_ARGUMENT\",method=\"geodex.v1."
-                         "Geodex/ComputeDistanceField\"}"),
+  EXPECT_EQ(Sample(text,
+                   "geodex_requests_total{code=\"INVALID_ARGUMENT\",method=\"geodex.v1."
+                   "Geodex/ComputeDistanceField\"}"),
             1);
-  EXPECT_EQ(Sample(text, "geodex_requests_total{code=\"OK\",method=\"geodex.v1.Geodex/CreateMesh\"}"),
-            1);
-  EXPECT_EQ(Sample(text, "geodex_request_duration_seconds_count{method=\"geodex.v1.Geodex/"
-                         "ComputeDistanceField\"}"),
+  EXPECT_EQ(
+      Sample(text, "geodex_requests_total{code=\"OK\",method=\"geodex.v1.Geodex/CreateMesh\"}"), 1);
+  EXPECT_EQ(Sample(text,
+                   "geodex_request_duration_seconds_count{method=\"geodex.v1.Geodex/"
+                   "ComputeDistanceField\"}"),
             3);
   EXPECT_EQ(Sample(text, "geodex_result_cache_hits_total"), 1);
   EXPECT_GT(Sample(text, "geodex_result_cache_bytes"), 0);

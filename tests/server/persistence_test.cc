@@ -1,6 +1,6 @@
 // geodexd's data directory: restarts lose nothing, corrupt or truncated files are skipped, crashed
-// writes are cleaned up, built-in samples appear on a fresh directory only, evicted meshes come back
-// from disk, and a server-side import directory is read at start.
+// writes are cleaned up, built-in samples appear on a fresh directory only, evicted meshes come
+// back from disk, and a server-side import directory is read at start.
 
 #include <filesystem>
 #include <fstream>
@@ -155,7 +155,8 @@ TEST_F(PersistenceTest, CorruptTruncatedAndForeignFilesAreSkippedAndTemporariesR
   ASSERT_EQ(report.skipped.size(), 3u);
   bool truncated_reported = false;
   for (const auto& s : report.skipped) {
-    truncated_reported |= s.path == MeshFile(cut.mesh) && s.reason.find("truncated") != std::string::npos;
+    truncated_reported |=
+        s.path == MeshFile(cut.mesh) && s.reason.find("truncated") != std::string::npos;
   }
   EXPECT_TRUE(truncated_reported);
   ASSERT_EQ(report.removed_temporaries.size(), 1u);
@@ -257,7 +258,8 @@ TEST(MeshFileHeaderTest, RoundTripsEveryFieldAndRefusesTruncation) {
   ASSERT_TRUE(dem->terrain.has_value());
   EXPECT_EQ(*dem->terrain, t);
   EXPECT_EQ(dem->display_name, r.display_name);
-  for (size_t cut : {size_t{0}, size_t{3}, bytes.size() / 2, bytes.size() - 1, with_terrain.size() - 9}) {
+  for (size_t cut :
+       {size_t{0}, size_t{3}, bytes.size() / 2, bytes.size() - 1, with_terrain.size() - 9}) {
     EXPECT_EQ(DecodeMeshFileHeader(kMeshFileVersion, with_terrain.substr(0, cut)).status().code(),
               absl::StatusCode::kDataLoss)
         << cut;
@@ -369,7 +371,8 @@ TEST_F(PersistenceTest, ImportDirectoryAtStart) {
   const StartupReport& report = server_->startup_report();
   EXPECT_EQ(report.imported.size(), 1u);
   ASSERT_EQ(report.import_errors.size(), 1u);
-  EXPECT_NE(report.import_errors[0].find("broken.off"), std::string::npos) << report.import_errors[0];
+  EXPECT_NE(report.import_errors[0].find("broken.off"), std::string::npos)
+      << report.import_errors[0];
   v1::Mesh mesh;
   ASSERT_TRUE(GetMesh("meshes/valley", &mesh).ok());
   EXPECT_EQ(mesh.vertex_count(), 30u);

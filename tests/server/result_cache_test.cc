@@ -184,7 +184,8 @@ TEST_F(ResultCacheTest, RepeatedMatrixAndRowsFromCachedFieldsAreNotSolvedAgain) 
   MatrixResult nearest = ReadMatrix(*stub_, sources, other_targets, 2);
   ASSERT_TRUE(nearest.status.ok());
   for (size_t r = 0; r < sources.size(); ++r) {
-    std::vector<double> row(from_fields.values.begin() + r * 4, from_fields.values.begin() + r * 4 + 4);
+    std::vector<double> row(from_fields.values.begin() + r * 4,
+                            from_fields.values.begin() + r * 4 + 4);
     std::vector<double> kept;
     for (size_t c = 0; c < 4; ++c) {
       if (!std::isinf(nearest.values[r * 4 + c])) kept.push_back(nearest.values[r * 4 + c]);

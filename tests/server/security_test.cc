@@ -106,7 +106,8 @@ TEST_F(SecurityTest, TlsWithTokensNeedsAValidToken) {
   EXPECT_TRUE(*anonymous.Health());
   EXPECT_EQ(anonymous.ListMeshes().status().code(), absl::StatusCode::kUnauthenticated);
   EXPECT_EQ(anonymous.DeleteMesh("meshes/x").code(), absl::StatusCode::kUnauthenticated);
-  client::MeshRef ref{"meshes/" + std::string(64, 'a'), std::string(64, 'a'), "", "", false, std::nullopt};
+  client::MeshRef ref{
+      "meshes/" + std::string(64, 'a'), std::string(64, 'a'), "", "", false, std::nullopt};
   EXPECT_EQ(anonymous.Locate(ref, {{0, 0, 0}}).status().code(), absl::StatusCode::kUnauthenticated);
   EXPECT_EQ(anonymous.ComputeVoronoi(ref, {SurfacePoint::AtVertex(0)}, {}).status().code(),
             absl::StatusCode::kUnauthenticated);

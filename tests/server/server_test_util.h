@@ -4,10 +4,10 @@
 // 127.0.0.1:0 with a client stub, chunked uploads and streamed distance fields.
 
 #include <chrono>
-#include <condition_variable>
-#include <mutex>
 #include <cmath>
+#include <condition_variable>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -17,12 +17,12 @@
 #include "geodex/triangle_mesh.h"
 #include "geodex/v1/geodex.grpc.pb.h"
 #include "geodex_server.h"
-#include "grpcpp/create_channel.h"
-#include "grpcpp/generic/generic_stub.h"
-#include "grpcpp/support/byte_buffer.h"
-#include "grpcpp/security/credentials.h"
 #include "google/rpc/error_details.pb.h"
 #include "google/rpc/status.pb.h"
+#include "grpcpp/create_channel.h"
+#include "grpcpp/generic/generic_stub.h"
+#include "grpcpp/security/credentials.h"
+#include "grpcpp/support/byte_buffer.h"
 #include "gtest/gtest.h"
 
 namespace geodex::server::testing {
@@ -161,7 +161,7 @@ struct RawResult {
 // One call of `method` through the generic stub (every gRPC call is a stream on the wire): sends
 // each of `messages` as raw bytes, half-closes, reads every reply.
 inline RawResult RawCall(const std::shared_ptr<grpc::Channel>& channel, const std::string& method,
-                  const std::vector<std::string>& messages, const std::string& token = "") {
+                         const std::vector<std::string>& messages, const std::string& token = "") {
   grpc::GenericStub stub(channel);
   grpc::CompletionQueue cq;
   grpc::ClientContext context;

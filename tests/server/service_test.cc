@@ -7,10 +7,10 @@
 #include "absl/time/clock.h"
 #include "geodex/distance_field.h"
 #include "geodex/geodesic_solver.h"
+#include "geodex/mesh_id.h"
 #include "geodex/shortest_path.h"
 #include "grpcpp/generic/generic_stub.h"
 #include "grpcpp/support/byte_buffer.h"
-#include "geodex/mesh_id.h"
 #include "server_test_util.h"
 
 namespace geodex::server {
@@ -107,7 +107,8 @@ TEST_F(ServiceTest, UploadGetListDelete) {
   }
 
   // More meshes, then list them two per page.
-  for (int cells = 2; cells <= 5; ++cells) ASSERT_TRUE(Upload(*stub_, GridOff(cells, 3, false)).status.ok());
+  for (int cells = 2; cells <= 5; ++cells)
+    ASSERT_TRUE(Upload(*stub_, GridOff(cells, 3, false)).status.ok());
   std::vector<std::string> names;
   std::string token;
   do {

@@ -96,8 +96,8 @@ class TerrainServiceTest : public testing::ServerFixture {
   void SetUp() override {
     GDALAllRegister();
     dir_ = fs::path(::testing::TempDir()) /
-           absl::StrCat("geodex-terrain-svc-", ::testing::UnitTest::GetInstance()->random_seed(), "-",
-                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+           absl::StrCat("geodex-terrain-svc-", ::testing::UnitTest::GetInstance()->random_seed(),
+                        "-", ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_ / "in");
     // A tilted plane in UTM 33N, 10 m cells, with a nodata slot (columns 14-15, rows 5 down).
@@ -116,7 +116,8 @@ class TerrainServiceTest : public testing::ServerFixture {
       for (int i = 0; i < 30; ++i) {
         row[i] = (i == 14 || i == 15) && j >= 5 ? -9999.0f : static_cast<float>(0.5 * i + 0.25 * j);
       }
-      EXPECT_EQ(band->RasterIO(GF_Write, 0, j, 30, 1, row.data(), 30, 1, GDT_Float32, 0, 0), CE_None);
+      EXPECT_EQ(band->RasterIO(GF_Write, 0, j, 30, 1, row.data(), 30, 1, GDT_Float32, 0, 0),
+                CE_None);
     }
     GDALClose(ds);
     std::ifstream in(tif_, std::ios::binary);
@@ -230,7 +231,8 @@ TEST_F(TerrainServiceTest, GeoTiffUploadKeepsItsMapAndTakesMapPoints) {
   testing::FieldResult in_hole = FieldFrom("meshes/slot", hole);
   EXPECT_EQ(in_hole.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_EQ(BadField(in_hole.status), "sources[0].map_point");
-  EXPECT_TRUE(Contains(in_hole.status.error_message(), "in a hole of the DEM")) << in_hole.status.error_message();
+  EXPECT_TRUE(Contains(in_hole.status.error_message(), "in a hole of the DEM"))
+      << in_hole.status.error_message();
   v1::SurfacePoint far;
   far.mutable_lon_lat()->set_lon(-70);
   far.mutable_lon_lat()->set_lat(10);
@@ -242,7 +244,8 @@ TEST_F(TerrainServiceTest, GeoTiffUploadKeepsItsMapAndTakesMapPoints) {
   ASSERT_TRUE(testing::Upload(*stub_, testing::GridOff(4, 4, false), "grid").status.ok());
   testing::FieldResult not_dem = FieldFrom("meshes/grid", map);
   EXPECT_EQ(not_dem.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
-  EXPECT_TRUE(Contains(not_dem.status.error_message(), "not a DEM's")) << not_dem.status.error_message();
+  EXPECT_TRUE(Contains(not_dem.status.error_message(), "not a DEM's"))
+      << not_dem.status.error_message();
 }
 
 TEST_F(TerrainServiceTest, UploadsAreCheckedAndLimited) {
@@ -251,26 +254,30 @@ TEST_F(TerrainServiceTest, UploadsAreCheckedAndLimited) {
   StartServer(options);
   testing::UploadResult big = UploadDem(bytes_, "big");
   EXPECT_EQ(big.status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
-  EXPECT_TRUE(Contains(big.status.error_message(), "(server flag --max_dem_cells)")) << big.status.error_message();
+  EXPECT_TRUE(Contains(big.status.error_message(), "(server flag --max_dem_cells)"))
+      << big.status.error_message();
   // The mesh's limits hold before any row is read too.
   options.limits.max_dem_cells = 900;
   options.limits.max_vertices = 899;
   StartServer(options);
   testing::UploadResult many = UploadDem(bytes_, "many");
   EXPECT_EQ(many.status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
-  EXPECT_TRUE(Contains(many.status.error_message(), "(server flag --max_vertices)")) << many.status.error_message();
+  EXPECT_TRUE(Contains(many.status.error_message(), "(server flag --max_vertices)"))
+      << many.status.error_message();
   options.limits.max_vertices = 900;
   options.limits.max_faces = 2 * 29 * 29 - 1;
   StartServer(options);
   testing::UploadResult faces = UploadDem(bytes_, "faces");
-  EXPECT_TRUE(Contains(faces.status.error_message(), "(server flag --max_faces)")) << faces.status.error_message();
+  EXPECT_TRUE(Contains(faces.status.error_message(), "(server flag --max_faces)"))
+      << faces.status.error_message();
 
   StartServer();
   // Not a GeoTIFF, a cut one, DEM options on a mesh file: INVALID_ARGUMENT naming the field.
   testing::UploadResult junk = UploadDem("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "junk");
   EXPECT_EQ(junk.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_EQ(BadField(junk.status), "chunk");
-  EXPECT_TRUE(Contains(junk.status.error_message(), "not a GeoTIFF")) << junk.status.error_message();
+  EXPECT_TRUE(Contains(junk.status.error_message(), "not a GeoTIFF"))
+      << junk.status.error_message();
   testing::UploadResult cut = UploadDem(bytes_.substr(0, bytes_.size() / 2), "cut");
   EXPECT_EQ(cut.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   testing::UploadResult options_on_off =
@@ -298,7 +305,8 @@ TEST_F(TerrainServiceTest, TheMapIsStoredAndGained) {
   const std::string off = (dir_ / "in" / "slot.off").string();
   ASSERT_TRUE(WriteMeshOff(off, local->mesh()).ok());
   std::ifstream in(off, std::ios::binary);
-  const std::string off_bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string off_bytes((std::istreambuf_iterator<char>(in)),
+                              std::istreambuf_iterator<char>());
   testing::UploadResult plain = testing::Upload(*stub_, off_bytes, "plain");
   ASSERT_TRUE(plain.status.ok()) << plain.status.error_message();
   EXPECT_FALSE(plain.mesh.has_terrain());
@@ -334,7 +342,6 @@ TEST_F(TerrainServiceTest, TheMapIsStoredAndGained) {
   EXPECT_EQ(after.distances, before.distances);
 }
 
-
 // Barriers as a request: DeriveMesh leaves out the faces a barrier covers and stores the result by
 // its content. On a DEM's mesh a GeoJSON wall (in longitude/latitude) gives exactly the mesh the
 // CLI makes with --barrier (the same id), map points still drop, and paths go around the wall.
@@ -361,8 +368,11 @@ TEST_F(TerrainServiceTest, DeriveMeshByABarrier) {
   OGRCoordinateTransformation* to_ll = OGRCreateCoordinateTransformation(&utm, &wgs84);
   ASSERT_NE(to_ll, nullptr);
   std::string ring;
-  for (auto [x, y] : std::vector<std::pair<double, double>>{
-           {500052, 5000010}, {500052, 4999795}, {500068, 4999795}, {500068, 5000010}, {500052, 5000010}}) {
+  for (auto [x, y] : std::vector<std::pair<double, double>>{{500052, 5000010},
+                                                            {500052, 4999795},
+                                                            {500068, 4999795},
+                                                            {500068, 5000010},
+                                                            {500052, 5000010}}) {
     ASSERT_TRUE(to_ll->Transform(1, &x, &y));
     absl::StrAppendFormat(&ring, "%s[%.15f, %.15f]", ring.empty() ? "" : ", ", x, y);
   }
@@ -406,7 +416,8 @@ TEST_F(TerrainServiceTest, DeriveMeshByABarrier) {
   ASSERT_TRUE(built.ok());
   absl::StatusOr<SurfacePoint> west_here = local->DropMapPoint(500025, 4999945);
   ASSERT_TRUE(west_here.ok());
-  absl::StatusOr<DistanceField> here = ComputeDistanceField(*built, {*west_here}, GeodesicOptions{});
+  absl::StatusOr<DistanceField> here =
+      ComputeDistanceField(*built, {*west_here}, GeodesicOptions{});
   ASSERT_TRUE(here.ok());
   EXPECT_EQ(around.distances, here->distance);
 
@@ -417,7 +428,8 @@ TEST_F(TerrainServiceTest, DeriveMeshByABarrier) {
   v1::Mesh dry;
   ASSERT_TRUE(derive("meshes/slot", low, "dry", &dry).ok());
   EXPECT_LT(dry.face_count(), slot.mesh.face_count());
-  testing::FieldResult from_far = testing::ReadField(*stub_, testing::FieldRequest("meshes/dry", {849}));
+  testing::FieldResult from_far =
+      testing::ReadField(*stub_, testing::FieldRequest("meshes/dry", {849}));
   ASSERT_TRUE(from_far.status.ok()) << from_far.status.error_message();
   EXPECT_TRUE(std::isinf(from_far.distances[0]));
   EXPECT_TRUE(std::isfinite(from_far.distances[849 - 1]));
@@ -425,7 +437,8 @@ TEST_F(TerrainServiceTest, DeriveMeshByABarrier) {
   // On a mesh without a map, polygons are in its own x y.
   ASSERT_TRUE(testing::Upload(*stub_, testing::GridOff(6, 6, false), "grid").status.ok());
   v1::Barrier square;
-  square.set_polygons_geojson(R"({"type": "Polygon", "coordinates": [[[2, -1], [4, -1], [4, 7], [2, 7], [2, -1]]]})");
+  square.set_polygons_geojson(
+      R"({"type": "Polygon", "coordinates": [[[2, -1], [4, -1], [4, 7], [2, 7], [2, -1]]]})");
   v1::Mesh cut;
   ASSERT_TRUE(derive("meshes/grid", square, "", &cut).ok());
   EXPECT_EQ(cut.face_count(), 72u - 24u);  // columns 2 and 3: 2 cells x 6 rows x 2 triangles
@@ -449,12 +462,14 @@ TEST_F(TerrainServiceTest, DeriveMeshByABarrier) {
   EXPECT_EQ(taken.error_message().rfind("display_name: \"walled\" already names mesh", 0), 0u)
       << taken.error_message();
   // Text that is not a GeoJSON object is never taken for a path or a URL.
-  for (const char* text : {"/etc/passwd", "https://127.0.0.1:1/x.geojson", "/vsimem/geodex-dem-0.tif"}) {
+  for (const char* text :
+       {"/etc/passwd", "https://127.0.0.1:1/x.geojson", "/vsimem/geodex-dem-0.tif"}) {
     v1::Barrier path;
     path.set_polygons_geojson(text);
     grpc::Status refused = derive("meshes/slot", path, "", &none);
     EXPECT_EQ(BadField(refused), "barrier.polygons_geojson") << text;
-    EXPECT_TRUE(Contains(refused.error_message(), "not GeoJSON (a JSON object")) << refused.error_message();
+    EXPECT_TRUE(Contains(refused.error_message(), "not GeoJSON (a JSON object"))
+        << refused.error_message();
   }
 }
 
@@ -619,14 +634,15 @@ TEST_F(TerrainServiceTest, ExportGisMakesTheCliFiles) {
   absl::StatusOr<DistanceField> field = ComputeDistanceField(*built, {*source}, GeodesicOptions{});
   ASSERT_TRUE(field.ok());
   const std::string path = "/vsimem/export-test.tif";
-  VSILFILE* file = VSIFileFromMemBuffer(path.c_str(), reinterpret_cast<GByte*>(const_cast<char*>(tiff.data())),
-                                        tiff.size(), FALSE);
+  VSILFILE* file = VSIFileFromMemBuffer(
+      path.c_str(), reinterpret_cast<GByte*>(const_cast<char*>(tiff.data())), tiff.size(), FALSE);
   ASSERT_NE(file, nullptr);
   VSIFCloseL(file);
   GDALDataset* ds = GDALDataset::Open(path.c_str(), GDAL_OF_RASTER);
   ASSERT_NE(ds, nullptr);
   std::vector<float> cells(30 * 30);
-  ASSERT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, 30, 30, cells.data(), 30, 30, GDT_Float32, 0, 0),
+  ASSERT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, 30, 30, cells.data(), 30, 30, GDT_Float32,
+                                           0, 0),
             CE_None);
   double gt[6];
   ds->GetGeoTransform(gt);

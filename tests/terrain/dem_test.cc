@@ -44,7 +44,8 @@ class DemTest : public ::testing::Test {
   void SetUp() override {
     GDALAllRegister();
     dir_ = fs::path(::testing::TempDir()) /
-           absl::StrCat("geodex-dem-", ::testing::UnitTest::GetInstance()->current_test_info()->name());
+           absl::StrCat("geodex-dem-",
+                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::create_directories(dir_);
   }
   void TearDown() override { fs::remove_all(dir_); }
@@ -66,8 +67,9 @@ class DemTest : public ::testing::Test {
       for (int i = 0; i < g.width; ++i) {
         row[i] = g.height_at(g.x0 + (i + 0.5) * g.dx, g.y0 - (j + 0.5) * g.dy, i, j);
       }
-      EXPECT_EQ(band->RasterIO(GF_Write, 0, j, g.width, 1, row.data(), g.width, 1, GDT_Float64, 0, 0),
-                CE_None);
+      EXPECT_EQ(
+          band->RasterIO(GF_Write, 0, j, g.width, 1, row.data(), g.width, 1, GDT_Float64, 0, 0),
+          CE_None);
     }
     GDALClose(ds);
     return path;
@@ -112,8 +114,8 @@ TEST_F(DemTest, ProjectedPlaneIsItsOwnGridAndGeodesicsAreStraight) {
   ASSERT_TRUE(mesh.ok());
   EXPECT_EQ(mesh->report().flipped_faces, 0u);  // every face wound the same way
   // Map points (not on vertices) dropped vertically: on the plane, at their x and y.
-  const std::vector<std::array<double, 2>> xy = {{500013.3, 4999981.7}, {500301.9, 4999722.2},
-                                                 {500390, 4999900}, {500150.5, 4999850.5}};
+  const std::vector<std::array<double, 2>> xy = {
+      {500013.3, 4999981.7}, {500301.9, 4999722.2}, {500390, 4999900}, {500150.5, 4999850.5}};
   std::vector<SurfacePoint> points;
   for (const auto& [x, y] : xy) {
     absl::StatusOr<SurfacePoint> p = dem->DropMapPoint(x, y);
@@ -236,9 +238,11 @@ TEST_F(DemTest, NodataHoleIsGoneAround) {
     EXPECT_NEAR(at[1], edge[1], 1e-9);
   }
   // A point in the slot, and one outside the grid, are errors naming them.
-  absl::StatusOr<SurfacePoint> in_hole = dem->DropMapPoint(centre(14.5, 20)[0], centre(14.5, 20)[1]);
+  absl::StatusOr<SurfacePoint> in_hole =
+      dem->DropMapPoint(centre(14.5, 20)[0], centre(14.5, 20)[1]);
   EXPECT_EQ(in_hole.status().code(), absl::StatusCode::kInvalidArgument);
-  EXPECT_NE(in_hole.status().message().find("in a hole of the DEM"), std::string::npos) << in_hole.status();
+  EXPECT_NE(in_hole.status().message().find("in a hole of the DEM"), std::string::npos)
+      << in_hole.status();
   absl::StatusOr<SurfacePoint> outside = dem->DropMapPoint(g.x0 - 1, g.y0 - 100);
   EXPECT_NE(outside.status().message().find("outside the DEM"), std::string::npos)
       << outside.status();
@@ -285,7 +289,8 @@ TEST_F(DemTest, BarrierBelowIsGoneAroundLikeNodata) {
       for (SurfacePoint* p : {&*pa, &*pb}) {
         const uint32_t* corners = &open->mesh().faces[3 * size_t{p->face}];
         for (size_t f = 0; f < file_rule.face_count(); ++f) {
-          if (std::equal(corners, corners + 3, &file_rule.faces[3 * f])) p->face = static_cast<uint32_t>(f);
+          if (std::equal(corners, corners + 3, &file_rule.faces[3 * f]))
+            p->face = static_cast<uint32_t>(f);
         }
       }
     }
@@ -328,10 +333,9 @@ TEST_F(DemTest, RastersOutAreAlignedWithTheGridAndMarkNodata) {
     const OGRSpatialReference file_crs(dem->info().file_crs_wkt.c_str());
     EXPECT_TRUE(ds->GetSpatialRef() != nullptr && ds->GetSpatialRef()->IsSame(&file_crs));
     std::vector<double> read(size_t{dem->info().grid_width} * dem->info().grid_height);
-    ASSERT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, dem->info().grid_width,
-                                             dem->info().grid_height, read.data(),
-                                             dem->info().grid_width, dem->info().grid_height,
-                                             GDT_Float64, 0, 0),
+    ASSERT_EQ(ds->GetRasterBand(1)->RasterIO(
+                  GF_Read, 0, 0, dem->info().grid_width, dem->info().grid_height, read.data(),
+                  dem->info().grid_width, dem->info().grid_height, GDT_Float64, 0, 0),
               CE_None);
     GDALClose(ds);
     for (uint32_t j = 0; j < dem->info().grid_height; ++j) {
@@ -387,7 +391,8 @@ TEST_F(DemTest, FootBasedCrsGivesAMeshInMetres) {
   absl::StatusOr<SurfacePoint> a = dem->DropMapPoint(6000120, 2099880);
   absl::StatusOr<SurfacePoint> b = dem->DropMapPoint(6000720, 2099280);
   ASSERT_TRUE(a.ok() && b.ok());
-  absl::StatusOr<std::vector<std::pair<double, uint32_t>>> d = ComputeExactDistancesAt(*mesh, {*a}, {*b});
+  absl::StatusOr<std::vector<std::pair<double, uint32_t>>> d =
+      ComputeExactDistancesAt(*mesh, {*a}, {*b});
   ASSERT_TRUE(d.ok());
   EXPECT_NEAR((*d)[0].first, std::hypot(600, 600) * foot, 1e-6);  // flat: straight, in metres
 }
@@ -399,8 +404,8 @@ TEST_F(DemTest, BadRastersAreClearErrors) {
   // No CRS.
   {
     const std::string path = (dir_ / "nocrs.tif").string();
-    GDALDataset* ds =
-        GetGDALDriverManager()->GetDriverByName("GTiff")->Create(path.c_str(), 4, 4, 1, GDT_Float32, nullptr);
+    GDALDataset* ds = GetGDALDriverManager()->GetDriverByName("GTiff")->Create(
+        path.c_str(), 4, 4, 1, GDT_Float32, nullptr);
     double gt[6] = {0, 1, 0, 0, 0, -1};
     ds->SetGeoTransform(gt);
     GDALClose(ds);
@@ -478,9 +483,10 @@ TEST_F(DemTest, TiledUnionEqualsTheGeneralUnionWithTouchingLobes) {
   ASSERT_TRUE(tiled != nullptr && general != nullptr);
   EXPECT_TRUE(tiled->IsValid());
   EXPECT_TRUE(general->IsValid());
-  const double area = tiled->toMultiPolygon() != nullptr && wkbFlatten(tiled->getGeometryType()) == wkbMultiPolygon
-                          ? tiled->toMultiPolygon()->get_Area()
-                          : tiled->toPolygon()->get_Area();
+  const double area =
+      tiled->toMultiPolygon() != nullptr && wkbFlatten(tiled->getGeometryType()) == wkbMultiPolygon
+          ? tiled->toMultiPolygon()->get_Area()
+          : tiled->toPolygon()->get_Area();
   EXPECT_GT(area, 1000);
   std::unique_ptr<OGRGeometry> difference(tiled->SymDifference(general.get()));
   ASSERT_NE(difference, nullptr);
@@ -491,7 +497,6 @@ TEST_F(DemTest, TiledUnionEqualsTheGeneralUnionWithTouchingLobes) {
                           : 0.0;
   EXPECT_LT(diff, 1e-9 * area);
 }
-
 
 std::string Slurp(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -549,18 +554,21 @@ TEST_F(DemTest, BytesAndStoredMeshGiveTheSameDem) {
   MeshData swapped = file->mesh();
   std::swap_ranges(swapped.positions.begin(), swapped.positions.begin() + 3,
                    swapped.positions.begin() + 3);
-  EXPECT_EQ(Dem::FromMesh(swapped, file->info()).status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(Dem::FromMesh(swapped, file->info()).status().code(),
+            absl::StatusCode::kInvalidArgument);
   MeshData stretched = file->mesh();
   stretched.faces[2] = stretched.faces[2] + 5;
   absl::Status across = Dem::FromMesh(stretched, file->info()).status();
-  EXPECT_NE(across.message().find("not one of a block's two triangles"), std::string::npos) << across;
+  EXPECT_NE(across.message().find("not one of a block's two triangles"), std::string::npos)
+      << across;
 
   // Bad bytes are clear errors, and the cell limit holds before any row is read.
   EXPECT_NE(Dem::ReadGeoTiffBytes("solid\nfacet", "x.tif").status().message().find("not a GeoTIFF"),
             std::string::npos);
   std::string cut = Slurp(path);
   cut.resize(cut.size() / 3);
-  EXPECT_EQ(Dem::ReadGeoTiffBytes(cut, "cut.tif").status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(Dem::ReadGeoTiffBytes(cut, "cut.tif").status().code(),
+            absl::StatusCode::kInvalidArgument);
   DemOptions small;
   small.max_cells = 899;
   EXPECT_EQ(Dem::ReadGeoTiffBytes(Slurp(path), "big.tif", small).status().code(),
@@ -578,7 +586,9 @@ TEST_F(DemTest, StoredGeographicMeshGivesTheSameDem) {
   g.dx = g.dy = 0.0002;
   g.width = 25;
   g.height = 20;
-  g.height_at = [&](double lon, double lat, int, int) { return 1000 * (lon - 14.99) + 300 * (lat - 45); };
+  g.height_at = [&](double lon, double lat, int, int) {
+    return 1000 * (lon - 14.99) + 300 * (lat - 45);
+  };
   absl::StatusOr<Dem> file = Dem::Read(Write("geo.tif", g));
   ASSERT_TRUE(file.ok()) << file.status();
   ASSERT_TRUE(file->info().reprojected);

@@ -45,7 +45,8 @@ class GeodexdChild {
       std::smatch m;
       if (std::regex_search(text, m, grpc_port)) port_ = std::stoi(m[1]);
       if (std::regex_search(text, m, metrics_port)) metrics_port_ = std::stoi(m[1]);
-      if (port_ == 0 || metrics_port_ == 0) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      if (port_ == 0 || metrics_port_ == 0)
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
     }
   }
   GeodexdChild(const GeodexdChild&) = delete;

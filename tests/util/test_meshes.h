@@ -2,8 +2,8 @@
 
 // The committed test meshes in tests/data, loaded through the project's own reader.
 
-#include <cstddef>  // geodex/mesh_data.h uses size_t without including it
 #include <cctype>
+#include <cstddef>  // geodex/mesh_data.h uses size_t without including it
 #include <string>
 #include <vector>
 

@@ -13,7 +13,7 @@ inline constexpr double kUnreachable = std::numeric_limits<double>::infinity();
 
 // Counters of one solve; filled in every build (not only debug).
 struct SolveStats {
-  uint64_t windows_created = 0;         // interval windows made (including ones filtered at once)
+  uint64_t windows_created = 0;  // interval windows made (including ones filtered at once)
   uint64_t windows_filtered_at_creation = 0;  // Lemma 2 (filter theorem) on a new child
   uint64_t windows_filtered_at_pop = 0;       // Lemma 2 again when dequeued (distances improved)
   uint64_t windows_filtered_overfilter = 0;   // removed only because of the lambda margin
@@ -21,12 +21,12 @@ struct SolveStats {
   uint64_t windows_deleted_one_split = 0;     // Lemma 1: windows of an old owner's removed subtree
   uint64_t windows_processed = 0;             // dequeued and propagated
   uint64_t pseudo_sources = 0;                // pseudo-source windows made (saddle/boundary/source)
-  uint64_t pseudo_sources_full_fan = 0;     // processed with windows on every opposite edge
+  uint64_t pseudo_sources_full_fan = 0;       // processed with windows on every opposite edge
   uint64_t pseudo_sources_shadow_only = 0;  // saddles reached straight through: shadow sector only
-  uint64_t edge_relaxations = 0;              // vertex-to-neighbour updates
-  uint32_t max_level = 0;                     // deepest window in the sequence tree
+  uint64_t edge_relaxations = 0;            // vertex-to-neighbour updates
+  uint32_t max_level = 0;                   // deepest window in the sequence tree
   uint64_t peak_live_windows = 0;
-  uint64_t peak_bytes = 0;                    // window pool + queue + per-vertex arrays at peak
+  uint64_t peak_bytes = 0;  // window pool + queue + per-vertex arrays at peak
   double solve_ms = 0;
 };
 
@@ -44,11 +44,11 @@ struct VertexOrigin {
 };
 
 // The result of a solve. Per-vertex arrays are in the FILE's vertex order (a file vertex split at
-// a non-manifold junction gets the best value over its copies); `internal_*` are per internal vertex
-// (see TriangleMesh) and are what paths and other consumers read.
+// a non-manifold junction gets the best value over its copies); `internal_*` are per internal
+// vertex (see TriangleMesh) and are what paths and other consumers read.
 struct DistanceField {
-  std::vector<double> distance;    // +inf where unreachable
-  std::vector<uint32_t> source;    // index into the source list; 0xffffffff where unreachable
+  std::vector<double> distance;  // +inf where unreachable
+  std::vector<uint32_t> source;  // index into the source list; 0xffffffff where unreachable
   std::vector<double> internal_distance;
   std::vector<uint32_t> internal_source;
   std::vector<VertexOrigin> internal_origin;

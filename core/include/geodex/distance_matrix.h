@@ -2,9 +2,8 @@
 
 #include <array>
 #include <cstdint>
-#include <vector>
-
 #include <functional>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "geodex/distance_field.h"

@@ -43,7 +43,7 @@ struct GeodesicOptions {
   uint64_t max_windows = 0;
   const CancelToken* cancel = nullptr;
   // Ablation switches for tests and benchmarks; both are exact either way.
-  bool use_filter = true;            // Lemma 2, the filter theorem
+  bool use_filter = true;               // Lemma 2, the filter theorem
   bool use_one_angle_one_split = true;  // Lemma 1, Chen & Han
 };
 

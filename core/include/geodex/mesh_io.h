@@ -21,22 +21,24 @@ struct ReadLimits {
   uint64_t max_decompressed_bytes = uint64_t{8} << 30;  // gzip expansion bound
 };
 
-// Reads a mesh file: OFF, OBJ (polygons fan-triangulated, 1-based and negative indices), PLY (ascii,
-// binary little/big endian, any property order), STL (ascii/binary; identical positions welded),
-// each optionally gzip-compressed (detected by magic bytes). The format comes from the extension
-// (after stripping .gz) and falls back to sniffing the content. Errors name the file and position
+// Reads a mesh file: OFF, OBJ (polygons fan-triangulated, 1-based and negative indices), PLY
+// (ascii, binary little/big endian, any property order), STL (ascii/binary; identical positions
+// welded), each optionally gzip-compressed (detected by magic bytes). The format comes from the
+// extension (after stripping .gz) and falls back to sniffing the content. Errors name the file and
+// position
 // ("bunny.off: line 12: expected 3 coordinates").
 absl::StatusOr<MeshData> ReadMeshFile(const std::string& path, const ReadLimits& limits = {});
 
-// Same, from bytes in memory (the server receives uploads this way). `name` is used in messages and,
-// with kAuto, its extension picks the format.
+// Same, from bytes in memory (the server receives uploads this way). `name` is used in messages
+// and, with kAuto, its extension picks the format.
 absl::StatusOr<MeshData> ReadMeshFromBuffer(absl::string_view bytes, MeshFormat format,
                                             const std::string& name, const ReadLimits& limits = {});
 
-// Optional per-vertex payload for writers: a scalar (e.g. distance; +inf allowed) and/or an RGB colour.
+// Optional per-vertex payload for writers: a scalar (e.g. distance; +inf allowed) and/or an RGB
+// colour.
 struct VertexAttributes {
-  std::vector<double> scalar;    // empty or vertex_count values
-  std::vector<uint8_t> colors;   // empty or 3 * vertex_count bytes
+  std::vector<double> scalar;   // empty or vertex_count values
+  std::vector<uint8_t> colors;  // empty or 3 * vertex_count bytes
 };
 
 // Writes OFF (ascii; colours as COFF when present, scalars are not representable and are dropped).

@@ -63,7 +63,7 @@ void ComputeFieldProducts(const TriangleMesh& mesh, const DistanceField& field,
 namespace geodex {
 
 struct PathQueryOptions {
-  GeodesicOptions solver;      // lambda, budget, cancel token, ... (max_distance is honoured)
+  GeodesicOptions solver;  // lambda, budget, cancel token, ... (max_distance is honoured)
   // Single source, single target (paper section 5): windows are ordered by
   // sigma + min over the interval of (|I p| + |p t|), a lower bound of any path through them, and
   // the solve stops once the smallest key reaches the target's distance. Exact either way.

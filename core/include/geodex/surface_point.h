@@ -20,12 +20,12 @@ struct SurfacePoint {
   // SurfaceLocator (geodex/locate.h) before use; solvers reject it.
   enum class Kind : uint8_t { kVertex, kEdge, kFace, kPosition };
   Kind kind = Kind::kVertex;
-  uint32_t vertex = 0;                 // kVertex
-  uint32_t edge_from = 0, edge_to = 0; // kEdge: the point (1 - t) * from + t * to
+  uint32_t vertex = 0;                  // kVertex
+  uint32_t edge_from = 0, edge_to = 0;  // kEdge: the point (1 - t) * from + t * to
   double t = 0;
-  uint32_t face = 0;                   // kFace: barycentric in the file's corner order
+  uint32_t face = 0;  // kFace: barycentric in the file's corner order
   std::array<double, 3> bary{};
-  std::array<double, 3> position{};    // kPosition
+  std::array<double, 3> position{};  // kPosition
 
   static SurfacePoint AtVertex(uint32_t v) {
     SurfacePoint p;
@@ -56,8 +56,9 @@ struct SurfacePoint {
   }
 };
 
-// Parses a comma list: `17` (vertex), `e:V1:V2:T`, `f:FACE:B0:B1:B2`, `p:X:Y:Z` (a position). Checks the syntax only; the
-// mesh checks ranges (see ValidateSurfacePoint). Errors name the offending item.
+// Parses a comma list: `17` (vertex), `e:V1:V2:T`, `f:FACE:B0:B1:B2`, `p:X:Y:Z` (a position).
+// Checks the syntax only; the mesh checks ranges (see ValidateSurfacePoint). Errors name the
+// offending item.
 absl::StatusOr<std::vector<SurfacePoint>> ParseSurfacePoints(absl::string_view spec);
 
 // Range and consistency checks against a mesh: unknown vertex or face, an edge that does not

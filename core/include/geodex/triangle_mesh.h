@@ -32,13 +32,13 @@ struct MeshReport {
   uint64_t boundary_loops = 0;
   uint64_t components = 0;  // connected pieces of faces after cutting at non-manifold vertices
   uint64_t vertex_connected_components = 0;  // pieces joined through any shared vertex
-  uint64_t isolated_vertices = 0;   // vertices referenced by no face
-  uint64_t non_manifold_edges = 0;  // edges shared by more than two faces (cut)
-  uint64_t non_manifold_vertices = 0;  // file vertices split into several internal copies
-  uint64_t degenerate_faces = 0;       // zero-area faces (no window crosses them)
-  uint64_t flipped_faces = 0;          // faces re-oriented to agree with their component
-  uint64_t orientation_cuts = 0;       // edges cut because no consistent orientation exists
-  uint64_t saddle_vertices = 0;        // interior vertices with angle sum >= 2*pi (within round-off)
+  uint64_t isolated_vertices = 0;            // vertices referenced by no face
+  uint64_t non_manifold_edges = 0;           // edges shared by more than two faces (cut)
+  uint64_t non_manifold_vertices = 0;        // file vertices split into several internal copies
+  uint64_t degenerate_faces = 0;             // zero-area faces (no window crosses them)
+  uint64_t flipped_faces = 0;                // faces re-oriented to agree with their component
+  uint64_t orientation_cuts = 0;             // edges cut because no consistent orientation exists
+  uint64_t saddle_vertices = 0;  // interior vertices with angle sum >= 2*pi (within round-off)
   uint64_t boundary_vertices = 0;
 };
 
@@ -72,7 +72,8 @@ class TriangleMesh {
   // Validates and builds. Errors (InvalidArgument, naming the face/vertex): empty mesh, face index
   // out of range, a face repeating a vertex, NaN/Inf coordinates; in strict mode also non-manifold
   // or inconsistently oriented input.
-  static absl::StatusOr<TriangleMesh> Build(const MeshData& data, const MeshBuildOptions& options = {});
+  static absl::StatusOr<TriangleMesh> Build(const MeshData& data,
+                                            const MeshBuildOptions& options = {});
   // The mesh as file data again: the file's vertices (recentred positions plus the centre, within
   // a few ulps of the file's values) and faces (file vertex ids, the file's corner order).
   MeshData ToMeshData() const;

@@ -6,11 +6,10 @@
 // As the row's near targets become final the ball is fitted again around the rest, so the search
 // narrows towards the far ones instead of growing a disk out to them.
 
-#include "ich/ich_solver.h"
-
 #include <algorithm>
 #include <cmath>
 
+#include "ich/ich_solver.h"
 #include "ich/numerics.h"
 
 namespace geodex::ich {
@@ -21,7 +20,7 @@ constexpr double kGoalBallMaxRel = 0.25;
 }  // namespace
 
 double IchSolver::WindowKey(uint32_t h, double b0, double b1, double ix, double iy, double sigma,
-                           double plain_key) const {
+                            double plain_key) const {
   // Section 5: rotate the target about this edge's line into the window's plane, on the far side
   // (distances from points of the edge are unchanged), then min over p of |I p| + |p t'| is the
   // straight segment I t' if it crosses the interval, else the better interval end. Exact, so the
@@ -39,7 +38,8 @@ double IchSolver::WindowKey(uint32_t h, double b0, double b1, double ix, double 
   if (cross >= b0 && cross <= b1) {
     best = Hypot(tx - ix, ty - iy);
   } else {
-    best = std::min(Hypot(b0 - ix, iy) + Hypot(tx - b0, ty), Hypot(b1 - ix, iy) + Hypot(tx - b1, ty));
+    best =
+        std::min(Hypot(b0 - ix, iy) + Hypot(tx - b0, ty), Hypot(b1 - ix, iy) + Hypot(tx - b1, ty));
   }
   return std::max(plain_key, sigma + best - goal_radius_);
 }

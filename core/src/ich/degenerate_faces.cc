@@ -1,10 +1,9 @@
 // Zero-area faces: a window or a vertex passes through a face collapsed to a segment.
 
-#include "ich/ich_solver.h"
-
 #include <algorithm>
 #include <cmath>
 
+#include "ich/ich_solver.h"
 #include "ich/numerics.h"
 
 namespace geodex::ich {
@@ -22,7 +21,8 @@ void IchSolver::EmitAcrossDegenerate(uint32_t id, uint32_t corner, double sigma,
   const double* b = pos + 3 * mesh_.To(t);
   const double* p = pos + 3 * v;
   const double x = ((p[0] - a[0]) * (b[0] - a[0]) + (p[1] - a[1]) * (b[1] - a[1]) +
-                    (p[2] - a[2]) * (b[2] - a[2])) / len;
+                    (p[2] - a[2]) * (b[2] - a[2])) /
+                   len;
   if (!(x > 0 && x < len)) return;  // v is an end of that edge: its own fan covers it
   EmitFromPointInFace(id, t, x, 0, sigma, v, source);
 }
@@ -45,7 +45,8 @@ void IchSolver::PassThroughDegenerate(uint32_t id, const Window& w) {
   // The face's middle vertex, if the window covers it, is reached straight.
   const uint32_t v3 = mesh_.Opposite(h);
   const double s3 = along(v3);
-  if (s3 >= w.b0 && s3 <= w.b1) UpdateVertex(v3, w.sigma + Hypot(s3 - w.ix, w.iy), id, h, w.ix, w.iy);
+  if (s3 >= w.b0 && s3 <= w.b1)
+    UpdateVertex(v3, w.sigma + Hypot(s3 - w.ix, w.iy), id, h, w.ix, w.iy);
   const uint32_t others[2] = {TriangleMesh::Next(h), TriangleMesh::Prev(h)};
   for (const uint32_t e : others) {
     const uint32_t t = mesh_.Twin(e);

@@ -1,11 +1,11 @@
 // Lemma 2, the filter theorem (Xin & Wang 2009): a window is dropped, or trimmed, where
-// every point of its interval is reached more cheaply straight from a vertex of the faces around it.
-
-#include "ich/ich_solver.h"
+// every point of its interval is reached more cheaply straight from a vertex of the faces around
+// it.
 
 #include <algorithm>
 #include <cmath>
 
+#include "ich/ich_solver.h"
 #include "ich/numerics.h"
 
 namespace geodex::ich {

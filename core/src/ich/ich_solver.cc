@@ -52,9 +52,7 @@ IchSolver::~IchSolver() {
   if (mesh_.workspaces() != nullptr) mesh_.workspaces()->Release(std::move(workspace_));
 }
 
-void IchSolver::Push(uint32_t id, double key) {
-  queue_.Push({key, id, pool_.generation(id)});
-}
+void IchSolver::Push(uint32_t id, double key) { queue_.Push({key, id, pool_.generation(id)}); }
 
 void IchSolver::SeedVertex(uint32_t v, uint32_t label) {
   if (dist_[v] <= 0) return;  // the same vertex given twice: the first label wins
@@ -123,9 +121,8 @@ bool IchSolver::UpdateVertex(uint32_t v, double d, uint32_t parent, uint32_t hal
   straight_through_[v] = 0;
   if (has_targets_ && vertex_is_target_[v]) targets_dirty_ = true;
   label_[v] = p.source;
-  origin_[v] = VertexOrigin{half_edge, p.kind == WindowKind::kPseudoSource ? p.element
-                                                                            : p.pseudo_source,
-                            ix, iy};
+  origin_[v] = VertexOrigin{
+      half_edge, p.kind == WindowKind::kPseudoSource ? p.element : p.pseudo_source, ix, iy};
   // Paths bend only at saddle and boundary vertices (P4); with lambda > 0 every vertex also passes
   // its distance along its edges, so it gets a (relax-only) pseudo-source window too.
   if (mesh_.IsPseudoSourceCandidate(v) || epsilon_ > 0) {
@@ -328,7 +325,8 @@ void IchSolver::ProcessInterval(uint32_t id, double popped_key) {
     // Endpoint reached along the interval's end ray: in exact arithmetic already set by the same
     // path, so only a real gain counts (a last-bit "gain" would hide a straight-through path).
     const double d1 = w.sigma + Hypot(w.ix, w.iy);
-    if (t0 <= 0 && w.b0 <= kTinyWindowRel * len && d1 < dist_[mesh_.From(h)] * (1 - kFilterRelTol)) {
+    if (t0 <= 0 && w.b0 <= kTinyWindowRel * len &&
+        d1 < dist_[mesh_.From(h)] * (1 - kFilterRelTol)) {
       UpdateVertex(mesh_.From(h), d1, id, h, w.ix, w.iy);
     }
     if (t != kNoIndex && t1 > t0) {
@@ -348,7 +346,8 @@ void IchSolver::ProcessInterval(uint32_t id, double popped_key) {
     const double t0 = sees_v3 ? 0.0 : RayHitParam(w.ix, w.iy, w.b0, x3, y3, wx, wy);
     const double t1 = RayHitParam(w.ix, w.iy, w.b1, x3, y3, wx, wy);
     const double d2 = w.sigma + Hypot(len - w.ix, w.iy);
-    if (t1 >= 1 && w.b1 >= len * (1 - kTinyWindowRel) && d2 < dist_[mesh_.To(h)] * (1 - kFilterRelTol)) {
+    if (t1 >= 1 && w.b1 >= len * (1 - kTinyWindowRel) &&
+        d2 < dist_[mesh_.To(h)] * (1 - kFilterRelTol)) {
       UpdateVertex(mesh_.To(h), d2, id, h, w.ix, w.iy);
     }
     if (t != kNoIndex && t1 > t0) {
@@ -474,10 +473,12 @@ absl::Status IchSolver::Run(const std::vector<ResolvedSource>& sources,
       }
     }
     if (options_.max_windows != 0 && stats_.windows_created > options_.max_windows) {
-      status = LimitExceededError(Limit::kWindows, absl::StrFormat(
-          "window budget exceeded: %d windows created (limit %d); use a larger budget, a "
-          "max_distance, or lambda > 0",
-          stats_.windows_created, options_.max_windows));
+      status = LimitExceededError(
+          Limit::kWindows,
+          absl::StrFormat(
+              "window budget exceeded: %d windows created (limit %d); use a larger budget, a "
+              "max_distance, or lambda > 0",
+              stats_.windows_created, options_.max_windows));
       break;
     }
     if (pool_[e.window].kind == WindowKind::kPseudoSource) {

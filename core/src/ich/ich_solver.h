@@ -51,7 +51,7 @@ struct TargetResult {
   uint32_t vertex = kNoIndex;  // vertex targets: the internal copy that is nearest
   VertexOrigin origin;
   double tx = 0, ty = 0;
-  uint32_t face = kNoIndex;    // face-point targets: the placement used, for the start position
+  uint32_t face = kNoIndex;  // face-point targets: the placement used, for the start position
   double px = 0, py = 0;
 };
 
@@ -91,8 +91,8 @@ class IchSolver {
 
  private:
   absl::Status Run(const std::vector<ResolvedSource>& sources,
-                   const std::vector<ResolvedTarget>* targets, bool use_heuristic,
-                   bool stop_early, std::vector<TargetResult>* results);
+                   const std::vector<ResolvedTarget>* targets, bool use_heuristic, bool stop_early,
+                   std::vector<TargetResult>* results);
   void TouchVertex(uint32_t v) { workspace_->touched_vertices.push_back(v); }
   void SeedVertex(uint32_t v, uint32_t label);
   // A pseudo-source window at `vertex` (kNoIndex: a source point's root), not yet queued.
@@ -120,8 +120,10 @@ class IchSolver {
   // (with the tree, deleting the old winner's doomed subtree). False when that deleted `id` itself.
   bool OneAngleOneSplit(uint32_t id, uint32_t generation, uint32_t h, double d3, double cross_x,
                         double cover_tol, bool* make_left, bool* make_right);
-  // Lower a vertex's distance if `d` is smaller; spawns a pseudo-source window where paths may bend.
-  bool UpdateVertex(uint32_t v, double d, uint32_t parent, uint32_t half_edge, double ix, double iy);
+  // Lower a vertex's distance if `d` is smaller; spawns a pseudo-source window where paths may
+  // bend.
+  bool UpdateVertex(uint32_t v, double d, uint32_t parent, uint32_t half_edge, double ix,
+                    double iy);
   // Creates an interval window on `half_edge` (propagating into its face) unless Lemma 2 or size
   // rules drop it.
   void MakeInterval(uint32_t parent, uint32_t half_edge, double b0, double b1, double ix, double iy,
@@ -195,8 +197,8 @@ class IchSolver {
   std::vector<uint32_t>& label_;
   std::vector<VertexOrigin>& origin_;
   std::vector<uint8_t>& straight_through_;
-  HugeVector<SplitRecord>& split_;        // Lemma 1, per half-edge
-  HugeVector<SplitOwner>& split_owner_;   // Lemma 1's winners, the paper's tree only
+  HugeVector<SplitRecord>& split_;       // Lemma 1, per half-edge
+  HugeVector<SplitOwner>& split_owner_;  // Lemma 1's winners, the paper's tree only
   // The paper's window tree (Method::kIch) is the pool's links: children are linked to their
   // parents so Lemma 1 can delete an old winner's subtree. Without them (Method::kExact) a window
   // is freed as soon as it is processed and Lemma 1 prunes forward only.

@@ -1,11 +1,10 @@
 // Lemma 1, one angle one split (Chen & Han): of the windows on a directed edge that see its
 // opposite vertex, only the one giving that vertex the smallest distance keeps both children.
 
-#include "ich/ich_solver.h"
-
 #include <algorithm>
 #include <cmath>
 
+#include "ich/ich_solver.h"
 #include "ich/numerics.h"
 
 namespace geodex::ich {

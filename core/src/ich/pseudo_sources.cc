@@ -1,10 +1,9 @@
 // Pseudo-sources: saddle, boundary and source vertices, where shortest paths may bend (P4).
 
-#include "ich/ich_solver.h"
-
 #include <algorithm>
 #include <cmath>
 
+#include "ich/ich_solver.h"
 #include "ich/numerics.h"
 
 namespace geodex::ich {
@@ -78,10 +77,10 @@ void IchSolver::SpawnShadowWindows(uint32_t id, uint32_t v, double sigma, uint32
   const uint32_t h = o.half_edge;
   const uint32_t corner_in = TriangleMesh::Prev(h);
   const double x3 = mesh_.OppX(h), y3 = mesh_.OppY(h);
-  const double ax = -x3, ay = -y3;                // v -> start of h
-  const double dx = o.ix - x3, dy = o.iy - y3;   // v -> image
-  const double back =
-      mesh_.CornerStartAngle(corner_in) + std::atan2(std::abs(ax * dy - ay * dx), ax * dx + ay * dy);
+  const double ax = -x3, ay = -y3;              // v -> start of h
+  const double dx = o.ix - x3, dy = o.iy - y3;  // v -> image
+  const double back = mesh_.CornerStartAngle(corner_in) +
+                      std::atan2(std::abs(ax * dy - ay * dx), ax * dx + ay * dy);
   // Geodesics through a saddle make angles >= pi on both sides (P4): new paths leave v only in the
   // sector [back + pi, back + total - pi], empty or nearly so for a flat vertex.
   const double total = mesh_.AngleSum(v);

@@ -1,11 +1,10 @@
 // Target bookkeeping: the points a targeted solve must answer exactly (paths, matrices, exact
 // point distances) are offered every window and vertex that can reach them straight.
 
-#include "ich/ich_solver.h"
-
 #include <algorithm>
 #include <cmath>
 
+#include "ich/ich_solver.h"
 #include "ich/numerics.h"
 
 namespace geodex::ich {

@@ -43,7 +43,9 @@ struct HugePageAllocator {
     }
   }
   template <typename U>
-  bool operator==(const HugePageAllocator<U>&) const { return true; }
+  bool operator==(const HugePageAllocator<U>&) const {
+    return true;
+  }
 };
 template <typename T>
 using HugeVector = std::vector<T, HugePageAllocator<T>>;
@@ -275,7 +277,8 @@ class WindowQueue {
 
   // No queued key is below this (the bucket being popped, less the round-off of quantising).
   double LowerBound() const {
-    return static_cast<double>(last_) * resolution_ * (1 - 4 * std::numeric_limits<double>::epsilon());
+    return static_cast<double>(last_) * resolution_ *
+           (1 - 4 * std::numeric_limits<double>::epsilon());
   }
 
  private:

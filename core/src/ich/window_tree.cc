@@ -1,11 +1,10 @@
 // The paper's window tree (Method::kIch only): children linked to parents so Lemma 1 can delete
 // an old winner's subtree; without it (Method::kExact) a window is freed once processed.
 
-#include "ich/ich_solver.h"
-
 #include <algorithm>
 #include <cmath>
 
+#include "ich/ich_solver.h"
 #include "ich/numerics.h"
 
 namespace geodex::ich {

@@ -1,7 +1,6 @@
 // Entry points of the mesh readers: load the file, gunzip when it carries the gzip magic, pick the
 // format from the extension or by sniffing the content, and hand the bytes to the format's reader.
 #include "geodex/mesh_io.h"
-#include "geodex/limits.h"
 
 #include <sys/stat.h>
 #include <zlib.h>
@@ -19,6 +18,7 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
+#include "geodex/limits.h"
 #include "io/io_util.h"
 
 namespace geodex {
@@ -255,9 +255,9 @@ absl::StatusOr<MeshData> ReadMeshFile(const std::string& path, const ReadLimits&
   if (std::fseek(f, 0, SEEK_END) == 0) {
     const long size = std::ftell(f);
     if (size >= 0 && static_cast<uint64_t>(size) > limits.max_decompressed_bytes) {
-      status = LimitExceededError(Limit::kInputBytes, absl::StrCat(path, ": file size ", size,
-                                                         " exceeds the limit of ",
-                                                         limits.max_decompressed_bytes, " bytes"));
+      status = LimitExceededError(Limit::kInputBytes,
+                                  absl::StrCat(path, ": file size ", size, " exceeds the limit of ",
+                                               limits.max_decompressed_bytes, " bytes"));
     } else if (size > 0) {
       bytes.reserve(static_cast<size_t>(size));
     }
@@ -269,8 +269,9 @@ absl::StatusOr<MeshData> ReadMeshFile(const std::string& path, const ReadLimits&
     const size_t n = std::fread(buffer, 1, sizeof(buffer), f);
     bytes.append(buffer, n);
     if (bytes.size() > limits.max_decompressed_bytes) {
-      status = LimitExceededError(Limit::kInputBytes, absl::StrCat(path, ": file exceeds the limit of ",
-                                                         limits.max_decompressed_bytes, " bytes"));
+      status = LimitExceededError(Limit::kInputBytes,
+                                  absl::StrCat(path, ": file exceeds the limit of ",
+                                               limits.max_decompressed_bytes, " bytes"));
     }
     if (n < sizeof(buffer)) {
       if (std::ferror(f)) {

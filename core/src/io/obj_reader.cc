@@ -11,8 +11,8 @@
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
-#include "geodex/mesh_data.h"
 #include "geodex/limits.h"
+#include "geodex/mesh_data.h"
 #include "geodex/mesh_io.h"
 #include "io/io_util.h"
 
@@ -47,9 +47,9 @@ absl::StatusOr<MeshData> ReadObj(absl::string_view bytes, const std::string& nam
     p += directive.size();
     if (directive == "v") {
       if (vertex_count >= MaxVertices(limits)) {
-        return LimitExceededError(Limit::kVertices, absl::StrCat(name, ": line ", lines.line_number(),
-                                                         ": more than ", MaxVertices(limits),
-                                                         " vertices"));
+        return LimitExceededError(Limit::kVertices,
+                                  absl::StrCat(name, ": line ", lines.line_number(), ": more than ",
+                                               MaxVertices(limits), " vertices"));
       }
       double xyz[3];
       for (int k = 0; k < 3; ++k) {
@@ -110,9 +110,9 @@ absl::StatusOr<MeshData> ReadObj(absl::string_view bytes, const std::string& nam
             absl::StrCat("face has ", polygon.size(), " vertices (at least 3 needed)"));
       }
       if (mesh.faces.size() / 3 + (polygon.size() - 2) > limits.max_faces) {
-        return LimitExceededError(
-            Limit::kFaces, absl::StrCat(name, ": line ", lines.line_number(), ": more than ",
-                                        limits.max_faces, " faces"));
+        return LimitExceededError(Limit::kFaces,
+                                  absl::StrCat(name, ": line ", lines.line_number(), ": more than ",
+                                               limits.max_faces, " faces"));
       }
       // Fan triangulation in order: (v0, v1, v2), (v0, v2, v3), ...
       for (size_t k = 2; k < polygon.size(); ++k) {

@@ -9,8 +9,8 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
 #include "absl/strings/strip.h"
-#include "geodex/mesh_data.h"
 #include "geodex/limits.h"
+#include "geodex/mesh_data.h"
 #include "geodex/mesh_io.h"
 #include "io/io_util.h"
 
@@ -104,8 +104,8 @@ absl::StatusOr<MeshData> ReadOff(absl::string_view bytes, const std::string& nam
     return LimitExceededError(
         nv > MaxVertices(limits) ? Limit::kVertices : Limit::kFaces,
         nv > MaxVertices(limits)
-            ? absl::StrCat(name, ": line ", header_line, ": ", nv,
-                           " vertices exceed the limit of ", MaxVertices(limits))
+            ? absl::StrCat(name, ": line ", header_line, ": ", nv, " vertices exceed the limit of ",
+                           MaxVertices(limits))
             : absl::StrCat(name, ": line ", header_line, ": ", nf, " faces exceed the limit of ",
                            limits.max_faces));
   }
@@ -186,9 +186,9 @@ absl::StatusOr<MeshData> ReadOff(absl::string_view bytes, const std::string& nam
     }
     triangles += static_cast<uint64_t>(n - 2);
     if (triangles > limits.max_faces) {
-      return LimitExceededError(Limit::kFaces, absl::StrCat(name, ": line ", lines.line_number(),
-                                                       ": more than ", limits.max_faces,
-                                                       " triangles after splitting polygons"));
+      return LimitExceededError(
+          Limit::kFaces, absl::StrCat(name, ": line ", lines.line_number(), ": more than ",
+                                      limits.max_faces, " triangles after splitting polygons"));
     }
     // A colour after the indices is ignored.
   }

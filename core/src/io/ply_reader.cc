@@ -14,8 +14,8 @@
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_split.h"
 #include "absl/strings/string_view.h"
-#include "geodex/mesh_data.h"
 #include "geodex/limits.h"
+#include "geodex/mesh_data.h"
 #include "geodex/mesh_io.h"
 #include "io/io_util.h"
 
@@ -323,9 +323,8 @@ absl::Status BodyReader::AddFace(const Element& e, uint64_t i, const Property& p
     polygon_.push_back(static_cast<uint32_t>(index));
   }
   if (mesh_->faces.size() / 3 + static_cast<uint64_t>(n - 2) > limits_.max_faces) {
-    return LimitExceededError(
-        Limit::kFaces,
-        absl::StrCat(name_, ": ", Where(e, i), ": more than ", limits_.max_faces, " triangles"));
+    return LimitExceededError(Limit::kFaces, absl::StrCat(name_, ": ", Where(e, i), ": more than ",
+                                                          limits_.max_faces, " triangles"));
   }
   for (size_t k = 2; k < polygon_.size(); ++k) {  // fan triangulation, in order
     mesh_->faces.insert(mesh_->faces.end(), {polygon_[0], polygon_[k - 1], polygon_[k]});

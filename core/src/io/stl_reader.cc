@@ -11,8 +11,8 @@
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/string_view.h"
-#include "geodex/mesh_data.h"
 #include "geodex/limits.h"
+#include "geodex/mesh_data.h"
 #include "geodex/mesh_io.h"
 #include "io/io_util.h"
 

@@ -29,12 +29,13 @@ using Property = std::pair<std::string, std::variant<std::monostate, double, int
 struct GeoFeature {
   enum class Kind { kArea, kLine, kPoint };
   Kind kind = Kind::kPoint;
-  std::vector<Polygon2> pieces;              // kArea: their union is the feature's (Multi)Polygon
+  std::vector<Polygon2> pieces;  // kArea: their union is the feature's (Multi)Polygon
   // kArea: the pieces tile their union exactly (neighbours share edges bit for bit, each piece
   // counter-clockwise, as SublevelPieces makes them): the union is built from the unshared edges
   // alone, in time linear in the pieces, instead of by a general polygon union.
   bool exact_tiling = false;
-  std::vector<std::array<double, 3>> points; // kLine (3D LineString), kPoint (one 3D point); mesh x y z
+  std::vector<std::array<double, 3>>
+      points;  // kLine (3D LineString), kPoint (one 3D point); mesh x y z
   std::vector<Property> properties;
 };
 

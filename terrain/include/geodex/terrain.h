@@ -54,14 +54,14 @@ MeshData RemoveFacesBelow(const MeshData& mesh, double z);
 
 // What a DEM mesh knows about its map.
 struct DemInfo {
-  std::string driver;                     // GDAL's short name ("GTiff")
+  std::string driver;                            // GDAL's short name ("GTiff")
   uint32_t raster_width = 0, raster_height = 0;  // the file's grid
   uint32_t step = 1;
-  uint32_t grid_width = 0, grid_height = 0;      // the used cells
-  uint64_t nodata_cells = 0;                     // used cells without data
-  uint64_t barrier_cells = 0;                    // used cells below DemOptions::barrier_below
-  uint64_t barrier_faces = 0;                    // grid triangles a barrier file removed or cut
-  std::string file_crs_name;  // the file's CRS ("WGS 84 / UTM zone 33N", "WGS 84")
+  uint32_t grid_width = 0, grid_height = 0;  // the used cells
+  uint64_t nodata_cells = 0;                 // used cells without data
+  uint64_t barrier_cells = 0;                // used cells below DemOptions::barrier_below
+  uint64_t barrier_faces = 0;                // grid triangles a barrier file removed or cut
+  std::string file_crs_name;                 // the file's CRS ("WGS 84 / UTM zone 33N", "WGS 84")
   std::string file_crs_wkt;
   bool reprojected = false;   // the file's CRS is geographic: the mesh is in mesh_crs
   std::string mesh_crs_name;  // the CRS of the mesh's x and y (metres)
