@@ -13,6 +13,8 @@ packages=(
   g++ cmake ninja-build pkgconf ccache
   # the libFuzzer tier (scripts/fuzz.sh): clang and its sanitizer/fuzzer runtimes
   clang libclang-rt-14-dev
+  # the format check (scripts/check-format.sh): the tree is formatted by clang-format 14
+  clang-format-14
   # runtime libraries of the service (gRPC, Protobuf, Abseil, spdlog)
   libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler libabsl-dev libspdlog-dev prometheus-cpp-dev
   grpc-proto
