@@ -366,37 +366,13 @@ absl::StatusOr<LocatedPoint> SurfaceLocator::Locate(const Vec3& xyz) const {
     ref = stack[--top].first;
   }
 
-  // Internal corners 1 and 2 of a flipped face are the file's corners 2 and 1.
+  // The nearest point in the file's terms, by the one classifier (a barycentric within
+  // kSurfaceSnap of 0 moves the point onto the edge or vertex).
   const uint32_t f = best_face;
-  const bool flipped = mesh_->FaceFlipped(f);
-  std::array<uint32_t, 3> corner;
-  for (int k = 0; k < 3; ++k) corner[k] = mesh_->FileVertex(mesh_->FaceVertex(f, k));
   std::array<double, 3> bary = best.bary;
-  if (flipped) {
-    std::swap(corner[1], corner[2]);
-    std::swap(bary[1], bary[2]);
-  }
-  int zeros = 0;
-  for (double& b : bary) {
-    if (b <= kLocateSnap) {
-      b = 0;
-      ++zeros;
-    }
-  }
-  const double sum = bary[0] + bary[1] + bary[2];
-  for (double& b : bary) b /= sum;
-
+  mesh_->SwapCornerOrder(f, &bary);
   LocatedPoint result;
-  if (zeros == 2) {
-    const int k = bary[0] > 0 ? 0 : (bary[1] > 0 ? 1 : 2);
-    result.point = SurfacePoint::AtVertex(corner[k]);
-  } else if (zeros == 1) {
-    const int z = bary[0] == 0 ? 0 : (bary[1] == 0 ? 1 : 2);
-    const int i = (z + 1) % 3, j = (z + 2) % 3;
-    result.point = SurfacePoint::OnEdge(corner[i], corner[j], bary[j] / (bary[i] + bary[j]));
-  } else {
-    result.point = SurfacePoint::InFace(f, bary[0], bary[1], bary[2]);
-  }
+  result.point = CanonicalFacePoint(f, mesh_->FileCorners(f), bary);
   for (int a = 0; a < 3; ++a) result.position[a] = best.point[a] + center[a];
   result.distance = std::sqrt(best.distance2);
   return result;

@@ -1,5 +1,6 @@
 #include "geodex/point_distance.h"
 
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -9,22 +10,18 @@
 namespace geodex {
 namespace {
 
-constexpr double kSnap = 1e-12;
-
 struct FacePlacement {
   uint32_t face;
   double px, py;  // in the frame of half-edge 3 * face
 };
 
-// Faces containing the point, with its 2D position in each (an edge point lies in two faces).
+// Faces containing the canonical point `p` (surface_point.h), with its 2D position in each (an
+// edge point lies in every face on its edge). Not for vertices.
 absl::Status PlacePoint(const TriangleMesh& mesh, const SurfacePoint& p,
                         std::vector<FacePlacement>* out) {
-  if (absl::Status s = ValidateSurfacePoint(mesh, p); !s.ok()) return s;
   if (p.kind == SurfacePoint::Kind::kFace) {
-    double b[3] = {p.bary[0], p.bary[1], p.bary[2]};
-    const double sum = b[0] + b[1] + b[2];
-    for (double& x : b) x = std::max(0.0, x / sum);
-    if (mesh.FaceFlipped(p.face)) std::swap(b[1], b[2]);
+    std::array<double, 3> b = p.bary;
+    mesh.SwapCornerOrder(p.face, &b);
     double x1, y1, x2, y2;
     CornerInFaceFrame(mesh, p.face, 1, &x1, &y1);
     CornerInFaceFrame(mesh, p.face, 2, &x2, &y2);
@@ -62,17 +59,13 @@ absl::StatusOr<PointEstimate> EstimateDistanceAt(const TriangleMesh& mesh,
   if (field.internal_distance.size() != mesh.vertex_count()) {
     return absl::InvalidArgumentError("the distance field was not computed on this mesh");
   }
-  if (point.kind == SurfacePoint::Kind::kVertex) {
-    if (absl::Status s = ValidateSurfacePoint(mesh, point); !s.ok()) return s;
-    return PointEstimate{field.distance[point.vertex], field.source[point.vertex]};
-  }
-  if (point.kind == SurfacePoint::Kind::kEdge && (point.t <= kSnap || point.t >= 1 - kSnap)) {
-    if (absl::Status s = ValidateSurfacePoint(mesh, point); !s.ok()) return s;
-    const uint32_t v = point.t <= kSnap ? point.edge_from : point.edge_to;
-    return PointEstimate{field.distance[v], field.source[v]};
+  if (absl::Status s = ValidateSurfacePoint(mesh, point); !s.ok()) return s;
+  const SurfacePoint canonical = CanonicalPoint(mesh, point);
+  if (canonical.kind == SurfacePoint::Kind::kVertex) {
+    return PointEstimate{field.distance[canonical.vertex], field.source[canonical.vertex]};
   }
   std::vector<FacePlacement> places;
-  if (absl::Status s = PlacePoint(mesh, point, &places); !s.ok()) return s;
+  if (absl::Status s = PlacePoint(mesh, canonical, &places); !s.ok()) return s;
   PointEstimate best;
   auto offer = [&](double d, uint32_t label) {
     if (d < best.distance) best = {d, label};
@@ -117,9 +110,11 @@ absl::StatusOr<PointEstimate> EstimateDistanceAt(const TriangleMesh& mesh,
   // at a corner are covered above, where d = 0.)
   for (uint32_t label = 0; label < field.sources.size(); ++label) {
     const SurfacePoint& s = field.sources[label];
-    if (s.kind == SurfacePoint::Kind::kVertex) continue;
+    const SurfacePoint cs = CanonicalPoint(mesh, s);
+    if (cs.kind == SurfacePoint::Kind::kVertex || cs.kind == SurfacePoint::Kind::kPosition)
+      continue;
     std::vector<FacePlacement> source_places;
-    if (!PlacePoint(mesh, s, &source_places).ok()) continue;
+    if (!PlacePoint(mesh, cs, &source_places).ok()) continue;
     for (const FacePlacement& sp : source_places) {
       for (const FacePlacement& fp : places) {
         if (sp.face == fp.face) offer(std::hypot(sp.px - fp.px, sp.py - fp.py), label);

@@ -215,12 +215,12 @@ class Tracer {
     double w_opp = cy > 0 ? q2.y / cy : 0;
     double w_to = len > 0 ? (q2.x - w_opp * cx) / len : 0;
     double w_from = 1 - w_opp - w_to;
-    double bary[3];
+    std::array<double, 3> bary;
     const int k = static_cast<int>(g % 3);
     bary[k] = w_from;
     bary[(k + 1) % 3] = w_to;
     bary[(k + 2) % 3] = w_opp;
-    if (mesh_.FaceFlipped(face)) std::swap(bary[1], bary[2]);
+    mesh_.SwapCornerOrder(face, &bary);
     Append(q, SurfacePoint::InFace(face, bary[0], bary[1], bary[2]));
   }
 

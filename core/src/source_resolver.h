@@ -3,6 +3,7 @@
 // Resolves user-facing SurfacePoints (file ids, file corner order) into the engine's internal
 // placements: vertex copies, or points in faces in the frame of half-edge 3*face. Private to core.
 
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -17,23 +18,21 @@
 
 namespace geodex {
 
-// Barycentrics (and edge parameters) this close to 0 or 1 snap to the face's edge or vertex, so a
-// point "on" an edge behaves exactly like the edge point.
-constexpr double kSnap = 1e-12;
-
 class SourceResolver {
  public:
   explicit SourceResolver(const TriangleMesh& mesh) : mesh_(mesh) {}
 
   absl::Status Add(const SurfacePoint& p, uint32_t label) {
     if (absl::Status s = ValidateSurfacePoint(mesh_, p); !s.ok()) return s;
-    switch (p.kind) {
+    // Errors name the point as given; it is placed as its canonical form (surface_point.h).
+    const SurfacePoint c = CanonicalPoint(mesh_, p);
+    switch (c.kind) {
       case SurfacePoint::Kind::kVertex:
-        return AddVertex(p.vertex, label);
+        return AddVertex(c.vertex, label);
       case SurfacePoint::Kind::kEdge:
-        return AddEdgePoint(p, p.edge_from, p.edge_to, p.t, label);
+        return AddEdgePoint(p, c.edge_from, c.edge_to, c.t, label);
       case SurfacePoint::Kind::kFace:
-        return AddFacePoint(p, label);
+        return AddFacePoint(p, c, label);
       case SurfacePoint::Kind::kPosition:
         break;  // rejected by ValidateSurfacePoint above
     }
@@ -57,8 +56,6 @@ class SourceResolver {
 
   absl::Status AddEdgePoint(const SurfacePoint& p, uint32_t a, uint32_t b, double t,
                             uint32_t label) {
-    if (t <= kSnap) return AddVertex(a, label);
-    if (t >= 1 - kSnap) return AddVertex(b, label);
     HalfEdgesOfFileEdge(mesh_, a, b, &half_edges_);
     const bool found = !half_edges_.empty();
     bool placed = false;
@@ -88,33 +85,15 @@ class SourceResolver {
     return absl::OkStatus();
   }
 
-  absl::Status AddFacePoint(const SurfacePoint& p, uint32_t label) {
-    const uint32_t f = p.face;
-    double bary[3] = {std::max(0.0, p.bary[0]), std::max(0.0, p.bary[1]), std::max(0.0, p.bary[2])};
-    const double sum = bary[0] + bary[1] + bary[2];
-    for (double& b : bary) b = b / sum < kSnap ? 0 : b / sum;
-    // File corners of the face (internal order may have corners 1 and 2 swapped).
-    uint32_t file_corner[3];
-    for (int k = 0; k < 3; ++k) file_corner[k] = mesh_.FileVertex(mesh_.FaceVertex(f, k));
-    if (mesh_.FaceFlipped(f)) std::swap(file_corner[1], file_corner[2]);
-    const int zeros = (bary[0] == 0) + (bary[1] == 0) + (bary[2] == 0);
-    if (zeros == 2) {
-      for (int k = 0; k < 3; ++k) {
-        if (bary[k] != 0) return AddVertex(file_corner[k], label);
-      }
-    }
-    if (zeros == 1) {
-      const int z = bary[0] == 0 ? 0 : (bary[1] == 0 ? 1 : 2);
-      const int i = (z + 1) % 3, j = (z + 2) % 3;
-      return AddEdgePoint(p, file_corner[i], file_corner[j], bary[j] / (bary[i] + bary[j]), label);
-    }
+  // `c` is the canonical face point (normalised barycentrics, in the file's corner order).
+  absl::Status AddFacePoint(const SurfacePoint& p, const SurfacePoint& c, uint32_t label) {
+    const uint32_t f = c.face;
     if (mesh_.FaceDegenerate(f)) {
       return absl::InvalidArgumentError(absl::StrFormat(
           "point %s: face %d is degenerate (zero area)", SurfacePointToString(p), f));
     }
-    // Internal barycentrics follow the internal corner order.
-    double ib[3] = {bary[0], bary[1], bary[2]};
-    if (mesh_.FaceFlipped(f)) std::swap(ib[1], ib[2]);
+    std::array<double, 3> ib = c.bary;
+    mesh_.SwapCornerOrder(f, &ib);  // internal barycentrics follow the internal corner order
     double x1, y1, x2, y2;
     CornerInFaceFrame(mesh_, f, 1, &x1, &y1);
     CornerInFaceFrame(mesh_, f, 2, &x2, &y2);

@@ -1,5 +1,6 @@
 #include "geodex/surface_point.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 
@@ -148,6 +149,44 @@ std::array<double, 3> PositionOf(const MeshData& m, const SurfacePoint& p) {
       return p.position;
   }
   return out;
+}
+
+SurfacePoint CanonicalEdgePoint(uint32_t from, uint32_t to, double t) {
+  if (t <= kSurfaceSnap) return SurfacePoint::AtVertex(from);
+  if (t >= 1 - kSurfaceSnap) return SurfacePoint::AtVertex(to);
+  return SurfacePoint::OnEdge(from, to, t);
+}
+
+SurfacePoint CanonicalFacePoint(uint32_t face, const std::array<uint32_t, 3>& file_corners,
+                                std::array<double, 3> bary) {
+  for (double& b : bary) b = std::max(0.0, b);
+  double sum = bary[0] + bary[1] + bary[2];
+  int zeros = 0;
+  for (double& b : bary) {
+    b /= sum;
+    if (b <= kSurfaceSnap) b = 0, ++zeros;
+  }
+  if (zeros == 0) return SurfacePoint::InFace(face, bary[0], bary[1], bary[2]);
+  if (zeros >= 2) {
+    const int k = bary[0] > 0 ? 0 : (bary[1] > 0 ? 1 : 2);
+    return SurfacePoint::AtVertex(file_corners[k]);
+  }
+  const int z = bary[0] == 0 ? 0 : (bary[1] == 0 ? 1 : 2);
+  const int i = (z + 1) % 3, j = (z + 2) % 3;
+  return SurfacePoint::OnEdge(file_corners[i], file_corners[j], bary[j] / (bary[i] + bary[j]));
+}
+
+SurfacePoint CanonicalPoint(const TriangleMesh& mesh, const SurfacePoint& p) {
+  switch (p.kind) {
+    case SurfacePoint::Kind::kEdge:
+      return CanonicalEdgePoint(p.edge_from, p.edge_to, p.t);
+    case SurfacePoint::Kind::kFace:
+      return CanonicalFacePoint(p.face, mesh.FileCorners(p.face), p.bary);
+    case SurfacePoint::Kind::kVertex:
+    case SurfacePoint::Kind::kPosition:
+      break;
+  }
+  return p;
 }
 
 std::string SurfacePointToString(const SurfacePoint& p) {

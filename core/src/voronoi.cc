@@ -164,7 +164,7 @@ class Builder {
   void Junction(uint32_t f, const uint32_t v[3], const uint32_t l[3]) {
     ++out_.junction_faces;
     uint32_t p[3];
-    double bary[3] = {0, 0, 0};
+    std::array<double, 3> bary{0, 0, 0};
     Node c;
     c.local = {0, 0, 0};
     for (int k = 0; k < 3; ++k) {
@@ -174,7 +174,7 @@ class Builder {
       bary[(k + 1) % 3] += s / 3;
       for (int i = 0; i < 3; ++i) c.local[i] += nodes_[p[k]].local[i] / 3;
     }
-    if (mesh_.FaceFlipped(f)) std::swap(bary[1], bary[2]);
+    mesh_.SwapCornerOrder(f, &bary);
     c.point = Reported(c.local, SurfacePoint::InFace(f, bary[0], bary[1], bary[2]));
     const uint32_t center = static_cast<uint32_t>(nodes_.size());
     nodes_.push_back(c);

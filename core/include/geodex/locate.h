@@ -27,13 +27,10 @@ TriangleClosestPoint ClosestPointOnTriangle(const std::array<double, 3>& p,
                                             const std::array<double, 3>& b,
                                             const std::array<double, 3>& c);
 
-// A barycentric within this of 0 is snapped to 0 (the point moves to an edge or vertex).
-inline constexpr double kLocateSnap = 1e-12;
-
 struct LocatedPoint {
   // A face point (f:FACE:B0:B1:B2, barycentrics in the file's corner order), snapped to kEdge or
-  // kVertex when a barycentric is within kLocateSnap of 0, so that it means the same thing to the
-  // solver as the position does.
+  // kVertex by the surface-point rules (CanonicalFacePoint, kSurfaceSnap), so that it means the
+  // same thing to the solver as the position does.
   SurfacePoint point;
   std::array<double, 3> position{};  // the closest surface point, file coordinates
   double distance = 0;               // |query - position|

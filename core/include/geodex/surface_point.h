@@ -70,6 +70,29 @@ absl::Status VertexOutOfRange(const SurfacePoint& p, uint32_t vertex, uint32_t v
 
 std::string SurfacePointToString(const SurfacePoint& p);
 
+// --- The surface-point rules, once for all of geodex (docs/engine.md, "Surface points") ---
+//
+// A point given on a face or an edge that lies (within round-off) on an edge or at a vertex is
+// that edge point or that vertex, wherever it comes from: parsed, located from a position,
+// resolved as a source or target, or placed for an estimate. One tolerance, one normalisation,
+// one classifier:
+//  - barycentrics: negatives clamp to 0, the weights are normalised to sum 1, each weight
+//    <= kSurfaceSnap becomes 0 and the others are renormalised; two zeros make the vertex, one
+//    zero the edge point between the other two corners (in cyclic order after the zero one, t
+//    measured from the first), none the face point;
+//  - edge parameters: t <= kSurfaceSnap is the edge's first vertex, t >= 1 - kSurfaceSnap its
+//    second.
+inline constexpr double kSurfaceSnap = 1e-12;
+
+// The canonical point of face `face` with file corners `file_corners` (file vertex ids, file
+// corner order) and weights `bary` in that order (not all zero).
+SurfacePoint CanonicalFacePoint(uint32_t face, const std::array<uint32_t, 3>& file_corners,
+                                std::array<double, 3> bary);
+// The canonical point of the edge point (1 - t) * from + t * to.
+SurfacePoint CanonicalEdgePoint(uint32_t from, uint32_t to, double t);
+// The canonical form of a point that passed ValidateSurfacePoint (positions come back unchanged).
+SurfacePoint CanonicalPoint(const TriangleMesh& mesh, const SurfacePoint& p);
+
 // The position (file coordinates) of a vertex, edge or face point of `mesh` (a position point is
 // its own position).
 std::array<double, 3> PositionOf(const MeshData& mesh, const SurfacePoint& p);

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -100,6 +101,20 @@ class TriangleMesh {
   uint32_t FaceVertex(uint32_t f, int k) const { return faces_[3 * f + k]; }
   const uint32_t* faces() const { return faces_.data(); }
   bool FaceFlipped(uint32_t f) const { return face_flags_[f] & kFaceFlipped; }
+  // The one place that knows the two corner orders: internal corners 1 and 2 of a flipped face are
+  // the file's corners 2 and 1. Swaps per-corner values (barycentrics, corner ids) from either
+  // order into the other; it is its own inverse.
+  template <typename T>
+  void SwapCornerOrder(uint32_t f, std::array<T, 3>* per_corner) const {
+    if (FaceFlipped(f)) std::swap((*per_corner)[1], (*per_corner)[2]);
+  }
+  // File vertex ids of face f's corners, in the file's corner order.
+  std::array<uint32_t, 3> FileCorners(uint32_t f) const {
+    std::array<uint32_t, 3> c{FileVertex(FaceVertex(f, 0)), FileVertex(FaceVertex(f, 1)),
+                              FileVertex(FaceVertex(f, 2))};
+    SwapCornerOrder(f, &c);
+    return c;
+  }
   bool FaceDegenerate(uint32_t f) const { return face_flags_[f] & kFaceDegenerate; }
 
   // --- half-edges (the engine's inner loop reads only these) ---
