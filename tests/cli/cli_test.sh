@@ -2,31 +2,15 @@
 # Drives the geodex CLI as a user would: outputs, exit codes, one-line errors.
 # Env: GEODEX (the binary), DATA (tests/data).
 set -u
-pass=0
-fail=0
-check() {  # check NAME CONDITION...
-  local name="$1"
-  shift
-  if "$@"; then
-    pass=$((pass + 1))
-  else
-    fail=$((fail + 1))
-    echo "FAIL: $name"
-  fi
-}
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+# shellcheck source-path=SCRIPTDIR source=../util/test_preamble.sh
+source "$(dirname "${BASH_SOURCE[0]}")/../util/test_preamble.sh"
 # remote_mode.sh runs this script again with GEODEX_SERVER set (every command through geodexd) and
 # GEODEX_MODE=remote: the same checks, except that local-only flags must be refused there.
 local_mode() { [ "${GEODEX_MODE:-local}" = local ]; }
-expect_usage() {  # NAME PATTERN ARGS...
+expect_usage() {  # NAME PATTERN ARGS...: exit 2, one line naming PATTERN
   local name="$1" pattern="$2"
   shift 2
-  "$GEODEX" "$@" >/dev/null 2>"$tmp/err.txt"
-  local rc=$?
-  check "$name: exit 2" test $rc -eq 2
-  check "$name: one line" test "$(wc -l <"$tmp/err.txt")" -eq 1
-  check "$name: names '$pattern'" grep -q -- "$pattern" "$tmp/err.txt"
+  expect_code "$name" 2 "$pattern" "$@"
 }
 
 # info: key: value lines with the documented keys; json parses; exit 0.
@@ -297,5 +281,4 @@ check "--stats carries snap_max" /usr/bin/python3 -c "import json; d=json.loads(
 "$GEODEX" path "$K" --from 1 --to p:-1.203724:-1.917213:1.356663 2>"$tmp/near.err" >/dev/null
 check "a snap on the surface is not warned about" test ! -s "$tmp/near.err"
 
-echo "cli: $pass passed, $fail failed"
-test "$fail" -eq 0
+finish "cli"

@@ -2,20 +2,8 @@
 # Drives geodex isolines / voronoi / delaunay as a user would: JSON, OBJ and SVG outputs, exit
 # codes, one-line errors. Env: GEODEX (the binary), DATA (tests/data).
 set -u
-pass=0
-fail=0
-check() {  # check NAME CONDITION...
-  local name="$1"
-  shift
-  if "$@"; then
-    pass=$((pass + 1))
-  else
-    fail=$((fail + 1))
-    echo "FAIL: $name"
-  fi
-}
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+# shellcheck source-path=SCRIPTDIR source=../util/test_preamble.sh
+source "$(dirname "${BASH_SOURCE[0]}")/../util/test_preamble.sh"
 py=/usr/bin/python3
 
 # isolines on a closed mesh: JSON on stdout, approximate, every polyline closed, K-1 levels.
@@ -110,16 +98,8 @@ PY
 check "delaunay .obj exits 0" test $? -eq 0
 check "delaunay .obj has one l line per edge" test "$(grep -c '^l ' "$tmp/del.obj")" -ge 6
 
-# bad arguments: exit 2 with one line naming the problem; unreadable mesh: exit 3.
-expect_code() {  # NAME CODE PATTERN ARGS...
-  local name="$1" code="$2" pattern="$3"
-  shift 3
-  "$GEODEX" "$@" >/dev/null 2>"$tmp/err.txt"
-  local rc=$?
-  check "$name: exit $code" test $rc -eq "$code"
-  check "$name: one line" test "$(wc -l <"$tmp/err.txt")" -eq 1
-  check "$name: names '$pattern'" grep -q -- "$pattern" "$tmp/err.txt"
-}
+# bad arguments: exit 2 with one line naming the problem; unreadable mesh: exit 3 (expect_code:
+# tests/util/test_preamble.sh).
 expect_code "levels and count" 2 "usage" isolines "$DATA/kitten.off" --sources 0 --levels 1 --count 3
 expect_code "neither levels nor count" 2 "usage" isolines "$DATA/kitten.off" --sources 0
 expect_code "bad count" 2 "--count" isolines "$DATA/kitten.off" --sources 0 --count 1
@@ -131,5 +111,4 @@ expect_code "bad site spec" 2 "--sites" delaunay "$DATA/kitten.off" --sites x:1
 expect_code "unknown option" 2 "--frobnicate" voronoi "$DATA/kitten.off" --sites 0 --frobnicate 1
 expect_code "missing mesh" 3 "missing.off" voronoi "$tmp/missing.off" --sites 0
 
-echo "geometry cli: $pass passed, $fail failed"
-test "$fail" -eq 0
+finish "geometry cli"

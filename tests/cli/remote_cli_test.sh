@@ -4,30 +4,10 @@
 # mesh management, health, one-line errors and exit codes. Bounded: every wait gives up.
 # Env: GEODEX, GEODEXD (the binaries), DATA (tests/data).
 set -u
-pass=0
-fail=0
-check() {
-  local name="$1"
-  shift
-  if "$@"; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAIL: $name"; fi
-}
-tmp=$(mktemp -d)
-"$GEODEXD" --listen 127.0.0.1:0 --data-dir "$tmp/data" --metrics_listen "" --pool-threads 2 \
-  --shutdown_grace_seconds 5 >"$tmp/server.log" 2>&1 &
-pid=$!
-cleanup() {
-  kill -TERM "$pid" 2>/dev/null
-  for _ in $(seq 1 100); do kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done
-  kill -KILL "$pid" 2>/dev/null
-  rm -rf "$tmp"
-}
-trap cleanup EXIT
-port=""
-for _ in $(seq 1 300); do
-  port=$(sed -n 's/.*listening on port \([0-9]*\).*/\1/p' "$tmp/server.log" | head -1)
-  [ -n "$port" ] && break
-  sleep 0.1
-done
+# shellcheck source-path=SCRIPTDIR source=../util/test_preamble.sh
+source "$(dirname "${BASH_SOURCE[0]}")/../util/test_preamble.sh"
+start_geodexd "$tmp/server.log" --data-dir "$tmp/data" --pool-threads 2 --shutdown_grace_seconds 5
+port=$geodexd_port
 check "server started" test -n "$port"
 R=("$GEODEX" --server "127.0.0.1:$port")
 
@@ -179,5 +159,4 @@ done
 check "by name, no file: render exits 0" test $? -eq 0
 check "by name: render wrote a PNG" test -s "$tmp/byname.png"
 
-echo "remote cli: $pass passed, $fail failed"
-test "$fail" -eq 0
+finish "remote cli"

@@ -5,24 +5,8 @@
 # the same bytes; bad arguments give one-line errors and exit 2.
 # Env: GEODEX, GEODEXD (the binaries), DATA (tests/data), PROBE (png_probe.py).
 set -u
-pass=0
-fail=0
-check() {
-  local name="$1"
-  shift
-  if "$@"; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAIL: $name"; fi
-}
-tmp=$(mktemp -d)
-pid=""
-cleanup() {
-  if [ -n "$pid" ]; then
-    kill -TERM "$pid" 2>/dev/null
-    for _ in $(seq 1 100); do kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done
-    kill -KILL "$pid" 2>/dev/null
-  fi
-  rm -rf "$tmp"
-}
-trap cleanup EXIT
+# shellcheck source-path=SCRIPTDIR source=../util/test_preamble.sh
+source "$(dirname "${BASH_SOURCE[0]}")/../util/test_preamble.sh"
 probe() { /usr/bin/python3 "$PROBE" "$@"; }
 value() { /usr/bin/python3 -c "import json,sys; d=json.load(open('$1')); print($2)"; }
 
@@ -127,18 +111,10 @@ assert len(base64.b64decode(buf['uri'].split(',', 1)[1])) == buf['byteLength']"
 check "ply: colours and distances" bash -c "head -c 400 '$tmp/k.ply' | grep -a -q 'property uchar red' && head -c 400 '$tmp/k.ply' | grep -a -q 'property double distance'"
 
 # Remote mode renders the same picture.
-"$GEODEXD" --listen 127.0.0.1:0 --metrics_listen "" --pool-threads 2 --shutdown_grace_seconds 5 \
-  >"$tmp/server.log" 2>&1 &
-pid=$!
-port=""
-for _ in $(seq 1 300); do
-  port=$(sed -n 's/.*listening on port \([0-9]*\).*/\1/p' "$tmp/server.log" | head -1)
-  [ -n "$port" ] && break
-  sleep 0.1
-done
-check "server started" test -n "$port"
-"$GEODEX" --server "127.0.0.1:$port" render "$DATA/kitten.off" --sources 0,1250 --isolines 12 \
-  --voronoi --delaunay --path 5 2000 --view front --output "$tmp/remote.png"
+start_geodexd "$tmp/server.log" --pool-threads 2 --shutdown_grace_seconds 5
+check "server started" test -n "$geodexd_port"
+"$GEODEX" --server "127.0.0.1:$geodexd_port" render "$DATA/kitten.off" --sources 0,1250 \
+  --isolines 12 --voronoi --delaunay --path 5 2000 --view front --output "$tmp/remote.png"
 check "remote render: exit 0" test $? -eq 0
 check "remote render: same bytes as local" cmp -s "$tmp/all.png" "$tmp/remote.png"
 
@@ -154,5 +130,4 @@ check "bad extension: exit 2" test $? -eq 2
 "$GEODEX" render "$DATA/knight.off" --sources 99999 --output "$tmp/x.png" 2>"$tmp/err.txt"
 check "bad source: exit 2" test $? -eq 2
 
-echo "render cli: $pass passed, $fail failed"
-test "$fail" -eq 0
+finish "render cli"

@@ -4,38 +4,16 @@
 # fails with one line (exit 1) while health stays open; plaintext to the TLS port fails.
 # Env: GEODEX, GEODEXD, DATA.
 set -u
-pass=0
-fail=0
-check() {
-  local name="$1"
-  shift
-  if "$@"; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAIL: $name"; fi
-}
-tmp=$(mktemp -d)
-pid=""
-cleanup() {
-  if [ -n "$pid" ]; then
-    kill -TERM "$pid" 2>/dev/null
-    for _ in $(seq 1 100); do kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done
-    kill -KILL "$pid" 2>/dev/null
-  fi
-  rm -rf "$tmp"
-}
-trap cleanup EXIT
+# shellcheck source-path=SCRIPTDIR source=../util/test_preamble.sh
+source "$(dirname "${BASH_SOURCE[0]}")/../util/test_preamble.sh"
 openssl req -x509 -newkey rsa:2048 -nodes -days 2 -subj /CN=localhost \
   -addext subjectAltName=IP:127.0.0.1,DNS:localhost -keyout "$tmp/key.pem" -out "$tmp/cert.pem" \
   >/dev/null 2>&1
 check "certificate made" test -s "$tmp/cert.pem"
 echo "token-$$-$RANDOM" >"$tmp/token"
-"$GEODEXD" --listen 127.0.0.1:0 --metrics_listen "" --tls_cert "$tmp/cert.pem" --tls_key "$tmp/key.pem" \
-  --auth_token_file "$tmp/token" --shutdown_grace_seconds 5 >"$tmp/server.log" 2>&1 &
-pid=$!
-port=""
-for _ in $(seq 1 300); do
-  port=$(sed -n 's/.*listening on port \([0-9]*\).*/\1/p' "$tmp/server.log" | head -1)
-  [ -n "$port" ] && break
-  sleep 0.1
-done
+start_geodexd "$tmp/server.log" --tls_cert "$tmp/cert.pem" --tls_key "$tmp/key.pem" \
+  --auth_token_file "$tmp/token" --shutdown_grace_seconds 5
+port=$geodexd_port
 check "server started" test -n "$port"
 check "startup says tls and tokens" grep -q "security: tls=true bearer_tokens=true" "$tmp/server.log"
 S=("$GEODEX" --server "127.0.0.1:$port" --ca "$tmp/cert.pem")
@@ -56,8 +34,7 @@ check "wrong token: exit 1" test $? -eq 1
 check "health needs no token" grep -qx SERVING "$tmp/health.txt"
 "$GEODEX" --server "127.0.0.1:$port" health >/dev/null 2>&1
 check "plaintext to the TLS port fails" test $? -ne 0
-kill -0 "$pid"
+kill -0 "$geodexd_pid"
 check "the server survived all of it" test $? -eq 0
 
-echo "secure cli: $pass passed, $fail failed"
-test "$fail" -eq 0
+finish "secure cli"

@@ -5,15 +5,8 @@
 # Also run in remote mode (remote_mode.sh): a GeoTIFF is then uploaded as it is and read by geodexd.
 # Env: GEODEX (the binary).
 set -u
-pass=0
-fail=0
-check() {
-  local name="$1"
-  shift
-  if "$@"; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAIL: $name"; fi
-}
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+# shellcheck source-path=SCRIPTDIR source=../util/test_preamble.sh
+source "$(dirname "${BASH_SOURCE[0]}")/../util/test_preamble.sh"
 PY=/usr/bin/python3
 
 $PY - "$tmp" <<'PY'
@@ -522,5 +515,4 @@ check "--dem-step on a mesh: exit 2" test $? -eq 2
 check "raster from a mesh: exit 2" test $? -eq 2
 check "raster from a mesh: says why" grep -q "needs a DEM" "$tmp/err.txt"
 
-echo "terrain cli: $pass passed, $fail failed"
-test "$fail" -eq 0
+finish "terrain cli"

@@ -3,10 +3,10 @@
 # valid isochrone polygons, rasters aligned with the DEM, the walk around the lake, a picture.
 # Env: GEODEX, EXAMPLE (the script).
 set -u
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-GEODEX="$GEODEX" bash "$EXAMPLE" "$tmp" >"$tmp/log.txt" 2>&1 || { cat "$tmp/log.txt"; echo "FAIL: the example"; exit 1; }
-/usr/bin/python3 - "$tmp" <<'PY' || { echo "FAIL: the example's outputs"; exit 1; }
+# shellcheck source-path=SCRIPTDIR source=../util/test_preamble.sh
+source "$(dirname "${BASH_SOURCE[0]}")/../util/test_preamble.sh"
+GEODEX="$GEODEX" bash "$EXAMPLE" "$tmp" >"$tmp/log.txt" 2>&1 || die "the example" "$tmp/log.txt"
+/usr/bin/python3 - "$tmp" <<'PY' || die "the example's outputs"
 import json, sys
 from osgeo import gdal
 from shapely.geometry import shape

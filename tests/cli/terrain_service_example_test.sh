@@ -1,30 +1,16 @@
 #!/usr/bin/env bash
-# README's terrain-through-geodexd example (scripts/terrain_service_example.sh and
+# docs/terrain.md's terrain-through-geodexd example (scripts/terrain_service_example.sh and
 # scripts/terrain_example.py) runs as written against a geodexd of its own (127.0.0.1, a port it
 # picks, no metrics port) and makes what it says. Bounded: every wait gives up.
 # Env: GEODEX, GEODEXD, EXAMPLE (the script), GEODEX_PYTHON_STUBS (build/python).
 set -u
-tmp=$(mktemp -d)
-"$GEODEXD" --listen 127.0.0.1:0 --metrics_listen "" --pool-threads 2 --shutdown_grace_seconds 5 \
-  >"$tmp/server.log" 2>&1 &
-pid=$!
-cleanup() {
-  kill -TERM "$pid" 2>/dev/null
-  for _ in $(seq 1 100); do kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done
-  kill -KILL "$pid" 2>/dev/null
-  rm -rf "$tmp"
-}
-trap cleanup EXIT
-port=""
-for _ in $(seq 1 300); do
-  port=$(sed -n 's/.*listening on port \([0-9]*\).*/\1/p' "$tmp/server.log" | head -1)
-  [ -n "$port" ] && break
-  sleep 0.1
-done
-[ -n "$port" ] || { echo "FAIL: geodexd did not start"; cat "$tmp/server.log"; exit 1; }
-GEODEX="$GEODEX" timeout 300 bash "$EXAMPLE" "127.0.0.1:$port" "$tmp/out" >"$tmp/log.txt" 2>&1 ||
-  { cat "$tmp/log.txt"; echo "FAIL: the example"; exit 1; }
-/usr/bin/python3 - "$tmp" <<'PY' || { cat "$tmp/log.txt"; echo "FAIL: the example's outputs"; exit 1; }
+# shellcheck source-path=SCRIPTDIR source=../util/test_preamble.sh
+source "$(dirname "${BASH_SOURCE[0]}")/../util/test_preamble.sh"
+start_geodexd "$tmp/server.log" --pool-threads 2 --shutdown_grace_seconds 5 ||
+  die "geodexd did not start" "$tmp/server.log"
+GEODEX="$GEODEX" timeout 300 bash "$EXAMPLE" "127.0.0.1:$geodexd_port" "$tmp/out" \
+  >"$tmp/log.txt" 2>&1 || die "the example" "$tmp/log.txt"
+/usr/bin/python3 - "$tmp" <<'PY' || die "the example's outputs" "$tmp/log.txt"
 import json, math, sys
 from shapely.geometry import shape
 t = sys.argv[1]

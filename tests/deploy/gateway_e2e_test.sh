@@ -7,19 +7,10 @@
 # and the other meshes stay where they were. Bounded; stops exactly what it started.
 # Env: GEODEX, GEODEXD, NGINX (binaries), CLUSTER (deploy/local-cluster.sh).
 set -u
-pass=0
-fail=0
-check() {
-  local name="$1"
-  shift
-  if "$@"; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAIL: $name"; fi
-}
-tmp=$(mktemp -d)
-cleanup() {
-  GEODEXD="$GEODEXD" NGINX="$NGINX" bash "$CLUSTER" stop "$tmp/cluster"
-  rm -rf "$tmp"
-}
-trap cleanup EXIT
+# shellcheck source-path=SCRIPTDIR source=../util/test_preamble.sh
+source "$(dirname "${BASH_SOURCE[0]}")/../util/test_preamble.sh"
+stop_cluster() { GEODEXD="$GEODEXD" NGINX="$NGINX" bash "$CLUSTER" stop "$tmp/cluster"; }
+on_exit stop_cluster  # before $tmp is removed
 GEODEXD="$GEODEXD" NGINX="$NGINX" bash "$CLUSTER" start "$tmp/cluster" 3 >/dev/null
 check "cluster started" test -s "$tmp/cluster/gateway-address"
 gw=$(cat "$tmp/cluster/gateway-address")
@@ -96,5 +87,4 @@ for k in $(seq 0 11); do
 done
 check "the killed replica owned at least one mesh" test "$moved" -ge 1
 
-echo "gateway e2e: $pass passed, $fail failed"
-test "$fail" -eq 0
+finish "gateway e2e"

@@ -5,15 +5,8 @@
 # both the schema and the consistency check (the checks can fail).
 # Env: K8S (deploy/k8s), HERE (tests/deploy).
 set -u
-pass=0
-fail=0
-check() {
-  local name="$1"
-  shift
-  if "$@"; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAIL: $name"; fi
-}
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+# shellcheck source-path=SCRIPTDIR source=../util/test_preamble.sh
+source "$(dirname "${BASH_SOURCE[0]}")/../util/test_preamble.sh"
 
 if command -v kubectl >/dev/null; then
   kubectl kustomize "$K8S" >"$tmp/all.yaml"
@@ -52,5 +45,4 @@ else
   echo "note: npm could not provide kubernetes-models here; schema step skipped"
 fi
 
-echo "k8s manifests: $pass passed, $fail failed"
-test "$fail" -eq 0
+finish "k8s manifests"

@@ -4,38 +4,17 @@
 # settings that cannot work make it exit 1 naming the flag. Bounded: gives up after 30 s.
 # Env: GEODEXD (the binary).
 set -u
-pass=0
-fail=0
-check() {
-  local name="$1"
-  shift
-  if "$@"; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAIL: $name"; fi
-}
-tmp=$(mktemp -d)
+# shellcheck source-path=SCRIPTDIR source=../util/test_preamble.sh
+source "$(dirname "${BASH_SOURCE[0]}")/../util/test_preamble.sh"
 # Every socket on a port of its own (port 0): a quickstart server may hold the default ports.
-"$GEODEXD" --listen 127.0.0.1:0 --metrics_listen 127.0.0.1:0 --data-dir "$tmp/data" \
-  --pool-threads 1 --shutdown_grace_seconds 2 >"$tmp/log" 2>&1 &
-pid=$!
-port=""
-for _ in $(seq 1 300); do  # up to 30 s for the listening line
-  port=$(sed -n 's/.*geodexd listening on port \([0-9]*\).*/\1/p' "$tmp/log" | head -1)
-  [ -n "$port" ] && break
-  kill -0 "$pid" 2>/dev/null || break
-  sleep 0.1
-done
+# start_geodexd adds --listen 127.0.0.1:0 and waits up to 30 s for the listening line.
+start_geodexd "$tmp/log" --metrics_listen 127.0.0.1:0 --data-dir "$tmp/data" \
+  --pool-threads 1 --shutdown_grace_seconds 2
+port=$geodexd_port
 check "reports a listening port" test -n "$port"
 check "the port is open on 127.0.0.1" bash -c "exec 3<>/dev/tcp/127.0.0.1/$port"
-kill -TERM "$pid"
-rc=124
-for _ in $(seq 1 300); do  # up to 30 s to drain and exit
-  if ! kill -0 "$pid" 2>/dev/null; then
-    wait "$pid"
-    rc=$?
-    break
-  fi
-  sleep 0.1
-done
-if [ "$rc" -eq 124 ]; then kill -KILL "$pid" 2>/dev/null; fi
+stop_geodexd "$geodexd_pid" 30  # up to 30 s to drain and exit (124 if it had not)
+rc=$?
 check "SIGTERM exits 0" test "$rc" -eq 0
 check "logs the shutdown" grep -q "shutting down" "$tmp/log"
 # Settings that cannot work: exit 1 at once with one line naming the flag, never a crash.
@@ -48,6 +27,4 @@ for bad in --pool_threads=100000 --stream_chunk_bytes=0 --mesh_budget_bytes=0 \
   check "$bad exits 1" test "$rc" -eq 1
   check "$bad is named in the error" grep -q -- "$flag" "$tmp/bad.log"
 done
-rm -rf "$tmp"
-echo "geodexd smoke: $pass passed, $fail failed"
-test "$fail" -eq 0
+finish "geodexd smoke"
