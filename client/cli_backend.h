@@ -20,6 +20,7 @@
 #include "geodex/distance_matrix.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/geojson.h"
+#include "geodex/geometry_queries.h"
 #include "geodex/isolines.h"
 #include "geodex/locate.h"
 #include "geodex/mesh_data.h"
@@ -73,12 +74,11 @@ class Backend {
   virtual absl::StatusOr<PathQueryResult> Path(const PathQuery& query) = 0;
   // query.options.on_row sees rows as they are solved (locally) or arrive (remotely).
   virtual absl::StatusOr<DistanceMatrix> Matrix(const MatrixQuery& query) = 0;
-  // Section 6 geometry of the exact field of `sources` (a local backend solves it once for all).
-  virtual absl::StatusOr<Isolines> ComputeIsolines(const std::vector<SurfacePoint>& sources,
-                                                   const IsolineOptions& levels) = 0;
-  virtual absl::StatusOr<VoronoiDiagram> ComputeVoronoi(const std::vector<SurfacePoint>& sites) = 0;
-  virtual absl::StatusOr<DelaunayTriangulation> ComputeDelaunay(
-      const std::vector<SurfacePoint>& sites) = 0;
+  // Section 6 geometry, asked whole (geometry_queries.h) and forwarded unchanged: a local backend
+  // solves the query's field once for all of them, a remote one sends the query.
+  virtual absl::StatusOr<Isolines> ComputeIsolines(const IsolineQuery& query) = 0;
+  virtual absl::StatusOr<VoronoiDiagram> ComputeVoronoi(const VoronoiQuery& query) = 0;
+  virtual absl::StatusOr<DelaunayTriangulation> ComputeDelaunay(const DelaunayQuery& query) = 0;
 
   // --stats members that say where the work ran, as `"key": value, ` pairs: the load and build
   // times locally; the server, replica, mesh and cache remotely.

@@ -434,33 +434,6 @@ int RunInfo(Backend& backend, const Args& args) {
   return kExitOk;
 }
 
-// --lambda, --lambda-scale, --max-distance and --max-windows, shared by distances, path and matrix.
-bool GetSolverFlags(const Args& args, GeodesicOptions* options, std::string* error) {
-  if (!GetDouble(args, "lambda", &options->lambda, error) ||
-      !GetDouble(args, "max-distance", &options->max_distance, error) ||
-      !GetUint(args, "max-windows", &options->max_windows, error)) {
-    return false;
-  }
-  if (absl::Status s = ValidateGeodesicOptions(*options); !s.ok()) {  // core's one check
-    std::string flag = InvalidOptionOf(s);
-    std::replace(flag.begin(), flag.end(), '_', '-');
-    *error = absl::StrFormat("--%s: %s", flag, s.message());
-    return false;
-  }
-  if (args.options.count("lambda-scale")) {
-    const std::string& s = args.options.at("lambda-scale");
-    if (s == "max") {
-      options->lambda_scale = LambdaScale::kMaxEdge;
-    } else if (s == "mean") {
-      options->lambda_scale = LambdaScale::kMeanEdge;
-    } else {
-      *error = "--lambda-scale must be max or mean";
-      return false;
-    }
-  }
-  return true;
-}
-
 // --stats members for the farthest snap of a p:X:Y:Z point (none without positions).
 std::string SnapJson(const SnapReport& snap) {
   if (snap.point.empty()) return "";

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <condition_variable>
@@ -17,6 +18,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
+#include "geodex/geodesic_solver.h"
 #include "geodex/mesh_io.h"
 #include "geodex/samples.h"
 #include "output_file.h"
@@ -149,22 +151,58 @@ bool GetUint(const Args& args, const std::string& key, uint64_t* out, std::strin
   return true;
 }
 
+// --lambda, --lambda-scale, --max-distance and --max-windows, shared by every command
+// that solves (distances, path, matrix, isolines, voronoi, delaunay).
+bool GetSolverFlags(const Args& args, GeodesicOptions* options, std::string* error) {
+  if (!GetDouble(args, "lambda", &options->lambda, error) ||
+      !GetDouble(args, "max-distance", &options->max_distance, error) ||
+      !GetUint(args, "max-windows", &options->max_windows, error)) {
+    return false;
+  }
+  if (absl::Status s = ValidateGeodesicOptions(*options); !s.ok()) {  // core's one check
+    std::string flag = InvalidOptionOf(s);
+    std::replace(flag.begin(), flag.end(), '_', '-');
+    *error = absl::StrFormat("--%s: %s", flag, s.message());
+    return false;
+  }
+  if (args.options.count("lambda-scale")) {
+    const std::string& s = args.options.at("lambda-scale");
+    if (s == "max") {
+      options->lambda_scale = LambdaScale::kMaxEdge;
+    } else if (s == "mean") {
+      options->lambda_scale = LambdaScale::kMeanEdge;
+    } else {
+      *error = "--lambda-scale must be max or mean";
+      return false;
+    }
+  }
+  return true;
+}
+
 bool GetLevels(const Args& args, const std::string& count_flag, IsolineOptions* options,
                std::string* error) {
   if (args.options.count("levels")) {
     for (absl::string_view item : absl::StrSplit(args.options.at("levels"), ',')) {
       double level;
-      if (!absl::SimpleAtod(item, &level) || !std::isfinite(level)) {
-        *error = absl::StrFormat("--levels: '%s' is not a finite number", item);
+      if (!absl::SimpleAtod(item, &level)) {
+        *error = absl::StrFormat("--levels: '%s' is not a number", item);
         return false;
       }
       options->levels.push_back(level);
     }
-  } else if (args.options.count(count_flag) &&
-             (!absl::SimpleAtoi(args.options.at(count_flag), &options->count) ||
-              options->count < 2)) {
-    *error = absl::StrFormat("--%s: '%s' is not an integer >= 2", count_flag,
-                             args.options.at(count_flag));
+  } else if (args.options.count(count_flag)) {
+    if (!absl::SimpleAtoi(args.options.at(count_flag), &options->count)) {
+      *error =
+          absl::StrFormat("--%s: '%s' is not an integer", count_flag, args.options.at(count_flag));
+      return false;
+    }
+  } else {
+    return true;  // neither: the command says whether it needs levels
+  }
+  if (absl::Status s = ValidateIsolineOptions(*options); !s.ok()) {  // core's one check
+    const std::string option = InvalidOptionOf(s);
+    *error = absl::StrFormat("--%s: %s", absl::StartsWith(option, "levels") ? "levels" : count_flag,
+                             s.message());
     return false;
   }
   return true;

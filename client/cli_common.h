@@ -13,6 +13,7 @@
 #include "absl/status/statusor.h"
 #include "cli_commands.h"
 #include "geodex/distance_matrix.h"
+#include "geodex/geodesic_solver.h"
 #include "geodex/isolines.h"
 #include "geodex/locate.h"
 #include "geodex/mesh_data.h"
@@ -62,8 +63,12 @@ inline const std::set<std::string> kMeshReadingFlags = {"dem-step", "barrier-bel
                                                         "barrier-width", "crs"};
 // False with *error naming the first option neither in `known` nor in kMeshReadingFlags.
 bool CheckKnown(const Args& args, const std::set<std::string>& known, std::string* error);
-// --levels L1,L2,... (finite numbers) or --COUNT_FLAG K (an integer >= 2; isolines' --count,
-// render's --isolines) into `options`; false with *error naming the flag.
+// --lambda, --lambda-scale, --max-distance and --max-windows into `options`, checked by core's
+// ValidateGeodesicOptions; false with *error naming the flag.
+bool GetSolverFlags(const Args& args, GeodesicOptions* options, std::string* error);
+// --levels L1,L2,... or --COUNT_FLAG K (isolines' --count, render's --isolines) into `options`,
+// checked by core's ValidateIsolineOptions (finite levels, a count >= 2); false with *error
+// naming the flag.
 bool GetLevels(const Args& args, const std::string& count_flag, IsolineOptions* options,
                std::string* error);
 

@@ -231,27 +231,37 @@ int Usage(const std::string& command, const std::string& key, const std::string&
 // geodex isolines: its entry of `geodex --help`.
 constexpr char kIsolinesHelp[] =
     R"(  isolines MESH --sources SPEC (--levels L1,L2,... | --count K) [--output FILE.json|.obj|.svg]
+                [--lambda L] [--lambda-scale max|mean] [--max-distance D] [--max-windows N]
       Approximate geodesic offsets (paper section 6.1; linear along edges): polylines of edge
       points per level. --count K: the levels D*j/K, j = 1..K-1, D the largest distance.
+      The solver flags (as for distances) apply to the field the lines are drawn on; voronoi
+      and delaunay take them too.
 )";
 
 int RunIsolines(Backend& backend, const Args& args) {
   std::string error;
-  if (!CheckKnown(args, {"sources", "levels", "count", "output", "max-snap"}, &error)) {
+  if (!CheckKnown(args,
+                  {"sources", "levels", "count", "output", "max-snap", "lambda", "lambda-scale",
+                   "max-distance", "max-windows"},
+                  &error)) {
     return Fail(kExitUsage, error);
   }
   if (args.positional.size() != 1 || !args.options.count("sources") ||
       args.options.count("levels") == args.options.count("count")) {
     return Usage("isolines", "sources", " (--levels L1,L2,... | --count K)");
   }
-  IsolineOptions options;
-  if (!GetLevels(args, "count", &options, &error)) return Fail(kExitUsage, error);
+  IsolineQuery query;
+  if (!GetLevels(args, "count", &query.levels, &error) ||
+      !GetSolverFlags(args, &query.options, &error)) {
+    return Fail(kExitUsage, error);
+  }
   Format format;
   if (!OutputFormat(args, &format, &error)) return Fail(kExitUsage, error);
   Solved s;
   absl::StatusOr<Isolines> iso;
   if (int code = Prepare(backend, args, "sources", &s)) return code;
-  iso = backend.ComputeIsolines(s.points, options);
+  query.sources = s.points;
+  iso = backend.ComputeIsolines(query);
   if (!iso.ok()) return FailQuery(iso.status());
 
   const double top = iso->levels.empty() ? 1 : std::max(iso->levels.back(), 1e-300);
@@ -269,7 +279,7 @@ int RunIsolines(Backend& backend, const Args& args) {
   json += "]}\n";
   if (format == Format::kGeoJson) {
     // Isochrones: per level, the area within that distance (union of each face's part below it).
-    absl::StatusOr<const DistanceField*> field = backend.Field({s.points, {}, false});
+    absl::StatusOr<const DistanceField*> field = backend.Field({s.points, query.options, false});
     if (!field.ok()) return FailQuery(field.status());
     return WriteVectorOutput(backend, args,
                              terrain::IsochroneFeatures(*s.data, (*field)->distance, iso->levels));
@@ -281,23 +291,32 @@ int RunIsolines(Backend& backend, const Args& args) {
 }
 
 // geodex voronoi: its entry of `geodex --help`.
-constexpr char kVoronoiHelp[] = R"(  voronoi MESH --sites SPEC [--output FILE.json|.obj|.svg]
+constexpr char kVoronoiHelp[] =
+    R"(  voronoi MESH --sites SPEC [--output FILE.json|.obj|.svg] [--lambda L ...]
       Approximate Voronoi diagram (section 6.2): boundaries, cells (faces, fragments, areas),
       adjacency.
 )";
 
 int RunVoronoi(Backend& backend, const Args& args) {
   std::string error;
-  if (!CheckKnown(args, {"sites", "output", "max-snap"}, &error)) return Fail(kExitUsage, error);
+  if (!CheckKnown(
+          args,
+          {"sites", "output", "max-snap", "lambda", "lambda-scale", "max-distance", "max-windows"},
+          &error)) {
+    return Fail(kExitUsage, error);
+  }
   if (args.positional.size() != 1 || !args.options.count("sites")) {
     return Usage("voronoi", "sites", "");
   }
+  VoronoiQuery query;
+  if (!GetSolverFlags(args, &query.options, &error)) return Fail(kExitUsage, error);
   Format format;
   if (!OutputFormat(args, &format, &error)) return Fail(kExitUsage, error);
   Solved s;
   absl::StatusOr<VoronoiDiagram> vd;
   if (int code = Prepare(backend, args, "sites", &s)) return code;
-  vd = backend.ComputeVoronoi(s.points);
+  query.sites = s.points;
+  vd = backend.ComputeVoronoi(query);
   if (!vd.ok()) return FailQuery(vd.status());
 
   std::vector<Line> lines;
@@ -352,7 +371,8 @@ std::string EdgeJson(const DelaunayEdge& e) {
 }
 
 // geodex delaunay: its entry of `geodex --help`.
-constexpr char kDelaunayHelp[] = R"(  delaunay MESH --sites SPEC [--output FILE.json|.obj|.svg]
+constexpr char kDelaunayHelp[] =
+    R"(  delaunay MESH --sites SPEC [--output FILE.json|.obj|.svg] [--lambda L ...]
       Approximate Delaunay triangulation (sections 6.3-6.4): edges as polylines, triangles, XL
       edges found and the Delaunay edges removed because of them.
       These three print JSON ("approximate": true) unless --output names an .obj (lines) or
@@ -361,16 +381,24 @@ constexpr char kDelaunayHelp[] = R"(  delaunay MESH --sites SPEC [--output FILE.
 
 int RunDelaunay(Backend& backend, const Args& args) {
   std::string error;
-  if (!CheckKnown(args, {"sites", "output", "max-snap"}, &error)) return Fail(kExitUsage, error);
+  if (!CheckKnown(
+          args,
+          {"sites", "output", "max-snap", "lambda", "lambda-scale", "max-distance", "max-windows"},
+          &error)) {
+    return Fail(kExitUsage, error);
+  }
   if (args.positional.size() != 1 || !args.options.count("sites")) {
     return Usage("delaunay", "sites", "");
   }
+  DelaunayQuery query;
+  if (!GetSolverFlags(args, &query.options, &error)) return Fail(kExitUsage, error);
   Format format;
   if (!OutputFormat(args, &format, &error)) return Fail(kExitUsage, error);
   Solved s;
   absl::StatusOr<DelaunayTriangulation> dt;
   if (int code = Prepare(backend, args, "sites", &s)) return code;
-  dt = backend.ComputeDelaunay(s.points);
+  query.sites = s.points;
+  dt = backend.ComputeDelaunay(query);
   if (!dt.ok()) return FailQuery(dt.status());
 
   std::vector<Line> lines;

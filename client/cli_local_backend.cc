@@ -112,22 +112,21 @@ class LocalBackend final : public Backend {
     return Reachable(ComputeDistanceMatrix(loaded_->mesh, query));
   }
 
-  absl::StatusOr<Isolines> ComputeIsolines(const std::vector<SurfacePoint>& sources,
-                                           const IsolineOptions& levels) override {
-    absl::StatusOr<const DistanceField*> field = CachedField(sources, GeodesicOptions{});
+  absl::StatusOr<Isolines> ComputeIsolines(const IsolineQuery& query) override {
+    if (absl::Status s = ValidateIsolineQuery(query); !s.ok()) return s;
+    absl::StatusOr<const DistanceField*> field = CachedField(query.sources, query.options);
     if (!field.ok()) return field.status();
-    return ExtractIsolines(loaded_->mesh, **field, levels);
+    return ExtractIsolines(loaded_->mesh, **field, query.levels);
   }
 
-  absl::StatusOr<VoronoiDiagram> ComputeVoronoi(const std::vector<SurfacePoint>& sites) override {
-    absl::StatusOr<const DistanceField*> field = CachedField(sites, GeodesicOptions{});
+  absl::StatusOr<VoronoiDiagram> ComputeVoronoi(const VoronoiQuery& query) override {
+    absl::StatusOr<const DistanceField*> field = CachedField(query.sites, query.options);
     if (!field.ok()) return field.status();
     return BuildVoronoi(loaded_->mesh, **field);
   }
 
-  absl::StatusOr<DelaunayTriangulation> ComputeDelaunay(
-      const std::vector<SurfacePoint>& sites) override {
-    absl::StatusOr<const DistanceField*> field = CachedField(sites, GeodesicOptions{});
+  absl::StatusOr<DelaunayTriangulation> ComputeDelaunay(const DelaunayQuery& query) override {
+    absl::StatusOr<const DistanceField*> field = CachedField(query.sites, query.options);
     if (!field.ok()) return field.status();
     return BuildDelaunay(loaded_->mesh, **field);
   }

@@ -288,19 +288,14 @@ class RemoteBackend final : public Backend {
     return Flagged(client_->Matrix(mesh_, query), {{"sources", "sources"}, {"targets", "targets"}});
   }
 
-  absl::StatusOr<Isolines> ComputeIsolines(const std::vector<SurfacePoint>& sources,
-                                           const IsolineOptions& levels) override {
-    return Flagged(client_->ComputeIsolines(mesh_, sources, levels, v1::SolverOptions()),
-                   {{"sources", "sources"}});
+  absl::StatusOr<Isolines> ComputeIsolines(const IsolineQuery& query) override {
+    return Flagged(client_->ComputeIsolines(mesh_, query), {{"sources", "sources"}});
   }
-  absl::StatusOr<VoronoiDiagram> ComputeVoronoi(const std::vector<SurfacePoint>& sites) override {
-    return Flagged(client_->ComputeVoronoi(mesh_, sites, v1::SolverOptions()),
-                   {{"sources", "sites"}});
+  absl::StatusOr<VoronoiDiagram> ComputeVoronoi(const VoronoiQuery& query) override {
+    return Flagged(client_->ComputeVoronoi(mesh_, query), {{"sources", "sites"}});
   }
-  absl::StatusOr<DelaunayTriangulation> ComputeDelaunay(
-      const std::vector<SurfacePoint>& sites) override {
-    return Flagged(client_->ComputeDelaunay(mesh_, sites, v1::SolverOptions()),
-                   {{"sources", "sites"}});
+  absl::StatusOr<DelaunayTriangulation> ComputeDelaunay(const DelaunayQuery& query) override {
+    return Flagged(client_->ComputeDelaunay(mesh_, query), {{"sources", "sites"}});
   }
 
   std::string StatsContext() const override {

@@ -143,17 +143,18 @@ int RunRender(Backend& backend, const Args& args) {
   if (!field.ok()) return FailQuery(field.status());
   layers.field = *field;
   if (isolines) {
-    absl::StatusOr<Isolines> iso = backend.ComputeIsolines(*sources, levels);
+    absl::StatusOr<Isolines> iso = backend.ComputeIsolines({*sources, GeodesicOptions{}, levels});
     if (!iso.ok()) return FailQuery(iso.status());
     layers.isolines = *std::move(iso);
   }
   if (voronoi) {
-    absl::StatusOr<VoronoiDiagram> v = backend.ComputeVoronoi(*sources);
+    absl::StatusOr<VoronoiDiagram> v = backend.ComputeVoronoi({*sources, GeodesicOptions{}});
     if (!v.ok()) return FailQuery(v.status());
     layers.voronoi = *std::move(v);
   }
   if (delaunay) {
-    absl::StatusOr<DelaunayTriangulation> d = backend.ComputeDelaunay(*sources);
+    absl::StatusOr<DelaunayTriangulation> d =
+        backend.ComputeDelaunay({*sources, GeodesicOptions{}});
     if (!d.ok()) return FailQuery(d.status());
     layers.delaunay = *std::move(d);
   }

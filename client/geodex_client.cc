@@ -357,6 +357,26 @@ absl::StatusOr<MeshRef> GeodexClient::ResolveMesh(const std::string& mesh) {
   return ref;
 }
 
+template <typename Assembler, typename Start, typename OnMessage>
+absl::Status GeodexClient::ReadStream(MeshRef& mesh, Start start, Assembler* out,
+                                      OnMessage on_message) {
+  grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
+    *out = Assembler();
+    auto reader = start(context);
+    typename Assembler::Message message;
+    while (reader->Read(&message)) {
+      out->Add(message);
+      on_message(*out);
+    }
+    return reader->Finish();
+  });
+  return status.ok() ? absl::OkStatus() : ToAbsl(status);
+}
+
+namespace {
+constexpr auto kNothing = [](const auto&) {};
+}  // namespace
+
 absl::StatusOr<DistanceField> GeodexClient::Field(MeshRef& mesh, const FieldQuery& query,
                                                   bool* cached) {
   v1::ComputeDistanceFieldRequest request;
@@ -364,14 +384,12 @@ absl::StatusOr<DistanceField> GeodexClient::Field(MeshRef& mesh, const FieldQuer
   api::FieldQueryToProto(query, &request);
   request.set_want_stats(true);
   api::FieldAssembler field;
-  grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
-    field = api::FieldAssembler();
-    auto reader = stub_->ComputeDistanceField(context, request);
-    v1::ComputeDistanceFieldResponse response;
-    while (reader->Read(&response)) field.Add(response);
-    return reader->Finish();
-  });
-  if (!status.ok()) return ToAbsl(status);
+  if (absl::Status s = ReadStream(
+          mesh, [&](grpc::ClientContext* c) { return stub_->ComputeDistanceField(c, request); },
+          &field, kNothing);
+      !s.ok()) {
+    return s;
+  }
   if (cached != nullptr) *cached = field.cached();
   return std::move(field.result());
 }
@@ -380,14 +398,12 @@ absl::StatusOr<MeshData> GeodexClient::GetMeshGeometry(MeshRef& mesh) {
   v1::GetMeshGeometryRequest request;
   request.set_name(mesh.name);
   api::MeshGeometryAssembler out;
-  grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
-    out = api::MeshGeometryAssembler();
-    auto reader = stub_->GetMeshGeometry(context, request);
-    v1::MeshGeometry message;
-    while (reader->Read(&message)) out.Add(message);
-    return reader->Finish();
-  });
-  if (!status.ok()) return ToAbsl(status);
+  if (absl::Status s = ReadStream(
+          mesh, [&](grpc::ClientContext* c) { return stub_->GetMeshGeometry(c, request); }, &out,
+          kNothing);
+      !s.ok()) {
+    return s;
+  }
   return std::move(out.result());
 }
 
@@ -410,19 +426,17 @@ absl::StatusOr<DistanceMatrix> GeodexClient::Matrix(MeshRef& mesh, const MatrixQ
   api::MatrixQueryToProto(query, &request);
   request.set_want_stats(true);
   api::MatrixAssembler matrix;
-  grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
-    matrix = api::MatrixAssembler();
-    auto reader = stub_->ComputeDistanceMatrix(context, request);
-    v1::ComputeDistanceMatrixResponse response;
-    while (reader->Read(&response)) {
-      matrix.Add(response);
-      if (query.options.on_row && matrix.result().cols > 0) {
-        query.options.on_row(matrix.rows_done(), matrix.result().rows);
-      }
-    }
-    return reader->Finish();
-  });
-  if (!status.ok()) return ToAbsl(status);
+  if (absl::Status s = ReadStream(
+          mesh, [&](grpc::ClientContext* c) { return stub_->ComputeDistanceMatrix(c, request); },
+          &matrix,
+          [&](api::MatrixAssembler& m) {
+            if (query.options.on_row && m.result().cols > 0) {
+              query.options.on_row(m.rows_done(), m.result().rows);
+            }
+          });
+      !s.ok()) {
+    return s;
+  }
   return std::move(matrix.result());
 }
 
@@ -456,62 +470,47 @@ absl::StatusOr<std::vector<LocatedPoint>> GeodexClient::Locate(
   return out;
 }
 
-absl::StatusOr<Isolines> GeodexClient::ComputeIsolines(MeshRef& mesh,
-                                                       const std::vector<SurfacePoint>& sources,
-                                                       const IsolineOptions& levels,
-                                                       const v1::SolverOptions& options) {
+absl::StatusOr<Isolines> GeodexClient::ComputeIsolines(MeshRef& mesh, const IsolineQuery& query) {
   v1::ComputeIsolinesRequest request;
   request.set_mesh(mesh.name);
-  for (const SurfacePoint& p : sources) api::SurfacePointToProto(p, request.add_sources());
-  for (double level : levels.levels) request.add_levels(level);
-  request.set_count(levels.count);
-  *request.mutable_options() = options;
+  api::IsolineQueryToProto(query, &request);
   api::IsolinesAssembler out;
-  grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
-    out = api::IsolinesAssembler();
-    auto reader = stub_->ComputeIsolines(context, request);
-    v1::ComputeIsolinesResponse response;
-    while (reader->Read(&response)) out.Add(response);
-    return reader->Finish();
-  });
-  if (!status.ok()) return ToAbsl(status);
+  if (absl::Status s = ReadStream(
+          mesh, [&](grpc::ClientContext* c) { return stub_->ComputeIsolines(c, request); }, &out,
+          kNothing);
+      !s.ok()) {
+    return s;
+  }
   return std::move(out.result());
 }
 
 absl::StatusOr<VoronoiDiagram> GeodexClient::ComputeVoronoi(MeshRef& mesh,
-                                                            const std::vector<SurfacePoint>& sites,
-                                                            const v1::SolverOptions& options) {
+                                                            const VoronoiQuery& query) {
   v1::ComputeVoronoiRequest request;
   request.set_mesh(mesh.name);
-  for (const SurfacePoint& p : sites) api::SurfacePointToProto(p, request.add_sources());
-  *request.mutable_options() = options;
+  api::VoronoiQueryToProto(query, &request);
   api::VoronoiAssembler out;
-  grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
-    out = api::VoronoiAssembler();
-    auto reader = stub_->ComputeVoronoi(context, request);
-    v1::ComputeVoronoiResponse response;
-    while (reader->Read(&response)) out.Add(response);
-    return reader->Finish();
-  });
-  if (!status.ok()) return ToAbsl(status);
+  if (absl::Status s = ReadStream(
+          mesh, [&](grpc::ClientContext* c) { return stub_->ComputeVoronoi(c, request); }, &out,
+          kNothing);
+      !s.ok()) {
+    return s;
+  }
   return std::move(out.result());
 }
 
-absl::StatusOr<DelaunayTriangulation> GeodexClient::ComputeDelaunay(
-    MeshRef& mesh, const std::vector<SurfacePoint>& sites, const v1::SolverOptions& options) {
+absl::StatusOr<DelaunayTriangulation> GeodexClient::ComputeDelaunay(MeshRef& mesh,
+                                                                    const DelaunayQuery& query) {
   v1::ComputeDelaunayRequest request;
   request.set_mesh(mesh.name);
-  for (const SurfacePoint& p : sites) api::SurfacePointToProto(p, request.add_sources());
-  *request.mutable_options() = options;
+  api::DelaunayQueryToProto(query, &request);
   api::DelaunayAssembler out;
-  grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
-    out = api::DelaunayAssembler();
-    auto reader = stub_->ComputeDelaunay(context, request);
-    v1::ComputeDelaunayResponse response;
-    while (reader->Read(&response)) out.Add(response);
-    return reader->Finish();
-  });
-  if (!status.ok()) return ToAbsl(status);
+  if (absl::Status s = ReadStream(
+          mesh, [&](grpc::ClientContext* c) { return stub_->ComputeDelaunay(c, request); }, &out,
+          kNothing);
+      !s.ok()) {
+    return s;
+  }
   return std::move(out.result());
 }
 

@@ -26,6 +26,7 @@
 #include "geodex/delaunay.h"
 #include "geodex/distance_field.h"
 #include "geodex/distance_matrix.h"
+#include "geodex/geometry_queries.h"
 #include "geodex/isolines.h"
 #include "geodex/locate.h"
 #include "geodex/mesh_data.h"
@@ -118,17 +119,11 @@ class GeodexClient {
   absl::StatusOr<v1::EstimateDistancesResponse> PointDistances(MeshRef& mesh,
                                                                const PointQuery& query,
                                                                v1::PointDistanceMode mode);
-  // The approximate geometry of section 6, reassembled from the streamed pieces. `sources` get
-  // the server's resolved points (positions snapped) when non-null.
-  absl::StatusOr<Isolines> ComputeIsolines(MeshRef& mesh, const std::vector<SurfacePoint>& sources,
-                                           const IsolineOptions& levels,
-                                           const v1::SolverOptions& options);
-  absl::StatusOr<VoronoiDiagram> ComputeVoronoi(MeshRef& mesh,
-                                                const std::vector<SurfacePoint>& sites,
-                                                const v1::SolverOptions& options);
-  absl::StatusOr<DelaunayTriangulation> ComputeDelaunay(MeshRef& mesh,
-                                                        const std::vector<SurfacePoint>& sites,
-                                                        const v1::SolverOptions& options);
+  // The approximate geometry of section 6, asked whole (api::IsolineQueryToProto, ...) and
+  // reassembled from the streamed pieces.
+  absl::StatusOr<Isolines> ComputeIsolines(MeshRef& mesh, const IsolineQuery& query);
+  absl::StatusOr<VoronoiDiagram> ComputeVoronoi(MeshRef& mesh, const VoronoiQuery& query);
+  absl::StatusOr<DelaunayTriangulation> ComputeDelaunay(MeshRef& mesh, const DelaunayQuery& query);
   // Positions -> surface points (vertex, edge or face point) on the server's copy of the mesh,
   // with where they landed and how far they moved. A finite `max_snap` makes the server refuse a
   // position farther than that from the surface (INVALID_ARGUMENT naming it).
@@ -155,6 +150,10 @@ class GeodexClient {
   // again and retries once.
   grpc::Status MeshCall(MeshRef& mesh,
                         const std::function<grpc::Status(grpc::ClientContext*)>& call);
+  // The one server-streaming call: `start(context)` opens the stream (a reader), every message
+  // goes to `on_message`, and a retried attempt starts over with a fresh `Assembler` in *out.
+  template <typename Assembler, typename Start, typename OnMessage>
+  absl::Status ReadStream(MeshRef& mesh, Start start, Assembler* out, OnMessage on_message);
 
   ClientOptions options_;
   std::shared_ptr<grpc::Channel> channel_;

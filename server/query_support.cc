@@ -21,6 +21,7 @@
 #include "geodex/point_distance.h"
 #include "geodex/shortest_path.h"
 #include "geodex/voronoi.h"
+#include "geometry_convert.h"
 #include "proto_convert.h"
 #include "service_limits.h"
 #include "status_convert.h"
@@ -167,29 +168,15 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> LookupMesh(const QueryEnv& env
 absl::StatusOr<IsolineOptions> IsolineLevels(const QueryEnv& env,
                                              const google::protobuf::RepeatedField<double>& levels,
                                              int32_t count) {
-  const uint32_t max_levels = env.limits->max_levels;
-  if (static_cast<uint64_t>(levels.size()) > max_levels) {
-    return ServerLimitError("max_levels", absl::StrCat("levels: ", levels.size(),
-                                                       " levels, over --max_levels=", max_levels));
-  }
-  IsolineOptions options;
-  for (int i = 0; i < levels.size(); ++i) {
-    if (!std::isfinite(levels[i])) {
-      return FieldError(absl::StrCat("levels[", i, "]"),
-                        absl::StrCat("must be finite, got ", levels[i]));
-    }
-    options.levels.push_back(levels[i]);
-  }
-  if (options.levels.empty()) {
-    if (count < 2) {
-      return FieldError("count", absl::StrCat("give levels, or a count >= 2 (got ", count, ")"));
-    }
-    if (static_cast<uint64_t>(count) > uint64_t{max_levels} + 1) {
+  IsolineOptions options = api::IsolineLevelsFromProto(levels, count);
+  // Core's one check; its errors name the option ("levels[2]", "count").
+  if (absl::Status s = ValidateIsolineOptions(options, env.limits->max_levels); !s.ok()) {
+    const std::string option = InvalidOptionOf(s);
+    if (absl::IsResourceExhausted(s)) {
       return ServerLimitError("max_levels",
-                              absl::StrCat("count: ", count, " gives ", count - 1,
-                                           " levels, over --max_levels=", max_levels));
+                              absl::StrCat(option, ": ", s.message(), " (--max_levels)"));
     }
-    options.count = count;
+    return FieldError(option, s.message());
   }
   return options;
 }

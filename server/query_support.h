@@ -42,8 +42,8 @@ absl::StatusOr<std::shared_ptr<const DistanceField>> CachedField(
     const GeodesicOptions& options, bool* cached);
 void FieldStatsToProto(const DistanceField& field, bool cached, v1::SolveStats* out);
 
-// Isoline levels from a request: explicit `levels` (finite, at most --max_levels) or a `count`
-// (ComputeIsolines' family). Errors name the field or the flag.
+// Isoline levels from a request (api::IsolineLevelsFromProto), checked by core's
+// ValidateIsolineOptions against --max_levels. Errors name the field or the flag.
 absl::StatusOr<IsolineOptions> IsolineLevels(const QueryEnv& env,
                                              const google::protobuf::RepeatedField<double>& levels,
                                              int32_t count);

@@ -19,13 +19,14 @@ namespace {
 // The option an InvalidArgument from ValidateGeodesicOptions is about (a type URL private to core).
 constexpr absl::string_view kOptionPayload = "geodex/option";
 
-absl::Status OptionError(absl::string_view option, const std::string& description) {
-  absl::Status status = absl::InvalidArgumentError(description);
+}  // namespace
+
+absl::Status OptionError(absl::string_view option, const std::string& description,
+                         absl::StatusCode code) {
+  absl::Status status(code, description);
   status.SetPayload(kOptionPayload, absl::Cord(option));
   return status;
 }
-
-}  // namespace
 
 absl::Status ValidateGeodesicOptions(const GeodesicOptions& options) {
   if (!(options.lambda >= 0 && options.lambda <= 1)) {  // also NaN

@@ -9,13 +9,11 @@
 #include <cmath>
 
 #include "absl/strings/str_format.h"
+#include "geodex/geodesic_solver.h"
+#include "geodex/surface_point.h"
 
 namespace geodex {
 namespace {
-
-// Edge parameters this close to 0 or 1 snap to the vertex (docs/numerics.md), so that a level
-// equal to a vertex's distance up to round-off gives one point there, not a cluster.
-constexpr double kSnap = 1e-12;
 
 // A face's segment for one level: from the point on half-edge `a` to the point on half-edge `b`.
 struct Segment {
@@ -116,10 +114,12 @@ class LevelStitcher {
     if (!(d_[from] < level_)) std::swap(from, to);
     double t = (level_ - d_[from]) / (d_[to] - d_[from]);
     *vertex_hit = kNoIndex;
-    if (t >= 1 - kSnap) {
+    // The edge-parameter rule of surface points (kSurfaceSnap): a level equal to a vertex's
+    // distance up to round-off gives one point there, not a cluster.
+    if (t >= 1 - kSurfaceSnap) {
       t = 1;
       *vertex_hit = to;
-    } else if (t <= kSnap) {
+    } else if (t <= kSurfaceSnap) {
       t = 0;
       *vertex_hit = from;
     }
@@ -146,22 +146,14 @@ class LevelStitcher {
 
 absl::StatusOr<std::vector<double>> ChooseLevels(const DistanceField& field,
                                                  const IsolineOptions& options) {
+  if (absl::Status s = ValidateIsolineOptions(options); !s.ok()) return s;
   std::vector<double> levels = options.levels;
   if (levels.empty()) {
-    if (options.count < 2) {
-      return absl::InvalidArgumentError(absl::StrFormat(
-          "isolines need explicit levels or a count >= 2 (got count %d)", options.count));
-    }
     double max_d = 0;
     for (double d : field.internal_distance) {
       if (std::isfinite(d)) max_d = std::max(max_d, d);
     }
     for (int j = 1; j < options.count; ++j) levels.push_back(max_d * j / options.count);
-  }
-  for (double l : levels) {
-    if (!std::isfinite(l)) {
-      return absl::InvalidArgumentError(absl::StrFormat("isoline level %g is not finite", l));
-    }
   }
   std::sort(levels.begin(), levels.end());
   levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
@@ -169,6 +161,33 @@ absl::StatusOr<std::vector<double>> ChooseLevels(const DistanceField& field,
 }
 
 }  // namespace
+
+absl::Status ValidateIsolineOptions(const IsolineOptions& options, uint64_t max_levels) {
+  if (options.levels.size() > max_levels) {
+    return OptionError(
+        "levels",
+        absl::StrFormat("%d levels, over the limit of %d", options.levels.size(), max_levels),
+        absl::StatusCode::kResourceExhausted);
+  }
+  for (size_t i = 0; i < options.levels.size(); ++i) {
+    if (!std::isfinite(options.levels[i])) {
+      return OptionError(absl::StrFormat("levels[%d]", i),
+                         absl::StrFormat("must be finite, got %g", options.levels[i]));
+    }
+  }
+  if (!options.levels.empty()) return absl::OkStatus();
+  if (options.count < 2) {
+    return OptionError("count",
+                       absl::StrFormat("give levels, or a count >= 2 (got %d)", options.count));
+  }
+  if (static_cast<uint64_t>(options.count) - 1 > max_levels) {
+    return OptionError("count",
+                       absl::StrFormat("%d gives %d levels, over the limit of %d", options.count,
+                                       options.count - 1, max_levels),
+                       absl::StatusCode::kResourceExhausted);
+  }
+  return absl::OkStatus();
+}
 
 absl::StatusOr<Isolines> ExtractIsolines(const TriangleMesh& mesh, const DistanceField& field,
                                          const IsolineOptions& options) {

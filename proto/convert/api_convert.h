@@ -75,6 +75,7 @@ void FieldChunkToProto(const DistanceField& field, const DistanceField& products
 // The messages, in order, back into one DistanceField (float32 distances widened).
 class FieldAssembler {
  public:
+  using Message = v1::ComputeDistanceFieldResponse;  // what it is fed, one stream message at a time
   void Add(const v1::ComputeDistanceFieldResponse& message);
   DistanceField& result() { return field_; }
   bool cached() const { return cached_; }  // the last stats said the server's cache answered
@@ -106,6 +107,8 @@ void MatrixChunkToProto(size_t rows, size_t cols, const std::vector<double>& val
                         size_t end, bool f32, v1::ComputeDistanceMatrixResponse* out);
 class MatrixAssembler {
  public:
+  using Message =
+      v1::ComputeDistanceMatrixResponse;  // what it is fed, one stream message at a time
   void Add(const v1::ComputeDistanceMatrixResponse& message);
   DistanceMatrix& result() { return matrix_; }
   // Rows received, or rows' worth of solves done by the server's last progress, if more.

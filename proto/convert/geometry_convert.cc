@@ -78,6 +78,31 @@ DelaunayEdge EdgeHeader(const v1::DelaunayEdge& first) {
 
 }  // namespace
 
+void IsolineQueryToProto(const IsolineQuery& query, v1::ComputeIsolinesRequest* out) {
+  for (const SurfacePoint& p : query.sources) SurfacePointToProto(p, out->add_sources());
+  SolverOptionsToProto(query.options, out->mutable_options());
+  for (double level : query.levels.levels) out->add_levels(level);
+  out->set_count(query.levels.count);
+}
+
+void VoronoiQueryToProto(const VoronoiQuery& query, v1::ComputeVoronoiRequest* out) {
+  for (const SurfacePoint& p : query.sites) SurfacePointToProto(p, out->add_sources());
+  SolverOptionsToProto(query.options, out->mutable_options());
+}
+
+void DelaunayQueryToProto(const DelaunayQuery& query, v1::ComputeDelaunayRequest* out) {
+  for (const SurfacePoint& p : query.sites) SurfacePointToProto(p, out->add_sources());
+  SolverOptionsToProto(query.options, out->mutable_options());
+}
+
+IsolineOptions IsolineLevelsFromProto(const google::protobuf::RepeatedField<double>& levels,
+                                      int32_t count) {
+  IsolineOptions out;
+  out.levels.assign(levels.begin(), levels.end());
+  out.count = count;
+  return out;
+}
+
 std::vector<v1::ComputeIsolinesResponse> IsolinesToProto(const Isolines& isolines,
                                                          size_t budget_bytes) {
   Chunker<v1::ComputeIsolinesResponse> chunker(budget_bytes);

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "geodex/delaunay.h"
+#include "geodex/geometry_queries.h"
 #include "geodex/isolines.h"
 #include "geodex/mesh_data.h"
 #include "geodex/surface_point.h"
@@ -17,6 +18,17 @@
 #include "geodex/voronoi.h"
 
 namespace geodex::api {
+
+// The queries asked whole (geometry_queries.h): sources, solver options and the product's own
+// options into the request (the mesh and want_stats are the caller's). geodexd reads the sources
+// and solver options with its limits (server/query_support.h) and the levels with
+// IsolineLevelsFromProto, then checks them with core's ValidateIsolineQuery.
+void IsolineQueryToProto(const IsolineQuery& query, v1::ComputeIsolinesRequest* out);
+void VoronoiQueryToProto(const VoronoiQuery& query, v1::ComputeVoronoiRequest* out);
+void DelaunayQueryToProto(const DelaunayQuery& query, v1::ComputeDelaunayRequest* out);
+// The levels of ComputeIsolines (and of ExportGis' isochrones): `levels`, or without them `count`.
+IsolineOptions IsolineLevelsFromProto(const google::protobuf::RepeatedField<double>& levels,
+                                      int32_t count);
 
 // At least one message each; stats (when wanted) go into the last one.
 std::vector<v1::ComputeIsolinesResponse> IsolinesToProto(const Isolines& isolines,
@@ -34,6 +46,7 @@ std::vector<v1::MeshGeometry> MeshGeometryToProto(const MeshData& mesh, size_t b
 // Reassembly as the messages arrive: Add each in order, then take result().
 class MeshGeometryAssembler {
  public:
+  using Message = v1::MeshGeometry;  // what it is fed, one stream message at a time
   void Add(const v1::MeshGeometry& message);
   MeshData& result() { return out_; }
 
@@ -43,6 +56,7 @@ class MeshGeometryAssembler {
 
 class IsolinesAssembler {
  public:
+  using Message = v1::ComputeIsolinesResponse;  // what it is fed, one stream message at a time
   void Add(const v1::ComputeIsolinesResponse& message);
   Isolines& result() { return out_; }
 
@@ -53,6 +67,7 @@ class IsolinesAssembler {
 
 class VoronoiAssembler {
  public:
+  using Message = v1::ComputeVoronoiResponse;  // what it is fed, one stream message at a time
   void Add(const v1::ComputeVoronoiResponse& message);
   VoronoiDiagram& result() { return out_; }
   const std::vector<SurfacePoint>& resolved_sources() const { return sources_; }
@@ -65,6 +80,7 @@ class VoronoiAssembler {
 
 class DelaunayAssembler {
  public:
+  using Message = v1::ComputeDelaunayResponse;  // what it is fed, one stream message at a time
   void Add(const v1::ComputeDelaunayResponse& message);
   DelaunayTriangulation& result() { return out_; }
   const std::vector<SurfacePoint>& resolved_sources() const { return sources_; }

@@ -98,6 +98,27 @@ PY
 check "delaunay .obj exits 0" test $? -eq 0
 check "delaunay .obj has one l line per edge" test "$(grep -c '^l ' "$tmp/del.obj")" -ge 6
 
+# The solver flags reach the field the geometry is drawn on (asked whole: IsolineQuery, ...):
+# lambda = 0.5 moves the isolines, and the answer is the same bytes as a local run's (in
+# remote mode this compares the server's answer with the local engine's).
+"$GEODEX" isolines "$DATA/kitten.off" --sources 0 --count 5 --lambda 0.5 >"$tmp/iso_lambda.json"
+check "isolines --lambda exits 0" test $? -eq 0
+"$GEODEX" isolines "$DATA/kitten.off" --sources 0 --count 5 >"$tmp/iso_exact.json"
+check "isolines --lambda 0.5 differs from the exact isolines" \
+  bash -c '! cmp -s "$1" "$2"' _ "$tmp/iso_lambda.json" "$tmp/iso_exact.json"
+env -u GEODEX_SERVER "$GEODEX" isolines "$DATA/kitten.off" --sources 0 --count 5 --lambda 0.5 \
+  >"$tmp/iso_lambda_local.json"
+check "isolines --lambda: the same bytes as the local engine's" \
+  cmp "$tmp/iso_lambda.json" "$tmp/iso_lambda_local.json"
+"$GEODEX" voronoi "$DATA/kitten.off" --sites 0,1234 --lambda 1 >"$tmp/vor_lambda.json"
+env -u GEODEX_SERVER "$GEODEX" voronoi "$DATA/kitten.off" --sites 0,1234 --lambda 1 \
+  >"$tmp/vor_lambda_local.json"
+check "voronoi --lambda 1: the same bytes as the local engine's" \
+  cmp "$tmp/vor_lambda.json" "$tmp/vor_lambda_local.json"
+expect_code "isolines bad lambda" 2 "--lambda" isolines "$DATA/kitten.off" --sources 0 --count 3 --lambda 2
+expect_code "delaunay bad max-distance" 2 "--max-distance" delaunay "$DATA/kitten.off" --sites 0,1 --max-distance -1
+expect_code "isolines non-finite level" 2 "--levels: must be finite" isolines "$DATA/kitten.off" --sources 0 --levels 1,nan
+
 # bad arguments: exit 2 with one line naming the problem; unreadable mesh: exit 3 (expect_code:
 # tests/util/test_preamble.sh).
 expect_code "levels and count" 2 "usage" isolines "$DATA/kitten.off" --sources 0 --levels 1 --count 3

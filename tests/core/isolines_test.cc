@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "geodex/geodesic_solver.h"
+#include "geodex/geometry_queries.h"
 #include "gtest/gtest.h"
 #include "util/mesh_factory.h"
 #include "util/test_meshes.h"
@@ -214,6 +215,60 @@ TEST(IsolinesTest, EmptyAndInvalidRequests) {
   const double d_max = *std::max_element(fx.field.distance.begin(), fx.field.distance.end());
   ASSERT_EQ(iso->levels.size(), 3u);
   for (int j = 1; j <= 3; ++j) EXPECT_DOUBLE_EQ(iso->levels[j - 1], d_max * j / 4);
+}
+
+// The one check of isoline options names the option, and tells a bad value from one over a limit.
+TEST(IsolinesTest, ValidateIsolineOptionsNamesTheOption) {
+  IsolineOptions options;
+  options.levels = {1, std::nan(""), 2};
+  absl::Status s = ValidateIsolineOptions(options);
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(InvalidOptionOf(s), "levels[1]");
+  options.levels = {1, 2, 3};
+  EXPECT_TRUE(ValidateIsolineOptions(options, 3).ok());
+  s = ValidateIsolineOptions(options, 2);
+  EXPECT_EQ(s.code(), absl::StatusCode::kResourceExhausted);
+  EXPECT_EQ(InvalidOptionOf(s), "levels");
+  options.levels.clear();
+  options.count = 1;
+  s = ValidateIsolineOptions(options);
+  EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(InvalidOptionOf(s), "count");
+  options.count = 4;  // 3 levels
+  EXPECT_TRUE(ValidateIsolineOptions(options, 3).ok());
+  s = ValidateIsolineOptions(options, 2);
+  EXPECT_EQ(s.code(), absl::StatusCode::kResourceExhausted);
+  EXPECT_EQ(InvalidOptionOf(s), "count");
+}
+
+// A geometry query carries its field's solver options: lambda reaches the field the isolines are
+// drawn on (lambda = 1 is Dijkstra's field, whose levels differ from the exact ones), and the
+// isolines equal those extracted from the field solved with the same options.
+TEST(IsolinesTest, IsolineQueryCarriesTheSolverOptions) {
+  const MeshData data = Square();
+  absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(data);
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  IsolineQuery query{{SurfacePoint::AtVertex(GridVertex(30, 30))}, {}, {}};
+  query.levels.count = 5;
+  absl::StatusOr<Isolines> exact = ComputeIsolines(*mesh, query);
+  query.options.lambda = 1;
+  absl::StatusOr<Isolines> graph = ComputeIsolines(*mesh, query);
+  ASSERT_TRUE(exact.ok() && graph.ok());
+  EXPECT_NE(exact->levels, graph->levels);
+  absl::StatusOr<DistanceField> field = ComputeDistanceField(*mesh, query.sources, query.options);
+  ASSERT_TRUE(field.ok());
+  absl::StatusOr<Isolines> direct = ExtractIsolines(*mesh, *field, query.levels);
+  ASSERT_TRUE(direct.ok());
+  EXPECT_EQ(direct->levels, graph->levels);
+  ASSERT_EQ(direct->polylines.size(), graph->polylines.size());
+  for (size_t i = 0; i < direct->polylines.size(); ++i) {
+    ASSERT_EQ(direct->polylines[i].points.size(), graph->polylines[i].points.size());
+  }
+  query.options.lambda = 2;
+  EXPECT_EQ(InvalidOptionOf(ComputeIsolines(*mesh, query).status()), "lambda");
+  query.options.lambda = 0;
+  query.levels.count = 1;
+  EXPECT_EQ(InvalidOptionOf(ComputeIsolines(*mesh, query).status()), "count");
 }
 
 TEST(IsolinesTest, UnreachableComponentGetsNoIsolinesAndCutLinesAreOpen) {

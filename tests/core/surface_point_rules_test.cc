@@ -5,10 +5,10 @@
 
 #include <algorithm>
 #include <array>
-#include <memory>
-#include <utility>
 #include <cmath>
+#include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "geodex/geodesic_solver.h"
@@ -36,14 +36,9 @@ MeshData Soup(const std::vector<Vec3>& points, const std::vector<std::array<uint
 // face 0 (so Build flips it).
 MeshData BentFlippedBowtie() {
   const double c = 0.5, s = std::sqrt(3.0) / 2;
-  return Soup({{0, 0, 0},
-               {c, -s, 0},
-               {1, 0, 0},
-               {c, s, 0.4},
-               {-c, s, 0},
-               {-1, 0, 0},
-               {-c, -s, 0.2}},
-              {{0, 1, 2}, {0, 3, 2}, {0, 4, 5}, {0, 5, 6}});
+  return Soup(
+      {{0, 0, 0}, {c, -s, 0}, {1, 0, 0}, {c, s, 0.4}, {-c, s, 0}, {-1, 0, 0}, {-c, -s, 0.2}},
+      {{0, 1, 2}, {0, 3, 2}, {0, 4, 5}, {0, 5, 6}});
 }
 
 double Dist(const Vec3& a, const Vec3& b) {
@@ -65,7 +60,8 @@ double Dist(const Vec3& a, const Vec3& b) {
       if (a.edge_from == b.edge_from && a.edge_to == b.edge_to && std::abs(a.t - b.t) <= tol) {
         return ::testing::AssertionSuccess();
       }
-      if (a.edge_from == b.edge_to && a.edge_to == b.edge_from && std::abs(a.t - (1 - b.t)) <= tol) {
+      if (a.edge_from == b.edge_to && a.edge_to == b.edge_from &&
+          std::abs(a.t - (1 - b.t)) <= tol) {
         return ::testing::AssertionSuccess();
       }
       return fail();
@@ -102,12 +98,11 @@ std::vector<Case> Cases() {
       {"edge t = 1", SurfacePoint::OnEdge(4, 5, 1), K::kVertex},
       {"face point inside", SurfacePoint::InFace(0, 0.2, 0.3, 0.5), K::kFace},
       {"flipped face point inside", SurfacePoint::InFace(1, 0.2, 0.3, 0.5), K::kFace},
-      {"face point 1e-13 from an edge", SurfacePoint::InFace(1, 1e-13, 0.4, 0.6 - 1e-13),
-       K::kEdge},
-      {"face point 1e-13 from a corner",
-       SurfacePoint::InFace(1, 1 - 2e-13, 1e-13, 1e-13), K::kVertex},
-      {"face point 1e-13 from the split corner",
-       SurfacePoint::InFace(3, 1 - 2e-13, 1e-13, 1e-13), K::kVertex},
+      {"face point 1e-13 from an edge", SurfacePoint::InFace(1, 1e-13, 0.4, 0.6 - 1e-13), K::kEdge},
+      {"face point 1e-13 from a corner", SurfacePoint::InFace(1, 1 - 2e-13, 1e-13, 1e-13),
+       K::kVertex},
+      {"face point 1e-13 from the split corner", SurfacePoint::InFace(3, 1 - 2e-13, 1e-13, 1e-13),
+       K::kVertex},
       {"face point 1e-9 from an edge", SurfacePoint::InFace(2, 1e-9, 0.5, 0.5 - 1e-9), K::kFace},
   };
 }
@@ -132,10 +127,11 @@ class SurfacePointRulesTest : public ::testing::Test {
     absl::Status s = resolver.Add(p, 0);
     EXPECT_TRUE(s.ok()) << s;
     std::vector<ich::ResolvedSource> out = resolver.sources();
-    std::sort(out.begin(), out.end(), [](const ich::ResolvedSource& a, const ich::ResolvedSource& b) {
-      return std::make_pair(a.is_vertex, a.is_vertex ? a.vertex : a.face) <
-             std::make_pair(b.is_vertex, b.is_vertex ? b.vertex : b.face);
-    });
+    std::sort(out.begin(), out.end(),
+              [](const ich::ResolvedSource& a, const ich::ResolvedSource& b) {
+                return std::make_pair(a.is_vertex, a.is_vertex ? a.vertex : a.face) <
+                       std::make_pair(b.is_vertex, b.is_vertex ? b.vertex : b.face);
+              });
     return out;
   }
 
@@ -230,7 +226,9 @@ TEST_F(SurfacePointRulesTest, TheRuleWhereTheOldRulesDisagreed) {
       {"weight 1.0000000001e-12 with weights summing to 1 + 5e-10",
        "locator (snap before normalising): face point; resolver: edge point",
        SurfacePoint::InFace(1, 1.0000000001e-12, 0.5, 0.5 + 5e-10), SurfacePoint::Kind::kEdge},
-      {"weight 1e-13", "estimate: a face point in face 0 only; resolver and locator: the edge point, in faces 0 and 1",
+      {"weight 1e-13",
+       "estimate: a face point in face 0 only; resolver and locator: the edge point, in faces 0 "
+       "and 1",
        SurfacePoint::InFace(0, 0.5, 1e-13, 0.5 - 1e-13), SurfacePoint::Kind::kEdge},
   };
   absl::StatusOr<DistanceField> field = ComputeDistanceField(*mesh_, {SurfacePoint::AtVertex(4)});

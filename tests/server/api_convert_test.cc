@@ -421,5 +421,44 @@ TEST(ApiConvertTest, PathAndMatrixQueriesFillTheirRequests) {
   EXPECT_EQ(matrix_request.options().lambda(), 0.5);
 }
 
+TEST(ApiConvertTest, GeometryQueriesFillTheirRequests) {
+  IsolineQuery iso{{SurfacePoint::AtVertex(3), SurfacePoint::OnEdge(4, 5, 0.25)}, {}, {}};
+  iso.options.lambda = 0.5;
+  iso.options.lambda_scale = LambdaScale::kMeanEdge;
+  iso.options.max_distance = 9;
+  iso.levels.levels = {0.5, 0.25};
+  v1::ComputeIsolinesRequest iso_request;
+  api::IsolineQueryToProto(iso, &iso_request);
+  ASSERT_EQ(iso_request.sources_size(), 2);
+  EXPECT_EQ(SurfacePointToString(api::SurfacePointFromProto(iso_request.sources(1))),
+            SurfacePointToString(iso.sources[1]));
+  EXPECT_EQ(iso_request.options().lambda(), 0.5);
+  EXPECT_EQ(iso_request.options().lambda_scale(), v1::LAMBDA_SCALE_MEAN_EDGE);
+  EXPECT_EQ(iso_request.options().max_distance(), 9);
+  const IsolineOptions levels =
+      api::IsolineLevelsFromProto(iso_request.levels(), iso_request.count());
+  EXPECT_EQ(levels.levels, iso.levels.levels);
+  EXPECT_EQ(levels.count, 0);
+  iso.levels = {{}, 6};
+  iso_request.Clear();
+  api::IsolineQueryToProto(iso, &iso_request);
+  EXPECT_EQ(iso_request.levels_size(), 0);
+  EXPECT_EQ(iso_request.count(), 6);
+
+  VoronoiQuery voronoi{{SurfacePoint::AtVertex(1), SurfacePoint::AtVertex(2)}, {}};
+  voronoi.options.lambda = 1;
+  v1::ComputeVoronoiRequest voronoi_request;
+  api::VoronoiQueryToProto(voronoi, &voronoi_request);
+  EXPECT_EQ(voronoi_request.sources_size(), 2);
+  EXPECT_EQ(voronoi_request.options().lambda(), 1);
+
+  DelaunayQuery delaunay{{SurfacePoint::AtVertex(1), SurfacePoint::AtVertex(2)}, {}};
+  delaunay.options.max_distance = 3;
+  v1::ComputeDelaunayRequest delaunay_request;
+  api::DelaunayQueryToProto(delaunay, &delaunay_request);
+  EXPECT_EQ(delaunay_request.sources_size(), 2);
+  EXPECT_EQ(delaunay_request.options().max_distance(), 3);
+}
+
 }  // namespace
 }  // namespace geodex

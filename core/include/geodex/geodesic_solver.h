@@ -5,7 +5,9 @@
 #include <string>
 #include <vector>
 
+#include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "absl/strings/string_view.h"
 #include "geodex/cancel.h"
 #include "geodex/distance_field.h"
 #include "geodex/surface_point.h"
@@ -53,6 +55,10 @@ struct GeodesicOptions {
 // "max_distance"), which each front end spells its own way (--lambda, options.lambda).
 absl::Status ValidateGeodesicOptions(const GeodesicOptions& options);
 std::string InvalidOptionOf(const absl::Status& status);  // "" when the error is not an option's
+// An error about `option` that InvalidOptionOf names: core's checks of query options make theirs
+// with it (InvalidArgument for a bad value; ResourceExhausted for a value over a caller's limit).
+absl::Status OptionError(absl::string_view option, const std::string& description,
+                         absl::StatusCode code = absl::StatusCode::kInvalidArgument);
 
 // Distances from every vertex to the nearest of `sources`, with the nearest source's index.
 // Errors: InvalidArgument for an empty source list or a bad source (named), Cancelled,

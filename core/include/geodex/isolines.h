@@ -50,6 +50,14 @@ struct Isolines {
   std::vector<IsolinePolyline> polylines;  // grouped by ascending level
 };
 
+// The one check of isoline options, made by ExtractIsolines and, before any work, by the CLI and
+// geodexd: levels finite, or else a count >= 2; at most `max_levels` levels either way (count - 1
+// levels for a count). Errors name the option for InvalidOptionOf (geodesic_solver.h): "levels[I]"
+// or "count", InvalidArgument for a bad value, ResourceExhausted over `max_levels` ("levels" or
+// "count"), each front end spelling it its own way (--levels, --count, levels[3]).
+absl::Status ValidateIsolineOptions(const IsolineOptions& options,
+                                    uint64_t max_levels = UINT64_MAX);
+
 // Extracts the isolines of `field` (computed on `mesh`). Faces with an unreachable vertex are
 // skipped, so an isoline that meets unreachable territory is an open polyline; on a closed mesh
 // every polyline is closed (paper, Theorem 3). Errors: InvalidArgument when the field does not
