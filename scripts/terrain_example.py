@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""README "Terrain through geodexd and Python": a GeoTIFF DEM through the geodex package.
+"""docs/terrain.md "Terrain through geodexd and Python": a GeoTIFF DEM through the geodex package.
 usage: terrain_example.py HOST:PORT OUTDIR  (OUTDIR holds valley.tif: scripts/sample_dem.py)"""
 import sys
 

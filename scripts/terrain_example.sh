@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# README "Terrain and GIS", end to end: a GeoTIFF DEM to isochrone polygons (GeoJSON), a distance
-# raster and a nearest-source raster (GeoTIFF), with the lake as a barrier, and a picture.
+# docs/terrain.md "Terrain and GIS", end to end: a GeoTIFF DEM to isochrone polygons (GeoJSON), a
+# distance raster and a nearest-source raster (GeoTIFF), with the lake as a barrier, and a picture.
 # usage: scripts/terrain_example.sh [OUTDIR]   (default /tmp/geodex-terrain; GEODEX overrides the
 # binary, default build/client/geodex). tests/CMakeLists.txt runs it, so it stays runnable.
 set -euo pipefail

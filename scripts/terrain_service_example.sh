@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# README "Terrain through geodexd and Python", end to end: the sample DEM uploaded to a geodexd as
-# a GeoTIFF, queried by its name with map points and the lake as a barrier derived on the server,
-# then the same from Python (scripts/terrain_example.py), isochrones written by the server.
+# docs/terrain.md "Terrain through geodexd and Python", end to end: the sample DEM uploaded to a
+# geodexd as a GeoTIFF, queried by its name with map points and the lake as a barrier derived on the
+# server, then the same from Python (scripts/terrain_example.py), isochrones written by the server.
 # usage: scripts/terrain_service_example.sh HOST:PORT [OUTDIR]   (default /tmp/geodex-terrain;
 # GEODEX overrides the binary, default build/client/geodex). A ctest runs it against its own geodexd.
 set -euo pipefail
