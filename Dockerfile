@@ -6,7 +6,7 @@
 # Stage 1 builds everything and runs the whole test suite; stage 2 holds only the two binaries and
 # their runtime libraries, runs as a non-root user and keeps meshes in the /data volume.
 # Ports: 50051 gRPC (geodex.v1, health, reflection), 9464 Prometheus /metrics.
-# Flags: every geodexd flag may follow the image name (see README "geodexd flags"); the defaults
+# Flags: every geodexd flag may follow the image name (see the flag table in docs/service.md); the defaults
 # below listen on all interfaces of the container, as Kubernetes pods need.
 
 FROM debian:bookworm AS build

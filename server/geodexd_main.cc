@@ -92,7 +92,7 @@ int main(int argc, char** argv) {
       "geodexd --listen HOST:PORT --data-dir DIR [flags]: the geodex gRPC server "
       "(geodex.v1.Geodex, grpc.health.v1.Health, server reflection)");
   // Accept --data-dir as well as --data_dir, for every flag (absl flags use underscores; the
-  // command-line contract in README uses dashes).
+  // command-line contract in docs/service.md uses dashes).
   std::vector<std::string> args(argv, argv + argc);
   std::vector<char*> fixed;
   for (std::string& a : args) {

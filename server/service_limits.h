@@ -1,7 +1,7 @@
 #pragma once
 
-// Request limits of geodexd. Every one is a flag (geodexd_main.cc, README "geodexd flags");
-// exceeding one answers RESOURCE_EXHAUSTED with a message naming the flag.
+// Request limits of geodexd. Every one is a flag (geodexd_main.cc, docs/service.md, its flag
+// table); exceeding one answers RESOURCE_EXHAUSTED with a message naming the flag.
 
 #include <cstddef>
 #include <cstdint>

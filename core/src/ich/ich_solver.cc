@@ -213,6 +213,127 @@ double IchSolver::IntervalKey(double b0, double b1, double ix, double iy, double
   return sigma - iy;
 }
 
+// ProcessInterval's steps (docs/engine.md, "Processing an interval window"), each named; they are
+// called once each from the one caller below and inlined there.
+
+// Step 1, lambda > 0 only: the re-test of an over-filtered window when it is popped. Vertex
+// distances may have dropped since the window was made, so it is trimmed (Lemma 2 by the edge's
+// endpoints) and tested (Lemma 2 against the face's vertices, exact and over-filtered) again. In
+// exact mode this is skipped: measured on gargoyle, armadillo and a terrain it drops under 0.05%
+// of the windows (every window was trimmed and tested when made, and the vertex ahead is rarely
+// reached in between) for ~17% of the instructions. Skipping a filter never costs exactness, only
+// work.
+[[gnu::always_inline]] inline IchSolver::PopRetest IchSolver::RetestOverFiltered(
+    uint32_t id, Window* w, double popped_key) {
+  const uint32_t h = w->element;
+  const double b0 = w->b0, b1 = w->b1;
+  double ra, rb;
+  if (!TrimByEndpoints(h, &w->b0, &w->b1, w->ix, w->iy, w->sigma, &ra, &rb)) {
+    return PopRetest::kDropped;
+  }
+  if (w->b0 != b0 || w->b1 != b1) {
+    pool_[id].b0 = w->b0;
+    pool_[id].b1 = w->b1;
+    // Trimming raised its key: queue it again, so windows keep being processed in key order.
+    double key = IntervalKey(w->b0, w->b1, w->ix, w->iy, w->sigma);
+    if (heuristic_) key = WindowKey(h, w->b0, w->b1, w->ix, w->iy, w->sigma, key);
+    if (key > popped_key * (1 + kFilterRelTol)) {
+      Push(id, key);
+      return PopRetest::kRequeued;
+    }
+  }
+  const double ra0 = Hypot(w->b0 - w->ix, w->iy), rb0 = Hypot(w->b1 - w->ix, w->iy);
+  if (IsFiltered(h, w->b0, w->b1, w->ix, w->iy, w->sigma, ra0, rb0, w->side, 0) ||
+      IsFiltered(h, w->b0, w->b1, w->ix, w->iy, w->sigma, ra0, rb0, w->side, epsilon_)) {
+    return PopRetest::kDropped;
+  }
+  return PopRetest::kKeep;
+}
+
+// Step 3, the straight-through bookkeeping. When v3's best path runs straight through it with
+// windows continuing on both sides, those windows already cover every direction within pi of the
+// incoming ray: v3's own windows are needed only in its shadow sector (see ProcessPseudoSource).
+// On regular grids the ray to v3 often runs exactly along the boundary between two windows of the
+// same image (a ray through an earlier vertex): each covers one side. Record the sides a window
+// covers (bit 1: rays pass left of v3, bit 2: right); the straight continuation is complete once
+// both sides are covered by the image that gives v3 its distance.
+[[gnu::always_inline]] inline void IchSolver::RecordStraightThrough(const Window& w, uint32_t h,
+                                                                    const Ahead& ahead) {
+  if (mesh_.Twin(TriangleMesh::Prev(h)) == kNoIndex ||
+      mesh_.Twin(TriangleMesh::Next(h)) == kNoIndex) {
+    return;
+  }
+  const uint32_t v3 = ahead.v3;
+  const uint8_t sides = static_cast<uint8_t>((ahead.make_left && ahead.cross_x > w.b0 ? 1 : 0) |
+                                             (ahead.make_right && ahead.cross_x < w.b1 ? 2 : 0));
+  if (ahead.v3_improved) {
+    straight_through_[v3] = sides;
+    return;
+  }
+  // A tie with the same image on the same edge completes the other side.
+  const VertexOrigin& o = origin_[v3];
+  const double d3 = w.sigma + Hypot(ahead.x3 - w.ix, ahead.y3 - w.iy);
+  const double tol = kSplitTieRel * (d3 + ahead.len);
+  if (o.half_edge == h && std::abs(d3 - dist_[v3]) <= tol && std::abs(o.ix - w.ix) <= tol &&
+      std::abs(o.iy - w.iy) <= tol) {
+    straight_through_[v3] |= sides;
+  }
+}
+
+// Step 4a, the child on the left: on the edge v1 -> v3 (v1 = this edge's start), in the twin's
+// frame, with v1's distance when the window reaches it along its end ray.
+[[gnu::always_inline]] inline void IchSolver::MakeLeftChild(uint32_t id, const Window& w,
+                                                            uint32_t h, const Ahead& ahead) {
+  const double x3 = ahead.x3, y3 = ahead.y3, len = ahead.len;
+  const uint32_t e = TriangleMesh::Prev(h);  // v3 -> v1 in this face
+  const uint32_t t = mesh_.Twin(e);
+  const double el = mesh_.Length(e);
+  const double t0 = RayHitParam(w.ix, w.iy, w.b0, 0, 0, x3, y3);
+  const double t1 = ahead.sees_v3 ? 1.0 : RayHitParam(w.ix, w.iy, w.b1, 0, 0, x3, y3);
+  // Endpoint reached along the interval's end ray: in exact arithmetic already set by the same
+  // path, so only a real gain counts (a last-bit "gain" would hide a straight-through path).
+  const double d1 = w.sigma + Hypot(w.ix, w.iy);
+  if (t0 <= 0 && w.b0 <= kTinyWindowRel * len && d1 < dist_[mesh_.From(h)] * (1 - kFilterRelTol)) {
+    UpdateVertex(mesh_.From(h), d1, id, h, w.ix, w.iy);
+  }
+  if (t != kNoIndex && t1 > t0) {
+    const double ux = x3 / el, uy = y3 / el;
+    const double nix = w.ix * ux + w.iy * uy;
+    const double niy = -w.ix * uy + w.iy * ux;
+    MakeInterval(id, t, t0 * el, t1 * el, nix, niy, WindowSide::kLeft, w.pseudo_source, w.sigma,
+                 w.source);
+  }
+}
+
+// Step 4b, the child on the right: on the edge v3 -> v2, in the twin's frame (origin v3), with
+// v2's distance when the window reaches it along its end ray.
+[[gnu::always_inline]] inline void IchSolver::MakeRightChild(uint32_t id, const Window& w,
+                                                             uint32_t h, const Ahead& ahead) {
+  const double x3 = ahead.x3, y3 = ahead.y3, len = ahead.len;
+  const uint32_t e = TriangleMesh::Next(h);  // v2 -> v3 in this face
+  const uint32_t t = mesh_.Twin(e);
+  const double el = mesh_.Length(e);
+  const double wx = len - x3, wy = -y3;
+  const double t0 = ahead.sees_v3 ? 0.0 : RayHitParam(w.ix, w.iy, w.b0, x3, y3, wx, wy);
+  const double t1 = RayHitParam(w.ix, w.iy, w.b1, x3, y3, wx, wy);
+  const double d2 = w.sigma + Hypot(len - w.ix, w.iy);
+  if (t1 >= 1 && w.b1 >= len * (1 - kTinyWindowRel) &&
+      d2 < dist_[mesh_.To(h)] * (1 - kFilterRelTol)) {
+    UpdateVertex(mesh_.To(h), d2, id, h, w.ix, w.iy);
+  }
+  if (t != kNoIndex && t1 > t0) {
+    const double ux = wx / el, uy = wy / el;
+    const double rx = w.ix - x3, ry = w.iy - y3;
+    const double nix = rx * ux + ry * uy;
+    const double niy = -rx * uy + ry * ux;
+    MakeInterval(id, t, t0 * el, t1 * el, nix, niy, WindowSide::kRight, w.pseudo_source, w.sigma,
+                 w.source);
+  }
+}
+
+// An interval window popped from the queue: (1) re-tested when over-filtering, (2) propagated
+// across its face to the opposite vertex v3 (its distance; Lemma 1 decides which sides go on),
+// (3) the straight-through bookkeeping at v3, (4) a child on each side that survives.
 void IchSolver::ProcessInterval(uint32_t id, double popped_key) {
   Window w = pool_[id];  // copy: the pool may grow below
   const uint32_t generation = pool_.generation(id);
@@ -221,42 +342,15 @@ void IchSolver::ProcessInterval(uint32_t id, double popped_key) {
     pool_.PrefetchLinks(pool_.links(id).parent);
   }
   const uint32_t h = w.element;
-  // With over-filtering (lambda > 0), test the window again: vertex distances have dropped since
-  // it was made. In exact mode this is skipped: measured on gargoyle, armadillo and a terrain it
-  // drops under 0.05% of the windows (every window was trimmed and tested when made, and the
-  // vertex ahead is rarely reached in between) for ~17% of the instructions. Skipping a filter
-  // never costs exactness, only work.
-  if (options_.use_filter && epsilon_ > 0) {
-    // Trim again, and if that raised its key, queue it again so windows keep being processed in
-    // distance order.
-    const double b0 = w.b0, b1 = w.b1;
-    double ra, rb;
-    if (!TrimByEndpoints(h, &w.b0, &w.b1, w.ix, w.iy, w.sigma, &ra, &rb)) {
+  if (options_.use_filter && epsilon_ > 0) {  // (1)
+    const PopRetest retest = RetestOverFiltered(id, &w, popped_key);
+    if (retest == PopRetest::kRequeued) return;
+    if (retest == PopRetest::kDropped) {
       ++stats_.windows_filtered_at_pop;
       pool_.MarkProcessed(id);
       ReleaseIfDone(id);
       return;
     }
-    if (w.b0 != b0 || w.b1 != b1) {
-      pool_[id].b0 = w.b0;
-      pool_[id].b1 = w.b1;
-      double key = IntervalKey(w.b0, w.b1, w.ix, w.iy, w.sigma);
-      if (heuristic_) key = WindowKey(h, w.b0, w.b1, w.ix, w.iy, w.sigma, key);
-      if (key > popped_key * (1 + kFilterRelTol)) {
-        Push(id, key);
-        return;
-      }
-    }
-  }
-  if (options_.use_filter && epsilon_ > 0 &&
-      (IsFiltered(h, w.b0, w.b1, w.ix, w.iy, w.sigma, Hypot(w.b0 - w.ix, w.iy),
-                  Hypot(w.b1 - w.ix, w.iy), w.side, 0) ||
-       IsFiltered(h, w.b0, w.b1, w.ix, w.iy, w.sigma, Hypot(w.b0 - w.ix, w.iy),
-                  Hypot(w.b1 - w.ix, w.iy), w.side, epsilon_))) {
-    ++stats_.windows_filtered_at_pop;
-    pool_.MarkProcessed(id);
-    ReleaseIfDone(id);
-    return;
   }
   pool_.MarkProcessed(id);
   ++stats_.windows_processed;
@@ -269,96 +363,31 @@ void IchSolver::ProcessInterval(uint32_t id, double popped_key) {
   if (has_targets_ && face_target_head_[TriangleMesh::FaceOf(h)] != kNoIndex) {
     OfferWindowToTargets(h, w);
   }
-  const double len = mesh_.Length(h);
-  const double x3 = mesh_.OppX(h), y3 = mesh_.OppY(h);
-  const uint32_t v3 = mesh_.Opposite(h);
-  // Where the ray from the image to the opposite vertex crosses this edge.
-  const double cross_x = w.ix + (x3 - w.ix) * (-w.iy) / (y3 - w.iy);
-  const double cover_tol = kCoverRelTol * len;
-  const bool sees_v3 = cross_x >= w.b0 - cover_tol && cross_x <= w.b1 + cover_tol;
-  bool make_left = cross_x > w.b0 - cover_tol;  // some rays pass left of v3
-  bool make_right = cross_x < w.b1 + cover_tol;
-  bool v3_improved = false;
-
-  if (sees_v3) {
-    const double d3 = w.sigma + Hypot(x3 - w.ix, y3 - w.iy);
-    v3_improved = UpdateVertex(v3, d3, id, h, w.ix, w.iy);
+  // (2) Across the face: where the ray from the image to the opposite vertex v3 crosses this
+  // edge decides whether the window sees v3 and which sides have rays.
+  Ahead ahead;
+  ahead.len = mesh_.Length(h);
+  ahead.x3 = mesh_.OppX(h);
+  ahead.y3 = mesh_.OppY(h);
+  ahead.v3 = mesh_.Opposite(h);
+  ahead.cross_x = w.ix + (ahead.x3 - w.ix) * (-w.iy) / (ahead.y3 - w.iy);
+  const double cover_tol = kCoverRelTol * ahead.len;
+  ahead.sees_v3 = ahead.cross_x >= w.b0 - cover_tol && ahead.cross_x <= w.b1 + cover_tol;
+  ahead.make_left = ahead.cross_x > w.b0 - cover_tol;  // some rays pass left of v3
+  ahead.make_right = ahead.cross_x < w.b1 + cover_tol;
+  ahead.v3_improved = false;
+  if (ahead.sees_v3) {
+    const double d3 = w.sigma + Hypot(ahead.x3 - w.ix, ahead.y3 - w.iy);
+    ahead.v3_improved = UpdateVertex(ahead.v3, d3, id, h, w.ix, w.iy);
     if (options_.use_one_angle_one_split &&
-        !OneAngleOneSplit(id, generation, h, d3, cross_x, cover_tol, &make_left, &make_right)) {
+        !OneAngleOneSplit(id, generation, h, d3, ahead.cross_x, cover_tol, &ahead.make_left,
+                          &ahead.make_right)) {
       return;  // the paper's tree deleted this very window
     }
+    RecordStraightThrough(w, h, ahead);  // (3)
   }
-
-  // When v3's best path runs straight through it with windows continuing on both sides, those
-  // windows already cover every direction within pi of the incoming ray: v3's own windows are
-  // needed only in its shadow sector (see ProcessPseudoSource).
-  // On regular grids the ray to v3 often runs exactly along the boundary between two windows of
-  // the same image (a ray through an earlier vertex): each covers one side. Record the sides a
-  // window covers (bit 1: rays pass left of v3, bit 2: right); the straight continuation is
-  // complete once both sides are covered by the image that gives v3 its distance.
-  if (sees_v3 && mesh_.Twin(TriangleMesh::Prev(h)) != kNoIndex &&
-      mesh_.Twin(TriangleMesh::Next(h)) != kNoIndex) {
-    const uint8_t sides = static_cast<uint8_t>((make_left && cross_x > w.b0 ? 1 : 0) |
-                                               (make_right && cross_x < w.b1 ? 2 : 0));
-    if (v3_improved) {
-      straight_through_[v3] = sides;
-    } else {
-      // A tie with the same image on the same edge completes the other side.
-      const VertexOrigin& o = origin_[v3];
-      const double d3 = w.sigma + Hypot(x3 - w.ix, y3 - w.iy);
-      const double tol = kSplitTieRel * (d3 + len);
-      if (o.half_edge == h && std::abs(d3 - dist_[v3]) <= tol && std::abs(o.ix - w.ix) <= tol &&
-          std::abs(o.iy - w.iy) <= tol) {
-        straight_through_[v3] |= sides;
-      }
-    }
-  }
-
-  if (make_left) {
-    // Child on the edge v1 -> v3 (v1 = this edge's start), in the twin's frame.
-    const uint32_t e = TriangleMesh::Prev(h);  // v3 -> v1 in this face
-    const uint32_t t = mesh_.Twin(e);
-    const double el = mesh_.Length(e);
-    const double t0 = RayHitParam(w.ix, w.iy, w.b0, 0, 0, x3, y3);
-    const double t1 = sees_v3 ? 1.0 : RayHitParam(w.ix, w.iy, w.b1, 0, 0, x3, y3);
-    // Endpoint distances when the child reaches a vertex.
-    // Endpoint reached along the interval's end ray: in exact arithmetic already set by the same
-    // path, so only a real gain counts (a last-bit "gain" would hide a straight-through path).
-    const double d1 = w.sigma + Hypot(w.ix, w.iy);
-    if (t0 <= 0 && w.b0 <= kTinyWindowRel * len &&
-        d1 < dist_[mesh_.From(h)] * (1 - kFilterRelTol)) {
-      UpdateVertex(mesh_.From(h), d1, id, h, w.ix, w.iy);
-    }
-    if (t != kNoIndex && t1 > t0) {
-      const double ux = x3 / el, uy = y3 / el;
-      const double nix = w.ix * ux + w.iy * uy;
-      const double niy = -w.ix * uy + w.iy * ux;
-      MakeInterval(id, t, t0 * el, t1 * el, nix, niy, WindowSide::kLeft, w.pseudo_source, w.sigma,
-                   w.source);
-    }
-  }
-  if (make_right) {
-    // Child on the edge v3 -> v2, in the twin's frame (origin v3).
-    const uint32_t e = TriangleMesh::Next(h);  // v2 -> v3 in this face
-    const uint32_t t = mesh_.Twin(e);
-    const double el = mesh_.Length(e);
-    const double wx = len - x3, wy = -y3;
-    const double t0 = sees_v3 ? 0.0 : RayHitParam(w.ix, w.iy, w.b0, x3, y3, wx, wy);
-    const double t1 = RayHitParam(w.ix, w.iy, w.b1, x3, y3, wx, wy);
-    const double d2 = w.sigma + Hypot(len - w.ix, w.iy);
-    if (t1 >= 1 && w.b1 >= len * (1 - kTinyWindowRel) &&
-        d2 < dist_[mesh_.To(h)] * (1 - kFilterRelTol)) {
-      UpdateVertex(mesh_.To(h), d2, id, h, w.ix, w.iy);
-    }
-    if (t != kNoIndex && t1 > t0) {
-      const double ux = wx / el, uy = wy / el;
-      const double rx = w.ix - x3, ry = w.iy - y3;
-      const double nix = rx * ux + ry * uy;
-      const double niy = -rx * uy + ry * ux;
-      MakeInterval(id, t, t0 * el, t1 * el, nix, niy, WindowSide::kRight, w.pseudo_source, w.sigma,
-                   w.source);
-    }
-  }
+  if (ahead.make_left) MakeLeftChild(id, w, h, ahead);  // (4)
+  if (ahead.make_right) MakeRightChild(id, w, h, ahead);
   ReleaseIfDone(id);
 }
 

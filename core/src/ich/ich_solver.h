@@ -100,6 +100,20 @@ class IchSolver {
   void SeedFacePoint(const ResolvedSource& s);
   void ProcessPseudoSource(uint32_t id);
   void ProcessInterval(uint32_t id, double popped_key);
+  // ProcessInterval's named steps (ich_solver.cc; docs/engine.md).
+  enum class PopRetest : uint8_t { kKeep, kDropped, kRequeued };
+  PopRetest RetestOverFiltered(uint32_t id, Window* w, double popped_key);
+  // What a window sees across its face: the opposite vertex v3 (its position in the edge's frame,
+  // whether the window's rays reach it, whether its distance improved) and the sides on which
+  // rays pass v3, where children go.
+  struct Ahead {
+    double len, x3, y3, cross_x;
+    uint32_t v3;
+    bool sees_v3, make_left, make_right, v3_improved;
+  };
+  void RecordStraightThrough(const Window& w, uint32_t h, const Ahead& ahead);
+  void MakeLeftChild(uint32_t id, const Window& w, uint32_t h, const Ahead& ahead);
+  void MakeRightChild(uint32_t id, const Window& w, uint32_t h, const Ahead& ahead);
   void PassThroughDegenerate(uint32_t id, const Window& w);
   void EmitAcrossDegenerate(uint32_t id, uint32_t corner, double sigma, uint32_t source);
   // Straight distances to a face's vertices and windows through its edges, from a point given in
