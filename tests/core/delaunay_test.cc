@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <set>
 
 #include "geodex/geodesic_solver.h"
@@ -20,6 +22,11 @@ namespace {
 using SitePairs = std::vector<std::array<uint32_t, 2>>;
 using Triples = std::vector<std::array<uint32_t, 3>>;
 
+[[noreturn]] void Abort(const char* what, const absl::Status& status) {
+  std::fprintf(stderr, "%s: %s\n", what, std::string(status.message()).c_str());
+  std::abort();
+}
+
 struct Fixture {
   MeshData data;
   TriangleMesh mesh;
@@ -28,11 +35,12 @@ struct Fixture {
 
 Fixture Solve(MeshData data, const std::vector<uint32_t>& sites) {
   absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(data);
-  EXPECT_TRUE(mesh.ok()) << mesh.status();
+  // A helper that returns cannot ASSERT: stop here rather than read an error's value.
+  if (!mesh.ok()) Abort("the fixture mesh does not build", mesh.status());
   std::vector<SurfacePoint> sources;
   for (uint32_t v : sites) sources.push_back(SurfacePoint::AtVertex(v));
   absl::StatusOr<DistanceField> field = ComputeDistanceField(*mesh, sources);
-  EXPECT_TRUE(field.ok()) << field.status();
+  if (!field.ok()) Abort("the fixture field does not solve", field.status());
   return Fixture{std::move(data), *std::move(mesh), *std::move(field)};
 }
 

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 
 #include "geodex/geodesic_solver.h"
@@ -16,6 +18,11 @@
 namespace geodex {
 namespace {
 
+[[noreturn]] void Abort(const char* what, const absl::Status& status) {
+  std::fprintf(stderr, "%s: %s\n", what, std::string(status.message()).c_str());
+  std::abort();
+}
+
 struct Fixture {
   MeshData data;
   TriangleMesh mesh;
@@ -24,9 +31,10 @@ struct Fixture {
 
 Fixture Solve(MeshData data, const std::vector<SurfacePoint>& sources) {
   absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(data);
-  EXPECT_TRUE(mesh.ok()) << mesh.status();
+  // A helper that returns cannot ASSERT: stop here rather than read an error's value.
+  if (!mesh.ok()) Abort("the fixture mesh does not build", mesh.status());
   absl::StatusOr<DistanceField> field = ComputeDistanceField(*mesh, sources);
-  EXPECT_TRUE(field.ok()) << field.status();
+  if (!field.ok()) Abort("the fixture field does not solve", field.status());
   return Fixture{std::move(data), *std::move(mesh), *std::move(field)};
 }
 
