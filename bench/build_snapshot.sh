@@ -6,8 +6,8 @@
 #   bench/build_snapshot.sh [COMMIT] [--with-working-harness]
 #
 # COMMIT defaults to HEAD. --with-working-harness copies the harness files of the working tree
-# (bench/, cmake/GeodexCgalReference.cmake, the CGAL wrapper and tests/CMakeLists.txt) over the
-# snapshot, for a harness that is not committed yet. Prints the path of the binary last.
+# (bench/ and testkit/, which has the CGAL wrapper) over the snapshot, for a harness that is not
+# committed yet. Prints the path of the binary last.
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 rev=HEAD
@@ -26,8 +26,7 @@ mkdir -p "$dir/src"
 git -C "$repo" archive "$commit" | tar -x -C "$dir/src"
 label=$commit
 if [[ $overlay == 1 ]]; then
-  for f in bench cmake/GeodexCgalReference.cmake tests/CMakeLists.txt tests/util/cgal_reference.h \
-           tests/cgal/cgal_reference.cc; do
+  for f in bench testkit; do
     mkdir -p "$dir/src/$(dirname "$f")"
     cp -r "$repo/$f" "$dir/src/$(dirname "$f")/"
   done

@@ -46,7 +46,7 @@
 #include "grpcpp/security/credentials.h"
 #include "grpcpp/support/channel_arguments.h"
 #include "query_mix.h"
-#include "util/geodexd_child.h"
+#include "testkit/geodexd_child.h"
 
 namespace geodex::bench {
 namespace {

@@ -1,5 +1,5 @@
 // ICH against CGAL's Surface_mesh_shortest_path on every committed mesh, and self-checks of the
-// CGAL reference itself (util/cgal_reference.h).
+// CGAL reference itself (testkit/cgal_reference.h).
 
 #include <algorithm>
 #include <array>
@@ -21,7 +21,7 @@
 #include "geodex/surface_point.h"
 #include "geodex/triangle_mesh.h"
 #include "gtest/gtest.h"
-#include "util/cgal_reference.h"
+#include "testkit/cgal_reference.h"
 #include "util/mesh_factory.h"
 #include "util/test_meshes.h"
 

@@ -11,7 +11,7 @@
 #include "absl/strings/str_cat.h"
 #include "absl/time/clock.h"
 #include "server_test_util.h"
-#include "util/geodexd_child.h"
+#include "testkit/geodexd_child.h"
 
 namespace geodex::server {
 namespace {
@@ -23,7 +23,7 @@ using testing::Upload;
 
 namespace fs = std::filesystem;
 
-// The binary (tests/util/geodexd_child.h) on DIR/data, one worker, with a client stub.
+// The binary (testkit/geodexd_child.h) on DIR/data, one worker, with a client stub.
 class Geodexd {
  public:
   Geodexd(const fs::path& dir, std::vector<std::string> extra)

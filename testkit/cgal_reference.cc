@@ -1,4 +1,4 @@
-#include "util/cgal_reference.h"
+#include "testkit/cgal_reference.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Surface_mesh.h>

@@ -2,8 +2,8 @@
 
 // Reference distances from CGAL's Surface_mesh_shortest_path (Xin & Wang / Chen & Han style exact
 // algorithm, independent implementation). Declared here without any CGAL header; the definition
-// lives in tests/cgal/cgal_reference.cc, built as the library geodex_cgal_reference
-// (cmake/GeodexCgalReference.cmake) that cgal_tests and bench/geodex_bench link.
+// lives in testkit/cgal_reference.cc, built as the library geodex_cgal_reference
+// (testkit/CMakeLists.txt) that cgal_tests and bench/geodex_bench link.
 
 #include <cstddef>  // geodex/mesh_data.h uses size_t without including it
 #include <vector>

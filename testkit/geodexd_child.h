@@ -3,7 +3,8 @@
 // The geodexd binary as a child process, for the process tests (tests/server) and the load bench
 // (bench/load_bench.cc): stdout and stderr go to a log file, the gRPC and metrics ports are read
 // from that log (start it with --listen 127.0.0.1:0 --metrics_listen 127.0.0.1:0), every wait is
-// bounded, and only this child is ever signalled. Header-only: the bench does not link the tests.
+// bounded, and only this child is ever signalled. Header-only, in testkit/ (the library
+// geodex_testkit) so that the bench does not reach into tests/.
 
 #include <signal.h>
 #include <sys/wait.h>
