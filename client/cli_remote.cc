@@ -14,11 +14,11 @@
 #include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
-#include "api_convert.h"
 #include "cli_backend.h"
 #include "cli_common.h"
 #include "geodex/surface_point.h"
 #include "geodex_client.h"
+#include "terrain_convert.h"
 
 namespace geodex::cli {
 namespace {
@@ -90,9 +90,9 @@ absl::StatusOr<MeshRef> UploadDerived(GeodexClient& client, const std::string& m
                                       const terrain::DemOptions& options, const MeshData& data) {
   // By its content's id, uploaded only if the server lacks it.
   if (terrain::IsGeoTiffPath(mesh) && options.barrier_file.empty()) {
-    v1::DemOptions dem;
-    dem.set_step(options.step);
-    if (std::isfinite(options.barrier_below)) dem.set_barrier_below(options.barrier_below);
+    client::DemUploadOptions dem;
+    dem.step = options.step;
+    if (std::isfinite(options.barrier_below)) dem.barrier_below = options.barrier_below;
     return client.ResolveDem(mesh, data, dem);
   }
   return client.ResolveMeshData(std::filesystem::path(mesh).stem().string() + ".off", data);
@@ -122,8 +122,8 @@ class RemoteBackend final : public Backend {
       if (dem_ == nullptr) data_ = std::make_unique<MeshData>(*data);
       ref = UploadDerived(*client_, mesh, dem_options, *data);
       if (ref.ok() && barrier) {  // the server's count of its parts, as local mode says it
-        absl::StatusOr<v1::Mesh> stored = client_->GetMesh(ref->name);
-        if (stored.ok()) WarnIfBarrierSplits(dem_options, stored->components());
+        absl::StatusOr<client::ServerMesh> stored = client_->GetMesh(ref->name);
+        if (stored.ok()) WarnIfBarrierSplits(dem_options, stored->summary.report.components);
       }
     } else {
       ref = client_->ResolveMesh(mesh);
@@ -139,15 +139,15 @@ class RemoteBackend final : public Backend {
   absl::Status OpenDerivedOnServer(const std::string& mesh, const terrain::DemOptions& options) {
     absl::StatusOr<MeshRef> base = client_->ResolveMesh(mesh);
     if (!base.ok()) return base.status();
-    v1::Barrier barrier;
-    if (std::isfinite(options.barrier_below)) barrier.set_below(options.barrier_below);
+    client::BarrierOptions barrier;
+    if (std::isfinite(options.barrier_below)) barrier.below = options.barrier_below;
     if (!options.barrier_file.empty()) {
       absl::StatusOr<std::string> text = ReadBarrierText(options.barrier_file);
       if (!text.ok()) return text.status();
-      barrier.set_polygons_geojson(*std::move(text));
-      barrier.set_width(options.barrier_width);
+      barrier.polygons_geojson = *std::move(text);
+      barrier.width = options.barrier_width;
     }
-    absl::StatusOr<v1::Mesh> derived = client_->DeriveMesh(base->name, barrier);
+    absl::StatusOr<client::ServerMesh> derived = client_->DeriveMesh(base->name, barrier);
     if (!derived.ok()) {
       std::optional<FieldViolation> violation = FieldViolationOf(derived.status());
       if (violation.has_value() && violation->field.rfind("barrier", 0) == 0) {
@@ -207,12 +207,13 @@ class RemoteBackend final : public Backend {
   const terrain::Dem* Terrain() const override {
     if (dem_ != nullptr || !mesh_.file_bytes.empty() || dem_fetched_) return dem_.get();
     dem_fetched_ = true;
-    absl::StatusOr<v1::Mesh> m = client_->GetMesh(mesh_.name);
-    if (!m.ok() || !m->has_terrain()) return nullptr;
+    absl::StatusOr<client::ServerMesh> m = client_->GetMesh(mesh_.name);
+    if (!m.ok() || !m->has_terrain) return nullptr;
+    absl::StatusOr<terrain::DemInfo> info = api::TerrainFromBytes(m->terrain);
+    if (!info.ok()) return nullptr;
     absl::StatusOr<MeshData> data = client_->GetMeshGeometry(mesh_);
     if (!data.ok()) return nullptr;
-    absl::StatusOr<terrain::Dem> dem =
-        terrain::Dem::FromMesh(*std::move(data), api::TerrainFromProto(m->terrain()));
+    absl::StatusOr<terrain::Dem> dem = terrain::Dem::FromMesh(*std::move(data), *std::move(info));
     if (dem.ok()) dem_ = std::make_shared<const terrain::Dem>(*std::move(dem));
     return dem_.get();
   }
@@ -232,12 +233,16 @@ class RemoteBackend final : public Backend {
 
   absl::StatusOr<InfoValues> Info() override {
     const auto t0 = std::chrono::steady_clock::now();
-    absl::StatusOr<v1::Mesh> m = client_->GetMesh(mesh_.name);
+    absl::StatusOr<client::ServerMesh> m = client_->GetMesh(mesh_.name);
     if (!m.ok()) return m.status();
     InfoValues v;
-    static_cast<MeshSummary&>(v) = api::MeshSummaryFromProto(*m);
+    static_cast<MeshSummary&>(v) = m->summary;
     v.load_ms = MsSince(t0);  // remote: the time to describe the mesh
-    if (dem_ == nullptr && m->has_terrain()) terrain_info_ = api::TerrainFromProto(m->terrain());
+    if (dem_ == nullptr && m->has_terrain) {
+      absl::StatusOr<terrain::DemInfo> info = api::TerrainFromBytes(m->terrain);
+      if (!info.ok()) return info.status();
+      terrain_info_ = *std::move(info);
+    }
     v.dem = dem_ ? &dem_->info() : terrain_info_ ? &*terrain_info_ : nullptr;
     return v;
   }
@@ -255,15 +260,13 @@ class RemoteBackend final : public Backend {
   }
 
   absl::StatusOr<AtValues> DistancesAt(const PointQuery& query) override {
-    absl::StatusOr<v1::EstimateDistancesResponse> r =
-        Flagged(client_->PointDistances(mesh_, query, v1::POINT_DISTANCE_MODE_BOTH),
+    absl::StatusOr<client::PointDistances> r =
+        Flagged(client_->DistancesAtPoints(mesh_, query, client::PointDistanceMode::kBoth),
                 {{"sources", "sources"}, {"points", "at"}});
     if (!r.ok()) return r.status();
     AtValues out;
-    for (const PointEstimate& e : api::PointEstimatesFromProto(*r)) {
-      out.estimate.push_back(e.distance);
-    }
-    out.exact = api::PointValuesFromProto(*r);
+    for (const PointEstimate& e : r->estimates) out.estimate.push_back(e.distance);
+    out.exact = std::move(r->exact);
     // What the command prints needs one value per point (a geodexd older than this client
     // answers without the directions it does not know).
     const size_t n = query.points.size();
@@ -319,18 +322,19 @@ class RemoteBackend final : public Backend {
   bool cached_ = false;  // the last field came from the server's result cache
 };
 
-std::string MeshLine(const v1::Mesh& m) {
-  return absl::StrFormat("%s\t%s\t%d vertices\t%d faces\t%d bytes%s\n", m.name(),
-                         m.display_name().empty() ? "-" : m.display_name(), m.vertex_count(),
-                         m.face_count(), m.memory_bytes(), m.pinned() ? "\tpinned" : "");
+std::string MeshLine(const client::ServerMesh& m) {
+  return absl::StrFormat("%s\t%s\t%d vertices\t%d faces\t%d bytes%s\n", m.name,
+                         m.display_name.empty() ? "-" : m.display_name,
+                         m.summary.report.file_vertices, m.summary.report.file_faces,
+                         m.memory_bytes, m.pinned ? "\tpinned" : "");
 }
 
-std::string MeshJson(const v1::Mesh& m) {
+std::string MeshJson(const client::ServerMesh& m) {
   return absl::StrFormat(
       "{\"name\": \"%s\", \"display_name\": \"%s\", \"vertices\": %d, \"faces\": %d, "
       "\"memory_bytes\": %d, \"upload_bytes\": %d, \"pinned\": %s}",
-      m.name(), m.display_name(), m.vertex_count(), m.face_count(), m.memory_bytes(),
-      m.upload_bytes(), m.pinned() ? "true" : "false");
+      m.name, m.display_name, m.summary.report.file_vertices, m.summary.report.file_faces,
+      m.memory_bytes, m.upload_bytes, m.pinned ? "true" : "false");
 }
 
 // geodex mesh upload FILE [--name NAME] | list | get MESH | delete MESH
@@ -343,7 +347,7 @@ int RemoteMesh(GeodexClient& client, const Args& args) {
   const std::vector<std::string>& p = args.positional;
   const std::string sub = p.empty() ? "" : p[0];
   if (sub == "list" && p.size() == 1) {
-    absl::StatusOr<std::vector<v1::Mesh>> meshes = client.ListMeshes();
+    absl::StatusOr<std::vector<client::ServerMesh>> meshes = client.ListMeshes();
     if (!meshes.ok()) return FailQuery(meshes.status());
     std::string out = json ? "[" : "";
     for (size_t i = 0; i < meshes->size(); ++i) {
@@ -361,7 +365,7 @@ int RemoteMesh(GeodexClient& client, const Args& args) {
       std::printf("deleted %s\n", mesh->name.c_str());
       return kExitOk;
     }
-    absl::StatusOr<v1::Mesh> m = client.GetMesh(mesh->name);
+    absl::StatusOr<client::ServerMesh> m = client.GetMesh(mesh->name);
     if (!m.ok()) return FailQuery(m.status());
     std::fputs((json ? MeshJson(*m) + "\n" : MeshLine(*m)).c_str(), stdout);
     return kExitOk;
@@ -375,10 +379,10 @@ int RemoteMesh(GeodexClient& client, const Args& args) {
         DerivedHere(p[1], *dem) ? UploadDerived(client, p[1], *dem, *data)
                                 : client.ResolveMesh(p[1]);
     if (!ref.ok()) return FailQuery(ref.status());
-    absl::StatusOr<v1::Mesh> m = args.options.count("name")
-                                     ? client.Upload(ref->file_name, ref->file_bytes,
-                                                     args.options.at("name"), ref->id, ref->dem)
-                                     : client.GetMesh(ref->name);
+    absl::StatusOr<client::ServerMesh> m =
+        args.options.count("name") ? client.Upload(ref->file_name, ref->file_bytes,
+                                                   args.options.at("name"), ref->id, ref->dem)
+                                   : client.GetMesh(ref->name);
     if (!m.ok()) return FailQuery(m.status());
     std::fputs((json ? MeshJson(*m) + "\n" : MeshLine(*m)).c_str(), stdout);
     return kExitOk;

@@ -15,6 +15,7 @@
 #include "geodex/mesh_id.h"
 #include "geodex/mesh_io.h"
 #include "geodex/samples.h"
+#include "geodex/v1/geodex.grpc.pb.h"
 #include "geometry_convert.h"
 #include "google/rpc/error_details.pb.h"
 #include "google/rpc/status.pb.h"
@@ -24,7 +25,56 @@
 #include "grpcpp/support/byte_buffer.h"
 
 namespace geodex::client {
+
+// The generated stub, kept out of the public header.
+struct GeodexClient::Stub : v1::Geodex::Stub {
+  using v1::Geodex::Stub::Stub;
+};
+
 namespace {
+
+// The client's own types on the wire (the rest is proto/convert's).
+ServerMesh ServerMeshFromProto(const v1::Mesh& m) {
+  ServerMesh out;
+  out.name = m.name();
+  out.display_name = m.display_name();
+  out.aliases.assign(m.aliases().begin(), m.aliases().end());
+  out.summary = api::MeshSummaryFromProto(m);
+  out.upload_bytes = m.upload_bytes();
+  out.memory_bytes = m.memory_bytes();
+  out.pinned = m.pinned();
+  out.create_time_seconds = m.create_time().seconds();
+  out.has_terrain = m.has_terrain();
+  if (out.has_terrain) out.terrain = m.terrain().SerializeAsString();
+  return out;
+}
+
+v1::DemOptions DemOptionsToProto(const DemUploadOptions& options) {
+  v1::DemOptions out;
+  out.set_step(options.step);
+  if (options.barrier_below.has_value()) out.set_barrier_below(*options.barrier_below);
+  return out;
+}
+
+v1::Barrier BarrierToProto(const BarrierOptions& options) {
+  v1::Barrier out;
+  if (options.below.has_value()) out.set_below(*options.below);
+  out.set_polygons_geojson(options.polygons_geojson);
+  out.set_width(options.width);
+  return out;
+}
+
+v1::PointDistanceMode ModeToProto(PointDistanceMode mode) {
+  switch (mode) {
+    case PointDistanceMode::kExact:
+      return v1::POINT_DISTANCE_MODE_EXACT;
+    case PointDistanceMode::kBoth:
+      return v1::POINT_DISTANCE_MODE_BOTH;
+    case PointDistanceMode::kEstimate:
+      break;
+  }
+  return v1::POINT_DISTANCE_MODE_ESTIMATE;
+}
 
 constexpr absl::string_view kFieldPayload = "geodex.client/field";
 constexpr absl::string_view kDescriptionPayload = "geodex.client/field-description";
@@ -85,8 +135,12 @@ GeodexClient::GeodexClient(ClientOptions options) : options_(std::move(options))
     credentials = grpc::SslCredentials(ssl);
   }
   channel_ = grpc::CreateCustomChannel(options_.target, credentials, args);
-  stub_ = v1::Geodex::NewStub(channel_);
+  stub_ = std::make_unique<Stub>(channel_);
 }
+
+GeodexClient::~GeodexClient() = default;
+GeodexClient::GeodexClient(GeodexClient&&) noexcept = default;
+GeodexClient& GeodexClient::operator=(GeodexClient&&) noexcept = default;
 
 namespace {
 // RESOURCE_EXHAUSTED because every worker was busy and the queue full (ErrorInfo reason QUEUE_FULL,
@@ -146,7 +200,7 @@ grpc::Status GeodexClient::MeshCall(MeshRef& mesh,
   if (status.error_code() == grpc::StatusCode::NOT_FOUND && !mesh.file_bytes.empty() &&
       ErrorReason(status) == "MESH_NOT_FOUND") {
     // The server lost (or never had) the mesh: upload it again and retry once.
-    absl::StatusOr<v1::Mesh> uploaded =
+    absl::StatusOr<ServerMesh> uploaded =
         Upload(mesh.file_name, mesh.file_bytes, "", mesh.id, mesh.dem);
     if (!uploaded.ok()) {
       return grpc::Status(static_cast<grpc::StatusCode>(uploaded.status().code()),
@@ -187,10 +241,10 @@ absl::StatusOr<bool> GeodexClient::Health(const std::string& service) {
   return reply == std::string("\x08\x01", 2);  // HealthCheckResponse{status: SERVING}
 }
 
-absl::StatusOr<v1::Mesh> GeodexClient::Upload(const std::string& file_name,
-                                              const std::string& bytes, const std::string& alias,
-                                              const std::string& expected_id,
-                                              const std::optional<v1::DemOptions>& dem) {
+absl::StatusOr<ServerMesh> GeodexClient::Upload(const std::string& file_name,
+                                                const std::string& bytes, const std::string& alias,
+                                                const std::string& expected_id,
+                                                const std::optional<DemUploadOptions>& dem) {
   v1::Mesh mesh;
   grpc::Status status = Call(expected_id, [&](grpc::ClientContext* context) {
     auto writer = stub_->CreateMesh(context, &mesh);
@@ -202,7 +256,7 @@ absl::StatusOr<v1::Mesh> GeodexClient::Upload(const std::string& file_name,
     metadata->set_total_bytes(bytes.size());
     if (dem.has_value()) {
       metadata->set_format(v1::MESH_FORMAT_GEOTIFF);
-      *metadata->mutable_dem() = *dem;
+      *metadata->mutable_dem() = DemOptionsToProto(*dem);
     }
     bool ok = writer->Write(request);
     for (size_t offset = 0; ok && offset < bytes.size(); offset += options_.upload_chunk_bytes) {
@@ -218,10 +272,10 @@ absl::StatusOr<v1::Mesh> GeodexClient::Upload(const std::string& file_name,
     return writer->Finish();
   });
   if (!status.ok()) return ToAbsl(status);
-  return mesh;
+  return ServerMeshFromProto(mesh);
 }
 
-absl::StatusOr<v1::Mesh> GeodexClient::GetMesh(const std::string& name) {
+absl::StatusOr<ServerMesh> GeodexClient::GetMesh(const std::string& name) {
   v1::GetMeshRequest request;
   request.set_name(name);
   v1::Mesh mesh;
@@ -229,11 +283,11 @@ absl::StatusOr<v1::Mesh> GeodexClient::GetMesh(const std::string& name) {
   grpc::Status status = Call(
       id, [&](grpc::ClientContext* context) { return stub_->GetMesh(context, request, &mesh); });
   if (!status.ok()) return ToAbsl(status);
-  return mesh;
+  return ServerMeshFromProto(mesh);
 }
 
-absl::StatusOr<std::vector<v1::Mesh>> GeodexClient::ListMeshes() {
-  std::vector<v1::Mesh> out;
+absl::StatusOr<std::vector<ServerMesh>> GeodexClient::ListMeshes() {
+  std::vector<ServerMesh> out;
   std::string token;
   do {
     v1::ListMeshesRequest request;
@@ -244,7 +298,7 @@ absl::StatusOr<std::vector<v1::Mesh>> GeodexClient::ListMeshes() {
       return stub_->ListMeshes(context, request, &response);
     });
     if (!status.ok()) return ToAbsl(status);
-    out.insert(out.end(), response.meshes().begin(), response.meshes().end());
+    for (const v1::Mesh& m : response.meshes()) out.push_back(ServerMeshFromProto(m));
     token = response.next_page_token();
   } while (!token.empty());
   return out;
@@ -260,26 +314,26 @@ absl::Status GeodexClient::DeleteMesh(const std::string& name) {
   }));
 }
 
-absl::StatusOr<v1::Mesh> GeodexClient::DeriveMesh(const std::string& name,
-                                                  const v1::Barrier& barrier,
-                                                  const std::string& alias) {
+absl::StatusOr<ServerMesh> GeodexClient::DeriveMesh(const std::string& name,
+                                                    const BarrierOptions& barrier,
+                                                    const std::string& alias) {
   v1::DeriveMeshRequest request;
   request.set_mesh(name);
-  *request.mutable_barrier() = barrier;
+  *request.mutable_barrier() = BarrierToProto(barrier);
   request.set_display_name(alias);
   v1::Mesh mesh;
   grpc::Status status = Call(IdOfName(name), [&](grpc::ClientContext* context) {
     return stub_->DeriveMesh(context, request, &mesh);
   });
   if (!status.ok()) return ToAbsl(status);
-  return mesh;
+  return ServerMeshFromProto(mesh);
 }
 
 absl::StatusOr<MeshRef> GeodexClient::UploadIfAbsent(MeshRef ref) {
-  absl::StatusOr<v1::Mesh> existing = GetMesh(ref.name);
+  absl::StatusOr<ServerMesh> existing = GetMesh(ref.name);
   if (existing.ok()) return ref;
   if (!absl::IsNotFound(existing.status())) return existing.status();
-  absl::StatusOr<v1::Mesh> uploaded = Upload(ref.file_name, ref.file_bytes, "", ref.id, ref.dem);
+  absl::StatusOr<ServerMesh> uploaded = Upload(ref.file_name, ref.file_bytes, "", ref.id, ref.dem);
   if (!uploaded.ok()) return uploaded.status();
   ref.uploaded = true;
   return ref;
@@ -296,7 +350,7 @@ absl::StatusOr<MeshRef> GeodexClient::ResolveMeshData(const std::string& file_na
 }
 
 absl::StatusOr<MeshRef> GeodexClient::ResolveDem(const std::string& path, const MeshData& mesh,
-                                                 const v1::DemOptions& options) {
+                                                 const DemUploadOptions& options) {
   MeshRef ref;
   ref.id = ComputeMeshId(mesh);
   ref.name = absl::StrCat("meshes/", ref.id);
@@ -304,11 +358,11 @@ absl::StatusOr<MeshRef> GeodexClient::ResolveDem(const std::string& path, const 
   ref.file_bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   ref.file_name = std::filesystem::path(path).filename().string();
   ref.dem = options;
-  absl::StatusOr<v1::Mesh> existing = GetMesh(ref.name);
-  if (existing.ok() && existing->has_terrain()) return ref;
+  absl::StatusOr<ServerMesh> existing = GetMesh(ref.name);
+  if (existing.ok() && existing->has_terrain) return ref;
   if (!existing.ok() && !absl::IsNotFound(existing.status())) return existing.status();
   // Absent, or stored without its map (uploaded as a mesh file): the raster gives it.
-  absl::StatusOr<v1::Mesh> uploaded = Upload(ref.file_name, ref.file_bytes, "", ref.id, ref.dem);
+  absl::StatusOr<ServerMesh> uploaded = Upload(ref.file_name, ref.file_bytes, "", ref.id, ref.dem);
   if (!uploaded.ok()) return uploaded.status();
   ref.uploaded = true;
   return ref;
@@ -341,7 +395,7 @@ absl::StatusOr<MeshRef> GeodexClient::ResolveMesh(const std::string& mesh) {
     ref.name = absl::StrCat("meshes/", key);
     return ref;
   }
-  absl::StatusOr<v1::Mesh> found = GetMesh(absl::StrCat("meshes/", key));
+  absl::StatusOr<ServerMesh> found = GetMesh(absl::StrCat("meshes/", key));
   if (!found.ok()) {
     if (absl::IsNotFound(found.status()) || absl::IsInvalidArgument(found.status())) {
       if (directory) {
@@ -352,8 +406,8 @@ absl::StatusOr<MeshRef> GeodexClient::ResolveMesh(const std::string& mesh) {
     }
     return found.status();
   }
-  ref.name = found->name();
-  ref.id = found->name().substr(7);
+  ref.name = found->name;
+  ref.id = found->id();
   return ref;
 }
 
@@ -440,18 +494,22 @@ absl::StatusOr<DistanceMatrix> GeodexClient::Matrix(MeshRef& mesh, const MatrixQ
   return std::move(matrix.result());
 }
 
-absl::StatusOr<v1::EstimateDistancesResponse> GeodexClient::PointDistances(
-    MeshRef& mesh, const PointQuery& query, v1::PointDistanceMode mode) {
+absl::StatusOr<PointDistances> GeodexClient::DistancesAtPoints(MeshRef& mesh,
+                                                               const PointQuery& query,
+                                                               PointDistanceMode mode) {
   v1::EstimateDistancesRequest request;
   request.set_mesh(mesh.name);
   api::PointQueryToProto(query, &request);
-  request.set_mode(mode);
+  request.set_mode(ModeToProto(mode));
   v1::EstimateDistancesResponse response;
   grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
     return stub_->EstimateDistances(context, request, &response);
   });
   if (!status.ok()) return ToAbsl(status);
-  return response;
+  PointDistances out;
+  out.estimates = api::PointEstimatesFromProto(response);
+  out.exact = api::PointValuesFromProto(response);
+  return out;
 }
 
 absl::StatusOr<std::vector<LocatedPoint>> GeodexClient::Locate(

@@ -13,6 +13,10 @@
 // - Every mesh-scoped call carries the mesh id as `x-mesh-id` metadata, so a gateway can route by
 //   mesh (uploads included). An alias is resolved to its id first (GetMesh).
 // Errors come back as absl::Status with the server's code and message.
+//
+// The API speaks core's types (geodex/*.h: SurfacePoint, FieldQuery, DistanceField, ...) and the
+// few of its own below; no generated geodex.v1 type appears here, and linking this library pulls
+// neither GDAL nor the terrain library (a DEM's map is read with proto/convert/terrain_convert.h).
 
 #include <cstdint>
 #include <functional>
@@ -22,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "geodex/delaunay.h"
 #include "geodex/distance_field.h"
@@ -30,12 +35,56 @@
 #include "geodex/isolines.h"
 #include "geodex/locate.h"
 #include "geodex/mesh_data.h"
+#include "geodex/point_distance.h"
 #include "geodex/shortest_path.h"
 #include "geodex/surface_point.h"
-#include "geodex/v1/geodex.grpc.pb.h"
+#include "geodex/triangle_mesh.h"
 #include "geodex/voronoi.h"
 
+namespace grpc {
+class Channel;
+class ClientContext;
+class Status;
+}  // namespace grpc
+
 namespace geodex::client {
+
+// A mesh as geodexd stores it (the geodex.v1.Mesh resource, in the client's terms).
+struct ServerMesh {
+  std::string name;          // "meshes/{id}"
+  std::string display_name;  // "" when none
+  std::vector<std::string> aliases;
+  MeshSummary summary;  // its counts and repairs, as Summarize() gives them locally
+  uint64_t upload_bytes = 0, memory_bytes = 0;
+  bool pinned = false;
+  int64_t create_time_seconds = 0;  // Unix time
+  // A DEM's mesh carries its map: `terrain` is the serialized geodex.v1.Terrain, read with
+  // api::TerrainFromBytes (proto/convert/terrain_convert.h, which links GDAL; this library does
+  // not).
+  bool has_terrain = false;
+  std::string terrain;
+  std::string id() const { return name.rfind("meshes/", 0) == 0 ? name.substr(7) : name; }
+};
+
+// How geodexd makes a mesh of an uploaded GeoTIFF DEM (geodex.v1.DemOptions).
+struct DemUploadOptions {
+  uint32_t step = 0;                    // every step-th cell (0 or 1: every cell)
+  std::optional<double> barrier_below;  // cells below this height are removed
+};
+
+// What DeriveMesh removes from a stored mesh (geodex.v1.Barrier).
+struct BarrierOptions {
+  std::optional<double> below;   // faces with a corner below this height
+  std::string polygons_geojson;  // polygons cut out, lines slit (docs/barriers.md)
+  double width = 0;              // lines and points widened to this width (map units)
+};
+
+// Which distances EstimateDistances answers with.
+enum class PointDistanceMode { kEstimate, kExact, kBoth };
+struct PointDistances {
+  std::vector<PointEstimate> estimates;  // the paper's unfolding estimate (kEstimate, kBoth)
+  PointValues exact;                     // exact values (kExact, kBoth)
+};
 
 // The request field a failed call named, read from the google.rpc.BadRequest geodexd attaches
 // (see server/status_convert.h): "sources[1].vertex" and what is wrong with it.
@@ -70,12 +119,15 @@ struct MeshRef {
   std::string file_name;
   bool uploaded = false;  // this client uploaded it
   // Set when file_bytes are a GeoTIFF DEM: uploaded as MESH_FORMAT_GEOTIFF with these options.
-  std::optional<v1::DemOptions> dem;
+  std::optional<DemUploadOptions> dem;
 };
 
 class GeodexClient {
  public:
   explicit GeodexClient(ClientOptions options);
+  ~GeodexClient();
+  GeodexClient(GeodexClient&&) noexcept;
+  GeodexClient& operator=(GeodexClient&&) noexcept;
 
   // grpc.health.v1 Check for `service` ("" = the server as a whole): true when SERVING.
   absl::StatusOr<bool> Health(const std::string& service = "");
@@ -89,22 +141,22 @@ class GeodexClient {
   // A GeoTIFF DEM at `path`, read here into `mesh` (whose id names it): the raster's bytes are
   // uploaded (MESH_FORMAT_GEOTIFF with `options`) unless the server has that mesh with its map.
   absl::StatusOr<MeshRef> ResolveDem(const std::string& path, const MeshData& mesh,
-                                     const v1::DemOptions& options);
+                                     const DemUploadOptions& options);
   // Uploads file bytes (idempotent). `expected_id` is checked by the server when set. With
   // `dem`, the bytes are a GeoTIFF DEM made a mesh with those options.
-  absl::StatusOr<v1::Mesh> Upload(const std::string& file_name, const std::string& bytes,
-                                  const std::string& alias, const std::string& expected_id,
-                                  const std::optional<v1::DemOptions>& dem = std::nullopt);
-  absl::StatusOr<v1::Mesh> GetMesh(const std::string& name);
+  absl::StatusOr<ServerMesh> Upload(const std::string& file_name, const std::string& bytes,
+                                    const std::string& alias, const std::string& expected_id,
+                                    const std::optional<DemUploadOptions>& dem = std::nullopt);
+  absl::StatusOr<ServerMesh> GetMesh(const std::string& name);
   // The mesh's positions and faces, as geodexd holds them (for drawing without the file).
   absl::StatusOr<MeshData> GetMeshGeometry(MeshRef& mesh);
-  absl::StatusOr<std::vector<v1::Mesh>> ListMeshes();  // every page
+  absl::StatusOr<std::vector<ServerMesh>> ListMeshes();  // every page
   absl::Status DeleteMesh(const std::string& name);
   // The mesh `name` without what `barrier` covers, stored by the server (DeriveMesh).
-  absl::StatusOr<v1::Mesh> DeriveMesh(const std::string& name, const v1::Barrier& barrier,
-                                      const std::string& alias = "");
+  absl::StatusOr<ServerMesh> DeriveMesh(const std::string& name, const BarrierOptions& barrier,
+                                        const std::string& alias = "");
 
-  // Queries (options: the proto's SolverOptions). Results in core's types.
+  // Queries, asked whole in core's types; results in core's types.
   // A field asked whole (api::FieldQueryToProto) and put back together (api::FieldAssembler),
   // with every product the query asks for; `cached`: the server's cache answered.
   absl::StatusOr<DistanceField> Field(MeshRef& mesh, const FieldQuery& query,
@@ -114,11 +166,10 @@ class GeodexClient {
   // The matrix asked whole (api::MatrixQueryToProto). The server streams rows as they finish;
   // query.options.on_row(rows received, rows), when set, is called as they arrive.
   absl::StatusOr<DistanceMatrix> Matrix(MeshRef& mesh, const MatrixQuery& query);
-  // EstimateDistances: the query sent whole (api::PointQueryToProto); read the exact part of the
-  // answer with api::PointValuesFromProto.
-  absl::StatusOr<v1::EstimateDistancesResponse> PointDistances(MeshRef& mesh,
-                                                               const PointQuery& query,
-                                                               v1::PointDistanceMode mode);
+  // EstimateDistances: the query sent whole (api::PointQueryToProto), the estimates and/or the
+  // exact values back.
+  absl::StatusOr<PointDistances> DistancesAtPoints(MeshRef& mesh, const PointQuery& query,
+                                                   PointDistanceMode mode);
   // The approximate geometry of section 6, asked whole (api::IsolineQueryToProto, ...) and
   // reassembled from the streamed pieces.
   absl::StatusOr<Isolines> ComputeIsolines(MeshRef& mesh, const IsolineQuery& query);
@@ -155,9 +206,11 @@ class GeodexClient {
   template <typename Assembler, typename Start, typename OnMessage>
   absl::Status ReadStream(MeshRef& mesh, Start start, Assembler* out, OnMessage on_message);
 
+  struct Stub;  // the generated geodex.v1 stub (geodex_client.cc)
+
   ClientOptions options_;
   std::shared_ptr<grpc::Channel> channel_;
-  std::unique_ptr<v1::Geodex::Stub> stub_;
+  std::unique_ptr<Stub> stub_;
   int calls_ = 0, retries_ = 0, reuploads_ = 0;
   std::string last_replica_;
 };

@@ -7,6 +7,7 @@
 #include "geodex/mesh_id.h"
 #include "google/protobuf/util/time_util.h"
 #include "status_convert.h"
+#include "terrain_convert.h"
 
 namespace geodex::server {
 namespace {

@@ -36,7 +36,7 @@ MessageProducer<Response> Streamed(std::vector<Response> messages, const SolvedF
 
 absl::StatusOr<MessageStream<v1::ComputeIsolinesResponse>> RunComputeIsolines(
     const QueryEnv& env, const v1::ComputeIsolinesRequest& request) {
-  absl::StatusOr<IsolineOptions> options = IsolineLevels(env, request.levels(), request.count());
+  absl::StatusOr<IsolineOptions> options = IsolineLevels(env, api::IsolineLevelsFromProto(request));
   if (!options.ok()) return options.status();
   absl::StatusOr<SolvedField> solved =
       SolveField(env, request.mesh(), request.sources(), request.options());

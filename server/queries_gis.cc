@@ -17,6 +17,7 @@
 #include "geodex/shortest_path.h"
 #include "geodex/terrain.h"
 #include "geodex/voronoi.h"
+#include "geometry_convert.h"
 #include "proto_convert.h"
 #include "queries.h"
 #include "query_support.h"
@@ -142,7 +143,7 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
   // The rest is made from the field of `sources` (cached like any field).
   absl::StatusOr<IsolineOptions> levels;
   if (product == v1::GIS_PRODUCT_ISOCHRONES) {
-    levels = IsolineLevels(env, request.levels(), request.count());
+    levels = IsolineLevels(env, api::IsolineLevelsFromProto(request.levels(), request.count()));
     if (!levels.ok()) return levels.status();
   }
   absl::StatusOr<SolvedField> solved =

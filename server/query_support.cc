@@ -165,10 +165,7 @@ absl::StatusOr<std::shared_ptr<const StoredMesh>> LookupMesh(const QueryEnv& env
   return mesh;  // or DataLoss (a corrupt file), ResourceExhausted (cannot be loaded back)
 }
 
-absl::StatusOr<IsolineOptions> IsolineLevels(const QueryEnv& env,
-                                             const google::protobuf::RepeatedField<double>& levels,
-                                             int32_t count) {
-  IsolineOptions options = api::IsolineLevelsFromProto(levels, count);
+absl::StatusOr<IsolineOptions> IsolineLevels(const QueryEnv& env, IsolineOptions options) {
   // Core's one check; its errors name the option ("levels[2]", "count").
   if (absl::Status s = ValidateIsolineOptions(options, env.limits->max_levels); !s.ok()) {
     const std::string option = InvalidOptionOf(s);

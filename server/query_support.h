@@ -42,11 +42,9 @@ absl::StatusOr<std::shared_ptr<const DistanceField>> CachedField(
     const GeodesicOptions& options, bool* cached);
 void FieldStatsToProto(const DistanceField& field, bool cached, v1::SolveStats* out);
 
-// Isoline levels from a request (api::IsolineLevelsFromProto), checked by core's
+// Isoline options read from a request (api::IsolineLevelsFromProto), checked by core's
 // ValidateIsolineOptions against --max_levels. Errors name the field or the flag.
-absl::StatusOr<IsolineOptions> IsolineLevels(const QueryEnv& env,
-                                             const google::protobuf::RepeatedField<double>& levels,
-                                             int32_t count);
+absl::StatusOr<IsolineOptions> IsolineLevels(const QueryEnv& env, IsolineOptions options);
 
 // The field behind distance fields, isolines, Voronoi and Delaunay.
 struct SolvedField {

@@ -13,7 +13,6 @@
 #include "geodex/point_distance.h"
 #include "geodex/shortest_path.h"
 #include "geodex/surface_point.h"
-#include "geodex/terrain.h"
 #include "geodex/triangle_mesh.h"
 #include "geodex/v1/geodex.pb.h"
 
@@ -36,11 +35,6 @@ SolveStats StatsFromProto(const v1::SolveStats& stats);
 // back (file_vertices and file_faces from vertex_count and face_count).
 void MeshSummaryToProto(const MeshSummary& summary, v1::Mesh* out);
 MeshSummary MeshSummaryFromProto(const v1::Mesh& mesh);
-
-// A DEM mesh's map (Mesh.terrain), both directions. A Terrain without 6 geotransform values
-// gives zeros (FromMesh then refuses it).
-void TerrainToProto(const terrain::DemInfo& info, v1::Terrain* out);
-terrain::DemInfo TerrainFromProto(const v1::Terrain& terrain);
 
 // The request's solver options: lambda, its scale and max_distance (the server's conversion back,
 // with validation and its window limit, is server/proto_convert.h's SolverOptionsFromProto).

@@ -95,6 +95,10 @@ void DelaunayQueryToProto(const DelaunayQuery& query, v1::ComputeDelaunayRequest
   SolverOptionsToProto(query.options, out->mutable_options());
 }
 
+IsolineOptions IsolineLevelsFromProto(const v1::ComputeIsolinesRequest& request) {
+  return IsolineLevelsFromProto(request.levels(), request.count());
+}
+
 IsolineOptions IsolineLevelsFromProto(const google::protobuf::RepeatedField<double>& levels,
                                       int32_t count) {
   IsolineOptions out;

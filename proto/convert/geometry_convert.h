@@ -26,7 +26,9 @@ namespace geodex::api {
 void IsolineQueryToProto(const IsolineQuery& query, v1::ComputeIsolinesRequest* out);
 void VoronoiQueryToProto(const VoronoiQuery& query, v1::ComputeVoronoiRequest* out);
 void DelaunayQueryToProto(const DelaunayQuery& query, v1::ComputeDelaunayRequest* out);
-// The levels of ComputeIsolines (and of ExportGis' isochrones): `levels`, or without them `count`.
+// The isoline options of ComputeIsolines (an option added to IsolineOptions is read here), and
+// the levels of ExportGis' isochrones: `levels`, or without them `count`.
+IsolineOptions IsolineLevelsFromProto(const v1::ComputeIsolinesRequest& request);
 IsolineOptions IsolineLevelsFromProto(const google::protobuf::RepeatedField<double>& levels,
                                       int32_t count);
 

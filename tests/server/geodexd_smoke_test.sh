@@ -13,6 +13,19 @@ start_geodexd "$tmp/log" --metrics_listen 127.0.0.1:0 --data-dir "$tmp/data" \
 port=$geodexd_port
 check "reports a listening port" test -n "$port"
 check "the port is open on 127.0.0.1" bash -c "exec 3<>/dev/tcp/127.0.0.1/$port"
+# The client library's example (it links geodex_client alone): a path on a mesh file it uploads.
+if [ -n "${PATH_CLIENT:-}" ]; then
+  "$PATH_CLIENT" "127.0.0.1:$port" "$DATA/kitten.off" 0 1000 >"$tmp/path.txt" 2>&1
+  check "the client example answers a path" test $? -eq 0
+  check "its length is positive and its points end at the vertices" /usr/bin/python3 - "$tmp/path.txt" <<'PY'
+import sys
+rows = open(sys.argv[1]).read().split("\n")
+length = float(rows[0].split()[1].rstrip(","))
+points = [r.split() for r in rows[1:] if r.strip()]
+assert length > 0 and len(points) >= 2, rows[:3]
+assert {points[0][3], points[-1][3]} == {"0", "1000"}, (points[0], points[-1])
+PY
+fi
 stop_geodexd "$geodexd_pid" 30  # up to 30 s to drain and exit (124 if it had not)
 rc=$?
 check "SIGTERM exits 0" test "$rc" -eq 0
