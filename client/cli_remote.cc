@@ -158,9 +158,9 @@ class RemoteBackend final : public Backend {
       }
       return derived.status();
     }
-    WarnIfBarrierSplits(options, derived->components());
-    mesh_.name = derived->name();
-    mesh_.id = derived->name().substr(7);
+    WarnIfBarrierSplits(options, derived->summary.report.components);
+    mesh_.name = derived->name;
+    mesh_.id = derived->id();
     return absl::OkStatus();
   }
 

@@ -27,8 +27,8 @@
 namespace geodex::client {
 
 // The generated stub, kept out of the public header.
-struct GeodexClient::Stub : v1::Geodex::Stub {
-  using v1::Geodex::Stub::Stub;
+struct GeodexClient::Stub {
+  std::unique_ptr<v1::Geodex::Stub> rpc;
 };
 
 namespace {
@@ -135,7 +135,7 @@ GeodexClient::GeodexClient(ClientOptions options) : options_(std::move(options))
     credentials = grpc::SslCredentials(ssl);
   }
   channel_ = grpc::CreateCustomChannel(options_.target, credentials, args);
-  stub_ = std::make_unique<Stub>(channel_);
+  stub_ = std::make_unique<Stub>(Stub{v1::Geodex::NewStub(channel_)});
 }
 
 GeodexClient::~GeodexClient() = default;
@@ -247,7 +247,7 @@ absl::StatusOr<ServerMesh> GeodexClient::Upload(const std::string& file_name,
                                                 const std::optional<DemUploadOptions>& dem) {
   v1::Mesh mesh;
   grpc::Status status = Call(expected_id, [&](grpc::ClientContext* context) {
-    auto writer = stub_->CreateMesh(context, &mesh);
+    auto writer = stub_->rpc->CreateMesh(context, &mesh);
     v1::CreateMeshRequest request;
     v1::CreateMeshMetadata* metadata = request.mutable_metadata();
     metadata->set_file_name(file_name);
@@ -280,8 +280,9 @@ absl::StatusOr<ServerMesh> GeodexClient::GetMesh(const std::string& name) {
   request.set_name(name);
   v1::Mesh mesh;
   const std::string id = IdOfName(name);
-  grpc::Status status = Call(
-      id, [&](grpc::ClientContext* context) { return stub_->GetMesh(context, request, &mesh); });
+  grpc::Status status = Call(id, [&](grpc::ClientContext* context) {
+    return stub_->rpc->GetMesh(context, request, &mesh);
+  });
   if (!status.ok()) return ToAbsl(status);
   return ServerMeshFromProto(mesh);
 }
@@ -295,7 +296,7 @@ absl::StatusOr<std::vector<ServerMesh>> GeodexClient::ListMeshes() {
     request.set_page_token(token);
     v1::ListMeshesResponse response;
     grpc::Status status = Call("", [&](grpc::ClientContext* context) {
-      return stub_->ListMeshes(context, request, &response);
+      return stub_->rpc->ListMeshes(context, request, &response);
     });
     if (!status.ok()) return ToAbsl(status);
     for (const v1::Mesh& m : response.meshes()) out.push_back(ServerMeshFromProto(m));
@@ -310,7 +311,7 @@ absl::Status GeodexClient::DeleteMesh(const std::string& name) {
   v1::DeleteMeshResponse response;
   const std::string id = IdOfName(name);
   return ToAbsl(Call(id, [&](grpc::ClientContext* context) {
-    return stub_->DeleteMesh(context, request, &response);
+    return stub_->rpc->DeleteMesh(context, request, &response);
   }));
 }
 
@@ -323,7 +324,7 @@ absl::StatusOr<ServerMesh> GeodexClient::DeriveMesh(const std::string& name,
   request.set_display_name(alias);
   v1::Mesh mesh;
   grpc::Status status = Call(IdOfName(name), [&](grpc::ClientContext* context) {
-    return stub_->DeriveMesh(context, request, &mesh);
+    return stub_->rpc->DeriveMesh(context, request, &mesh);
   });
   if (!status.ok()) return ToAbsl(status);
   return ServerMeshFromProto(mesh);
@@ -439,7 +440,8 @@ absl::StatusOr<DistanceField> GeodexClient::Field(MeshRef& mesh, const FieldQuer
   request.set_want_stats(true);
   api::FieldAssembler field;
   if (absl::Status s = ReadStream(
-          mesh, [&](grpc::ClientContext* c) { return stub_->ComputeDistanceField(c, request); },
+          mesh,
+          [&](grpc::ClientContext* c) { return stub_->rpc->ComputeDistanceField(c, request); },
           &field, kNothing);
       !s.ok()) {
     return s;
@@ -453,8 +455,8 @@ absl::StatusOr<MeshData> GeodexClient::GetMeshGeometry(MeshRef& mesh) {
   request.set_name(mesh.name);
   api::MeshGeometryAssembler out;
   if (absl::Status s = ReadStream(
-          mesh, [&](grpc::ClientContext* c) { return stub_->GetMeshGeometry(c, request); }, &out,
-          kNothing);
+          mesh, [&](grpc::ClientContext* c) { return stub_->rpc->GetMeshGeometry(c, request); },
+          &out, kNothing);
       !s.ok()) {
     return s;
   }
@@ -468,7 +470,7 @@ absl::StatusOr<PathQueryResult> GeodexClient::ShortestPath(MeshRef& mesh, const 
   request.set_want_stats(true);
   v1::FindShortestPathResponse response;
   grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
-    return stub_->FindShortestPath(context, request, &response);
+    return stub_->rpc->FindShortestPath(context, request, &response);
   });
   if (!status.ok()) return ToAbsl(status);
   return api::PathResultFromProto(response);
@@ -481,7 +483,8 @@ absl::StatusOr<DistanceMatrix> GeodexClient::Matrix(MeshRef& mesh, const MatrixQ
   request.set_want_stats(true);
   api::MatrixAssembler matrix;
   if (absl::Status s = ReadStream(
-          mesh, [&](grpc::ClientContext* c) { return stub_->ComputeDistanceMatrix(c, request); },
+          mesh,
+          [&](grpc::ClientContext* c) { return stub_->rpc->ComputeDistanceMatrix(c, request); },
           &matrix,
           [&](api::MatrixAssembler& m) {
             if (query.options.on_row && m.result().cols > 0) {
@@ -503,7 +506,7 @@ absl::StatusOr<PointDistances> GeodexClient::DistancesAtPoints(MeshRef& mesh,
   request.set_mode(ModeToProto(mode));
   v1::EstimateDistancesResponse response;
   grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
-    return stub_->EstimateDistances(context, request, &response);
+    return stub_->rpc->EstimateDistances(context, request, &response);
   });
   if (!status.ok()) return ToAbsl(status);
   PointDistances out;
@@ -520,7 +523,7 @@ absl::StatusOr<std::vector<LocatedPoint>> GeodexClient::Locate(
   if (std::isfinite(max_snap)) request.set_max_snap(max_snap);
   v1::LocatePointsResponse response;
   grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
-    return stub_->LocatePoints(context, request, &response);
+    return stub_->rpc->LocatePoints(context, request, &response);
   });
   if (!status.ok()) return ToAbsl(status);
   std::vector<LocatedPoint> out;
@@ -534,8 +537,8 @@ absl::StatusOr<Isolines> GeodexClient::ComputeIsolines(MeshRef& mesh, const Isol
   api::IsolineQueryToProto(query, &request);
   api::IsolinesAssembler out;
   if (absl::Status s = ReadStream(
-          mesh, [&](grpc::ClientContext* c) { return stub_->ComputeIsolines(c, request); }, &out,
-          kNothing);
+          mesh, [&](grpc::ClientContext* c) { return stub_->rpc->ComputeIsolines(c, request); },
+          &out, kNothing);
       !s.ok()) {
     return s;
   }
@@ -549,8 +552,8 @@ absl::StatusOr<VoronoiDiagram> GeodexClient::ComputeVoronoi(MeshRef& mesh,
   api::VoronoiQueryToProto(query, &request);
   api::VoronoiAssembler out;
   if (absl::Status s = ReadStream(
-          mesh, [&](grpc::ClientContext* c) { return stub_->ComputeVoronoi(c, request); }, &out,
-          kNothing);
+          mesh, [&](grpc::ClientContext* c) { return stub_->rpc->ComputeVoronoi(c, request); },
+          &out, kNothing);
       !s.ok()) {
     return s;
   }
@@ -564,8 +567,8 @@ absl::StatusOr<DelaunayTriangulation> GeodexClient::ComputeDelaunay(MeshRef& mes
   api::DelaunayQueryToProto(query, &request);
   api::DelaunayAssembler out;
   if (absl::Status s = ReadStream(
-          mesh, [&](grpc::ClientContext* c) { return stub_->ComputeDelaunay(c, request); }, &out,
-          kNothing);
+          mesh, [&](grpc::ClientContext* c) { return stub_->rpc->ComputeDelaunay(c, request); },
+          &out, kNothing);
       !s.ok()) {
     return s;
   }
