@@ -4,6 +4,7 @@
 #include <future>
 #include <random>
 
+#include "absl/status/status.h"
 #include "grpcpp/client_context.h"
 #include "grpcpp/support/byte_buffer.h"
 
@@ -65,25 +66,8 @@ void MixResult::Merge(const MixResult& other) {
 }
 
 std::string StatusName(grpc::StatusCode code) {
-  static const char* const kNames[] = {"OK",
-                                       "CANCELLED",
-                                       "UNKNOWN",
-                                       "INVALID_ARGUMENT",
-                                       "DEADLINE_EXCEEDED",
-                                       "NOT_FOUND",
-                                       "ALREADY_EXISTS",
-                                       "PERMISSION_DENIED",
-                                       "RESOURCE_EXHAUSTED",
-                                       "FAILED_PRECONDITION",
-                                       "ABORTED",
-                                       "OUT_OF_RANGE",
-                                       "UNIMPLEMENTED",
-                                       "INTERNAL",
-                                       "UNAVAILABLE",
-                                       "DATA_LOSS",
-                                       "UNAUTHENTICATED"};
-  const int i = static_cast<int>(code);
-  return i >= 0 && i <= 16 ? kNames[i] : "code " + std::to_string(i);
+  const std::string name = absl::StatusCodeToString(static_cast<absl::StatusCode>(code));
+  return name.empty() ? "code " + std::to_string(static_cast<int>(code)) : name;
 }
 
 MixResult RunMixClient(const std::shared_ptr<grpc::Channel>& channel,
