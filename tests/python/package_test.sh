@@ -14,3 +14,14 @@ cd "$tmp"  # nothing of the source tree on the path
 unset PYTHONPATH
 "$tmp/venv/bin/python" -c "import geodex, sys; assert 'site-packages' in geodex.__file__, geodex.__file__"
 "$tmp/venv/bin/python" "$SRC/tests/python/python_client_test.py"
+
+# examples/planner.py with the installed package: the exact length alone on line 1, the CLI's to
+# the bit, and a too-short timeout that is DEADLINE_EXCEEDED before the same client answers.
+start_geodexd "$tmp/server.log" --data-dir "$tmp/data" || die "geodexd did not start" "$tmp/server.log"
+"$tmp/venv/bin/python" "$SRC/examples/planner.py" "127.0.0.1:$geodexd_port" "$DATA/kitten.off" 0 1000 \
+  >"$tmp/planner.out" 2>&1 || die "examples/planner.py failed" "$tmp/planner.out"
+expected=$("$GEODEX" path "$DATA/kitten.off" --from 0 --to 1000 | head -1)
+test "$(head -1 "$tmp/planner.out")" = "$expected" || die "planner.py's length is not the CLI's ($expected)" "$tmp/planner.out"
+grep -q "^deadline 1 us: DEADLINE_EXCEEDED" "$tmp/planner.out" || die "no deadline error" "$tmp/planner.out"
+grep -q "^deadline 60 s: 2500 distances" "$tmp/planner.out" || die "no answer after the deadline" "$tmp/planner.out"
+echo "examples/planner.py: ok"

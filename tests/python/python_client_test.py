@@ -10,10 +10,13 @@ import re
 import signal
 import subprocess
 import tempfile
+import threading
 import time
 import unittest
 
 import json
+
+import numpy
 
 import geodex
 from geodex import GeodexClient, face_point, position, vertex
@@ -72,8 +75,9 @@ class PythonClientTest(unittest.TestCase):
         expected = [float(x) for x in
                     self.local("distances", os.path.join(DATA, "kitten.off"), "--sources",
                                "0,f:10:0.2:0.3:0.5").split()]
-        self.assertEqual(distances, expected)  # bit for bit (%.17g round-trips)
-        self.assertEqual(set(labels), {0, 1})
+        self.assertEqual((distances.dtype, labels.dtype), (numpy.float64, numpy.uint32))
+        self.assertEqual(distances.tolist(), expected)  # bit for bit (%.17g round-trips)
+        self.assertEqual(set(labels.tolist()), {0, 1})
         self.assertGreater(stats.windows_created, 0)
 
     def test_direction_field_equals_the_cli(self):
@@ -84,7 +88,8 @@ class PythonClientTest(unittest.TestCase):
         self.assertEqual(len(field.directions), 2500)
         for (x, y, z), line in zip(field.directions, lines):
             self.assertEqual([x, y, z], [float(v) for v in line.split("\t")[1].split()])
-        self.assertEqual(field.directions[0], (0.0, 0.0, 0.0))  # a source
+        self.assertEqual(field.directions.shape, (2500, 3))
+        self.assertEqual(field.directions[0].tolist(), [0.0, 0.0, 0.0])  # a source
         self.assertAlmostEqual(sum(c * c for c in field.directions[7]), 1.0, delta=1e-12)
 
     def test_directions_at_points_equal_the_cli(self):
@@ -96,10 +101,10 @@ class PythonClientTest(unittest.TestCase):
         self.assertEqual(len(at.directions), 3)
         for d, line in zip(at.directions, lines):  # bit for bit
             self.assertEqual(list(d), [float(v) for v in line.split("\t")[4].split()[1:]])
-        self.assertEqual(at.directions[2], (0.0, 0.0, 0.0))  # a source
+        self.assertEqual(at.directions[2].tolist(), [0.0, 0.0, 0.0])  # a source
         self.assertAlmostEqual(sum(c * c for c in at.directions[0]), 1.0, delta=1e-12)
         plain = self.client.point_distances(self.mesh.name, [vertex(0)], [vertex(5)])
-        self.assertEqual(plain.directions, [])
+        self.assertEqual(plain.directions.shape, (0, 3))
 
     def test_shortest_path_equals_the_cli(self):
         length, points = self.client.shortest_path(self.mesh.name, vertex(0), vertex(1250))
@@ -125,7 +130,8 @@ class PythonClientTest(unittest.TestCase):
         lines = self.local("matrix", os.path.join(DATA, "kitten.off"), "--sources",
                            ",".join(map(str, sources)), "--targets",
                            ",".join(map(str, targets))).splitlines()
-        self.assertEqual(full, [[float(x) for x in line.split()] for line in lines])  # bit for bit
+        self.assertEqual(full.shape, (3, 4))
+        self.assertEqual(full.tolist(), [[float(x) for x in line.split()] for line in lines])
         nearest = self.client.distance_matrix(self.mesh.name, [vertex(v) for v in sources],
                                               [vertex(v) for v in targets], k_nearest=2)
         for row, kept in zip(full, nearest):
@@ -135,7 +141,7 @@ class PythonClientTest(unittest.TestCase):
         capped = self.client.distance_matrix(self.mesh.name, [vertex(v) for v in sources],
                                              [vertex(v) for v in targets], max_distance=limit)
         for row, cut in zip(full, capped):
-            self.assertEqual(cut, [d if d < limit else float("inf") for d in row])
+            self.assertEqual(cut.tolist(), [d if d < limit else float("inf") for d in row])
         with self.assertRaises(geodex.InvalidArgumentError) as error:
             self.client.distance_matrix(self.mesh.name, [vertex(0)], [vertex(7)], lambda_=2.0)
         self.assertEqual(error.exception.field, "options.lambda")
@@ -186,9 +192,9 @@ class PythonClientTest(unittest.TestCase):
                                          [vertex(7), face_point(30, 0.2, 0.2, 0.6)])
         cli = json.loads(self.local("distances", kitten, "--sources", "1", "--at",
                                     "7,f:30:0.2:0.2:0.6", "--format", "json"))["points"]
-        self.assertEqual(at.exact, [p["exact"] for p in cli])
-        self.assertEqual(at.estimates, [p["estimate"] for p in cli])
-        self.assertEqual(at.exact_labels, [0, 0])
+        self.assertEqual(at.exact.tolist(), [p["exact"] for p in cli])
+        self.assertEqual(at.estimates.tolist(), [p["estimate"] for p in cli])
+        self.assertEqual(at.exact_labels.tolist(), [0, 0])
         located = self.client.locate(self.mesh.name, [(0, 0, 0), (0, 100, 0)])
         cli = json.loads(self.local("locate", kitten, "--points", "p:0:0:0,p:0:100:0",
                                     "--format", "json"))["points"]
@@ -239,8 +245,8 @@ class PythonClientTest(unittest.TestCase):
         expected = [float(x) for x in self.local(
             "distances", tif, "--sources",
             "g:500031.5:4999903.5,ll:%.17g:%.17g" % (lon, lat)).split()]
-        self.assertEqual(field.distances, expected)  # dropped where the CLI drops them
-        self.assertEqual(set(field.labels), {0, 1})
+        self.assertEqual(field.distances.tolist(), expected)  # dropped where the CLI drops them
+        self.assertEqual(set(field.labels.tolist()), {0, 1})
         with self.assertRaises(geodex.InvalidArgumentError) as error:  # in the nodata slot
             self.client.distance_field("meshes/slope", [geodex.map_point(500125, 4999850)])
         self.assertEqual(error.exception.field, "sources[0].map_point")
@@ -262,7 +268,7 @@ class PythonClientTest(unittest.TestCase):
         around = self.client.distance_field("meshes/walled", [geodex.map_point(500031.5, 4999903.5)])
         expected = [float(x) for x in self.local(
             "distances", tif, "--sources", "g:500031.5:4999903.5", "--barrier", wall_file).split()]
-        self.assertEqual(around.distances, expected)
+        self.assertEqual(around.distances.tolist(), expected)
         self.assertGreater(around.distances[7], field.distances[7])
         with self.assertRaises(geodex.InvalidArgumentError) as error:
             self.client.derive_mesh("meshes/slope")
@@ -308,6 +314,148 @@ class PythonClientTest(unittest.TestCase):
         self.assertEqual((error.exception.reason, error.exception.flag), ("LIMIT", "max_targets"))
         with self.assertRaises(geodex.UnavailableError):
             geodex.GeodexClient("127.0.0.1:1", timeout=5).health()
+
+
+def start_geodexd(tmp, listen="127.0.0.1:0", name="server"):
+    """A geodexd child on 127.0.0.1 (the port it picks, or `listen`); returns (process, port, log)."""
+    log = open(os.path.join(tmp, name + ".log"), "w+")
+    server = subprocess.Popen(
+        [GEODEXD, "--listen", listen, "--metrics_listen", "", "--pool-threads", "2",
+         "--data-dir", os.path.join(tmp, "data"), "--shutdown_grace_seconds", "5"],
+        stdout=log, stderr=subprocess.STDOUT)
+    for _ in range(300):
+        log.seek(0)
+        match = re.search(r"listening on port (\d+)", log.read())
+        if match:
+            return server, match.group(1), log
+        if server.poll() is not None:
+            break
+        time.sleep(0.1)
+    server.kill()
+    raise AssertionError("geodexd did not start")
+
+
+def stop_geodexd(server, log):
+    server.send_signal(signal.SIGTERM)
+    try:
+        server.wait(timeout=30)
+    finally:
+        if server.poll() is None:
+            server.kill()
+            server.wait(timeout=10)
+        log.close()
+
+
+def read_off(path):
+    """Vertices (n x 3) and faces (m x 3) of a plain OFF file."""
+    rows = [r.split() for r in open(path) if r.strip() and not r.startswith("#")]
+    nv, nf = int(rows[1][0]), int(rows[1][1])
+    vertices = numpy.array([[float(x) for x in r[:3]] for r in rows[2:2 + nv]])
+    faces = numpy.array([[int(x) for x in r[1:4]] for r in rows[2 + nv:2 + nv + nf]])
+    return vertices, faces
+
+
+def bumpy_grid(n):
+    """An n x n vertex grid of bumps: 2 (n - 1)^2 faces."""
+    x, y = numpy.meshgrid(numpy.linspace(0, 1, n), numpy.linspace(0, 1, n))
+    z = 0.05 * numpy.sin(9 * x) * numpy.cos(7 * y)
+    vertices = numpy.stack([x.ravel(), y.ravel(), z.ravel()], axis=1)
+    i = numpy.arange(n - 1)
+    a = (i[None, :] + n * i[:, None]).ravel()
+    faces = numpy.concatenate([numpy.stack([a, a + 1, a + n + 1], 1),
+                               numpy.stack([a, a + n + 1, a + n], 1)])
+    return vertices, faces
+
+
+class ControlLoopTest(unittest.TestCase):
+    """What a planner's control loop needs: a deadline per call, retries across a restart, the
+    mesh uploaded again after the server lost it, meshes from bytes and arrays."""
+
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        self.server, self.port, self.log = start_geodexd(self.tmp.name)
+
+    def tearDown(self):
+        if self.server is not None:
+            stop_geodexd(self.server, self.log)
+        self.tmp.cleanup()
+
+    def client(self, **kwargs):
+        return GeodexClient("127.0.0.1:" + self.port, **kwargs)
+
+    def test_a_timeout_per_call(self):
+        client = self.client(timeout=120)
+        mesh = client.upload(bumpy_grid(211))  # 88,200 faces, sent as arrays
+        self.assertEqual(mesh.face_count, 88200)
+        with self.assertRaises(geodex.DeadlineExceededError):
+            client.distance_field(mesh.name, [vertex(0)], timeout=0.005)
+        field = client.distance_field(mesh.name, [vertex(0)], timeout=60)  # the same client
+        self.assertEqual(field.distances.shape, (211 * 211,))
+        self.assertTrue(numpy.isfinite(field.distances).all())
+        path = client.shortest_path(mesh.name, vertex(0), vertex(5), timeout=1)  # not an option
+        self.assertGreater(path.length, 0)
+
+    def test_bytes_and_arrays_upload_as_the_file(self):
+        client = self.client(timeout=60)
+        kitten = os.path.join(DATA, "kitten.off")
+        from_file = client.upload(kitten)
+        with open(kitten, "rb") as f:
+            from_bytes = client.upload(f.read(), file_name="kitten.off")
+        from_arrays = client.upload(read_off(kitten), name="kitten-arrays")
+        self.assertEqual(from_bytes.name, from_file.name)
+        self.assertEqual(from_arrays.name, from_file.name)  # float64 round-trips: the same id
+        self.assertIn("kitten-arrays", from_arrays.aliases)
+        self.assertEqual(client.get_mesh("meshes/kitten-arrays").name, from_file.name)
+        self.assertTrue(from_file.name.startswith("meshes/") and len(from_file.id) == 64)
+        with self.assertRaises(geodex.InvalidArgumentError) as error:
+            client.upload(b"OFF\n")
+        self.assertEqual(error.exception.field, "file_name")
+
+    def test_the_mesh_is_uploaded_again_after_the_server_lost_it(self):
+        client = self.client(timeout=60)
+        mesh = client.upload(os.path.join(DATA, "kitten.off"))
+        before = client.shortest_path(mesh.name, vertex(0), vertex(1250))
+        self.client(timeout=60).delete_mesh(mesh.name)  # another client: the server loses it
+        again = client.shortest_path(mesh.name, vertex(0), vertex(1250))
+        self.assertEqual(again, before)
+        self.assertEqual(client.reuploads, 1)
+
+    def test_retries_survive_a_restart(self):
+        client = self.client(timeout=60, retry=geodex.RetryPolicy(max_attempts=10,
+                                                                   initial_backoff=0.1))
+        mesh = client.upload(os.path.join(DATA, "kitten.off"))
+        before = client.shortest_path(mesh.name, vertex(0), vertex(1250))
+        stop_geodexd(self.server, self.log)  # down; back on the same port a moment later
+        self.server = None
+        restarted = {}
+
+        def restart():
+            time.sleep(0.5)
+            restarted["server"] = start_geodexd(self.tmp.name, "127.0.0.1:" + self.port, "again")
+        thread = threading.Thread(target=restart)
+        thread.start()
+        try:
+            again = client.shortest_path(mesh.name, vertex(0), vertex(1250))
+        finally:
+            thread.join(timeout=60)
+            if "server" in restarted:
+                self.server, _, self.log = restarted["server"]
+        self.assertEqual(again, before)
+        self.assertGreater(client.retries, 0)
+
+    def test_bad_names_are_typed_errors(self):
+        client = self.client(timeout=60)
+        mesh = client.upload(os.path.join(DATA, "knight.off"))
+        with self.assertRaises(geodex.InvalidArgumentError) as error:
+            client.export_gis(mesh.name, "isochrone", [vertex(0)])
+        self.assertIn("isochrones", str(error.exception))  # lists the valid ones
+        self.assertEqual(error.exception.field, "product")
+        with self.assertRaises(geodex.InvalidArgumentError) as error:
+            client.shortest_path(mesh.name, vertex(0), vertex(5), lamda=0.5)
+        self.assertEqual(error.exception.field, "options.lamda")
+        path = client.shortest_path(mesh.name, vertex(0), vertex(5), lambda_scale="mean_edge",
+                                    lambda_=0.5)
+        self.assertGreater(path.length, 0)
 
 
 if __name__ == "__main__":
