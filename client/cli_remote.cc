@@ -16,8 +16,8 @@
 #include "absl/strings/str_format.h"
 #include "cli_backend.h"
 #include "cli_common.h"
+#include "geodex/geodex_client.h"
 #include "geodex/surface_point.h"
-#include "geodex_client.h"
 #include "terrain_convert.h"
 
 namespace geodex::cli {

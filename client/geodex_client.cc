@@ -1,4 +1,4 @@
-#include "geodex_client.h"
+#include "geodex/geodex_client.h"
 
 #include <chrono>
 #include <cmath>
@@ -177,6 +177,7 @@ grpc::Status GeodexClient::Call(const std::string& mesh_id,
     context.set_deadline(
         std::chrono::system_clock::now() +
         std::chrono::microseconds(static_cast<int64_t>(options_.deadline_seconds * 1e6)));
+    if (options_.wait_for_ready) context.set_wait_for_ready(true);
     if (!mesh_id.empty()) context.AddMetadata("x-mesh-id", mesh_id);
     if (!options_.token.empty()) context.AddMetadata("authorization", "Bearer " + options_.token);
     ++calls_;

@@ -9,9 +9,9 @@
 #include <cstdlib>
 #include <string>
 
+#include "geodex/geodex_client.h"
 #include "geodex/shortest_path.h"
 #include "geodex/surface_point.h"
-#include "geodex_client.h"
 
 int main(int argc, char** argv) {
   if (argc != 5) {

@@ -8,9 +8,9 @@
 
 #include "absl/time/clock.h"
 #include "geodex/geodesic_solver.h"
+#include "geodex/geodex_client.h"
 #include "geodex/mesh_id.h"
 #include "geodex/samples.h"
-#include "geodex_client.h"
 #include "server_test_util.h"
 
 namespace geodex::server {

@@ -7,7 +7,7 @@
 #include <fstream>
 
 #include "absl/strings/str_cat.h"
-#include "geodex_client.h"
+#include "geodex/geodex_client.h"
 #include "server_test_util.h"
 
 namespace geodex::server {

@@ -2,7 +2,9 @@
 
 // The C++ client library of geodexd (what `geodex --server` uses).
 //
-// - Every call has a deadline and is retried with exponential backoff when the server answers
+// - Every call has a deadline (ClientOptions::deadline_seconds, changed between calls with
+//   set_deadline_seconds: a control loop gives each call its own budget; it bounds each attempt)
+//   and is retried with exponential backoff when the server answers
 //   UNAVAILABLE (not yet listening, restarting, draining), or RESOURCE_EXHAUSTED with the
 //   ErrorInfo reason QUEUE_FULL (every worker busy and the queue full: a moment later it may
 //   fit). RESOURCE_EXHAUSTED for a limit (reason LIMIT) is never retried: it would fail again.
@@ -99,7 +101,10 @@ struct ClientOptions {
   double deadline_seconds = 600;           // per call
   int max_attempts = 4;                    // tries on UNAVAILABLE or a full queue
   double initial_backoff_seconds = 0.2;    // doubled after each retry
-  bool retry_queue_full = true;            // retry RESOURCE_EXHAUSTED reason QUEUE_FULL
+  // Wait for the server to come up (until the deadline) instead of failing an attempt at once
+  // with UNAVAILABLE while the channel is not connected (gRPC's wait-for-ready).
+  bool wait_for_ready = false;
+  bool retry_queue_full = true;  // retry RESOURCE_EXHAUSTED reason QUEUE_FULL
   size_t upload_chunk_bytes = 1 << 20;
   // TLS: `tls` on, with `ca_pem` the PEM roots to trust ("" = the system's roots).
   bool tls = false;
@@ -181,6 +186,11 @@ class GeodexClient {
   absl::StatusOr<std::vector<LocatedPoint>> Locate(
       MeshRef& mesh, const std::vector<std::array<double, 3>>& xyz,
       double max_snap = std::numeric_limits<double>::infinity());
+
+  // The deadline of each attempt of the calls made from now on (seconds; ClientOptions' at first).
+  // A GeodexClient is not thread-safe: one per thread, or one call at a time.
+  void set_deadline_seconds(double seconds) { options_.deadline_seconds = seconds; }
+  double deadline_seconds() const { return options_.deadline_seconds; }
 
   // Calls made, retries (UNAVAILABLE, full queue) and transparent re-uploads (for tests and
   // --stats).
