@@ -37,5 +37,6 @@ install(FILES ${CMAKE_CURRENT_BINARY_DIR}/geodexConfig.cmake
         DESTINATION ${GEODEX_CMAKE_DIR})
 
 # pkg-config: the client and everything it links, in link order.
+file(RELATIVE_PATH GEODEX_PC_TO_PREFIX "/p/${CMAKE_INSTALL_LIBDIR}/pkgconfig" "/p")
 configure_file(${PROJECT_SOURCE_DIR}/cmake/geodex.pc.in ${CMAKE_CURRENT_BINARY_DIR}/geodex.pc @ONLY)
 install(FILES ${CMAKE_CURRENT_BINARY_DIR}/geodex.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
