@@ -24,7 +24,8 @@ echo "| client | mesh | targets | calls | p50 ms | p99 ms | queries/s | server s
 echo "|---|---|---|---:|---:|---:|---:|---:|---:|"
 for mesh in "${meshes[@]}"; do
   [ -f "$mesh" ] || { echo "(missing $mesh)"; continue; }
-  "$build/bench/geodex_client_latency" "127.0.0.1:$port" "$mesh" "$calls"
+  "$build/client/geodex" distances "$mesh" --sources 0 >"$tmp/distances.txt"  # locally
+  "$build/bench/geodex_client_latency" "127.0.0.1:$port" "$mesh" "$tmp/distances.txt" "$calls"
   PYTHONPATH=client/python:"$build/python" /usr/bin/python3 bench/client_latency.py \
-    "127.0.0.1:$port" "$mesh" "$calls"
+    "127.0.0.1:$port" "$mesh" "$tmp/distances.txt" "$calls"
 done

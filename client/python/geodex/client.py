@@ -67,8 +67,9 @@ def lon_lat(lon: float, lat: float) -> "pb.SurfacePoint":
 # --- results: one kind of object, dataclasses; each also unpacks like a tuple ---------------
 
 class _Unpacks:
-    def __iter__(self):
-        return iter(getattr(self, f.name) for f in dataclasses.fields(self))
+    def __iter__(self):  # the fields marked unpack=False (added later) are left out
+        return iter(getattr(self, f.name) for f in dataclasses.fields(self)
+                    if f.metadata.get("unpack", True))
 
 
 @dataclasses.dataclass
@@ -81,9 +82,11 @@ class PathPoint(_Unpacks):
 
 @dataclasses.dataclass
 class Path(_Unpacks):
-    """An exact shortest path: its length and its points (`length, points = path`)."""
+    """An exact shortest path: its length and its points (`length, points = path`); with
+    want_stats, the solve's SolveStats in `stats` (solve_ms, windows_created, cached, ...)."""
     length: float
     points: List[PathPoint]
+    stats: Any = dataclasses.field(default=None, compare=False, metadata={"unpack": False})
 
 
 @dataclasses.dataclass(eq=False)
@@ -547,14 +550,15 @@ class GeodexClient:
                          (np.concatenate(directions) if directions else np.zeros(0)).reshape(-1, 3))
         return self._stream(self._raw_field, request, mesh, timeout, consume)
 
-    def shortest_path(self, mesh: str, start, end, timeout: Optional[float] = None,
-                      **options) -> Path:
-        """The exact shortest path: Path(length, [PathPoint(position, simplex), ...]). An
-        unreachable end raises UnreachableError."""
+    def shortest_path(self, mesh: str, start, end, want_stats: bool = False,
+                      timeout: Optional[float] = None, **options) -> Path:
+        """The exact shortest path: Path(length, [PathPoint(position, simplex), ...]), with the
+        solve's stats when `want_stats`. An unreachable end raises UnreachableError."""
         response = self._unary(self.stub.FindShortestPath, pb.FindShortestPathRequest(
-            mesh=mesh, to=end, options=_solver_options(options), **{"from": start}), mesh,
-            timeout)
-        return Path(response.distance, _path_points(response.points))
+            mesh=mesh, to=end, options=_solver_options(options), want_stats=want_stats,
+            **{"from": start}), mesh, timeout)
+        return Path(response.distance, _path_points(response.points),
+                    response.stats if response.HasField("stats") else None)
 
     def shortest_paths(self, mesh: str, pairs: Sequence[Tuple[Any, Any]],
                        timeout: Optional[float] = None, **options) -> List[Path]:
