@@ -37,13 +37,6 @@ Vec3 Cross(const Vec3& a, const Vec3& b) {
 }
 double Norm(const Vec3& a) { return std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]); }
 
-MeshData Soup(const std::vector<Vec3>& points, const std::vector<std::array<uint32_t, 3>>& faces) {
-  MeshData m;
-  for (const Vec3& p : points) m.positions.insert(m.positions.end(), p.begin(), p.end());
-  for (const auto& f : faces) m.faces.insert(m.faces.end(), f.begin(), f.end());
-  return m;
-}
-
 // File position of file face f's point with file-order barycentrics b.
 Vec3 FacePoint(const MeshData& data, uint32_t f, const Vec3& b) {
   Vec3 p{0, 0, 0};

@@ -35,13 +35,6 @@ constexpr double kPi = std::numbers::pi;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr uint32_t kNoLabel = 0xffffffffu;
 
-MeshData Soup(const std::vector<Vec3>& points, const std::vector<std::array<uint32_t, 3>>& faces) {
-  MeshData m;
-  for (const Vec3& p : points) m.positions.insert(m.positions.end(), p.begin(), p.end());
-  for (const auto& f : faces) m.faces.insert(m.faces.end(), f.begin(), f.end());
-  return m;
-}
-
 // Appends `b` to `a` (b's vertex ids shifted).
 MeshData Concat(MeshData a, const MeshData& b) {
   const uint32_t offset = static_cast<uint32_t>(a.vertex_count());

@@ -18,18 +18,12 @@
 #include "geodex/triangle_mesh.h"
 #include "gtest/gtest.h"
 #include "source_resolver.h"
+#include "util/mesh_factory.h"
 
 namespace geodex {
 namespace {
 
 using Vec3 = std::array<double, 3>;
-
-MeshData Soup(const std::vector<Vec3>& points, const std::vector<std::array<uint32_t, 3>>& faces) {
-  MeshData m;
-  for (const Vec3& p : points) m.positions.insert(m.positions.end(), p.begin(), p.end());
-  for (const auto& f : faces) m.faces.insert(m.faces.end(), f.begin(), f.end());
-  return m;
-}
 
 // Two fans meeting only at vertex 0 (a bowtie, so vertex 0 is split into two internal copies),
 // the first fan bent along edge 0-2 so that the surface is not a plane, and face 1 wound against

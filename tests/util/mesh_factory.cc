@@ -438,4 +438,12 @@ void ApplyRigidMotion(MeshData* mesh, const Vec3& axis, double angle, const Vec3
   }
 }
 
+MeshData Soup(const std::vector<std::array<double, 3>>& points,
+              const std::vector<std::array<uint32_t, 3>>& faces) {
+  MeshData m;
+  for (const auto& p : points) m.positions.insert(m.positions.end(), p.begin(), p.end());
+  for (const auto& f : faces) m.faces.insert(m.faces.end(), f.begin(), f.end());
+  return m;
+}
+
 }  // namespace geodex

@@ -118,4 +118,8 @@ double CylinderDistance(const Cylinder& cylinder, uint32_t a, uint32_t b);
 // move planar meshes off the z = 0 plane and away from the origin.
 void ApplyRigidMotion(MeshData* mesh, const Vec3& axis, double angle, const Vec3& translation);
 
+// A mesh from explicit points and faces (vertex ids into `points`), as a file would give them.
+MeshData Soup(const std::vector<std::array<double, 3>>& points,
+              const std::vector<std::array<uint32_t, 3>>& faces);
+
 }  // namespace geodex
