@@ -72,8 +72,22 @@ void MeshToProto(const StoredMesh& mesh, v1::Mesh* out) {
   if (mesh.terrain) api::TerrainToProto(*mesh.terrain, out->mutable_terrain());
 }
 
-absl::StatusOr<SurfacePoint> ResolvePoint(const StoredMesh& mesh, const v1::SurfacePoint& point,
-                                          const std::string& field) {
+absl::StatusOr<PointSnaps> SnapsFromRequest(bool has_max_snap, double max_snap) {
+  PointSnaps out;
+  if (has_max_snap) {
+    if (!(max_snap > 0)) {  // also NaN
+      return FieldError("max_snap", absl::StrCat("must be > 0 when set, got ", max_snap));
+    }
+    out.max_snap = max_snap;
+  }
+  return out;
+}
+
+namespace {
+
+// One point; `*snap` is how far a position moved (left 0 otherwise).
+absl::StatusOr<SurfacePoint> ResolveOne(const StoredMesh& mesh, const v1::SurfacePoint& point,
+                                        const std::string& field, double max_snap, double* snap) {
   SurfacePoint p;
   switch (point.point_case()) {
     case v1::SurfacePoint::kVertex:
@@ -103,9 +117,10 @@ absl::StatusOr<SurfacePoint> ResolvePoint(const StoredMesh& mesh, const v1::Surf
     case v1::SurfacePoint::kPosition: {
       const v1::Position& q = point.position();
       absl::StatusOr<LocatedPoint> located = mesh.locator->Locate({q.x(), q.y(), q.z()});
-      if (!located.ok()) {
-        return FieldError(absl::StrCat(field, ".position"), located.status().message());
-      }
+      absl::Status status = located.status();
+      if (status.ok()) status = CheckSnapDistance({q.x(), q.y(), q.z()}, *located, max_snap);
+      if (!status.ok()) return FieldError(absl::StrCat(field, ".position"), status.message());
+      *snap = located->distance;
       return located->point;
     }
     case v1::SurfacePoint::kMapPoint:
@@ -136,6 +151,16 @@ absl::StatusOr<SurfacePoint> ResolvePoint(const StoredMesh& mesh, const v1::Surf
                                    " and ", p.edge_to));
   }
   return p;
+}
+
+}  // namespace
+
+absl::StatusOr<SurfacePoint> ResolvePoint(const StoredMesh& mesh, const v1::SurfacePoint& point,
+                                          const std::string& field, PointSnaps* snaps) {
+  double snap = 0;
+  absl::StatusOr<SurfacePoint> out = ResolveOne(mesh, point, field, snaps->max_snap, &snap);
+  if (out.ok()) snaps->distances.push_back(snap);
+  return out;
 }
 
 absl::StatusOr<GeodesicOptions> SolverOptionsFromProto(const v1::SolverOptions& options,

@@ -4,7 +4,9 @@
 // InvalidArgument and names the request field ("sources[2].edge.t: ...").
 
 #include <array>
+#include <limits>
 #include <string>
+#include <vector>
 
 #include "absl/status/statusor.h"
 #include "api_convert.h"
@@ -27,10 +29,26 @@ absl::Status ValidateDisplayName(const std::string& name, const std::string& fie
 // Fills a Mesh resource.
 void MeshToProto(const StoredMesh& mesh, v1::Mesh* out);
 
+// A request's snapping rule and record (the proto's "Snapping"): positions farther than
+// `max_snap` from the surface are refused; ResolvePoint appends each point's snap distance, in
+// the order the points are resolved (0 for points given on the surface or dropped from a map).
+struct PointSnaps {
+  double max_snap = std::numeric_limits<double>::infinity();
+  std::vector<double> distances;
+};
+
+// The request's optional max_snap field: > 0 when set (InvalidArgument naming "max_snap").
+absl::StatusOr<PointSnaps> SnapsFromRequest(bool has_max_snap, double max_snap);
+template <typename Request>
+absl::StatusOr<PointSnaps> SnapsOf(const Request& request) {
+  return SnapsFromRequest(request.has_max_snap(), request.max_snap());
+}
+
 // A request point as a solver-ready SurfacePoint: range-checked against the mesh; positions are
-// snapped to the surface with the mesh's locator.
+// snapped to the surface with the mesh's locator, within `snaps->max_snap`, and every point's
+// snap distance recorded in `snaps`.
 absl::StatusOr<SurfacePoint> ResolvePoint(const StoredMesh& mesh, const v1::SurfacePoint& point,
-                                          const std::string& field);
+                                          const std::string& field, PointSnaps* snaps);
 
 // The plain conversions (shared with the client library).
 using api::PathPointToProto;

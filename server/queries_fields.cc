@@ -32,7 +32,7 @@ absl::StatusOr<MessageStream<v1::ComputeDistanceFieldResponse>> RunComputeDistan
     return FieldError("value_type", absl::StrCat("unknown value ", request.value_type()));
   }
   absl::StatusOr<SolvedField> solved =
-      SolveField(env, request.mesh(), request.sources(), request.options());
+      SolveField(env, request.mesh(), request.sources(), request.options(), SnapsOf(request));
   if (!solved.ok()) return solved.status();
 
   // Produced lazily from the field: no second copy of a large result. The products the request
@@ -64,6 +64,7 @@ absl::StatusOr<MessageStream<v1::ComputeDistanceFieldResponse>> RunComputeDistan
         if (state->started && state->next >= n) return false;
         const size_t begin = state->next, end = std::min(n, begin + chunk);
         api::FieldChunkToProto(field, state->products, begin, end, encoding, out);
+        if (!state->started) SnapsToProto(state->solved.snaps, out);
         if (end == n && want_stats) {
           FieldStatsToProto(field, state->solved.cached, out->mutable_stats());
         }
@@ -167,6 +168,7 @@ struct MatrixStreamState {
   bool done = false;
   SolveStats stats;
   bool cached = false;
+  std::vector<double> snap_distances;      // sent in the first message
   size_t next = 0;                         // the next value to send
   bool sent = false;                       // a message went out (an empty matrix still gets one)
   double progress = 0, progress_sent = 0;  // fraction of the solves done; the last one sent
@@ -187,6 +189,8 @@ Produced NextMatrixMessage(MatrixStreamState& state, bool f32, bool want_stats, 
   const size_t begin = state.next, end = std::min(ready, begin + chunk);
   api::MatrixChunkToProto(state.rows, state.cols, state.values, begin, end, f32, out);
   out->set_progress(progress);
+  if (!state.sent)
+    out->mutable_snap_distances()->Add(state.snap_distances.begin(), state.snap_distances.end());
   state.progress_sent = progress;
   if (end == n && want_stats) {
     StatsToProto(state.stats, out->mutable_stats());
@@ -206,11 +210,13 @@ absl::StatusOr<MessageStream<v1::ComputeDistanceMatrixResponse>> RunComputeDista
   }
   absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh = LookupMesh(env, request.mesh(), "mesh");
   if (!mesh.ok()) return mesh.status();
+  absl::StatusOr<PointSnaps> snaps = SnapsOf(request);
+  if (!snaps.ok()) return snaps.status();
   absl::StatusOr<std::vector<SurfacePoint>> sources =
-      ResolveSources(env, **mesh, request.sources());
+      ResolveSources(env, **mesh, request.sources(), &*snaps);
   if (!sources.ok()) return sources.status();
-  absl::StatusOr<std::vector<SurfacePoint>> targets =
-      ResolvePoints(**mesh, request.targets(), "targets", env.limits->max_targets, "max_targets");
+  absl::StatusOr<std::vector<SurfacePoint>> targets = ResolvePoints(
+      **mesh, request.targets(), "targets", env.limits->max_targets, "max_targets", &*snaps);
   if (!targets.ok()) return targets.status();
   const uint64_t values = uint64_t{sources->size()} * targets->size();
   if (values > env.limits->max_output_values) {
@@ -236,6 +242,7 @@ absl::StatusOr<MessageStream<v1::ComputeDistanceMatrixResponse>> RunComputeDista
   auto state = std::make_shared<MatrixStreamState>();
   state->rows = sources->size();
   state->cols = targets->size();
+  state->snap_distances = std::move(snaps->distances);
   const bool f32 = request.value_type() == v1::VALUE_TYPE_FLOAT32;
   const bool want_stats = request.want_stats();
   const size_t chunk = std::max<size_t>(1, env.limits->stream_chunk_bytes / (f32 ? 4 : 8));

@@ -24,10 +24,12 @@
 namespace geodex::server {
 namespace {
 
-// The geometry's messages as a stream, the field's stats in the last one when asked for.
+// The geometry's messages as a stream: the sources' snap distances in the first one, the field's
+// stats in the last one when asked for.
 template <typename Response>
 MessageProducer<Response> Streamed(std::vector<Response> messages, const SolvedField& solved,
                                    bool want_stats) {
+  SnapsToProto(solved.snaps, &messages.front());
   if (want_stats) FieldStatsToProto(*solved.field, solved.cached, messages.back().mutable_stats());
   return ProducerOf(std::move(messages));
 }
@@ -39,7 +41,7 @@ absl::StatusOr<MessageStream<v1::ComputeIsolinesResponse>> RunComputeIsolines(
   absl::StatusOr<IsolineOptions> options = IsolineLevels(env, api::IsolineLevelsFromProto(request));
   if (!options.ok()) return options.status();
   absl::StatusOr<SolvedField> solved =
-      SolveField(env, request.mesh(), request.sources(), request.options());
+      SolveField(env, request.mesh(), request.sources(), request.options(), SnapsOf(request));
   if (!solved.ok()) return solved.status();
   absl::StatusOr<Isolines> isolines =
       ExtractIsolines(*solved->mesh->mesh, *solved->field, *options);
@@ -53,7 +55,7 @@ absl::StatusOr<MessageStream<v1::ComputeIsolinesResponse>> RunComputeIsolines(
 absl::StatusOr<MessageStream<v1::ComputeVoronoiResponse>> RunComputeVoronoi(
     const QueryEnv& env, const v1::ComputeVoronoiRequest& request) {
   absl::StatusOr<SolvedField> solved =
-      SolveField(env, request.mesh(), request.sources(), request.options());
+      SolveField(env, request.mesh(), request.sources(), request.options(), SnapsOf(request));
   if (!solved.ok()) return solved.status();
   absl::StatusOr<VoronoiDiagram> diagram = BuildVoronoi(*solved->mesh->mesh, *solved->field);
   if (!diagram.ok()) return diagram.status();
@@ -66,7 +68,7 @@ absl::StatusOr<MessageStream<v1::ComputeVoronoiResponse>> RunComputeVoronoi(
 absl::StatusOr<MessageStream<v1::ComputeDelaunayResponse>> RunComputeDelaunay(
     const QueryEnv& env, const v1::ComputeDelaunayRequest& request) {
   absl::StatusOr<SolvedField> solved =
-      SolveField(env, request.mesh(), request.sources(), request.options());
+      SolveField(env, request.mesh(), request.sources(), request.options(), SnapsOf(request));
   if (!solved.ok()) return solved.status();
   absl::StatusOr<DelaunayTriangulation> delaunay =
       BuildDelaunay(*solved->mesh->mesh, *solved->field);

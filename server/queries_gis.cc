@@ -50,12 +50,13 @@ std::string SpecOf(const v1::SurfacePoint& p) {
   return "";
 }
 
-// The file, cut into messages of at most --stream_chunk_bytes; a file over 8 bytes per
-// --max_output_values is refused.
+// The file, cut into messages of at most --stream_chunk_bytes (the request points' snap
+// distances in the first); a file over 8 bytes per --max_output_values is refused.
 absl::StatusOr<MessageStream<v1::ExportGisResponse>> FileStream(const std::string& bytes,
                                                                 const char* media_type,
                                                                 uint32_t chunk_bytes,
-                                                                uint64_t max_output_values) {
+                                                                uint64_t max_output_values,
+                                                                const PointSnaps& snaps) {
   if (bytes.size() / 8 > max_output_values) {
     return ServerLimitError(
         "max_output_values",
@@ -65,7 +66,10 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> FileStream(const std::strin
   std::vector<v1::ExportGisResponse> messages;
   for (size_t offset = 0; offset < bytes.size() || messages.empty(); offset += chunk_bytes) {
     v1::ExportGisResponse& m = messages.emplace_back();
-    if (offset == 0) m.set_media_type(media_type);
+    if (offset == 0) {
+      m.set_media_type(media_type);
+      SnapsToProto(snaps, &m);
+    }
     m.set_data(bytes.substr(offset, chunk_bytes));
   }
   return ProducerOf(std::move(messages));
@@ -85,6 +89,8 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
     return FieldError("mesh", "not a DEM's mesh (upload a GeoTIFF): GIS files need its map");
   }
   const terrain::Dem& dem = *(*found)->dem;
+  absl::StatusOr<PointSnaps> snaps = SnapsOf(request);
+  if (!snaps.ok()) return snaps.status();
   const uint32_t chunk = env.limits->stream_chunk_bytes;
   const char* kGeoJson = "application/geo+json";
   auto geojson_of = [&](const terrain::Dem& on, const std::vector<terrain::GeoFeature>& features)
@@ -93,7 +99,7 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
     absl::StatusOr<std::string> text =
         terrain::GeoJsonText(on.info(), features, request.native_crs());
     if (!text.ok()) return text.status();
-    return FileStream(*text, kGeoJson, chunk, env.limits->max_output_values);
+    return FileStream(*text, kGeoJson, chunk, env.limits->max_output_values, *snaps);
   };
   auto geojson = [&](const std::vector<terrain::GeoFeature>& features) {
     return geojson_of(dem, features);
@@ -108,9 +114,10 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
         return FieldError(request.sources_size() != 1 ? "sources" : "points",
                           "a path needs exactly one source (its start) and one point (its end)");
       }
-      absl::StatusOr<SurfacePoint> from = ResolvePoint(mesh, request.sources(0), "sources[0]");
+      absl::StatusOr<SurfacePoint> from =
+          ResolvePoint(mesh, request.sources(0), "sources[0]", &*snaps);
       if (!from.ok()) return from.status();
-      absl::StatusOr<SurfacePoint> to = ResolvePoint(mesh, request.points(0), "points[0]");
+      absl::StatusOr<SurfacePoint> to = ResolvePoint(mesh, request.points(0), "points[0]", &*snaps);
       if (!to.ok()) return to.status();
       PathQueryOptions options;
       options.solver = *solver;
@@ -121,10 +128,10 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
       return geojson({terrain::PathFeature(path->path.points, path->distance)});
     }
     absl::StatusOr<std::vector<SurfacePoint>> sources =
-        ResolveSources(env, mesh, request.sources());
+        ResolveSources(env, mesh, request.sources(), &*snaps);
     if (!sources.ok()) return sources.status();
-    absl::StatusOr<std::vector<SurfacePoint>> points =
-        ResolvePoints(mesh, request.points(), "points", env.limits->max_targets, "max_targets");
+    absl::StatusOr<std::vector<SurfacePoint>> points = ResolvePoints(
+        mesh, request.points(), "points", env.limits->max_targets, "max_targets", &*snaps);
     if (!points.ok()) return points.status();
     absl::StatusOr<std::vector<std::pair<double, uint32_t>>> exact =
         ComputeExactDistancesAt(*mesh.mesh, *sources, *points, *solver);
@@ -147,8 +154,9 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
     if (!levels.ok()) return levels.status();
   }
   absl::StatusOr<SolvedField> solved =
-      SolveField(env, request.mesh(), request.sources(), request.options());
+      SolveField(env, request.mesh(), request.sources(), request.options(), *snaps);
   if (!solved.ok()) return solved.status();
+  *snaps = solved->snaps;  // the sources' distances, for the file's first message
   const TriangleMesh& mesh = *solved->mesh->mesh;
   const DistanceField& field = *solved->field;
   // The mesh the field was solved on (the name was looked up again: it may name another mesh now).
@@ -178,7 +186,7 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
                                              ? grid.FloatRasterBytes(field.distance)
                                              : grid.IndexRasterBytes(field.source);
       if (!tiff.ok()) return tiff.status();
-      return FileStream(*tiff, "image/tiff", chunk, env.limits->max_output_values);
+      return FileStream(*tiff, "image/tiff", chunk, env.limits->max_output_values, *snaps);
     }
     default:
       break;

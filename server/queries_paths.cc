@@ -31,10 +31,13 @@ absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPath
                                  v1::FindShortestPathResponse* response) {
   absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh = LookupMesh(env, request.mesh(), "mesh");
   if (!mesh.ok()) return mesh.status();
-  absl::StatusOr<SurfacePoint> from = ResolvePoint(**mesh, request.from(), "from");
+  absl::StatusOr<PointSnaps> snaps = SnapsOf(request);
+  if (!snaps.ok()) return snaps.status();
+  absl::StatusOr<SurfacePoint> from = ResolvePoint(**mesh, request.from(), "from", &*snaps);
   if (!from.ok()) return from.status();
-  absl::StatusOr<SurfacePoint> to = ResolvePoint(**mesh, request.to(), "to");
+  absl::StatusOr<SurfacePoint> to = ResolvePoint(**mesh, request.to(), "to", &*snaps);
   if (!to.ok()) return to.status();
+  SnapsToProto(*snaps, response);
   absl::StatusOr<GeodesicOptions> solver = Options(env, request.options());
   if (!solver.ok()) return solver.status();
   // From a cached field of `from` a path to a vertex is a trace, not a solve; the second query
@@ -100,16 +103,20 @@ absl::Status RunFindShortestPaths(const QueryEnv& env, const v1::FindShortestPat
   }
   absl::StatusOr<GeodesicOptions> solver = Options(env, request.options());
   if (!solver.ok()) return solver.status();
+  absl::StatusOr<PointSnaps> rule = SnapsOf(request);
+  if (!rule.ok()) return rule.status();
   // Group the pairs by their source point (bit for bit), in order of first appearance.
   std::vector<SurfacePoint> froms, tos;
   std::map<std::string, size_t> group_of;
   std::vector<std::vector<size_t>> groups;
   for (int i = 0; i < request.pairs_size(); ++i) {
     const std::string field = absl::StrCat("pairs[", i, "]");
+    PointSnaps snaps{rule->max_snap, {}};  // this pair's
     absl::StatusOr<SurfacePoint> from =
-        ResolvePoint(**mesh, request.pairs(i).from(), field + ".from");
+        ResolvePoint(**mesh, request.pairs(i).from(), field + ".from", &snaps);
     if (!from.ok()) return from.status();
-    absl::StatusOr<SurfacePoint> to = ResolvePoint(**mesh, request.pairs(i).to(), field + ".to");
+    absl::StatusOr<SurfacePoint> to =
+        ResolvePoint(**mesh, request.pairs(i).to(), field + ".to", &snaps);
     if (!to.ok()) return to.status();
     const std::string key = FieldCacheKey("", {*from}, *solver);
     auto [it, fresh] = group_of.emplace(key, groups.size());
@@ -119,7 +126,7 @@ absl::Status RunFindShortestPaths(const QueryEnv& env, const v1::FindShortestPat
     }
     groups[it->second].push_back(static_cast<size_t>(i));
     tos.push_back(*to);
-    response->add_paths();
+    SnapsToProto(snaps, response->add_paths());
   }
   PathQueryOptions options;
   options.solver = *solver;
@@ -149,12 +156,15 @@ absl::Status RunEstimateDistances(const QueryEnv& env, const v1::EstimateDistanc
   absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh = LookupMesh(env, request.mesh(), "mesh");
   if (!mesh.ok()) return mesh.status();
   const TriangleMesh& tm = *(*mesh)->mesh;
+  absl::StatusOr<PointSnaps> snaps = SnapsOf(request);
+  if (!snaps.ok()) return snaps.status();
   absl::StatusOr<std::vector<SurfacePoint>> sources =
-      ResolveSources(env, **mesh, request.sources());
+      ResolveSources(env, **mesh, request.sources(), &*snaps);
   if (!sources.ok()) return sources.status();
-  absl::StatusOr<std::vector<SurfacePoint>> points =
-      ResolvePoints(**mesh, request.points(), "points", env.limits->max_targets, "max_targets");
+  absl::StatusOr<std::vector<SurfacePoint>> points = ResolvePoints(
+      **mesh, request.points(), "points", env.limits->max_targets, "max_targets", &*snaps);
   if (!points.ok()) return points.status();
+  SnapsToProto(*snaps, response);
   if (!v1::PointDistanceMode_IsValid(request.mode())) {
     return FieldError("mode", absl::StrCat("unknown value ", request.mode()));
   }
@@ -207,11 +217,9 @@ absl::Status RunLocatePoints(const QueryEnv& env, const v1::LocatePointsRequest&
                             absl::StrCat("positions: ", request.positions_size(),
                                          " points, over --max_targets=", env.limits->max_targets));
   }
-  const double max_snap =
-      request.has_max_snap() ? request.max_snap() : std::numeric_limits<double>::infinity();
-  if (!(max_snap > 0)) {  // also NaN
-    return FieldError("max_snap", absl::StrCat("must be > 0 when set, got ", request.max_snap()));
-  }
+  absl::StatusOr<PointSnaps> snaps = SnapsOf(request);
+  if (!snaps.ok()) return snaps.status();
+  const double max_snap = snaps->max_snap;
   for (int i = 0; i < request.positions_size(); ++i) {
     if ((i & 1023) == 0 && env.cancel->IsCancelled()) return absl::CancelledError("cancelled");
     const v1::Position& q = request.positions(i);

@@ -32,7 +32,7 @@ namespace geodex::server {
 absl::StatusOr<std::vector<SurfacePoint>> ResolvePoints(const StoredMesh& mesh,
                                                         const PointList& points,
                                                         const std::string& field, uint64_t limit,
-                                                        const char* flag) {
+                                                        const char* flag, PointSnaps* snaps) {
   if (points.empty()) {
     return FieldError(field, "at least one point is required");
   }
@@ -44,7 +44,7 @@ absl::StatusOr<std::vector<SurfacePoint>> ResolvePoints(const StoredMesh& mesh,
   out.reserve(points.size());
   for (int i = 0; i < points.size(); ++i) {
     absl::StatusOr<SurfacePoint> p =
-        ResolvePoint(mesh, points[i], absl::StrCat(field, "[", i, "]"));
+        ResolvePoint(mesh, points[i], absl::StrCat(field, "[", i, "]"), snaps);
     if (!p.ok()) return p.status();
     out.push_back(*p);
   }
@@ -53,8 +53,9 @@ absl::StatusOr<std::vector<SurfacePoint>> ResolvePoints(const StoredMesh& mesh,
 
 absl::StatusOr<std::vector<SurfacePoint>> ResolveSources(const QueryEnv& env,
                                                          const StoredMesh& mesh,
-                                                         const PointList& sources) {
-  return ResolvePoints(mesh, sources, "sources", env.limits->max_sources, "max_sources");
+                                                         const PointList& sources,
+                                                         PointSnaps* snaps) {
+  return ResolvePoints(mesh, sources, "sources", env.limits->max_sources, "max_sources", snaps);
 }
 
 absl::StatusOr<GeodesicOptions> Options(const QueryEnv& env, const v1::SolverOptions& options) {
@@ -121,13 +122,17 @@ void FieldStatsToProto(const DistanceField& field, bool cached, v1::SolveStats* 
 }
 
 absl::StatusOr<SolvedField> SolveField(const QueryEnv& env, const std::string& mesh_name,
-                                       const PointList& sources, const v1::SolverOptions& options) {
+                                       const PointList& sources, const v1::SolverOptions& options,
+                                       absl::StatusOr<PointSnaps> snaps) {
+  if (!snaps.ok()) return snaps.status();
   SolvedField out;
+  out.snaps = *std::move(snaps);
   absl::StatusOr<std::shared_ptr<const StoredMesh>> mesh = LookupMesh(env, mesh_name, "mesh");
   if (!mesh.ok()) return mesh.status();
   out.mesh = *std::move(mesh);
   if (absl::Status s = CheckFieldSize(env, *out.mesh); !s.ok()) return s;
-  absl::StatusOr<std::vector<SurfacePoint>> resolved = ResolveSources(env, *out.mesh, sources);
+  absl::StatusOr<std::vector<SurfacePoint>> resolved =
+      ResolveSources(env, *out.mesh, sources, &out.snaps);
   if (!resolved.ok()) return resolved.status();
   out.sources = *std::move(resolved);
   absl::StatusOr<GeodesicOptions> solver = Options(env, options);

@@ -15,20 +15,28 @@
 #include "geodex/surface_point.h"
 #include "geodex/v1/geodex.pb.h"
 #include "mesh_store.h"
+#include "proto_convert.h"
 #include "queries.h"
 
 namespace geodex::server {
 
 using PointList = google::protobuf::RepeatedPtrField<v1::SurfacePoint>;
 
-// Resolves a list of request points (sources or targets) after checking its size against a limit.
+// Resolves a list of request points (sources or targets) after checking its size against a limit;
+// the points' snap distances are appended to `snaps` (see ResolvePoint).
 absl::StatusOr<std::vector<SurfacePoint>> ResolvePoints(const StoredMesh& mesh,
                                                         const PointList& points,
                                                         const std::string& field, uint64_t limit,
-                                                        const char* flag);
+                                                        const char* flag, PointSnaps* snaps);
 absl::StatusOr<std::vector<SurfacePoint>> ResolveSources(const QueryEnv& env,
                                                          const StoredMesh& mesh,
-                                                         const PointList& sources);
+                                                         const PointList& sources,
+                                                         PointSnaps* snaps);
+// The snap distances as the response field `snap_distances` of any response that has it.
+template <typename Response>
+void SnapsToProto(const PointSnaps& snaps, Response* out) {
+  out->mutable_snap_distances()->Add(snaps.distances.begin(), snaps.distances.end());
+}
 // The request's solver options with the server's window budget and the call's cancel token.
 absl::StatusOr<GeodesicOptions> Options(const QueryEnv& env, const v1::SolverOptions& options);
 // Core's InvalidArgument from a solve concerns the points: name the field.
@@ -52,8 +60,11 @@ struct SolvedField {
   std::vector<SurfacePoint> sources;
   std::shared_ptr<const DistanceField> field;
   bool cached = false;
+  PointSnaps snaps;  // the sources' snap distances
 };
+// `snaps` is the request's rule (SnapsOf); the result's `snaps` carries the sources' distances.
 absl::StatusOr<SolvedField> SolveField(const QueryEnv& env, const std::string& mesh_name,
-                                       const PointList& sources, const v1::SolverOptions& options);
+                                       const PointList& sources, const v1::SolverOptions& options,
+                                       absl::StatusOr<PointSnaps> snaps);
 
 }  // namespace geodex::server

@@ -4,7 +4,9 @@
 
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <map>
+#include <tuple>
 
 #include "geodex/delaunay.h"
 #include "geodex/distance_matrix.h"
@@ -401,6 +403,177 @@ TEST_F(QueriesTest, LocatePointsEqualsCore) {
       }
     }
   }
+}
+
+// max_snap and snap_distances on every request that takes points (the proto's "Snapping"): a
+// position `d` off the surface is refused below d naming its field, passes above it and unset, and
+// every answer reports d for it (bit for bit LocatePoints' distance) and 0 for a vertex.
+TEST_F(QueriesTest, MaxSnapOnEveryRequestThatTakesPoints) {
+  const std::array<double, 3> off_surface = {7.3, 5.2, 4.0};
+  absl::StatusOr<LocatedPoint> located = SurfaceLocator(*local_).Locate(off_surface);
+  ASSERT_TRUE(located.ok());
+  const double d = located->distance;
+  ASSERT_GT(d, 0.5);
+  v1::SurfacePoint vertex, far;
+  vertex.set_vertex(3);
+  far.mutable_position()->set_x(off_surface[0]);
+  far.mutable_position()->set_y(off_surface[1]);
+  far.mutable_position()->set_z(off_surface[2]);
+
+  // Each case: fills a request (vertex first, then the far position), runs it with `max_snap`
+  // (< 0: unset) and returns its status and the answer's snap distances.
+  struct Answer {
+    Answer(grpc::Status s) : status(std::move(s)) {}  // NOLINT: implicit, from a call's status
+    grpc::Status status;
+    std::vector<double> snaps;
+  };
+  using Run = std::function<Answer(double max_snap)>;
+  std::vector<std::tuple<std::string, std::string, Run>> cases;
+
+  {
+    v1::ComputeDistanceFieldRequest r;
+    r.set_mesh("meshes/hills");
+    *r.add_sources() = vertex;
+    *r.add_sources() = far;
+    cases.emplace_back("field", "sources[1].position", [=, this](double max_snap) {
+      auto q = r;
+      if (max_snap >= 0) q.set_max_snap(max_snap);
+      std::vector<v1::ComputeDistanceFieldResponse> m;
+      Answer a{ReadAll<v1::ComputeDistanceFieldResponse>(
+          [&](grpc::ClientContext* c, const auto& x) { return stub_->ComputeDistanceField(c, x); },
+          q, &m)};
+      if (a.status.ok()) a.snaps.assign(m[0].snap_distances().begin(), m[0].snap_distances().end());
+      return a;
+    });
+  }
+  {
+    v1::FindShortestPathRequest r;
+    r.set_mesh("meshes/hills");
+    *r.mutable_from() = vertex;
+    *r.mutable_to() = far;
+    cases.emplace_back("path", "to.position", [=, this](double max_snap) {
+      auto q = r;
+      if (max_snap >= 0) q.set_max_snap(max_snap);
+      grpc::ClientContext c;
+      c.set_deadline(In(120));
+      v1::FindShortestPathResponse response;
+      Answer a{stub_->FindShortestPath(&c, q, &response)};
+      a.snaps.assign(response.snap_distances().begin(), response.snap_distances().end());
+      return a;
+    });
+  }
+  {
+    v1::FindShortestPathsRequest r;
+    r.set_mesh("meshes/hills");
+    v1::ShortestPathPair* pair = r.add_pairs();
+    *pair->mutable_from() = vertex;
+    *pair->mutable_to() = far;
+    cases.emplace_back("paths", "pairs[0].to.position", [=, this](double max_snap) {
+      auto q = r;
+      if (max_snap >= 0) q.set_max_snap(max_snap);
+      grpc::ClientContext c;
+      c.set_deadline(In(120));
+      v1::FindShortestPathsResponse response;
+      Answer a{stub_->FindShortestPaths(&c, q, &response)};
+      if (a.status.ok()) {
+        a.snaps.assign(response.paths(0).snap_distances().begin(),
+                       response.paths(0).snap_distances().end());
+      }
+      return a;
+    });
+  }
+  {
+    v1::ComputeDistanceMatrixRequest r;
+    r.set_mesh("meshes/hills");
+    *r.add_sources() = vertex;
+    *r.add_targets() = far;
+    cases.emplace_back("matrix", "targets[0].position", [=, this](double max_snap) {
+      auto q = r;
+      if (max_snap >= 0) q.set_max_snap(max_snap);
+      std::vector<v1::ComputeDistanceMatrixResponse> m;
+      Answer a{ReadAll<v1::ComputeDistanceMatrixResponse>(
+          [&](grpc::ClientContext* c, const auto& x) { return stub_->ComputeDistanceMatrix(c, x); },
+          q, &m)};
+      if (a.status.ok()) a.snaps.assign(m[0].snap_distances().begin(), m[0].snap_distances().end());
+      return a;
+    });
+  }
+  {
+    v1::EstimateDistancesRequest r;
+    r.set_mesh("meshes/hills");
+    *r.add_sources() = vertex;
+    *r.add_points() = far;
+    r.set_mode(v1::POINT_DISTANCE_MODE_BOTH);
+    cases.emplace_back("estimate", "points[0].position", [=, this](double max_snap) {
+      auto q = r;
+      if (max_snap >= 0) q.set_max_snap(max_snap);
+      grpc::ClientContext c;
+      c.set_deadline(In(120));
+      v1::EstimateDistancesResponse response;
+      Answer a{stub_->EstimateDistances(&c, q, &response)};
+      a.snaps.assign(response.snap_distances().begin(), response.snap_distances().end());
+      return a;
+    });
+  }
+  auto geometry = [&](const std::string& name, auto request, auto method, auto response_type) {
+    request.set_mesh("meshes/hills");
+    *request.add_sources() = vertex;
+    *request.add_sources() = far;
+    using Request = decltype(request);
+    cases.emplace_back(name, "sources[1].position", [=, this](double max_snap) {
+      Request q = request;
+      if (max_snap >= 0) q.set_max_snap(max_snap);
+      using Response = decltype(response_type);
+      std::vector<Response> m;
+      Answer a{ReadAll<Response>(
+          [&](grpc::ClientContext* c, const Request& x) { return method(stub_.get(), c, x); }, q,
+          &m)};
+      if (a.status.ok()) a.snaps.assign(m[0].snap_distances().begin(), m[0].snap_distances().end());
+      return a;
+    });
+  };
+  {
+    v1::ComputeIsolinesRequest r;
+    r.set_count(4);
+    geometry(
+        "isolines", r,
+        [](v1::Geodex::Stub* s, grpc::ClientContext* c, const auto& x) {
+          return s->ComputeIsolines(c, x);
+        },
+        v1::ComputeIsolinesResponse());
+  }
+  geometry(
+      "voronoi", v1::ComputeVoronoiRequest(),
+      [](v1::Geodex::Stub* s, grpc::ClientContext* c, const auto& x) {
+        return s->ComputeVoronoi(c, x);
+      },
+      v1::ComputeVoronoiResponse());
+  geometry(
+      "delaunay", v1::ComputeDelaunayRequest(),
+      [](v1::Geodex::Stub* s, grpc::ClientContext* c, const auto& x) {
+        return s->ComputeDelaunay(c, x);
+      },
+      v1::ComputeDelaunayResponse());
+
+  for (const auto& [name, field, run] : cases) {
+    SCOPED_TRACE(name);
+    for (const double max_snap : {-1.0, 2 * d}) {  // unset, above
+      Answer a = run(max_snap);
+      ASSERT_TRUE(a.status.ok()) << a.status.error_message();
+      ASSERT_EQ(a.snaps.size(), 2u);
+      EXPECT_EQ(a.snaps[0], 0.0);
+      EXPECT_TRUE(BitEqual(a.snaps[1], d)) << a.snaps[1] << " vs " << d;
+    }
+    Answer below = run(0.5 * d);
+    EXPECT_EQ(below.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_NE(below.status.error_message().find(field + ": "), std::string::npos)
+        << below.status.error_message();
+    EXPECT_NE(below.status.error_message().find("maximum snap distance"), std::string::npos);
+    Answer zero = run(0.0);
+    EXPECT_EQ(zero.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_NE(zero.status.error_message().find("max_snap"), std::string::npos);
+  }
+  EXPECT_EQ(cases.size(), 8u);  // ExportGis: in terrain_service_test (it needs a DEM)
 }
 
 TEST_F(QueriesTest, IsolinesEqualCoreAcrossManyMessages) {

@@ -600,6 +600,7 @@ TEST_F(TerrainServiceTest, ExportGisMakesTheCliFiles) {
   options.limits.stream_chunk_bytes = 1000;  // several messages per file
   StartServer(options);
   ASSERT_TRUE(UploadDem(bytes_, "slot").status.ok());
+  std::vector<double> snaps;  // of the last run
   auto run = [&](const v1::ExportGisRequest& request, std::string* media) {
     grpc::ClientContext context;
     context.set_deadline(testing::In(120));
@@ -608,7 +609,12 @@ TEST_F(TerrainServiceTest, ExportGisMakesTheCliFiles) {
     std::string bytes;
     int messages = 0;
     while (reader->Read(&message)) {
-      if (messages++ == 0) *media = message.media_type();
+      if (messages++ == 0) {
+        *media = message.media_type();
+        snaps.assign(message.snap_distances().begin(), message.snap_distances().end());
+      } else {
+        EXPECT_EQ(message.snap_distances_size(), 0);
+      }
       EXPECT_LE(message.data().size(), 1000u);
       bytes += message.data();
     }
@@ -670,6 +676,31 @@ TEST_F(TerrainServiceTest, ExportGisMakesTheCliFiles) {
   const std::string points = run(request, &media);
   EXPECT_TRUE(Contains(points, "\"point\": \"g:500205:4999845\"")) << points.substr(0, 600);
   EXPECT_TRUE(Contains(points, "\"point\": \"0\""));
+  EXPECT_EQ(snaps, std::vector<double>(3, 0.0));  // map points drop, vertices are on the surface
+  // A position 5 m above a vertex: its snap distance reported, max_snap below it refuses it.
+  const std::array<double, 3> above = built->Position(built->vertex_count() / 2);  // recentred
+  v1::Position* p = request.add_points()->mutable_position();
+  p->set_x(above[0] + built->Center()[0]);
+  p->set_y(above[1] + built->Center()[1]);
+  p->set_z(above[2] + built->Center()[2] + 5);
+  run(request, &media);
+  ASSERT_EQ(snaps.size(), 4u);
+  EXPECT_GT(snaps[3], 0.1);
+  EXPECT_LE(snaps[3], 5.0 + 1e-9);
+  request.set_max_snap(snaps[3] / 2);
+  {
+    grpc::ClientContext context;
+    context.set_deadline(testing::In(60));
+    auto reader = stub_->ExportGis(&context, request);
+    v1::ExportGisResponse message;
+    while (reader->Read(&message)) {
+    }
+    grpc::Status status = reader->Finish();
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_EQ(BadField(status), "points[2].position") << status.error_message();
+  }
+  request.clear_max_snap();
+  request.mutable_points()->RemoveLast();
   // Beyond max_distance: distance and source are null, not left out.
   request.mutable_options()->set_max_distance(20);
   const std::string near_only = run(request, &media);
