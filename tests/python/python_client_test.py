@@ -5,6 +5,8 @@ is started and stopped here, every wait gives up.
 Env: GEODEX, GEODEXD (binaries), DATA (tests/data); `import geodex` works (PYTHONPATH with
 build/python and client/python, or the package installed: tests/python/package_test.sh).
 """
+import asyncio
+import json
 import os
 import re
 import signal
@@ -13,8 +15,7 @@ import tempfile
 import threading
 import time
 import unittest
-
-import json
+import warnings
 
 import numpy
 
@@ -348,7 +349,8 @@ def stop_geodexd(server, log):
 
 def read_off(path):
     """Vertices (n x 3) and faces (m x 3) of a plain OFF file."""
-    rows = [r.split() for r in open(path) if r.strip() and not r.startswith("#")]
+    with open(path) as f:
+        rows = [r.split() for r in f if r.strip() and not r.startswith("#")]
     nv, nf = int(rows[1][0]), int(rows[1][1])
     vertices = numpy.array([[float(x) for x in r[:3]] for r in rows[2:2 + nv]])
     faces = numpy.array([[int(x) for x in r[1:4]] for r in rows[2 + nv:2 + nv + nf]])
@@ -442,6 +444,118 @@ class ControlLoopTest(unittest.TestCase):
                 self.server, _, self.log = restarted["server"]
         self.assertEqual(again, before)
         self.assertGreater(client.retries, 0)
+
+    def test_max_snap_refuses_far_points_and_answers_say_how_far(self):
+        client = self.client(timeout=60)
+        mesh = client.upload(os.path.join(DATA, "kitten.off"))
+        box = mesh.resource.info
+        far = (box.bbox_max.x + 0.2 * mesh.diagonal, box.bbox_max.y, box.bbox_max.z)
+        d = client.locate(mesh.name, [far])[0].distance
+        self.assertGreater(d, 0.1 * mesh.diagonal)
+        # Refused by the server on path, paths and matrix, naming the point.
+        for call, field in [
+                (lambda **k: client.shortest_path(mesh.name, vertex(0), position(*far), **k),
+                 "to.position"),
+                (lambda **k: client.shortest_paths(mesh.name, [(vertex(0), position(*far))], **k),
+                 "pairs[0].to.position"),
+                (lambda **k: client.distance_matrix(mesh.name, [vertex(0)], [position(*far)], **k),
+                 "targets[0].position")]:
+            with self.assertRaises(geodex.InvalidArgumentError) as error:
+                call(max_snap=d / 2)
+            self.assertEqual(error.exception.field, field)
+            self.assertIn("maximum snap distance", str(error.exception))
+        with self.assertRaises(geodex.InvalidArgumentError) as error:  # the client's default
+            self.client(timeout=60, max_snap=d / 2).shortest_path(mesh.name, vertex(0),
+                                                                  position(*far))
+        self.assertEqual(error.exception.field, "to.position")
+        # Without max_snap it is snapped: the answer says how far (LocatePoints' distance, to the
+        # bit) and, beyond 1% of the diagonal, a SnapWarning names it.
+        with self.assertWarns(geodex.SnapWarning) as warned:
+            path = client.shortest_path(mesh.name, vertex(0), position(*far))
+        self.assertIn("end is", str(warned.warning))
+        self.assertEqual(warned.filename, __file__)  # the caller's line, not the client's
+        self.assertEqual(path.snap_distances.tolist(), [0.0, d])
+        with self.assertWarns(geodex.SnapWarning):
+            matrix = client.distance_matrix(mesh.name, [vertex(0), position(*far)], [vertex(9)])
+        self.assertEqual(matrix.snap_distances.tolist(), [0.0, d, 0.0])
+        self.assertEqual(matrix.shape, (2, 1))
+        # A point a little off the surface passes without max_snap, silently.
+        on = path.points[len(path.points) // 2].position
+        near = (on[0], on[1], on[2] + 1e-3 * mesh.diagonal)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", geodex.SnapWarning)
+            near_path = client.shortest_path(mesh.name, vertex(0), position(*near))
+            field = client.distance_field(mesh.name, [position(*near), vertex(3)])
+        self.assertGreater(near_path.snap_distances[1], 0)
+        self.assertLessEqual(near_path.snap_distances[1], 1e-3 * mesh.diagonal * (1 + 1e-9))
+        self.assertEqual(field.snap_distances.tolist(), [near_path.snap_distances[1], 0.0])
+        self.assertEqual(client.shortest_path(mesh.name, vertex(0), position(*near),
+                                              max_snap=2e-3 * mesh.diagonal).length,
+                         near_path.length)
+
+    def test_the_asyncio_client_gives_the_same_answers(self):
+        from geodex.aio import AsyncGeodexClient
+        quiet = warnings.catch_warnings()  # position(1, 2, 3) is far, on purpose
+        quiet.__enter__()
+        self.addCleanup(quiet.__exit__, None, None, None)
+        warnings.simplefilter("ignore", geodex.SnapWarning)
+        sync = self.client(timeout=120)
+        kitten = os.path.join(DATA, "kitten.off")
+        mesh = sync.upload(kitten)
+        sites = [vertex(0), vertex(800), vertex(1600), position(1, 2, 3)]
+        want = {
+            "field": sync.distance_field(mesh.name, sites, want_directions=True),
+            "path": sync.shortest_path(mesh.name, vertex(0), vertex(1250)),
+            "paths": sync.shortest_paths(mesh.name, [(vertex(0), vertex(5)), (vertex(7), vertex(9))]),
+            "matrix": sync.distance_matrix(mesh.name, sites, sites),
+            "points": sync.point_distances(mesh.name, sites[:2], [vertex(5), position(0, 0, 0)]),
+            "isolines": sync.isolines(mesh.name, sites, count=5),
+            "voronoi": sync.voronoi(mesh.name, sites),
+            "delaunay": sync.delaunay(mesh.name, sites),
+            "locate": sync.locate(mesh.name, [(0, 0, 0), (1, 2, 3)]),
+        }
+
+        async def run():
+            async with AsyncGeodexClient("127.0.0.1:" + self.port, timeout=120) as client:
+                uploaded = await client.upload(read_off(kitten))
+                self.assertEqual(uploaded.name, mesh.name)
+                got = {
+                    "field": await client.distance_field(mesh.name, sites, want_directions=True),
+                    "path": await client.shortest_path(mesh.name, vertex(0), vertex(1250)),
+                    "paths": await client.shortest_paths(
+                        mesh.name, [(vertex(0), vertex(5)), (vertex(7), vertex(9))]),
+                    "matrix": await client.distance_matrix(mesh.name, sites, sites),
+                    "points": await client.point_distances(mesh.name, sites[:2],
+                                                           [vertex(5), position(0, 0, 0)]),
+                    "isolines": await client.isolines(mesh.name, sites, count=5),
+                    "voronoi": await client.voronoi(mesh.name, sites),
+                    "delaunay": await client.delaunay(mesh.name, sites),
+                    "locate": await client.locate(mesh.name, [(0, 0, 0), (1, 2, 3)]),
+                }
+                # The same errors, deadline and snapping rule.
+                big = await client.upload(bumpy_grid(211))
+                with self.assertRaises(geodex.DeadlineExceededError):
+                    await client.distance_field(big.name, [vertex(0)], timeout=0.005)
+                with self.assertRaises(geodex.InvalidArgumentError) as error:
+                    await client.shortest_path(mesh.name, vertex(0), position(1, 2, 3),
+                                               max_snap=1e-9)
+                self.assertEqual(error.exception.field, "to.position")
+                with self.assertRaises(geodex.InvalidArgumentError) as error:
+                    await client.export_gis(mesh.name, "isochrone", [vertex(0)])
+                self.assertEqual(error.exception.field, "product")
+                self.assertTrue(await client.health())
+                return got
+        got = asyncio.run(run())
+        for name in ("field", "points"):
+            for a, b in zip(want[name], got[name]):
+                if isinstance(a, numpy.ndarray):
+                    self.assertEqual(a.tobytes(), b.tobytes(), name)
+            self.assertEqual(want[name].snap_distances.tobytes(), got[name].snap_distances.tobytes())
+        self.assertEqual(want["matrix"].tobytes(), got["matrix"].tobytes())
+        self.assertEqual(want["matrix"].snap_distances.tolist(),
+                         got["matrix"].snap_distances.tolist())
+        for name in ("path", "paths", "isolines", "voronoi", "delaunay", "locate"):
+            self.assertEqual(want[name], got[name], name)
 
     def test_bad_names_are_typed_errors(self):
         client = self.client(timeout=60)

@@ -1,0 +1,176 @@
+"""What the clients return: one kind of result object, dataclasses, each also unpacking like a
+tuple of its main fields (`length, points = client.shortest_path(...)`).
+
+Every answer to a request that takes points carries `snap_distances`: how far each request point
+moved onto the surface, in request order (numpy float64; 0 for vertices, edge and face points and
+map points). The fields marked "not unpacked" are left out of tuple unpacking.
+"""
+import dataclasses
+from typing import Any, Dict, List, Tuple
+
+import numpy as np
+
+
+def _extra(default=None):
+    """A field added after the tuple shape was fixed: not unpacked, not compared."""
+    return dataclasses.field(default=default, compare=False, metadata={"unpack": False})
+
+
+def _no_snaps():
+    return dataclasses.field(default_factory=lambda: np.zeros(0), compare=False, repr=False,
+                             metadata={"unpack": False})
+
+
+class _Unpacks:
+    def __iter__(self):
+        return iter(getattr(self, f.name) for f in dataclasses.fields(self)
+                    if f.metadata.get("unpack", True))
+
+
+@dataclasses.dataclass
+class PathPoint(_Unpacks):
+    """A point of a path or polyline: its position (x, y, z) and the simplex it lies on,
+    ("v", vertex) / ("e", from, to, t) / ("f", face, b0, b1, b2)."""
+    position: Tuple[float, float, float]
+    simplex: tuple
+
+
+@dataclasses.dataclass
+class Path(_Unpacks):
+    """An exact shortest path: its length and its points (`length, points = path`); with
+    want_stats, the solve's SolveStats in `stats` (solve_ms, windows_created, cached, ...);
+    `snap_distances` of (start, end) (not unpacked)."""
+    length: float
+    points: List[PathPoint]
+    stats: Any = _extra()
+    snap_distances: np.ndarray = _no_snaps()
+
+
+@dataclasses.dataclass(eq=False)
+class Field(_Unpacks):
+    """A distance field: per vertex the distance (float64, inf where unreachable) and the nearest
+    source's index (uint32), the solve's stats (with want_stats, else None), and with
+    want_directions the geodesic direction field, shape (n, 3): per vertex the unit tangent
+    towards the nearest source, (0, 0, 0) at a source, NaN where unreachable (shape (0, 3)
+    otherwise). `snap_distances`: one per source (not unpacked)."""
+    distances: np.ndarray
+    labels: np.ndarray
+    stats: Any
+    directions: np.ndarray
+    snap_distances: np.ndarray = _no_snaps()
+
+
+class DistanceMatrix(np.ndarray):
+    """A (sources x targets) float64 numpy array of exact distances (inf where unreachable or
+    beyond k_nearest / max_distance), with `snap_distances`: the sources', then the targets'."""
+
+    snap_distances: np.ndarray
+
+    def __array_finalize__(self, obj):
+        self.snap_distances = getattr(obj, "snap_distances", np.zeros(0))
+
+
+@dataclasses.dataclass
+class Located(_Unpacks):
+    """Where a 3D position lands: the surface point (a SurfacePoint), its position, how far it
+    moved."""
+    point: Any
+    position: Tuple[float, float, float]
+    distance: float
+
+
+@dataclasses.dataclass(eq=False)
+class PointDistances(_Unpacks):
+    """Distances at surface points (arrays, one entry per point): the unfolding estimate and the
+    exact distance, each with its source; with want_directions each point's geodesic direction
+    towards its nearest source, shape (n, 3) (else (0, 3)). `snap_distances`: the sources', then
+    the points' (not unpacked)."""
+    estimates: np.ndarray
+    estimate_labels: np.ndarray
+    exact: np.ndarray
+    exact_labels: np.ndarray
+    directions: np.ndarray
+    snap_distances: np.ndarray = _no_snaps()
+
+
+@dataclasses.dataclass
+class Isolines(_Unpacks):
+    """Approximate isolines (paper section 6.1): the levels and (level, closed, [PathPoint])
+    lines; `snap_distances` of the sources (not unpacked)."""
+    levels: List[float]
+    lines: list
+    snap_distances: np.ndarray = _no_snaps()
+
+
+@dataclasses.dataclass
+class Voronoi(_Unpacks):
+    """Approximate Voronoi diagram: {site: area}, [(site_a, site_b, [PathPoint])] boundaries,
+    [(a, b)] adjacency; `snap_distances` of the sites (not unpacked)."""
+    areas: Dict[int, float]
+    boundaries: list
+    adjacency: List[Tuple[int, int]]
+    snap_distances: np.ndarray = _no_snaps()
+
+
+@dataclasses.dataclass
+class Delaunay(_Unpacks):
+    """Approximate Delaunay triangulation: [(site_a, site_b, length, [PathPoint])] edges and
+    [(a, b, c)] triangles; `snap_distances` of the sites (not unpacked)."""
+    edges: list
+    triangles: List[Tuple[int, int, int]]
+    snap_distances: np.ndarray = _no_snaps()
+
+
+class GisFile(bytes):
+    """A GIS file's bytes (GeoJSON text or a GeoTIFF), with its `media_type` and the
+    `snap_distances` of the request's sources, then points."""
+
+    media_type: str
+    snap_distances: np.ndarray
+
+
+@dataclasses.dataclass
+class Mesh:
+    """A mesh as geodexd stores it. `name` is canonical, "meshes/<64-hex id>"; `aliases` are all
+    the names given to it (the first upload's `display_name` and later ones: "kitten" makes
+    "meshes/kitten" work wherever the name does). `terrain` is the DEM's map
+    (a geodex.v1.Terrain message) for a DEM's mesh, else None. `diagonal` is the length of its
+    bounding box's diagonal. `resource` is the full message."""
+    name: str
+    display_name: str
+    aliases: List[str]
+    vertex_count: int
+    face_count: int
+    upload_bytes: int
+    memory_bytes: int
+    pinned: bool
+    components: int
+    boundary_edges: int
+    terrain: Any
+    resource: Any = dataclasses.field(repr=False, compare=False)
+
+    @property
+    def id(self) -> str:
+        return self.name[len("meshes/"):]
+
+    @property
+    def diagonal(self) -> float:
+        lo, hi = self.resource.info.bbox_min, self.resource.info.bbox_max
+        return float(np.sqrt((hi.x - lo.x) ** 2 + (hi.y - lo.y) ** 2 + (hi.z - lo.z) ** 2))
+
+    @staticmethod
+    def from_proto(m) -> "Mesh":
+        names = [n for n in [m.display_name, *m.aliases] if n]
+        return Mesh(m.name, m.display_name, names, m.vertex_count, m.face_count,
+                    m.upload_bytes, m.memory_bytes, m.pinned, m.components, m.boundary_edges,
+                    m.terrain if m.HasField("terrain") else None, m)
+
+
+@dataclasses.dataclass
+class RetryPolicy:
+    """Which failures are tried again, how often and how far apart (see geodex.client).
+    Retries happen only while the call's deadline leaves room for the wait."""
+    max_attempts: int = 4
+    initial_backoff: float = 0.2
+    multiplier: float = 2.0
+    retry_queue_full: bool = True
