@@ -1,5 +1,6 @@
 #include "geodex/geodex_client.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -32,6 +33,12 @@ struct GeodexClient::Stub {
 };
 
 namespace {
+
+// ClientOptions::max_snap on a request that takes points (unset when +inf).
+template <typename Request>
+void SetMaxSnap(double max_snap, Request* request) {
+  if (std::isfinite(max_snap)) request->set_max_snap(max_snap);
+}
 
 // The client's own types on the wire (the rest is proto/convert's).
 ServerMesh ServerMeshFromProto(const v1::Mesh& m) {
@@ -438,6 +445,7 @@ absl::StatusOr<DistanceField> GeodexClient::Field(MeshRef& mesh, const FieldQuer
   v1::ComputeDistanceFieldRequest request;
   request.set_mesh(mesh.name);
   api::FieldQueryToProto(query, &request);
+  SetMaxSnap(options_.max_snap, &request);
   request.set_want_stats(true);
   api::FieldAssembler field;
   if (absl::Status s = ReadStream(
@@ -468,6 +476,7 @@ absl::StatusOr<PathQueryResult> GeodexClient::ShortestPath(MeshRef& mesh, const 
   v1::FindShortestPathRequest request;
   request.set_mesh(mesh.name);
   api::PathQueryToProto(query, &request);
+  SetMaxSnap(options_.max_snap, &request);
   request.set_want_stats(true);
   v1::FindShortestPathResponse response;
   grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
@@ -481,6 +490,7 @@ absl::StatusOr<DistanceMatrix> GeodexClient::Matrix(MeshRef& mesh, const MatrixQ
   v1::ComputeDistanceMatrixRequest request;
   request.set_mesh(mesh.name);
   api::MatrixQueryToProto(query, &request);
+  SetMaxSnap(options_.max_snap, &request);
   request.set_want_stats(true);
   api::MatrixAssembler matrix;
   if (absl::Status s = ReadStream(
@@ -504,6 +514,7 @@ absl::StatusOr<PointDistances> GeodexClient::DistancesAtPoints(MeshRef& mesh,
   v1::EstimateDistancesRequest request;
   request.set_mesh(mesh.name);
   api::PointQueryToProto(query, &request);
+  SetMaxSnap(options_.max_snap, &request);
   request.set_mode(ModeToProto(mode));
   v1::EstimateDistancesResponse response;
   grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
@@ -521,7 +532,7 @@ absl::StatusOr<std::vector<LocatedPoint>> GeodexClient::Locate(
   v1::LocatePointsRequest request;
   request.set_mesh(mesh.name);
   for (const auto& q : xyz) api::PositionToProto(q, request.add_positions());
-  if (std::isfinite(max_snap)) request.set_max_snap(max_snap);
+  SetMaxSnap(std::min(max_snap, options_.max_snap), &request);
   v1::LocatePointsResponse response;
   grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
     return stub_->rpc->LocatePoints(context, request, &response);
@@ -536,6 +547,7 @@ absl::StatusOr<Isolines> GeodexClient::ComputeIsolines(MeshRef& mesh, const Isol
   v1::ComputeIsolinesRequest request;
   request.set_mesh(mesh.name);
   api::IsolineQueryToProto(query, &request);
+  SetMaxSnap(options_.max_snap, &request);
   api::IsolinesAssembler out;
   if (absl::Status s = ReadStream(
           mesh, [&](grpc::ClientContext* c) { return stub_->rpc->ComputeIsolines(c, request); },
@@ -551,6 +563,7 @@ absl::StatusOr<VoronoiDiagram> GeodexClient::ComputeVoronoi(MeshRef& mesh,
   v1::ComputeVoronoiRequest request;
   request.set_mesh(mesh.name);
   api::VoronoiQueryToProto(query, &request);
+  SetMaxSnap(options_.max_snap, &request);
   api::VoronoiAssembler out;
   if (absl::Status s = ReadStream(
           mesh, [&](grpc::ClientContext* c) { return stub_->rpc->ComputeVoronoi(c, request); },
@@ -566,6 +579,7 @@ absl::StatusOr<DelaunayTriangulation> GeodexClient::ComputeDelaunay(MeshRef& mes
   v1::ComputeDelaunayRequest request;
   request.set_mesh(mesh.name);
   api::DelaunayQueryToProto(query, &request);
+  SetMaxSnap(options_.max_snap, &request);
   api::DelaunayAssembler out;
   if (absl::Status s = ReadStream(
           mesh, [&](grpc::ClientContext* c) { return stub_->rpc->ComputeDelaunay(c, request); },

@@ -100,6 +100,34 @@ TEST_F(ClientTest, AQueryForALostMeshReuploadsItOnce) {
       client.Field(by_id, FieldQuery{{SurfacePoint::AtVertex(0)}, {}, false}).status()));
 }
 
+// ClientOptions::max_snap rides on every query that takes points: the server refuses a position
+// farther than that, naming it; without it the position is snapped.
+TEST_F(ClientTest, MaxSnapIsCheckedByTheServerOnEveryQuery) {
+  StartServer();
+  const std::string path = WriteFile("client-snap.off", GridOff(6, 6, true));
+  const SurfacePoint far = SurfacePoint::AtPosition(2, 2, 50);  // far above the grid
+  GeodexClient snapping = Client();
+  absl::StatusOr<MeshRef> mesh = snapping.ResolveMesh(path);
+  ASSERT_TRUE(mesh.ok());
+  PathQuery path_query;
+  path_query.from = SurfacePoint::AtVertex(0);
+  path_query.to = far;
+  ASSERT_TRUE(snapping.ShortestPath(*mesh, path_query).ok());
+  ClientOptions options;
+  options.target = absl::StrCat("127.0.0.1:", server_->port());
+  options.max_snap = 1;
+  GeodexClient strict(options);
+  absl::StatusOr<PathQueryResult> refused = strict.ShortestPath(*mesh, path_query);
+  ASSERT_TRUE(absl::IsInvalidArgument(refused.status())) << refused.status();
+  ASSERT_TRUE(client::FieldViolationOf(refused.status()).has_value());
+  EXPECT_EQ(client::FieldViolationOf(refused.status())->field, "to.position");
+  absl::StatusOr<DistanceField> field = strict.Field(*mesh, FieldQuery{{far}, {}, false});
+  ASSERT_TRUE(absl::IsInvalidArgument(field.status())) << field.status();
+  EXPECT_EQ(client::FieldViolationOf(field.status())->field, "sources[0].position");
+  EXPECT_TRUE(strict.Locate(*mesh, {{2, 2, 50}}).status().code() ==
+              absl::StatusCode::kInvalidArgument);
+}
+
 // A full queue (every worker busy, no room to wait) is worth retrying a moment later; a request
 // over a limit is not. The worker is held by a task of the test's own, released after the first
 // refusal, so the first attempt is refused for certain and a later one succeeds.

@@ -111,6 +111,9 @@ struct ClientOptions {
   std::string ca_pem;
   // Bearer token sent as "authorization: Bearer TOKEN" on every call ("" = none).
   std::string token;
+  // On every query that takes points: the server refuses a 3D position farther than this from
+  // the surface (INVALID_ARGUMENT; FieldViolationOf names it, e.g. "to.position"); +inf snaps any.
+  double max_snap = std::numeric_limits<double>::infinity();
   // Called with (bytes sent, total) during uploads (the CLI's progress bar); may be empty.
   std::function<void(uint64_t, uint64_t)> upload_progress;
 };
