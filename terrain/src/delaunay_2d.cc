@@ -18,12 +18,6 @@ Delaunay2d::Delaunay2d(double x0, double y0, double x1, double y1) {
   neighbours_ = {{kNone, 1, kNone}, {kNone, kNone, 0}};
 }
 
-void Delaunay2d::Reserve(uint32_t vertices) {
-  points_.reserve(vertices);
-  corners_.reserve(2 * size_t{vertices});
-  neighbours_.reserve(2 * size_t{vertices});
-}
-
 uint32_t Delaunay2d::AddTriangle() {
   corners_.push_back({kNone, kNone, kNone});
   neighbours_.push_back({kNone, kNone, kNone});

@@ -47,9 +47,6 @@ class Delaunay2d {
   // neighbours(t)[k]: the triangle across the edge opposite corners(t)[k], or kNone.
   const std::array<uint32_t, 3>& neighbours(uint32_t t) const { return neighbours_[t]; }
 
-  // Reserves room for this many vertices (and their triangles).
-  void Reserve(uint32_t vertices);
-
  private:
   // Where a point lies: inside triangle `t`, on its edge `edge` (opposite corner `edge`), or on
   // its corner `corner`; or outside the rectangle (t == kNone).
@@ -67,7 +64,7 @@ class Delaunay2d {
                    uint32_t nc);
   // In triangle `t`, the neighbour slot that holds `old` now holds `now`.
   void ReplaceNeighbour(uint32_t t, uint32_t old, uint32_t now);
-  // Restores the Delaunay property around new vertex `v`: `stack` holds triangles with v as
+  // Restores the Delaunay property around new vertex `v`: `stack_` holds triangles with v as
   // corner 0 whose edge opposite v may be illegal.
   void Legalize(uint32_t v, std::vector<uint32_t>* changed);
 
@@ -76,7 +73,6 @@ class Delaunay2d {
   std::vector<std::array<uint32_t, 3>> neighbours_;
   std::vector<uint32_t> stack_;  // Legalize's work list, kept to save allocations
   uint32_t last_ = 0;            // the triangle the last insertion ended in
-  uint32_t walk_turn_ = 0;       // varies the first edge a walk step tries
 };
 
 }  // namespace geodex::terrain

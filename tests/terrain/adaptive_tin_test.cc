@@ -7,10 +7,12 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <random>
+#include <thread>
 #include <vector>
 
 #include "geodex/limits.h"
@@ -340,6 +342,30 @@ TEST(AdaptiveTinTest, Cancelled) {
   cancel = false;
   EXPECT_TRUE(
       BuildAdaptiveTin(raster.heights.data(), raster.rows, raster.cols, nullptr, options).ok());
+}
+
+// A cancel that lands during the insertions (noise at a tiny Z: every one of 250,000 cells
+// becomes a vertex, about a second's work) stops the build.
+TEST(AdaptiveTinTest, CancelledWhileInserting) {
+  Raster raster{500, 500, std::vector<double>(500 * 500), {}};
+  std::mt19937_64 random(9);
+  std::uniform_real_distribution<double> noise(0, 1);
+  for (double& h : raster.heights) h = noise(random);
+  std::atomic<bool> cancel{false};
+  AdaptiveTinOptions options;
+  options.z_tolerance = 1e-12;
+  options.cancel = &cancel;
+  std::thread canceller([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    cancel = true;
+  });
+  const auto start = std::chrono::steady_clock::now();
+  const auto tin =
+      BuildAdaptiveTin(raster.heights.data(), raster.rows, raster.cols, nullptr, options);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  canceller.join();
+  EXPECT_EQ(tin.status().code(), absl::StatusCode::kCancelled) << seconds << " s";
 }
 
 }  // namespace
