@@ -302,6 +302,17 @@ absl::StatusOr<terrain::DemOptions> MeshReadOptions(const Args& args, const std:
     return absl::InvalidArgumentError(
         "--barrier-width goes with --barrier (the width of its lines and points)");
   }
+  if (!GetDouble(args, "z-tolerance", &dem.z_tolerance, &error)) {
+    return absl::InvalidArgumentError(error);
+  }
+  if (!(dem.z_tolerance >= 0) || !std::isfinite(dem.z_tolerance)) {
+    return absl::InvalidArgumentError(
+        "--z-tolerance must be a finite height (the DEM's vertical unit), > 0 for a TIN");
+  }
+  if (args.options.count("z-tolerance") && !terrain::IsDemPath(mesh)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--z-tolerance: ", mesh, " is not a DEM (a raster such as .tif)"));
+  }
   if (args.options.count("dem-step") && !terrain::IsDemPath(mesh)) {
     return absl::InvalidArgumentError(
         absl::StrCat("--dem-step: ", mesh, " is not a DEM (a raster such as .tif)"));
@@ -378,6 +389,13 @@ std::string FormatInfo(const InfoValues& v, bool json) {
         {"vertical_unit", d.vertical_unit.empty() ? "m (assumed)" : d.vertical_unit},
         {"driver", d.driver},
     };
+    if (d.z_tolerance > 0) {  // an adaptive TIN: how far it is from the cells (metres)
+      dem_rows.push_back({"z_tolerance", absl::StrFormat("%.17g", d.z_tolerance)});
+      dem_rows.push_back(
+          {"max_vertical_deviation", absl::StrFormat("%.17g", d.max_vertical_deviation)});
+      dem_rows.push_back(
+          {"rms_vertical_deviation", absl::StrFormat("%.17g", d.rms_vertical_deviation)});
+    }
   }
   std::string out;
   if (!json) {
@@ -396,8 +414,9 @@ std::string FormatInfo(const InfoValues& v, bool json) {
   }
   for (const auto& [k, value] : dem_rows) {
     const bool pair = k == "raster" || k == "grid";
-    const bool number =
-        k == "dem_step" || k == "nodata_cells" || k == "barrier_cells" || k == "barrier_faces";
+    const bool number = k == "dem_step" || k == "nodata_cells" || k == "barrier_cells" ||
+                        k == "barrier_faces" || absl::StrContains(k, "_deviation") ||
+                        k == "z_tolerance";
     out += absl::StrFormat(
         ", \"%s\": %s", k,
         pair     ? absl::StrCat("[", absl::StrJoin(absl::StrSplit(value, ' '), ", "), "]")
@@ -671,9 +690,14 @@ int RunDistances(Backend& backend, const Args& args) {
     stats = (*field)->stats;
     if (stats.solve_ms == 0) stats.solve_ms = MsSince(t_solve);
     absl::Status written = absl::OkStatus();
-    if (raster) written = dem->WriteFloatRaster(output, (*field)->distance);
-    if (written.ok() && !labels_output.empty()) {
-      written = dem->WriteIndexRaster(labels_output, (*field)->source);
+    if (raster || !labels_output.empty()) {  // the used grid's cells (on a TIN: sampled)
+      absl::StatusOr<terrain::CellValues> cells =
+          terrain::SampleCells(*dem, **field, nullptr, &query.options);
+      if (!cells.ok()) return FailQuery(cells.status());
+      if (raster) written = dem->WriteDistanceRaster(output, *cells);
+      if (written.ok() && !labels_output.empty()) {
+        written = dem->WriteLabelRaster(labels_output, *cells);
+      }
     }
     if (!written.ok()) return Fail(kExitUsage, std::string(written.message()));
     if (!raster) {

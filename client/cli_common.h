@@ -59,8 +59,8 @@ void WarnIfBarrierSplits(const terrain::DemOptions& dem_options, uint64_t compon
 
 // How MESH is read (--dem-step, --barrier-below, --barrier) and GeoJSON written (--crs): options
 // of every command that takes a MESH, checked by MeshReadOptions (cli_backend.h).
-inline const std::set<std::string> kMeshReadingFlags = {"dem-step", "barrier-below", "barrier",
-                                                        "barrier-width", "crs"};
+inline const std::set<std::string> kMeshReadingFlags = {
+    "dem-step", "z-tolerance", "barrier-below", "barrier", "barrier-width", "crs"};
 // False with *error naming the first option neither in `known` nor in kMeshReadingFlags.
 bool CheckKnown(const Args& args, const std::set<std::string>& known, std::string* error);
 // --lambda, --lambda-scale, --max-distance and --max-windows into `options`, checked by core's

@@ -93,6 +93,7 @@ absl::StatusOr<MeshRef> UploadDerived(GeodexClient& client, const std::string& m
     client::DemUploadOptions dem;
     dem.step = options.step;
     if (std::isfinite(options.barrier_below)) dem.barrier_below = options.barrier_below;
+    dem.z_tolerance = options.z_tolerance;
     return client.ResolveDem(mesh, data, dem);
   }
   return client.ResolveMeshData(std::filesystem::path(mesh).stem().string() + ".off", data);

@@ -60,6 +60,7 @@ v1::DemOptions DemOptionsToProto(const DemUploadOptions& options) {
   v1::DemOptions out;
   out.set_step(options.step);
   if (options.barrier_below.has_value()) out.set_barrier_below(*options.barrier_below);
+  out.set_z_tolerance(options.z_tolerance);
   return out;
 }
 

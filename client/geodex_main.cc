@@ -27,7 +27,9 @@ MESH is a mesh file (OFF, OBJ, PLY, STL, optionally .gz), a built-in sample (sam
 sample:torus, sample:sphere), or a DEM: a raster GDAL reads (.tif, .tiff, .asc, .img, .hgt, .dem,
 .bil, .nc; a .vrt is refused: its sources may name other files or URLs), triangulated cell centre by cell centre, nodata cells left out, in metres (a
 longitude/latitude grid is projected to the UTM zone of its centre). --dem-step N uses every Nth
-cell (a quick look). --barrier-below Z (any MESH) removes what lies below Z (the sea at 0): a DEM's
+cell (a quick look). --z-tolerance Z makes the DEM an adaptive TIN: the few cells needed for the
+surface to stay within Z (the DEM's height unit) of every cell, Delaunay-triangulated; far fewer
+vertices on smooth terrain, rasters still on the DEM's grid (docs/terrain.md). --barrier-below Z (any MESH) removes what lies below Z (the sea at 0): a DEM's
 cells, a mesh's faces with a corner below Z; paths go around it, exactly, and beyond it is inf.
 --barrier FILE (GeoJSON; on a DEM also Shapefile, GeoPackage, FlatGeobuf) cuts its polygons exactly
 out of the surface (on a DEM in the file's CRS, WGS 84 when it names none; on a mesh in its own

@@ -135,6 +135,10 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
             !std::isfinite(metadata_.dem().barrier_below())) {
           return FieldError("metadata.dem.barrier_below", "must be finite");
         }
+        if (!(metadata_.dem().z_tolerance() >= 0) ||
+            !std::isfinite(metadata_.dem().z_tolerance())) {
+          return FieldError("metadata.dem.z_tolerance", "must be finite and >= 0 (0: the grid)");
+        }
       }
       if (!metadata_.expected_mesh_id().empty() && !IsMeshId(metadata_.expected_mesh_id())) {
         return FieldError("metadata.expected_mesh_id", "must be 64 lowercase hex digits");
@@ -229,6 +233,7 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
     options.step = std::max<uint32_t>(1, metadata_.dem().step());
     if (metadata_.dem().has_barrier_below())
       options.barrier_below = metadata_.dem().barrier_below();
+    options.z_tolerance = metadata_.dem().z_tolerance();
     options.max_cells = env_.limits->max_dem_cells;
     options.max_vertices = env_.limits->max_vertices;
     options.max_faces = env_.limits->max_faces;

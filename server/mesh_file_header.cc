@@ -137,13 +137,14 @@ std::string EncodeMeshFileHeader(const MeshRecord& record) {
     w.Str(t.vertical_unit);
     w.F64(t.vertical_scale);
     for (double v : t.geotransform) w.F64(v);
+    for (double v : {t.z_tolerance, t.max_vertical_deviation, t.rms_vertical_deviation}) w.F64(v);
   }
   return w.Take();
 }
 
 absl::StatusOr<MeshRecord> DecodeMeshFileHeader(uint32_t version, absl::string_view bytes) {
   if (version == 1) return DecodeVersion1(bytes);
-  if (version != 2 && version != 3) {
+  if (version < 2 || version > 4) {
     return absl::DataLossError(absl::StrCat("unsupported format version ", version));
   }
   Reader r(bytes);
@@ -183,6 +184,11 @@ absl::StatusOr<MeshRecord> DecodeMeshFileHeader(uint32_t version, absl::string_v
     t.vertical_unit = r.Str();
     t.vertical_scale = r.F64();
     for (double& v : t.geotransform) v = r.F64();
+    if (version >= 4) {
+      for (double* v : {&t.z_tolerance, &t.max_vertical_deviation, &t.rms_vertical_deviation}) {
+        *v = r.F64();
+      }
+    }
   }
   if (!r.ok() || !r.done()) return absl::DataLossError("corrupt header");
   return record;

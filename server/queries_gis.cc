@@ -182,9 +182,15 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
     }
     case v1::GIS_PRODUCT_DISTANCE_RASTER:
     case v1::GIS_PRODUCT_LABEL_RASTER: {
+      // The used grid's cells (on a TIN: solved exactly at the point below each centre).
+      absl::StatusOr<GeodesicOptions> solver = Options(env, request.options());
+      if (!solver.ok()) return solver.status();
+      absl::StatusOr<terrain::CellValues> cells =
+          terrain::SampleCells(grid, field, &mesh, &*solver);
+      if (!cells.ok()) return cells.status();
       absl::StatusOr<std::string> tiff = product == v1::GIS_PRODUCT_DISTANCE_RASTER
-                                             ? grid.FloatRasterBytes(field.distance)
-                                             : grid.IndexRasterBytes(field.source);
+                                             ? grid.DistanceRasterBytes(*cells)
+                                             : grid.LabelRasterBytes(*cells);
       if (!tiff.ok()) return tiff.status();
       return FileStream(*tiff, "image/tiff", chunk, env.limits->max_output_values, *snaps);
     }

@@ -458,8 +458,9 @@ absl::StatusOr<PointValues> ComputePointValues(const TriangleMesh& mesh, const P
   // One targeted solve (A* towards the points when they are close together), stopping once every
   // point is final; the solver stays for the directions (read off its per-vertex origins).
   ich::IchSolver solver(mesh, query.options);
-  if (absl::Status s = solver.SolveForTargets(*src, *resolved, /*use_heuristic=*/true, true,
-                                              &results, &out.stats);
+  const bool targeted = !query.covers_surface;
+  if (absl::Status s =
+          solver.SolveForTargets(*src, *resolved, targeted, targeted, &results, &out.stats);
       !s.ok()) {
     return s;
   }

@@ -21,6 +21,9 @@ void TerrainToProto(const terrain::DemInfo& info, v1::Terrain* out) {
   out->set_vertical_unit(info.vertical_unit);
   out->set_vertical_scale(info.vertical_scale);
   out->mutable_geotransform()->Assign(info.geotransform.begin(), info.geotransform.end());
+  out->set_z_tolerance(info.z_tolerance);
+  out->set_max_vertical_deviation(info.max_vertical_deviation);
+  out->set_rms_vertical_deviation(info.rms_vertical_deviation);
 }
 
 terrain::DemInfo TerrainFromProto(const v1::Terrain& t) {
@@ -42,6 +45,9 @@ terrain::DemInfo TerrainFromProto(const v1::Terrain& t) {
   info.horizontal_scale = t.horizontal_scale();
   info.vertical_unit = t.vertical_unit();
   info.vertical_scale = t.vertical_scale();
+  info.z_tolerance = t.z_tolerance();
+  info.max_vertical_deviation = t.max_vertical_deviation();
+  info.rms_vertical_deviation = t.rms_vertical_deviation();
   if (t.geotransform_size() == 6) {
     std::copy(t.geotransform().begin(), t.geotransform().end(), info.geotransform.begin());
   }

@@ -8,6 +8,7 @@
 #include <functional>
 #include <limits>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <utility>
 
@@ -24,8 +25,11 @@
 #include "cpl_string.h"
 #include "gdal_priv.h"
 #include "gdal_quiet.h"
+#include "geodex/adaptive_tin.h"
+#include "geodex/distance_matrix.h"
 #include "geodex/gis_formats.h"
 #include "geodex/limits.h"
+#include "geodex/point_distance.h"
 #include "geodex/terrain.h"
 #include "mem_file.h"
 #include "ogr_api.h"
@@ -580,6 +584,10 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
         absl::StrFormat("%s: %ux%u cells, more than the %u a DEM may have here", path,
                         info.raster_width, info.raster_height, options.max_cells));
   }
+  if (!(options.z_tolerance >= 0) || !std::isfinite(options.z_tolerance)) {
+    return absl::InvalidArgumentError(absl::StrCat(
+        "--z-tolerance: must be finite and >= 0 (0: the full grid), got ", options.z_tolerance));
+  }
   info.step = options.step;
   info.grid_width = (info.raster_width + options.step - 1) / options.step;
   info.grid_height = (info.raster_height + options.step - 1) / options.step;
@@ -589,14 +597,15 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
   }
   const uint64_t most_vertices = uint64_t{info.grid_width} * info.grid_height;
   const uint64_t most_faces = 2 * uint64_t{info.grid_width - 1} * (info.grid_height - 1);
-  if (options.max_vertices != 0 && most_vertices > options.max_vertices) {
+  if (options.z_tolerance == 0 && options.max_vertices != 0 &&
+      most_vertices > options.max_vertices) {
     return LimitExceededError(
         Limit::kVertices,
         absl::StrFormat(
             "%s: %ux%u used cells can make %d vertices, more than the %d a mesh may have here",
             path, info.grid_width, info.grid_height, most_vertices, options.max_vertices));
   }
-  if (options.max_faces != 0 && most_faces > options.max_faces) {
+  if (options.z_tolerance == 0 && options.max_faces != 0 && most_faces > options.max_faces) {
     return LimitExceededError(
         Limit::kFaces,
         absl::StrFormat(
@@ -755,6 +764,20 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
   // Faces: per block, corners a (i, j), b (i+1, j), c (i, j+1), d (i+1, j+1), split along a-d:
   // (a, c, d) and (a, d, b), counter-clockwise seen from above when rows run south (gt[5] < 0).
   const bool flip = gt[1] * gt[5] > 0;  // rows run north: mirror the winding
+  if (options.z_tolerance > 0) {
+    absl::StatusOr<MeshData> tin = BuildTin(dem, options, flip, file_crs, path, &info);
+    if (!tin.ok()) return tin.status();
+    info.z_tolerance = options.z_tolerance;
+    if (barrier == nullptr) return FromMesh(*std::move(tin), info);
+    CutStats stats;
+    absl::StatusOr<MeshData> cut =
+        CutBarrier(*tin, *barrier, &info, &file_crs, options.barrier_width, options.max_vertices,
+                   barrier_name, &stats);
+    if (!cut.ok()) return cut.status();
+    if (cut->faces.empty()) return bad("the barrier covers every face: nothing is left");
+    info.barrier_faces = stats.faces_removed + stats.faces_cut;
+    return FromMesh(*std::move(cut), info);
+  }
   dem.face_of_block_.assign(2 * size_t{W - 1} * (H - 1), kNoVertex);
   for (uint32_t j = 0; j + 1 < H; ++j) {
     for (uint32_t i = 0; i + 1 < W; ++i) {
@@ -787,6 +810,133 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
   return FromMesh(*std::move(cut), info);
 }
 
+absl::StatusOr<std::array<double, 2>> Dem::CellCentreInMesh(uint32_t col, uint32_t row) const {
+  const std::array<double, 6>& gt = info_.geotransform;
+  double x = gt[0] + (col + 0.5) * gt[1], y = gt[3] + (row + 0.5) * gt[5];
+  if (!info_.reprojected)
+    return std::array<double, 2>{x * info_.horizontal_scale, y * info_.horizontal_scale};
+  QuietGdal quiet;
+  OGRSpatialReference file_crs, mesh_crs;
+  file_crs.importFromWkt(info_.file_crs_wkt.c_str());
+  mesh_crs.importFromWkt(info_.mesh_crs_wkt.c_str());
+  file_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  mesh_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  TransformPtr t = MakeTransform(file_crs, mesh_crs);
+  if (t == nullptr || !t->Transform(1, &x, &y)) {
+    return absl::InvalidArgumentError("a cell centre does not project to the mesh's CRS");
+  }
+  return std::array<double, 2>{x, y};
+}
+
+absl::StatusOr<MeshData> Dem::BuildTin(const Dem& grid, const DemOptions& options, bool flip,
+                                       const OGRSpatialReference& file_crs, const std::string& name,
+                                       DemInfo* info) {
+  const uint32_t W = grid.info_.grid_width, H = grid.info_.grid_height;
+  // Heights in metres, row by row (the tolerance is in metres too); cells without data (or below
+  // the barrier) are holes: they do not shape the TIN, and are cut out of it below.
+  std::vector<double> heights(size_t{W} * H, 0.0);
+  std::vector<uint8_t> valid(size_t{W} * H, 0);
+  bool holes = false;
+  for (size_t cell = 0; cell < heights.size(); ++cell) {
+    const uint32_t v = grid.vertex_of_cell_[cell];
+    holes |= v == kNoVertex;
+    if (v == kNoVertex) continue;
+    heights[cell] = grid.mesh_.positions[3 * size_t{v} + 2];
+    valid[cell] = 1;
+  }
+  AdaptiveTinOptions tin_options;
+  tin_options.z_tolerance = options.z_tolerance * grid.info_.vertical_scale;
+  tin_options.max_vertices = options.max_vertices;
+  absl::StatusOr<AdaptiveTin> tin =
+      BuildAdaptiveTin(heights.data(), H, W, holes ? valid.data() : nullptr, tin_options);
+  if (!tin.ok()) {
+    if (absl::IsInvalidArgument(tin.status())) {
+      return absl::InvalidArgumentError(
+          absl::StrCat("--z-tolerance: ", name, ": ", tin.status().message()));
+    }
+    return tin.status();
+  }
+  if (options.max_faces != 0 && tin->faces.size() > options.max_faces) {
+    return LimitExceededError(
+        Limit::kFaces, absl::StrFormat("%s: the TIN has %d faces, more than the %d a mesh may "
+                                       "have here (a larger --z-tolerance makes fewer)",
+                                       name, tin->faces.size(), options.max_faces));
+  }
+  // Vertices in row order (what FromMesh reads a DEM's cells by), faces wound like the grid's. A
+  // corner in a hole keeps the height the TIN gave it (it is cut away with the hole).
+  const size_t n = tin->vertices.size();
+  std::vector<uint32_t> order(n), new_index(n);
+  for (uint32_t v = 0; v < n; ++v) order[v] = v;
+  auto cell_of = [&](uint32_t v) {
+    return size_t{tin->source_cell[v].first} * W + tin->source_cell[v].second;
+  };
+  std::sort(order.begin(), order.end(),
+            [&](uint32_t a, uint32_t b) { return cell_of(a) < cell_of(b); });
+  MeshData out;
+  out.positions.reserve(3 * n);
+  for (uint32_t k = 0; k < n; ++k) {
+    new_index[order[k]] = k;
+    const uint32_t v = grid.vertex_of_cell_[cell_of(order[k])];
+    if (v != kNoVertex) {
+      const double* p = &grid.mesh_.positions[3 * size_t{v}];
+      out.positions.insert(out.positions.end(), p, p + 3);
+    } else {  // a corner in a hole: its map position, the TIN's height
+      absl::StatusOr<std::array<double, 2>> xy = grid.CellCentreInMesh(
+          tin->source_cell[order[k]].second, tin->source_cell[order[k]].first);
+      if (!xy.ok()) return xy.status();
+      out.positions.insert(out.positions.end(), {(*xy)[0], (*xy)[1], tin->vertices[order[k]][2]});
+    }
+  }
+  out.faces.reserve(3 * tin->faces.size());
+  for (const std::array<uint32_t, 3>& f : tin->faces) {
+    // The TIN's faces turn counter-clockwise in (column, row); the grid's (a, c, d) clockwise
+    // there (rows run south), mirrored when they run north.
+    std::array<uint32_t, 3> t = {new_index[f[0]], new_index[f[1]], new_index[f[2]]};
+    if (!flip) std::swap(t[1], t[2]);
+    out.faces.insert(out.faces.end(), t.begin(), t.end());
+  }
+  info->max_vertical_deviation = tin->max_vertical_deviation;
+  info->rms_vertical_deviation = tin->rms_vertical_deviation;
+  if (!holes) return out;
+  // The grid's holes, exactly: a grid triangle goes when a corner has no data, so a hole cell
+  // takes the six triangles around it, a hexagon of cell centres; a row's run of hole cells
+  // i0..i1 takes their union, (i0-1, j-1) (i1, j-1) (i1+1, j) (i1+1, j+1) (i0, j+1) (i0-1, j).
+  const std::array<double, 6>& gt = grid.info_.geotransform;
+  auto at = [&](double i, double j) {
+    return std::pair{gt[0] + (i + 0.5) * gt[1], gt[3] + (j + 0.5) * gt[5]};
+  };
+  OGRMultiPolygon runs;
+  for (uint32_t j = 0; j < H; ++j) {
+    for (uint32_t i = 0; i < W;) {
+      if (valid[size_t{j} * W + i]) {
+        ++i;
+        continue;
+      }
+      uint32_t end = i;
+      while (end + 1 < W && !valid[size_t{j} * W + end + 1]) ++end;
+      const double i0 = i, i1 = end, jj = j;
+      OGRLinearRing ring;
+      for (auto [u, v] : {std::pair{i0 - 1, jj - 1}, std::pair{i1, jj - 1}, std::pair{i1 + 1, jj},
+                          std::pair{i1 + 1, jj + 1}, std::pair{i0, jj + 1}, std::pair{i0 - 1, jj},
+                          std::pair{i0 - 1, jj - 1}}) {
+        const auto [x, y] = at(u, v);
+        ring.addPoint(x, y);
+      }
+      OGRPolygon hexagon;
+      hexagon.addRing(&ring);
+      runs.addGeometry(&hexagon);
+      i = end + 1;
+    }
+  }
+  std::unique_ptr<OGRGeometry> cut_out(runs.UnionCascaded());
+  if (cut_out == nullptr) {
+    return absl::InternalError(absl::StrCat(name, ": cannot join the DEM's holes (GEOS)"));
+  }
+  CutStats stats;
+  return CutBarrier(out, *cut_out, &grid.info_, &file_crs, 0, options.max_vertices,
+                    absl::StrCat(name, " (its cells without data)"), &stats);
+}
+
 absl::StatusOr<Dem> Dem::FromMesh(MeshData mesh, DemInfo info) {
   auto bad = [](const std::string& why) {
     return absl::InvalidArgumentError(absl::StrCat("not the mesh of this DEM: ", why));
@@ -800,7 +950,9 @@ absl::StatusOr<Dem> Dem::FromMesh(MeshData mesh, DemInfo info) {
   const size_t n = mesh.vertex_count();
   // The grid maps are W x H: bounded by the mesh (a DEM up to 255 of 256 cells without data),
   // whatever a header says.
-  if (uint64_t{W} * H > 256 * (uint64_t{n} + 1) + (uint64_t{1} << 24)) {
+  // (A TIN's grid may be far larger than its mesh: up to 2^28 cells, 1 GiB of maps.)
+  if (info.z_tolerance > 0 ? uint64_t{W} * H > (uint64_t{1} << 28)
+                           : uint64_t{W} * H > 256 * (uint64_t{n} + 1) + (uint64_t{1} << 24)) {
     return bad("its grid is far larger than its mesh");
   }
   // Each vertex's map position in the file's CRS.
@@ -858,8 +1010,10 @@ absl::StatusOr<Dem> Dem::FromMesh(MeshData mesh, DemInfo info) {
     if (!(u >= -1e-6 && w >= -1e-6 && u <= W - 1 + 1e-6 && w <= H - 1 + 1e-6)) {
       return bad(absl::StrCat("vertex ", v, " is outside the grid"));
     }
-    if (std::abs(u - std::round(u)) < 1e-6 && std::abs(w - std::round(w)) < 1e-6) {
-      // At a cell centre only as a copy of that cell's vertex (a line barrier's two sides).
+    // On the grid a cut's vertex is at a cell centre only as a copy of that cell's vertex (a line
+    // barrier's two sides); on a TIN also where a hole's outline turns (most cells are no vertex).
+    if (info.z_tolerance == 0 && std::abs(u - std::round(u)) < 1e-6 &&
+        std::abs(w - std::round(w)) < 1e-6) {
       const size_t cell =
           static_cast<size_t>(std::round(w)) * W + static_cast<size_t>(std::round(u));
       const uint32_t original =
@@ -869,6 +1023,16 @@ absl::StatusOr<Dem> Dem::FromMesh(MeshData mesh, DemInfo info) {
         return bad(absl::StrCat("vertex ", v, " is out of row order"));
       }
     }
+  }
+  if (info.z_tolerance > 0) {  // an adaptive TIN: its faces are not blocks
+    dem.cell_uv_.resize(n);
+    for (size_t v = 0; v < n; ++v) {
+      dem.cell_uv_[v] = {(xs[v] - gt[0]) / gt[1] - 0.5, (ys[v] - gt[3]) / gt[5] - 0.5};
+    }
+    dem.mesh_ = std::move(mesh);
+    dem.info_ = std::move(info);
+    if (absl::Status mapped = dem.MapTin(); !mapped.ok()) return bad(std::string(mapped.message()));
+    return dem;
   }
   dem.face_of_block_.assign(2 * size_t{W - 1} * (H - 1), kNoVertex);
   std::vector<std::pair<uint64_t, uint32_t>> pieces;  // (block triangle, face) of a cut's faces
@@ -919,6 +1083,217 @@ absl::StatusOr<Dem> Dem::FromMesh(MeshData mesh, DemInfo info) {
   dem.mesh_ = std::move(mesh);
   dem.info_ = std::move(info);
   return dem;
+}
+
+namespace {
+
+// Barycentrics of (u, v) in the triangle p0 p1 p2 of the plane; false when it is degenerate.
+bool Barycentrics(const std::array<double, 2>& p0, const std::array<double, 2>& p1,
+                  const std::array<double, 2>& p2, double u, double v, std::array<double, 3>* b) {
+  const double det = (p1[0] - p0[0]) * (p2[1] - p0[1]) - (p2[0] - p0[0]) * (p1[1] - p0[1]);
+  if (det == 0) return false;
+  const double b1 = ((u - p0[0]) * (p2[1] - p0[1]) - (p2[0] - p0[0]) * (v - p0[1])) / det;
+  const double b2 = ((p1[0] - p0[0]) * (v - p0[1]) - (u - p0[0]) * (p1[1] - p0[1])) / det;
+  *b = {1 - b1 - b2, b1, b2};
+  return true;
+}
+
+// A face point from barycentrics a hair outside the face: clamped and normalised.
+SurfacePoint ClampedFacePoint(uint32_t face, std::array<double, 3> b) {
+  double sum = 0;
+  for (double& x : b) sum += (x = x > 0 ? x : 0.0);  // also turns -0 into 0
+  return SurfacePoint::InFace(face, b[0] / sum, b[1] / sum, b[2] / sum);
+}
+
+}  // namespace
+
+absl::Status Dem::MapTin() {
+  const uint32_t W = info_.grid_width, H = info_.grid_height;
+  const size_t faces = mesh_.face_count(), n = mesh_.vertex_count();
+  for (uint32_t v : mesh_.faces) {
+    if (v >= n) return absl::InvalidArgumentError(absl::StrCat("a face has no vertex ", v));
+  }
+  // Neighbours across each edge (the edge opposite corner k), from the edges sorted by their ends.
+  std::vector<std::pair<uint64_t, uint32_t>> edges;
+  edges.reserve(3 * faces);
+  for (size_t f = 0; f < faces; ++f) {
+    for (int k = 0; k < 3; ++k) {
+      const uint64_t a = mesh_.faces[3 * f + (k + 1) % 3], b = mesh_.faces[3 * f + (k + 2) % 3];
+      edges.push_back({std::min(a, b) << 32 | std::max(a, b), static_cast<uint32_t>(3 * f + k)});
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  neighbours_.assign(3 * faces, kNoVertex);
+  for (size_t i = 0; i < edges.size();) {
+    size_t j = i;
+    while (j < edges.size() && edges[j].first == edges[i].first) ++j;
+    if (j - i == 2) {  // an inner edge (a non-manifold one stays a boundary for the walk)
+      neighbours_[edges[i].second] = edges[i + 1].second / 3;
+      neighbours_[edges[i + 1].second] = edges[i].second / 3;
+    }
+    i = j;
+  }
+  // The face holding each cell centre: each face's cells, over its bounding box (TIN faces are
+  // Delaunay triangles of the grid's cells: their boxes hold about twice their cells).
+  face_of_cell_.assign(size_t{W} * H, kNoVertex);
+  constexpr double kOn = 1e-9;  // a centre on an edge belongs to the first face that finds it
+  for (size_t f = 0; f < faces; ++f) {
+    const std::array<double, 2>& p0 = cell_uv_[mesh_.faces[3 * f]];
+    const std::array<double, 2>& p1 = cell_uv_[mesh_.faces[3 * f + 1]];
+    const std::array<double, 2>& p2 = cell_uv_[mesh_.faces[3 * f + 2]];
+    const double lo_u = std::max(0.0, std::ceil(std::min({p0[0], p1[0], p2[0]}) - kOn));
+    const double hi_u = std::min(W - 1.0, std::floor(std::max({p0[0], p1[0], p2[0]}) + kOn));
+    const double lo_v = std::max(0.0, std::ceil(std::min({p0[1], p1[1], p2[1]}) - kOn));
+    const double hi_v = std::min(H - 1.0, std::floor(std::max({p0[1], p1[1], p2[1]}) + kOn));
+    for (double v = lo_v; v <= hi_v; ++v) {
+      for (double u = lo_u; u <= hi_u; ++u) {
+        std::array<double, 3> b;
+        if (!Barycentrics(p0, p1, p2, u, v, &b) || std::min({b[0], b[1], b[2]}) < -kOn) continue;
+        uint32_t& slot = face_of_cell_[static_cast<size_t>(v) * W + static_cast<size_t>(u)];
+        if (slot == kNoVertex) slot = static_cast<uint32_t>(f);
+      }
+    }
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<SurfacePoint> Dem::DropOnTin(double /*mx*/, double /*my*/, double u, double v,
+                                            const std::string& name) const {
+  // Faces and cells share the grid's plane (the TIN was made there): walk from the face of a cell
+  // near the point towards it, across the edge it lies beyond, until a face holds it.
+  const int W = static_cast<int>(info_.grid_width), H = static_cast<int>(info_.grid_height);
+  const int ci = std::clamp(static_cast<int>(std::lround(u)), 0, W - 1);
+  const int cj = std::clamp(static_cast<int>(std::lround(v)), 0, H - 1);
+  std::vector<uint32_t> starts;
+  for (int r = 0; r <= 2 && starts.empty(); ++r) {
+    for (int j = std::max(0, cj - r); j <= std::min(H - 1, cj + r); ++j) {
+      for (int i = std::max(0, ci - r); i <= std::min(W - 1, ci + r); ++i) {
+        const uint32_t f = face_of_cell_[size_t(j) * W + i];
+        if (f != kNoVertex && std::find(starts.begin(), starts.end(), f) == starts.end()) {
+          starts.push_back(f);
+        }
+      }
+    }
+  }
+  const size_t faces = mesh_.face_count();
+  for (uint32_t f : starts) {
+    for (size_t step = 0; step <= faces; ++step) {
+      std::array<double, 3> b;
+      if (!Barycentrics(cell_uv_[mesh_.faces[3 * size_t{f}]],
+                        cell_uv_[mesh_.faces[3 * size_t{f} + 1]],
+                        cell_uv_[mesh_.faces[3 * size_t{f} + 2]], u, v, &b)) {
+        break;
+      }
+      const int k = static_cast<int>(std::min_element(b.begin(), b.end()) - b.begin());
+      if (b[k] >= -1e-12) return ClampedFacePoint(f, b);
+      const uint32_t next = neighbours_[3 * size_t{f} + k];
+      if (next == kNoVertex) {
+        if (b[k] >= -1e-7) return ClampedFacePoint(f, b);  // on the boundary, to round-off
+        break;  // beyond a boundary here: another start may go round
+      }
+      f = next;
+    }
+  }
+  return absl::InvalidArgumentError(
+      absl::StrCat(name, ": in a hole of the DEM (nodata or a barrier)"));
+}
+
+absl::StatusOr<SurfacePoint> Dem::CellPoint(uint32_t col, uint32_t row) const {
+  if (col >= info_.grid_width || row >= info_.grid_height) {
+    return absl::InvalidArgumentError(absl::StrCat("cell (", col, ", ", row, ") is off the grid"));
+  }
+  const size_t cell = size_t{row} * info_.grid_width + col;
+  if (!is_tin()) {
+    if (vertex_of_cell_[cell] == kNoVertex) return absl::NotFoundError("a cell without surface");
+    return SurfacePoint::AtVertex(vertex_of_cell_[cell]);
+  }
+  const uint32_t f = face_of_cell_[cell];
+  if (f == kNoVertex) return absl::NotFoundError("a cell without surface");
+  if (vertex_of_cell_[cell] != kNoVertex) return SurfacePoint::AtVertex(vertex_of_cell_[cell]);
+  std::array<double, 3> b;
+  if (!Barycentrics(cell_uv_[mesh_.faces[3 * size_t{f}]], cell_uv_[mesh_.faces[3 * size_t{f} + 1]],
+                    cell_uv_[mesh_.faces[3 * size_t{f} + 2]], col, row, &b)) {
+    return absl::NotFoundError("a cell on a degenerate face");
+  }
+  return ClampedFacePoint(f, b);
+}
+
+absl::StatusOr<CellValues> SampleCells(const Dem& dem, const DistanceField& field,
+                                       const TriangleMesh* mesh, const GeodesicOptions* exact) {
+  std::optional<TriangleMesh> built;
+  if (dem.is_tin() && mesh == nullptr) {
+    absl::StatusOr<TriangleMesh> m = TriangleMesh::Build(dem.mesh());
+    if (!m.ok()) return m.status();
+    mesh = &built.emplace(*std::move(m));
+  }
+  // A field received from geodexd holds the file vertices' values only: the estimate reads the
+  // engine's vertices, each a file vertex's copy with its value.
+  std::optional<DistanceField> widened;
+  if (dem.is_tin() && field.internal_distance.size() != mesh->vertex_count()) {
+    DistanceField& w = widened.emplace();
+    w.sources = field.sources;  // a source in the cell's own face is measured straight
+    w.internal_distance.resize(mesh->vertex_count());
+    w.internal_source.resize(mesh->vertex_count());
+    for (uint32_t v = 0; v < mesh->vertex_count(); ++v) {
+      w.internal_distance[v] = field.distance[mesh->FileVertex(v)];
+      w.internal_source[v] = field.source[mesh->FileVertex(v)];
+    }
+  }
+  const DistanceField& for_estimates = widened ? *widened : field;
+  const DemInfo& info = dem.info();
+  const size_t cells = size_t{info.grid_width} * info.grid_height;
+  if (field.distance.size() < dem.mesh().vertex_count() ||
+      field.source.size() < dem.mesh().vertex_count()) {
+    return absl::InternalError("one value per vertex expected");
+  }
+  CellValues out;
+  out.distance.assign(cells, std::numeric_limits<double>::infinity());
+  out.source.assign(cells, kNoVertex);
+  out.hole.assign(cells, 0);
+  std::vector<bool> on_surface(dem.mesh().vertex_count());  // a vertex no face uses: a hole
+  for (uint32_t v : dem.mesh().faces) on_surface[v] = true;
+  std::vector<SurfacePoint> targets;  // exact: the cells inside faces, solved at once below
+  std::vector<size_t> target_cell;
+  for (uint32_t row = 0; row < info.grid_height; ++row) {
+    for (uint32_t col = 0; col < info.grid_width; ++col) {
+      const size_t cell = size_t{row} * info.grid_width + col;
+      absl::StatusOr<SurfacePoint> p = dem.CellPoint(col, row);
+      if (!p.ok() || (p->kind == SurfacePoint::Kind::kVertex && !on_surface[p->vertex])) {
+        out.hole[cell] = 1;
+        continue;
+      }
+      if (p->kind == SurfacePoint::Kind::kVertex) {
+        out.distance[cell] = field.distance[p->vertex];
+        out.source[cell] = field.source[p->vertex];
+        continue;
+      }
+      if (exact != nullptr) {
+        targets.push_back(*p);
+        target_cell.push_back(cell);
+        continue;
+      }
+      absl::StatusOr<PointEstimate> e = EstimateDistanceAt(*mesh, for_estimates, *p);
+      if (!e.ok()) return e.status();
+      out.distance[cell] = e->distance;
+      out.source[cell] = e->source;
+      out.estimated = true;
+    }
+  }
+  if (!targets.empty()) {
+    PointQuery query;
+    query.sources = field.sources;
+    query.points = std::move(targets);
+    query.options = *exact;
+    query.covers_surface = true;
+    absl::StatusOr<PointValues> values = ComputePointValues(*mesh, query);
+    if (!values.ok()) return values.status();
+    for (size_t k = 0; k < target_cell.size(); ++k) {
+      out.distance[target_cell[k]] = values->distance[k];
+      out.source[target_cell[k]] = values->source[k];
+    }
+    out.exact_stats = values->stats;
+  }
+  return out;
 }
 
 namespace {
@@ -1038,6 +1413,7 @@ absl::StatusOr<SurfacePoint> Dem::DropMeshPoint(double mx, double my, double u, 
   if (!(u >= -kEdge && u <= W - 1 + kEdge && v >= -kEdge && v <= H - 1 + kEdge)) {
     return absl::InvalidArgumentError(absl::StrCat(name, ": outside the DEM"));
   }
+  if (is_tin()) return DropOnTin(mx, my, u, v, name);
   const int bi = std::clamp(static_cast<int>(std::floor(u)), 0, static_cast<int>(W) - 2);
   const int bj = std::clamp(static_cast<int>(std::floor(v)), 0, static_cast<int>(H) - 2);
   // The point's block and its neighbours: a point on a grid line belongs to two blocks (one may be
@@ -1099,12 +1475,11 @@ absl::StatusOr<SurfacePoint> Dem::DropMeshPoint(double mx, double my, double u, 
 namespace {
 
 // One band on the used grid, made in memory and copied out by the format the path's extension
-// names (GisFormatOf): a cell without a vertex, or whose vertex no face uses (inside a barrier),
-// has no surface (kRasterNoSurface, the band's nodata); `value_of_vertex` gives the others.
-absl::Status WriteRaster(const DemInfo& info, const std::vector<uint32_t>& vertex_of_cell,
-                         const MeshData& mesh, const std::string& path, GDALDataType type,
+// names (GisFormatOf); `value_of_cell` gives each cell's value (row-major index), kRasterNoSurface
+// (the band's nodata) where there is no surface.
+absl::Status WriteRaster(const DemInfo& info, const std::string& path, GDALDataType type,
                          const char* description, const char* unit,
-                         const std::function<double(uint32_t)>& value_of_vertex) {
+                         const std::function<double(size_t)>& value_of_cell) {
   QuietGdal quiet;
   const GisFormat* format = GisFormatOf(path);
   if (format == nullptr || format->kind != GisFileKind::kRaster) {
@@ -1135,15 +1510,10 @@ absl::Status WriteRaster(const DemInfo& info, const std::vector<uint32_t>& verte
   band->SetNoDataValue(kRasterNoSurface);
   band->SetDescription(description);
   if (unit != nullptr) band->SetUnitType(unit);
-  std::vector<bool> on_surface(mesh.vertex_count());
-  for (uint32_t v : mesh.faces) {
-    if (v < on_surface.size()) on_surface[v] = true;
-  }
   std::vector<double> row(info.grid_width);
   for (uint32_t j = 0; j < info.grid_height; ++j) {
     for (uint32_t i = 0; i < info.grid_width; ++i) {
-      const uint32_t v = vertex_of_cell[size_t{j} * info.grid_width + i];
-      row[i] = v == kNoVertex || !on_surface[v] ? kRasterNoSurface : value_of_vertex(v);
+      row[i] = value_of_cell(size_t{j} * info.grid_width + i);
     }
     if (band->RasterIO(GF_Write, 0, static_cast<int>(j), static_cast<int>(info.grid_width), 1,
                        row.data(), static_cast<int>(info.grid_width), 1, GDT_Float64, 0,
@@ -1169,21 +1539,55 @@ absl::Status WriteRaster(const DemInfo& info, const std::vector<uint32_t>& verte
 
 absl::Status Dem::WriteFloatRaster(const std::string& path,
                                    const std::vector<double>& values) const {
-  if (values.size() < mesh_.vertex_count())
-    return absl::InternalError("one value per vertex expected");
-  return WriteRaster(
-      info_, vertex_of_cell_, mesh_, path, GDT_Float32, "geodesic distance", "m",
-      [&](uint32_t v) { return std::isfinite(values[v]) ? values[v] : kRasterUnreachable; });
+  if (values.size() < mesh_.vertex_count() || is_tin()) {
+    return absl::InternalError("one value per vertex of a grid expected (a TIN: SampleCells)");
+  }
+  std::vector<bool> on_surface(mesh_.vertex_count());  // a vertex no face uses: a hole
+  for (uint32_t v : mesh_.faces) on_surface[v] = true;
+  return WriteRaster(info_, path, GDT_Float32, "geodesic distance", "m", [&](size_t cell) {
+    const uint32_t v = vertex_of_cell_[cell];
+    if (v == kNoVertex || !on_surface[v]) return kRasterNoSurface;
+    return std::isfinite(values[v]) ? values[v] : kRasterUnreachable;
+  });
 }
 
 absl::Status Dem::WriteIndexRaster(const std::string& path,
                                    const std::vector<uint32_t>& values) const {
-  if (values.size() < mesh_.vertex_count())
-    return absl::InternalError("one value per vertex expected");
-  return WriteRaster(
-      info_, vertex_of_cell_, mesh_, path, GDT_Int32, "nearest source", nullptr, [&](uint32_t v) {
-        return values[v] >= 0x80000000u ? kRasterUnreachable : static_cast<double>(values[v]);
-      });
+  if (values.size() < mesh_.vertex_count() || is_tin()) {
+    return absl::InternalError("one value per vertex of a grid expected (a TIN: SampleCells)");
+  }
+  std::vector<bool> on_surface(mesh_.vertex_count());
+  for (uint32_t v : mesh_.faces) on_surface[v] = true;
+  return WriteRaster(info_, path, GDT_Int32, "nearest source", nullptr, [&](size_t cell) {
+    const uint32_t v = vertex_of_cell_[cell];
+    if (v == kNoVertex || !on_surface[v]) return kRasterNoSurface;
+    return values[v] >= 0x80000000u ? kRasterUnreachable : static_cast<double>(values[v]);
+  });
+}
+
+absl::Status Dem::WriteDistanceRaster(const std::string& path, const CellValues& cells) const {
+  if (cells.distance.size() != size_t{info_.grid_width} * info_.grid_height) {
+    return absl::InternalError("one value per used cell expected");
+  }
+  return WriteRaster(info_, path, GDT_Float32,
+                     cells.estimated ? "geodesic distance (section-4 estimate at cell centres)"
+                                     : "geodesic distance",
+                     "m", [&](size_t cell) {
+                       if (cells.hole[cell]) return kRasterNoSurface;
+                       const double d = cells.distance[cell];
+                       return std::isfinite(d) ? d : kRasterUnreachable;
+                     });
+}
+
+absl::Status Dem::WriteLabelRaster(const std::string& path, const CellValues& cells) const {
+  if (cells.source.size() != size_t{info_.grid_width} * info_.grid_height) {
+    return absl::InternalError("one value per used cell expected");
+  }
+  return WriteRaster(info_, path, GDT_Int32, "nearest source", nullptr, [&](size_t cell) {
+    if (cells.hole[cell]) return kRasterNoSurface;
+    const uint32_t s = cells.source[cell];
+    return s >= 0x80000000u ? kRasterUnreachable : static_cast<double>(s);
+  });
 }
 
 namespace {
@@ -1204,6 +1608,14 @@ absl::StatusOr<std::string> Dem::FloatRasterBytes(const std::vector<double>& val
 
 absl::StatusOr<std::string> Dem::IndexRasterBytes(const std::vector<uint32_t>& values) const {
   return RasterBytes([&](const std::string& path) { return WriteIndexRaster(path, values); });
+}
+
+absl::StatusOr<std::string> Dem::DistanceRasterBytes(const CellValues& cells) const {
+  return RasterBytes([&](const std::string& path) { return WriteDistanceRaster(path, cells); });
+}
+
+absl::StatusOr<std::string> Dem::LabelRasterBytes(const CellValues& cells) const {
+  return RasterBytes([&](const std::string& path) { return WriteLabelRaster(path, cells); });
 }
 
 }  // namespace geodex::terrain

@@ -72,6 +72,7 @@ struct ServerMesh {
 struct DemUploadOptions {
   uint32_t step = 0;                    // every step-th cell (0 or 1: every cell)
   std::optional<double> barrier_below;  // cells below this height are removed
+  double z_tolerance = 0;               // > 0: an adaptive TIN within this height (docs/terrain.md)
 };
 
 // What DeriveMesh removes from a stored mesh (geodex.v1.Barrier).

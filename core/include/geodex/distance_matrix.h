@@ -89,6 +89,9 @@ struct PointQuery {
   // Also each point's geodesic direction: what a robot at the point follows towards the nearest
   // source (the direction field of ComputeDirectionField, at any surface point).
   bool directions = false;
+  // The points cover the surface (a raster's cells on a TIN): the whole field is solved, without
+  // A* towards them or the early stop, whose bookkeeping costs O(points) whenever one improves.
+  bool covers_surface = false;
 };
 // Its answer, one entry per point, in order.
 struct PointValues {

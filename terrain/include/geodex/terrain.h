@@ -12,6 +12,13 @@
 // CRS (longitude/latitude) is projected to the UTM zone of the DEM's centre (WGS 84 datum), so
 // every distance is in metres. Heights are converted to metres from the band's unit ("m", "ft",
 // "US survey foot"; none given: metres).
+//
+// An adaptive TIN (DemOptions::z_tolerance > 0): instead of every used cell, the few cells a
+// greedy insertion needs for the surface to lie within Z of every used cell's height (Garland and
+// Heckbert; adaptive_tin.h), Delaunay-triangulated in the grid's plane. Its vertices are cell
+// centres (row order, as the grid's); its faces are large. Map points drop onto its faces, and
+// rasters (on the used grid as ever) take at each cell the value at the TIN's point below the
+// cell's centre (SampleCells).
 
 #include <array>
 #include <cstdint>
@@ -22,10 +29,14 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "geodex/distance_field.h"
+#include "geodex/geodesic_solver.h"
 #include "geodex/mesh_data.h"
 #include "geodex/surface_point.h"
+#include "geodex/triangle_mesh.h"
 
 class GDALDataset;
+class OGRSpatialReference;
 
 namespace geodex::terrain {
 
@@ -46,6 +57,10 @@ struct DemOptions {
   uint64_t max_cells = 0;
   uint64_t max_vertices = 0;
   uint64_t max_faces = 0;
+  // > 0: the mesh is an adaptive TIN whose surface is within this many of the band's height units
+  // (converted to metres like the heights) of every used cell with data; 0: every used cell is a
+  // vertex (the grid). Finite; negative is refused.
+  double z_tolerance = 0;
 };
 
 // The faces of `mesh` with no corner lower than `z` (the same barrier on a mesh file: a face
@@ -72,6 +87,11 @@ struct DemInfo {
   // The used grid's geotransform in the file's CRS (the file's own when step = 1): pixel (i, j)
   // has its corner at (gt[0] + i gt[1] + j gt[2], gt[3] + i gt[4] + j gt[5]).
   std::array<double, 6> geotransform{};
+  // An adaptive TIN's (0 for the grid): DemOptions::z_tolerance, and the vertical distance between
+  // the TIN and the used cells' heights (metres) measured at every used cell with data.
+  double z_tolerance = 0;
+  double max_vertical_deviation = 0;
+  double rms_vertical_deviation = 0;
 
   bool operator==(const DemInfo&) const = default;
 };
@@ -119,6 +139,8 @@ absl::StatusOr<std::string> FilePointSpec(const FilePoint& point);
 
 inline constexpr uint32_t kNoVertex = 0xffffffffu;
 
+struct CellValues;  // below: a field's values at the used grid's cells
+
 class Dem {
  public:
   // Errors: InvalidArgument naming the file (GDAL cannot read it, not one band, no CRS or
@@ -141,12 +163,14 @@ class Dem {
 
   const MeshData& mesh() const { return mesh_; }
   const DemInfo& info() const { return info_; }
+  bool is_tin() const { return info_.z_tolerance > 0; }
   // The memory it holds (mesh copy and grid maps).
   uint64_t MemoryBytes() const {
     return mesh_.positions.capacity() * sizeof(double) +
-           (mesh_.faces.capacity() + vertex_of_cell_.capacity() + face_of_block_.capacity()) *
+           (mesh_.faces.capacity() + vertex_of_cell_.capacity() + face_of_block_.capacity() +
+            face_of_cell_.capacity() + neighbours_.capacity()) *
                sizeof(uint32_t) +
-           pieces_.capacity() * sizeof(pieces_[0]);
+           pieces_.capacity() * sizeof(pieces_[0]) + cell_uv_.capacity() * sizeof(cell_uv_[0]);
   }
   // The vertex of used cell (col, row), or kNoVertex (nodata).
   uint32_t VertexAt(uint32_t col, uint32_t row) const {
@@ -175,6 +199,18 @@ class Dem {
   absl::StatusOr<std::string> FloatRasterBytes(const std::vector<double>& values) const;
   absl::StatusOr<std::string> IndexRasterBytes(const std::vector<uint32_t>& values) const;
 
+  // The rasters of a field's values at the cells (SampleCells): float32 distances with nodata -1
+  // where there is no surface and -2 where it is unreachable; int32 labels likewise.
+  absl::Status WriteDistanceRaster(const std::string& path, const CellValues& cells) const;
+  absl::Status WriteLabelRaster(const std::string& path, const CellValues& cells) const;
+  absl::StatusOr<std::string> DistanceRasterBytes(const CellValues& cells) const;
+  absl::StatusOr<std::string> LabelRasterBytes(const CellValues& cells) const;
+
+  // The surface point below used cell (col, row)'s centre: its vertex on the grid (and on a TIN
+  // when the cell is a vertex), else on a TIN a point of the face holding the centre. NotFound for
+  // a cell in a hole (nodata, a barrier).
+  absl::StatusOr<SurfacePoint> CellPoint(uint32_t col, uint32_t row) const;
+
  private:
   Dem() = default;
   // Read's work once GDAL has opened the raster (`name` spells it in errors).
@@ -193,7 +229,48 @@ class Dem {
   // A barrier cut's faces: (block triangle, face), sorted; the triangle's face_of_block_ is then
   // kNoVertex.
   std::vector<std::pair<uint64_t, uint32_t>> pieces_;
+  // An adaptive TIN's maps (empty on the grid): the face holding each used cell's centre
+  // (kNoVertex in a hole), each face's neighbour across the edge opposite each corner (kNoVertex on
+  // a boundary), and each vertex's (column, row) in cell units.
+  std::vector<uint32_t> face_of_cell_;
+  std::vector<uint32_t> neighbours_;
+  std::vector<std::array<double, 2>> cell_uv_;
+  // ReadDataset's TIN: the adaptive TIN of the grid `grid` (every used cell with data a vertex,
+  // no face yet) with its vertices in row order, the grid's holes cut out of it exactly (`file_crs`
+  // places them); fills `info`'s deviations.
+  static absl::StatusOr<MeshData> BuildTin(const Dem& grid, const DemOptions& options, bool flip,
+                                           const OGRSpatialReference& file_crs,
+                                           const std::string& name, DemInfo* info);
+  // Used cell (col, row)'s centre in the mesh's x y (metres; projected when reprojected).
+  absl::StatusOr<std::array<double, 2>> CellCentreInMesh(uint32_t col, uint32_t row) const;
+  // FromMesh's TIN part: the maps above from the mesh (cell_uv_ set).
+  absl::Status MapTin();
+  // DropMeshPoint on a TIN: a walk from the face of the nearest cell.
+  absl::StatusOr<SurfacePoint> DropOnTin(double mx, double my, double u, double v,
+                                         const std::string& name) const;
 };
+
+// A field's values at the used grid's cells, row by row (what the rasters hold): on the grid each
+// cell's vertex's; on a TIN at the point below the cell's centre (CellPoint), with the nearest
+// source's label: exact (one targeted solve from the field's sources that stops once every cell
+// is final, as ComputePointValues) when `exact` options are given, else the paper's section-4
+// estimate from the field (exact at the TIN's vertices and for a source in the point's own face;
+// it can err by a percent behind an obstacle that large faces straddle). Cells in a hole: +inf and
+// kNoVertex, with `hole` set.
+struct CellValues {
+  std::vector<double> distance;
+  std::vector<uint32_t> source;
+  std::vector<uint8_t> hole;
+  bool estimated = false;  // some value is the section-4 estimate (a TIN without `exact`)
+  SolveStats exact_stats;  // the targeted solve's, when there was one
+};
+// `mesh`: the engine's mesh of dem.mesh() when the caller has one (a TIN's values need it; null:
+// built here, a TIN being small). The CLI and geodexd pass `exact` (the field's own options): a
+// raster is then the exact field at every cell centre, at the cost of about a second solve on
+// the TIN (docs/performance.md).
+absl::StatusOr<CellValues> SampleCells(const Dem& dem, const DistanceField& field,
+                                       const TriangleMesh* mesh = nullptr,
+                                       const GeodesicOptions* exact = nullptr);
 
 // True when `path` names a raster by its extension (.tif, .tiff, .vrt, .asc, .img, .hgt, .dem,
 // .bil, .nc): what the CLI reads as a DEM instead of a mesh file.
