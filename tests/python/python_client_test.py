@@ -298,6 +298,15 @@ class PythonClientTest(unittest.TestCase):
         coarse = self.client.upload(tif, dem_step=2)
         self.assertEqual(coarse.terrain.grid_width, 15)
         self.assertNotEqual(coarse.name, mesh.name)
+        # An adaptive TIN: the CLI's (the same field at its vertices), within its tolerance.
+        tin = self.client.upload(tif, z_tolerance=0.05, name="slope-tin")
+        self.assertEqual(tin.terrain.z_tolerance, 0.05)
+        self.assertLessEqual(tin.terrain.max_vertical_deviation, 0.05)
+        self.assertLess(tin.vertex_count, mesh.vertex_count / 4)
+        expected = [float(x) for x in self.local(
+            "distances", tif, "--z-tolerance", "0.05", "--sources", "g:500031.5:4999903.5").split()]
+        self.assertEqual(self.client.distance_field("meshes/slope-tin", [source]).distances.tolist(),
+                         expected)
 
     def test_errors_are_typed_and_carry_the_details(self):
         with self.assertRaises(geodex.InvalidArgumentError) as error:

@@ -137,7 +137,8 @@ class TerrainServiceTest : public testing::ServerFixture {
 
   testing::UploadResult UploadDem(const std::string& bytes, const std::string& name,
                                   v1::MeshFormat format = v1::MESH_FORMAT_GEOTIFF,
-                                  const std::string& file_name = "slot.tif", uint32_t step = 0) {
+                                  const std::string& file_name = "slot.tif", uint32_t step = 0,
+                                  double z_tolerance = 0) {
     testing::UploadResult result;
     grpc::ClientContext context;
     context.set_deadline(testing::In(120));
@@ -147,6 +148,7 @@ class TerrainServiceTest : public testing::ServerFixture {
     request.mutable_metadata()->set_file_name(file_name);
     request.mutable_metadata()->set_display_name(name);
     if (step != 0) request.mutable_metadata()->mutable_dem()->set_step(step);
+    if (z_tolerance != 0) request.mutable_metadata()->mutable_dem()->set_z_tolerance(z_tolerance);
     writer->Write(request);
     request.Clear();
     request.set_chunk(bytes);
@@ -592,6 +594,74 @@ TEST_F(TerrainServiceTest, NoRequestMakesTheServerReachOut) {
   absl::StatusOr<bool> health = client.Health();
   ASSERT_TRUE(health.ok()) << health.status();
   EXPECT_TRUE(*health);
+}
+
+// A GeoTIFF uploaded with dem.z_tolerance: the adaptive TIN the CLI makes (the same mesh id), its
+// deviations in the Terrain, kept across a restart (mesh file version 4); map points drop onto it
+// and its distance raster is the one made here. A bad tolerance names its field.
+TEST_F(TerrainServiceTest, AdaptiveTinUploadIsTheClisTin) {
+  Restart();
+  terrain::DemOptions options;
+  options.z_tolerance = 0.25;
+  absl::StatusOr<terrain::Dem> local = terrain::Dem::Read(tif_, options);
+  ASSERT_TRUE(local.ok()) << local.status();
+  ASSERT_LT(local->mesh().vertex_count(), 100u);  // a plane with a slot: a few vertices
+  testing::UploadResult up = UploadDem(bytes_, "tin", v1::MESH_FORMAT_GEOTIFF, "slot.tif", 0, 0.25);
+  ASSERT_TRUE(up.status.ok()) << up.status.error_message();
+  EXPECT_EQ(up.mesh.name(), absl::StrCat("meshes/", ComputeMeshId(local->mesh())));
+  EXPECT_EQ(up.mesh.terrain().z_tolerance(), 0.25);
+  EXPECT_EQ(up.mesh.terrain().max_vertical_deviation(), local->info().max_vertical_deviation);
+  EXPECT_EQ(up.mesh.vertex_count(), local->mesh().vertex_count());
+
+  Restart();  // loaded back from the data directory
+  v1::ExportGisRequest request;
+  request.set_mesh("meshes/tin");
+  request.set_product(v1::GIS_PRODUCT_DISTANCE_RASTER);
+  request.add_sources()->mutable_map_point()->set_x(500061.7);
+  request.mutable_sources(0)->mutable_map_point()->set_y(4999822.9);
+  grpc::ClientContext context;
+  context.set_deadline(testing::In(120));
+  auto reader = stub_->ExportGis(&context, request);
+  v1::ExportGisResponse message;
+  std::string tiff;
+  while (reader->Read(&message)) tiff += message.data();
+  grpc::Status status = reader->Finish();
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  absl::StatusOr<TriangleMesh> built = TriangleMesh::Build(local->mesh());
+  ASSERT_TRUE(built.ok());
+  absl::StatusOr<SurfacePoint> source = local->DropMapPoint(500061.7, 4999822.9);
+  ASSERT_TRUE(source.ok());
+  absl::StatusOr<DistanceField> field = ComputeDistanceField(*built, {*source});
+  ASSERT_TRUE(field.ok());
+  GeodesicOptions exact;
+  absl::StatusOr<terrain::CellValues> cells = terrain::SampleCells(*local, *field, &*built, &exact);
+  ASSERT_TRUE(cells.ok());
+  absl::StatusOr<std::string> want = local->DistanceRasterBytes(*cells);
+  ASSERT_TRUE(want.ok());
+  const std::string path = "/vsimem/tin-export.tif", want_path = "/vsimem/tin-want.tif";
+  for (const auto& [p, bytes] : {std::pair{path, &tiff}, std::pair{want_path, &*want}}) {
+    VSILFILE* f = VSIFileFromMemBuffer(p.c_str(), reinterpret_cast<GByte*>(bytes->data()),
+                                       bytes->size(), FALSE);
+    ASSERT_NE(f, nullptr);
+    VSIFCloseL(f);
+  }
+  std::vector<float> got(30 * 30), expected(30 * 30);
+  for (const auto& [p, out] : {std::pair{path, &got}, std::pair{want_path, &expected}}) {
+    GDALDataset* ds = GDALDataset::Open(p.c_str(), GDAL_OF_RASTER);
+    ASSERT_NE(ds, nullptr);
+    ASSERT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Read, 0, 0, 30, 30, out->data(), 30, 30,
+                                             GDT_Float32, 0, 0),
+              CE_None);
+    GDALClose(ds);
+    VSIUnlink(p.c_str());
+  }
+  EXPECT_EQ(got, expected);
+  EXPECT_EQ(got[15 * 30 + 14], -1);  // the slot
+  EXPECT_GT(got[20 * 30 + 3], 0);
+
+  testing::UploadResult bad = UploadDem(bytes_, "bad", v1::MESH_FORMAT_GEOTIFF, "slot.tif", 0, -1);
+  EXPECT_EQ(bad.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_EQ(BadField(bad.status), "metadata.dem.z_tolerance") << bad.status.error_message();
 }
 
 // ExportGis: the files the CLI writes, made by geodexd from a stored DEM's mesh.

@@ -188,7 +188,8 @@ TEST_F(DemTest, TinRastersAgreeWithTheGridsAndAStoredTinLoadsTheSame) {
   absl::StatusOr<TriangleMesh> tin_mesh = TriangleMesh::Build(tin->mesh());
   ASSERT_TRUE(grid_mesh.ok() && tin_mesh.ok());
   const double sx = 500105, sy = 4999405;
-  absl::StatusOr<DistanceField> gf = ComputeDistanceField(*grid_mesh, {*grid->DropMapPoint(sx, sy)});
+  absl::StatusOr<DistanceField> gf =
+      ComputeDistanceField(*grid_mesh, {*grid->DropMapPoint(sx, sy)});
   absl::StatusOr<DistanceField> tf = ComputeDistanceField(*tin_mesh, {*tin->DropMapPoint(sx, sy)});
   ASSERT_TRUE(gf.ok() && tf.ok());
   GeodesicOptions exact;

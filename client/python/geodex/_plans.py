@@ -212,7 +212,8 @@ class Plans:
 
     def upload(self, source: MeshSource, name: str = "", pin: bool = False,
                dem_step: Optional[int] = None, barrier_below: Optional[float] = None,
-               file_name: Optional[str] = None, timeout: Optional[float] = None) -> Plan[Mesh]:
+               z_tolerance: float = 0.0, file_name: Optional[str] = None,
+               timeout: Optional[float] = None) -> Plan[Mesh]:
         """Uploads a mesh in 1 MiB chunks (idempotent: by content hash) and returns its `Mesh`.
 
         `source`: a file path; the file's bytes (give `file_name`, whose extension names the
@@ -222,7 +223,9 @@ class Plans:
 
         A GeoTIFF (.tif, .tiff) is a DEM: geodexd makes it a mesh in metres and keeps its map
         (Mesh.terrain), so map_point() and lon_lat() work on it. `dem_step` uses every Nth cell;
-        `barrier_below` leaves out cells lower than that many metres (the sea at 0)."""
+        `barrier_below` leaves out cells lower than that many metres (the sea at 0);
+        `z_tolerance` > 0 makes it an adaptive TIN within that height of every cell (the CLI's
+        --z-tolerance; Mesh.terrain then reports max_vertical_deviation)."""
         if isinstance(source, tuple):
             data, file_name = _wire.off_text(*source), file_name or "arrays.off"
         elif isinstance(source, (bytes, bytearray, memoryview)):
@@ -236,8 +239,9 @@ class Plans:
                 data = f.read()
             file_name = file_name or os.path.basename(path)
         dem = None
-        if file_name.lower().endswith((".tif", ".tiff")) or dem_step or barrier_below is not None:
-            dem = pb.DemOptions(step=dem_step or 0)
+        if (file_name.lower().endswith((".tif", ".tiff")) or dem_step or barrier_below is not None
+                or z_tolerance):
+            dem = pb.DemOptions(step=dem_step or 0, z_tolerance=z_tolerance)
             if barrier_below is not None:
                 dem.barrier_below = barrier_below
         mesh = yield from self._upload_rpc(data, file_name, name, pin, dem)
