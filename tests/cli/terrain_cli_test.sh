@@ -500,6 +500,52 @@ while rows[y][3 * (12 + run):3 * (12 + run) + 3] == bytes([30, 30, 30]):
 assert abs(run - 688 * 0.9 / 390 * 100) <= 2, run
 PY
 
+# An adaptive TIN (--z-tolerance): the plane is two triangles, its raster the exact plane distance
+# at every cell; the slot is cut out along the grid's boundary (the same nodata cells); info says Z
+# and the deviation; a bad Z is named. In remote mode the GeoTIFF goes up with Z (the same TIN).
+"$GEODEX" info "$tmp/plane.tif" --z-tolerance 0.5 --format json >"$tmp/tin.json"
+check "tin info: exit 0" test $? -eq 0
+check "tin info: 4 vertices, 2 faces, Z, deviation" $PY -c "
+import json; d = json.load(open('$tmp/tin.json'))
+assert d['vertices'] == 4 and d['faces'] == 2 and d['z_tolerance'] == 0.5, d
+assert d['max_vertical_deviation'] < 1e-9, d"
+"$GEODEX" distances "$tmp/plane.tif" --z-tolerance 0.5 --sources g:500013.3:4999981.7 \
+  --output "$tmp/tin.tif"
+check "tin raster: exit 0" test $? -eq 0
+check "tin raster: the plane's straight distance at every cell" $PY - "$tmp/tin.tif" <<'PY'
+import math, sys
+import numpy as np
+from osgeo import gdal
+a = gdal.Open(sys.argv[1]).ReadAsArray().astype(float)
+z = lambda x, y: 0.1 * (x - 500000) + 0.2 * (y - 4999700)
+s = (500013.3, 4999981.7)
+worst = 0
+for j in range(30):
+    for i in range(40):
+        x, y = 500000 + (i + 0.5) * 10, 5000000 - (j + 0.5) * 10
+        want = math.dist((*s, z(*s)), (x, y, z(x, y)))
+        worst = max(worst, abs(a[j, i] - want) / want)
+assert worst < 1e-6, worst   # float32 cells
+PY
+"$GEODEX" distances "$tmp/slot.tif" --sources g:500105:4999845 --output "$tmp/grid-slot.tif"
+"$GEODEX" distances "$tmp/slot.tif" --z-tolerance 0.1 --sources g:500105:4999845 \
+  --output "$tmp/tin-slot.tif"
+check "tin slot: the grid's holes and distances" $PY - "$tmp/grid-slot.tif" "$tmp/tin-slot.tif" <<'PY'
+import sys
+import numpy as np
+from osgeo import gdal
+a = gdal.Open(sys.argv[1]).ReadAsArray().astype(float)
+b = gdal.Open(sys.argv[2]).ReadAsArray().astype(float)
+assert ((a == -1) == (b == -1)).all() and (a == -1).sum() == 50
+m = a >= 0
+assert np.abs(a[m] - b[m]).max() <= 1e-6 * a[m].max(), np.abs(a[m] - b[m]).max()
+PY
+"$GEODEX" info "$tmp/plane.tif" --z-tolerance -1 2>"$tmp/err.txt" >/dev/null
+check "bad Z: exit 2" test $? -eq 2
+check "bad Z: named" grep -q -- "--z-tolerance" "$tmp/err.txt"
+"$GEODEX" info "$tmp/tri.off" --z-tolerance 1 2>"$tmp/err.txt" >/dev/null
+check "Z on a mesh: exit 2" test $? -eq 2
+
 # Errors: map points need a DEM, a point outside or in the slot is named, --dem-step needs a DEM.
 "$GEODEX" distances "$tmp/tri.off" --sources g:1:2 2>"$tmp/err.txt" >/dev/null
 check "g: on a mesh: exit 2" test $? -eq 2
