@@ -1,6 +1,7 @@
 // libFuzzer target: what geodexd does with an uploaded GeoTIFF (MESH_FORMAT_GEOTIFF), on arbitrary
 // bytes: GDAL's GTiff driver under a cell limit, then (for what reads) the stored-mesh round trip
-// (Dem::FromMesh) and map points dropped at the grid's corners and centre. Byte 0 is the step.
+// (Dem::FromMesh) and map points dropped at the grid's corners and centre. Byte 0 is the step, and
+// from bit 2 up a z tolerance (0: the grid; else an adaptive TIN, holes and all).
 // Nothing may crash, hang or allocate beyond the limit.
 
 #include <cstddef>
@@ -23,6 +24,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size < 1) return 0;
   DemOptions options;
   options.step = 1 + data[0] % 4;
+  options.z_tolerance = (data[0] >> 2) * 0.25;
   options.max_cells = 1 << 16;
   const std::string bytes(reinterpret_cast<const char*>(data) + 1, size - 1);
   absl::StatusOr<Dem> dem = Dem::ReadGeoTiffBytes(bytes, "fuzz.tif", options);
