@@ -1,9 +1,12 @@
 #include "testkit/cgal_reference.h"
 
+#include <CGAL/Delaunay_triangulation_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/Surface_mesh_shortest_path.h>
+#include <CGAL/Triangulation_vertex_base_with_info_2.h>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -166,6 +169,28 @@ std::vector<double> CgalDistances(const MeshData& data, const std::vector<Surfac
     timing->query_ms = MsSince(query_start);
   }
   return distance;
+}
+
+std::vector<std::array<uint32_t, 3>> CgalDelaunayTriangles(
+    const std::vector<std::array<double, 2>>& points) {
+  using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+  using Vb = CGAL::Triangulation_vertex_base_with_info_2<uint32_t, K>;
+  using Tds = CGAL::Triangulation_data_structure_2<Vb>;
+  using Delaunay = CGAL::Delaunay_triangulation_2<K, Tds>;
+  Delaunay dt;
+  for (uint32_t i = 0; i < points.size(); ++i) {
+    const size_t before = dt.number_of_vertices();
+    Delaunay::Vertex_handle v = dt.insert(K::Point_2(points[i][0], points[i][1]));
+    if (dt.number_of_vertices() > before) v->info() = i;  // a duplicate keeps the first index
+  }
+  std::vector<std::array<uint32_t, 3>> out;
+  for (auto f = dt.finite_faces_begin(); f != dt.finite_faces_end(); ++f) {
+    std::array<uint32_t, 3> t = {f->vertex(0)->info(), f->vertex(1)->info(), f->vertex(2)->info()};
+    std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+    out.push_back(t);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
 }
 
 }  // namespace geodex

@@ -5,7 +5,9 @@
 // lives in testkit/cgal_reference.cc, built as the library geodex_cgal_reference
 // (testkit/CMakeLists.txt) that cgal_tests and bench/geodex_bench link.
 
+#include <array>
 #include <cstddef>  // geodex/mesh_data.h uses size_t without including it
+#include <cstdint>
 #include <vector>
 
 #include "geodex/mesh_data.h"
@@ -32,5 +34,11 @@ struct CgalTiming {
 };
 std::vector<double> CgalDistances(const MeshData& mesh, const std::vector<SurfacePoint>& sources,
                                   CgalTiming* timing = nullptr);
+
+// CGAL's Delaunay triangulation (Delaunay_triangulation_2, exact predicates) of `points`: its
+// finite triangles as counter-clockwise triples of indices into `points`, each rotated to start
+// at its smallest index, sorted. Duplicate points are one vertex (the first index).
+std::vector<std::array<uint32_t, 3>> CgalDelaunayTriangles(
+    const std::vector<std::array<double, 2>>& points);
 
 }  // namespace geodex
