@@ -68,6 +68,19 @@ TransformPtr MakeTransform(const OGRSpatialReference& from, const OGRSpatialRefe
                       &OGRCoordinateTransformation::DestroyCT);
 }
 
+// A reprojected DEM's file CRS to its mesh CRS (the UTM zone), or back; null when either CRS does
+// not parse or PROJ has no transformation.
+TransformPtr FileMeshTransform(const DemInfo& info, bool to_mesh) {
+  OGRSpatialReference file_crs, mesh_crs;
+  if (file_crs.importFromWkt(info.file_crs_wkt.c_str()) != OGRERR_NONE ||
+      mesh_crs.importFromWkt(info.mesh_crs_wkt.c_str()) != OGRERR_NONE) {
+    return TransformPtr(nullptr, &OGRCoordinateTransformation::DestroyCT);
+  }
+  file_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  mesh_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  return to_mesh ? MakeTransform(file_crs, mesh_crs) : MakeTransform(mesh_crs, file_crs);
+}
+
 // Metres per unit of a band's height unit; 0 when the unit is not one geodex knows.
 double MetresPerHeightUnit(std::string unit) {
   unit = absl::AsciiStrToLower(unit);
@@ -816,12 +829,7 @@ absl::StatusOr<std::array<double, 2>> Dem::CellCentreInMesh(uint32_t col, uint32
   if (!info_.reprojected)
     return std::array<double, 2>{x * info_.horizontal_scale, y * info_.horizontal_scale};
   QuietGdal quiet;
-  OGRSpatialReference file_crs, mesh_crs;
-  file_crs.importFromWkt(info_.file_crs_wkt.c_str());
-  mesh_crs.importFromWkt(info_.mesh_crs_wkt.c_str());
-  file_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  mesh_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  TransformPtr t = MakeTransform(file_crs, mesh_crs);
+  TransformPtr t = FileMeshTransform(info_, /*to_mesh=*/true);
   if (t == nullptr || !t->Transform(1, &x, &y)) {
     return absl::InvalidArgumentError("a cell centre does not project to the mesh's CRS");
   }
@@ -963,14 +971,8 @@ absl::StatusOr<Dem> Dem::FromMesh(MeshData mesh, DemInfo info) {
   }
   if (info.reprojected) {
     QuietGdal quiet;
-    OGRSpatialReference file_crs, mesh_crs;
-    if (file_crs.importFromWkt(info.file_crs_wkt.c_str()) != OGRERR_NONE ||
-        mesh_crs.importFromWkt(info.mesh_crs_wkt.c_str()) != OGRERR_NONE) {
-      return bad("its CRS does not parse");
-    }
-    file_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-    mesh_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-    TransformPtr back = MakeTransform(mesh_crs, file_crs);
+    TransformPtr back = FileMeshTransform(info, /*to_mesh=*/false);
+    if (back == nullptr) return bad("its CRS does not parse, or does not project");
     std::vector<int> ok(n);
     if (back == nullptr ||
         (n > 0 &&
@@ -1364,12 +1366,7 @@ absl::StatusOr<SurfacePoint> Dem::DropNamed(double x, double y, const std::strin
   double mx = x * info_.horizontal_scale, my = y * info_.horizontal_scale;
   if (info_.reprojected) {
     QuietGdal quiet;
-    OGRSpatialReference file_crs, utm;
-    file_crs.importFromWkt(info_.file_crs_wkt.c_str());
-    utm.importFromWkt(info_.mesh_crs_wkt.c_str());
-    file_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-    utm.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-    TransformPtr t = MakeTransform(file_crs, utm);
+    TransformPtr t = FileMeshTransform(info_, /*to_mesh=*/true);
     if (t == nullptr || !t->Transform(1, &mx, &my)) {
       return absl::InvalidArgumentError(
           absl::StrCat(name, ": cannot project it (", QuietGdal::LastMessage(), ")"));

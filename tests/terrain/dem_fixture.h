@@ -3,6 +3,8 @@
 // The DEM tests' fixture: GeoTIFFs made with GDAL at test time in a temporary directory (a Grid:
 // its CRS, corner, cell size and a height function), removed after the test.
 
+#include <array>
+#include <cmath>
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -66,5 +68,10 @@ class DemTest : public ::testing::Test {
 
   fs::path dir_;
 };
+
+// The straight 3D distance between two points.
+inline double Dist(const std::array<double, 3>& a, const std::array<double, 3>& b) {
+  return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+}
 
 }  // namespace geodex::terrain

@@ -38,10 +38,6 @@ DemOptions Step(uint32_t step) {
   return options;
 }
 
-double Dist(const std::array<double, 3>& a, const std::array<double, 3>& b) {
-  return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
-}
-
 TEST_F(DemTest, ProjectedPlaneIsItsOwnGridAndGeodesicsAreStraight) {
   Grid g;
   g.height_at = [](double x, double y, int, int) { return Plane(x, y); };

@@ -26,10 +26,6 @@ DemOptions Tin(double z) {
   return options;
 }
 
-double Dist(const std::array<double, 3>& a, const std::array<double, 3>& b) {
-  return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
-}
-
 // Smooth hills on a 10 m grid, heights in metres.
 double Hills(double x, double y) {
   const double u = (x - 500000) / 10, v = (5000000 - y) / 10;

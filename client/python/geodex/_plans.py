@@ -54,6 +54,29 @@ class Rpc:
         return self.method if self.method.startswith("/") else "/geodex.v1.Geodex/" + self.method
 
 
+def credentials(token: Optional[str], root_pem: Optional[bytes]):
+    """TLS credentials (with a bearer token) for a secure channel, or None for an insecure one."""
+    if root_pem is None and token is None:
+        return None
+    out = grpc.ssl_channel_credentials(root_certificates=root_pem)
+    if token is not None:
+        out = grpc.composite_channel_credentials(out, grpc.access_token_call_credentials(token))
+    return out
+
+
+def multicallable(channel, cache: Dict[tuple, Any], rpc: "Rpc"):
+    """The channel's callable for `rpc` (blocking or grpc.aio alike), made once per kind."""
+    key = (rpc.path, rpc.stream, rpc.client_stream, rpc.response)
+    found = cache.get(key)
+    if found is None:
+        kind = (channel.stream_unary if rpc.client_stream else
+                channel.unary_stream if rpc.stream else channel.unary_unary)
+        found = kind(rpc.path, request_serializer=serializer,
+                     response_deserializer=deserializer(rpc.response))
+        cache[key] = found
+    return found
+
+
 def mesh_metadata(mesh_name):
     """x-mesh-id for a mesh-affine gateway, when the name is an id."""
     if not mesh_name:

@@ -31,7 +31,7 @@ from typing import Any, Dict, Optional
 import grpc
 
 from . import _plans
-from ._plans import Plans, Rpc, SnapWarning, deserializer, mesh_metadata, serializer
+from ._plans import Plans, Rpc, SnapWarning, credentials, mesh_metadata, multicallable
 from .points import edge_point, face_point, lon_lat, map_point, position, vertex
 from .results import (Delaunay, DistanceMatrix, Field, GisFile, Isolines, Located, Mesh, Path,
                       PathPoint, PointDistances, RetryPolicy, Voronoi)
@@ -56,14 +56,9 @@ class GeodexClient(Plans):
                  root_pem: Optional[bytes] = None, retry: Optional[RetryPolicy] = None,
                  wait_for_ready: bool = False, max_snap: Optional[float] = None):
         super().__init__(timeout, retry, wait_for_ready, max_snap)
-        if root_pem is not None or token is not None:
-            credentials = grpc.ssl_channel_credentials(root_certificates=root_pem)
-            if token is not None:
-                credentials = grpc.composite_channel_credentials(
-                    credentials, grpc.access_token_call_credentials(token))
-            self.channel = grpc.secure_channel(target, credentials)
-        else:
-            self.channel = grpc.insecure_channel(target)
+        secure = credentials(token, root_pem)
+        self.channel = (grpc.insecure_channel(target) if secure is None
+                        else grpc.secure_channel(target, secure))
         self._callables: Dict[tuple, Any] = {}
 
     def close(self):
@@ -75,19 +70,8 @@ class GeodexClient(Plans):
     def __exit__(self, *exc):
         self.close()
 
-    def _callable(self, rpc: Rpc):
-        key = (rpc.path, rpc.stream, rpc.client_stream, rpc.response)
-        found = self._callables.get(key)
-        if found is None:
-            kind = (self.channel.stream_unary if rpc.client_stream else
-                    self.channel.unary_stream if rpc.stream else self.channel.unary_unary)
-            found = kind(rpc.path, request_serializer=serializer,
-                         response_deserializer=deserializer(rpc.response))
-            self._callables[key] = found
-        return found
-
     def _attempt(self, rpc: Rpc, seconds: float):
-        call = self._callable(rpc)
+        call = multicallable(self.channel, self._callables, rpc)
         request = rpc.request() if rpc.client_stream else rpc.request
         answer = call(request, timeout=seconds, metadata=mesh_metadata(rpc.mesh),
                       wait_for_ready=self.wait_for_ready)
