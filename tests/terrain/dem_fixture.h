@@ -69,6 +69,18 @@ class DemTest : public ::testing::Test {
   fs::path dir_;
 };
 
+// Flat ground, 30 x 30 cells of 10 m, with a slot of nodata cells in columns 14-15 from row 5 to
+// the bottom edge: the shortest path across goes over the slot's top, a taut string.
+inline Grid SlotGrid() {
+  Grid g;
+  g.width = g.height = 30;
+  g.has_nodata = true;
+  g.height_at = [nodata = g.nodata](double, double, int col, int row) {
+    return (col == 14 || col == 15) && row >= 5 ? nodata : 0.0;
+  };
+  return g;
+}
+
 // The straight 3D distance between two points.
 inline double Dist(const std::array<double, 3>& a, const std::array<double, 3>& b) {
   return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);

@@ -146,12 +146,7 @@ TEST_F(DemTest, GeographicGridIsProjectedToUtmInMetres) {
 // A slot of nodata cells (columns 14-15, rows 5 to the bottom edge) on flat ground: the shortest
 // path from one side to the other goes over the slot's top, a taut string through its corners.
 TEST_F(DemTest, NodataHoleIsGoneAround) {
-  Grid g;
-  g.width = g.height = 30;
-  g.has_nodata = true;
-  g.height_at = [&](double, double, int col, int row) {
-    return (col == 14 || col == 15) && row >= 5 ? g.nodata : 0.0;
-  };
+  const Grid g = SlotGrid();
   absl::StatusOr<Dem> dem = Dem::Read(Write("slot.tif", g));
   ASSERT_TRUE(dem.ok()) << dem.status();
   EXPECT_EQ(dem->info().nodata_cells, 2u * 25u);

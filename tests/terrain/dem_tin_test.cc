@@ -113,12 +113,7 @@ TEST_F(DemTest, EveryCellIsWithinZOfTheTin) {
 // The flat slot of NodataHoleIsGoneAround, as a TIN: two triangles with the slot cut out along the
 // grid's own hole boundary, so the detour is the grid's, exactly.
 TEST_F(DemTest, TinHolesKeepTheGridsExactBoundary) {
-  Grid g;
-  g.width = g.height = 30;
-  g.has_nodata = true;
-  g.height_at = [&](double, double, int col, int row) {
-    return (col == 14 || col == 15) && row >= 5 ? g.nodata : 0.0;
-  };
+  const Grid g = SlotGrid();
   const std::string path = Write("slot.tif", g);
   absl::StatusOr<Dem> grid = Dem::Read(path);
   absl::StatusOr<Dem> tin = Dem::Read(path, Tin(0.25));
