@@ -42,6 +42,8 @@ inline const char* FlagOfLimit(Limit limit) {
       return "max_windows";
     case Limit::kDemCells:
       return "max_dem_cells";
+    case Limit::kSteinerPoints:
+      return "max_steiner_points";
   }
   return "unknown";
 }

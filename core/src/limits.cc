@@ -10,7 +10,8 @@ namespace {
 
 constexpr absl::string_view kPayloadUrl = "geodex/limit";
 
-constexpr absl::string_view kNames[] = {"vertices", "faces", "input_bytes", "windows", "dem_cells"};
+constexpr absl::string_view kNames[] = {"vertices", "faces",     "input_bytes",
+                                        "windows",  "dem_cells", "steiner_points"};
 
 }  // namespace
 

@@ -12,11 +12,12 @@
 namespace geodex {
 
 enum class Limit {
-  kVertices,    // ReadLimits::max_vertices
-  kFaces,       // ReadLimits::max_faces
-  kInputBytes,  // ReadLimits::max_decompressed_bytes (file size, gzip expansion)
-  kWindows,     // GeodesicOptions::max_windows
-  kDemCells,    // terrain::DemOptions::max_cells (a raster's width x height)
+  kVertices,       // ReadLimits::max_vertices
+  kFaces,          // ReadLimits::max_faces
+  kInputBytes,     // ReadLimits::max_decompressed_bytes (file size, gzip expansion)
+  kWindows,        // GeodesicOptions::max_windows
+  kDemCells,       // terrain::DemOptions::max_cells (a raster's width x height)
+  kSteinerPoints,  // WeightedOptions::max_steiner_points (weighted_field.h)
 };
 
 absl::Status LimitExceededError(Limit limit, absl::string_view message);

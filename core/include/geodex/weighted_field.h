@@ -1,0 +1,139 @@
+#pragma once
+
+// Weighted ("travel cost") shortest paths: least costs on a triangle mesh whose faces carry
+// weights (friction), within a stated factor (1 + epsilon) of the true least cost, by the Steiner
+// point method.
+//
+// Cost: a straight piece inside face f costs its 3D length x w(f); a piece along an edge shared by
+// two faces costs its length x the smaller of their weights. A face of weight +inf is impassable
+// (its edges stay usable when a passable face borders them). Times = cost / speed are the caller's.
+//
+// Method (Aleksandrov, Lanthier, Maheshwari, Sack, SWAT 1998 / Aleksandrov, Maheshwari, Sack,
+// JACM 52(1) 2005, with the Steiner points on the EDGES as in the former and the geometric
+// progression of the latter):
+//  * per vertex v (passable, non-degenerate faces around v only): d(v) = the smallest height of
+//    those faces from v (a lower bound of the distance from v to the boundary of its star),
+//    w_min(v), w_max(v) their smallest and largest weight, and the vicinity radius
+//        r(v) = (epsilon / 8) * d(v) * w_min(v) / w_max(v);
+//  * per edge e = ab of length L (same faces): theta(e) = the smallest corner angle at a or b in
+//    the faces beside e (capped at 90 degrees) and lambda(e) = 1 + sqrt(epsilon / 2) sin theta(e);
+//  * Steiner points on e at distances r(a) lambda^i (i = 0, 1, ...) from a while below L / 2, the
+//    same from b, and the midpoint. Per edge that is
+//        k(e) = 1 + sum over its ends v of ceil(ln(L / (2 r(v))) / ln lambda(e))
+//             ~ (2 / sin theta) sqrt(2 / epsilon) ln(4 L w_max / (epsilon d w_min)),
+//    i.e. O(log(1/epsilon) / sqrt(epsilon)) per edge (about 55 at epsilon 0.1 and 260 at 0.01 on
+//    a grid of right isosceles triangles);
+//  * the graph: the vertices and Steiner points; within a face, every node on one edge to every
+//    node on the other two edges (cost = segment length x w(f)); along an edge, consecutive nodes
+//    (cost x the edge's weight). Face edges are never stored: they are generated when a node is
+//    settled, so memory grows with the number of points, not with k^2 per face;
+//  * Dijkstra with an indexed binary heap over flat arrays (decrease-key, ties by node id, so runs
+//    are bit-for-bit deterministic). A source or target on a face or an edge joins the graph with
+//    edges to every node on its face(s) (and the straight segment when source and target share a
+//    face or an edge).
+//
+// The bound. Every cost is the cost of an actual path on the surface (a polyline through the
+// nodes), so it is never below the true least cost. Above: cost <= (1 + epsilon) x the least cost
+// is the AMS bound for their placement; the argument carried over to edge points is, in sketch:
+// take an optimal path, (1) reroute each stretch of it inside the vicinity ball B(v) of radius
+// r(v) through v: it adds <= 2 r(v) w_max(v), and the path spends at least weighted
+// (d(v) - r(v)) w_min(v) on each side of the stretch inside v's star, with every point of the path
+// in at most 4 stars: total <= (epsilon / 4) x the cost; (2) snap every other crossing point x (at
+// distance t >= r(v) from its nearer end v) to its nearest Steiner point: the move is
+// <= t (lambda - 1) / 2 <= sqrt(epsilon / 8) t sin theta, both pieces at x are >= t sin theta
+// long, the optimal path is stationary in each crossing point (Snell's law), so first-order
+// changes cancel and the second-order change is <= about (epsilon / 2) x the pieces' cost. What
+// is NOT proved here: (2)'s stationarity next to a stretch rerouted by (1), and sources or targets
+// strictly inside faces or edges close to a vertex (AMS make them vertices). The tests measure the
+// bound on planes (against Euclidean and Snell's-law optima) and on real meshes (against the
+// exact engine) and find the error far inside epsilon (typically < epsilon / 10).
+//
+// Memory: 8 bytes per Steiner point for its position on its edge plus, during a solve, 20 bytes
+// per node (cost, label, parent, heap slot) and 4 per heap entry: about 32 bytes per Steiner point,
+// bounded by WeightedOptions::max_steiner_points. Time: settling a node relaxes the nodes of the
+// other edges of its faces, O(k) each, O(k^2) per face in total.
+
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "absl/status/status.h"
+#include "absl/status/statusor.h"
+#include "geodex/cancel.h"
+#include "geodex/shortest_path.h"
+#include "geodex/surface_point.h"
+#include "geodex/triangle_mesh.h"
+
+namespace geodex {
+
+struct WeightedOptions {
+  // The stated bound: every cost is at most (1 + epsilon) x the true least cost and never below
+  // it. Must be in (0, 1).
+  double epsilon = 0.01;
+  // One weight per FILE face: > 0 and finite, or +inf (impassable). Empty: every face weighs 1.
+  std::vector<double> face_weight;
+  // Nodes costlier than this stay +inf; the search stops there. Must be > 0.
+  double max_distance = std::numeric_limits<double>::infinity();
+  // 0 = unlimited; otherwise a solve needing more Steiner points fails with
+  // LimitExceededError(Limit::kSteinerPoints) before allocating them.
+  uint64_t max_steiner_points = 0;
+  const CancelToken* cancel = nullptr;  // polled every few thousand settled nodes
+};
+
+// Checks epsilon, max_distance and the weights (their count against the mesh's faces). Errors
+// are InvalidArgument naming the option (InvalidOptionOf: "epsilon", "max_distance",
+// "face_weight", "face_weight[7]").
+absl::Status ValidateWeightedOptions(const TriangleMesh& mesh, const WeightedOptions& options);
+
+struct WeightedStats {
+  uint64_t nodes_settled = 0;
+  uint64_t edge_relaxations = 0;  // graph edges evaluated (generated on the fly)
+  uint64_t peak_bytes = 0;        // Steiner positions + per-node state + heap
+  double solve_ms = 0;
+};
+
+struct WeightedField {
+  std::vector<double> cost;      // per FILE vertex; +inf where unreachable (or beyond max_distance)
+  std::vector<uint32_t> source;  // index into the sources; 0xffffffff where unreachable
+  uint64_t steiner_points = 0;
+  uint64_t graph_edges = 0;  // edges of the (implicit) graph
+  double epsilon = 0;
+  WeightedStats stats;
+};
+
+// Least costs from every vertex to the nearest of `sources` (vertex, edge or face points).
+// Errors: InvalidArgument (options, an empty source list, a bad source), ResourceExhausted
+// (LimitExceededError kSteinerPoints), Cancelled.
+absl::StatusOr<WeightedField> ComputeWeightedField(const TriangleMesh& mesh,
+                                                   const std::vector<SurfacePoint>& sources,
+                                                   const WeightedOptions& options);
+
+struct WeightedCosts {
+  std::vector<double> cost;      // per target; +inf when unreachable
+  std::vector<uint32_t> source;  // per target; 0xffffffff when unreachable
+  uint64_t steiner_points = 0;
+  WeightedStats stats;
+};
+
+// Least costs at arbitrary surface points (vertex, edge or face points).
+absl::StatusOr<WeightedCosts> ComputeWeightedCostsAt(const TriangleMesh& mesh,
+                                                     const std::vector<SurfacePoint>& sources,
+                                                     const std::vector<SurfacePoint>& targets,
+                                                     const WeightedOptions& options);
+
+struct WeightedPath {
+  double cost = 0;
+  // points.front() is `from`, points.back() is `to`; straight inside each face, bending only on
+  // edges and at vertices (at Steiner points and vertices).
+  std::vector<PathPoint> points;
+  uint64_t steiner_points = 0;
+  WeightedStats stats;
+};
+
+// The least-cost path between two surface points (the search stops once `to` is final).
+// Errors: as ComputeWeightedField, and NotFound when `to` cannot be reached.
+absl::StatusOr<WeightedPath> ComputeWeightedPath(const TriangleMesh& mesh, const SurfacePoint& from,
+                                                 const SurfacePoint& to,
+                                                 const WeightedOptions& options);
+
+}  // namespace geodex

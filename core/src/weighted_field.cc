@@ -1,0 +1,749 @@
+#include "geodex/weighted_field.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <utility>
+#include <vector>
+
+#include "absl/strings/str_format.h"
+#include "geodex/geodesic_solver.h"
+#include "geodex/limits.h"
+#include "mesh_lookup.h"
+
+namespace geodex {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kHalfPi = 1.5707963267948966;
+// Parent markers of nodes seeded by a source: the node is a source vertex, or it is reached by
+// one straight segment from a source point.
+constexpr uint32_t kFromSourceVertex = kNoIndex - 1;
+constexpr uint32_t kFromSourcePoint = kNoIndex - 2;
+constexpr uint32_t kMaxNodes = kNoIndex - 3;
+
+using Vec = std::array<double, 3>;
+
+double Dist(const Vec& a, const Vec& b) {
+  const double dx = a[0] - b[0], dy = a[1] - b[1], dz = a[2] - b[2];
+  return std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+// The Steiner points (positions along the edges) and the per-face/per-edge weights. Node ids:
+// internal vertices 0..nv-1, then the Steiner points of edge e at nv + first[e] .. nv +
+// first[e+1] - 1 in order of increasing parameter along the edge's canonical half-edge.
+class SteinerGraph {
+ public:
+  SteinerGraph(const TriangleMesh& mesh, const WeightedOptions& options)
+      : mesh_(mesh), weights_(options.face_weight), nv_(mesh.vertex_count()) {}
+
+  absl::Status Build(double epsilon, uint64_t max_points);
+
+  const TriangleMesh& mesh() const { return mesh_; }
+  uint32_t nv() const { return nv_; }
+  uint64_t steiner_points() const { return param_.size(); }
+  uint64_t graph_edges() const { return graph_edges_; }
+  uint32_t node_count() const { return nv_ + static_cast<uint32_t>(param_.size()); }
+  double FaceWeight(uint32_t f) const { return weights_.empty() ? 1.0 : weights_[f]; }
+  uint32_t EdgeOfHalf(uint32_t h) const { return edge_of_half_[h]; }
+  uint32_t EdgeHalf(uint32_t e) const { return edge_half_[e]; }
+  double EdgeWeight(uint32_t e) const { return edge_weight_[e]; }
+  uint32_t First(uint32_t e) const { return nv_ + first_[e]; }  // first Steiner node of e
+  uint32_t End(uint32_t e) const { return nv_ + first_[e + 1]; }
+  // The edge of a Steiner node.
+  uint32_t EdgeOfNode(uint32_t node) const {
+    const uint32_t i = node - nv_;
+    return static_cast<uint32_t>(std::upper_bound(first_.begin(), first_.end(), i) -
+                                 first_.begin()) -
+           1;
+  }
+  double Param(uint32_t node) const { return param_[node - nv_]; }
+  Vec Pos(uint32_t node) const {
+    if (node < nv_) return mesh_.Position(node);
+    const uint32_t h = edge_half_[EdgeOfNode(node)];
+    return Lerp(mesh_.Position(mesh_.From(h)), mesh_.Position(mesh_.To(h)), Param(node));
+  }
+  static Vec Lerp(const Vec& a, const Vec& b, double s) {
+    return {a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1]), a[2] + s * (b[2] - a[2])};
+  }
+  uint64_t bytes() const {
+    return param_.capacity() * sizeof(double) +
+           (first_.capacity() + edge_half_.capacity() + edge_of_half_.capacity()) *
+               sizeof(uint32_t) +
+           edge_weight_.capacity() * sizeof(double);
+  }
+
+ private:
+  // Number of i >= 0 with r lambda^i < half.
+  static uint32_t SideCount(double r, double lambda, double half) {
+    if (!(r < half)) return 0;
+    double n = std::floor(std::log(half / r) / std::log(lambda)) + 1;
+    n = std::min(n, 1e9);  // the limits below stop such meshes (near-zero angles)
+    uint32_t k = static_cast<uint32_t>(n);
+    while (k > 0 && r * std::pow(lambda, k - 1) >= half) --k;
+    while (k < 1000000000u && r * std::pow(lambda, k) < half) ++k;
+    return k;
+  }
+
+  const TriangleMesh& mesh_;
+  const std::vector<double>& weights_;
+  uint32_t nv_;
+  std::vector<uint32_t> edge_of_half_, edge_half_, first_;
+  std::vector<double> edge_weight_, param_;
+  uint64_t graph_edges_ = 0;
+};
+
+absl::Status SteinerGraph::Build(double epsilon, uint64_t max_points) {
+  const uint32_t nf = mesh_.face_count();
+  auto usable = [&](uint32_t f) {
+    return std::isfinite(FaceWeight(f)) && !mesh_.FaceDegenerate(f);
+  };
+  // Per vertex: the vicinity radius r(v).
+  std::vector<double> d(nv_, kInf), wmin(nv_, kInf), wmax(nv_, 0), radius(nv_, kInf);
+  for (uint32_t f = 0; f < nf; ++f) {
+    if (!usable(f)) continue;
+    const double w = FaceWeight(f);
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t c = 3 * f + k;
+      const uint32_t v = mesh_.FaceVertex(f, k);
+      const double height =
+          mesh_.Length(3 * f) * mesh_.OppY(3 * f) / mesh_.Length(TriangleMesh::Next(c));
+      d[v] = std::min(d[v], height);
+      wmin[v] = std::min(wmin[v], w);
+      wmax[v] = std::max(wmax[v], w);
+    }
+  }
+  for (uint32_t v = 0; v < nv_; ++v) {
+    if (std::isfinite(d[v]) && d[v] > 0) radius[v] = epsilon / 8 * d[v] * wmin[v] / wmax[v];
+  }
+  // Edges: one id per twin pair (or boundary half-edge).
+  edge_of_half_.assign(3 * static_cast<size_t>(nf), kNoIndex);
+  for (uint32_t h = 0; h < 3 * nf; ++h) {
+    const uint32_t t = mesh_.Twin(h);
+    if (t != kNoIndex && t < h) continue;
+    edge_of_half_[h] = static_cast<uint32_t>(edge_half_.size());
+    if (t != kNoIndex) edge_of_half_[t] = edge_of_half_[h];
+    edge_half_.push_back(h);
+  }
+  const uint32_t ne = static_cast<uint32_t>(edge_half_.size());
+  edge_weight_.assign(ne, kInf);
+  std::vector<double> lambda(ne, 0);
+  std::vector<uint32_t> count_a(ne, 0), count_b(ne, 0);
+  const double root = std::sqrt(epsilon / 2);
+  uint64_t total = 0;
+  for (uint32_t e = 0; e < ne; ++e) {
+    const uint32_t h0 = edge_half_[e];
+    double sin_theta = kInf;
+    for (const uint32_t h : {h0, mesh_.Twin(h0)}) {
+      if (h == kNoIndex) continue;
+      const uint32_t f = TriangleMesh::FaceOf(h);
+      edge_weight_[e] = std::min(edge_weight_[e], FaceWeight(f));
+      if (!usable(f)) continue;
+      for (const uint32_t c : {h, TriangleMesh::Next(h)}) {
+        sin_theta = std::min(sin_theta, std::sin(std::min(mesh_.CornerAngle(c), kHalfPi)));
+      }
+    }
+    if (!std::isfinite(sin_theta) || !(sin_theta > 0)) continue;  // no passable face: no points
+    lambda[e] = 1 + root * sin_theta;
+    const double half = mesh_.Length(h0) / 2;
+    count_a[e] = SideCount(radius[mesh_.From(h0)], lambda[e], half);
+    count_b[e] = SideCount(radius[mesh_.To(h0)], lambda[e], half);
+    total += uint64_t{count_a[e]} + count_b[e] + 1;
+  }
+  if (max_points != 0 && total > max_points) {
+    return LimitExceededError(
+        Limit::kSteinerPoints,
+        absl::StrFormat("epsilon %g needs %d Steiner points on this mesh, more than the %d allowed "
+                        "(max_steiner_points)",
+                        epsilon, total, max_points));
+  }
+  if (total > kMaxNodes - nv_) {
+    return LimitExceededError(
+        Limit::kSteinerPoints,
+        absl::StrFormat("epsilon %g needs %d Steiner points on this mesh, more than a solve can "
+                        "index (%d)",
+                        epsilon, total, kMaxNodes - nv_));
+  }
+  first_.assign(ne + 1, 0);
+  param_.resize(total);
+  uint32_t at = 0;
+  for (uint32_t e = 0; e < ne; ++e) {
+    first_[e] = at;
+    if (lambda[e] == 0) continue;
+    const uint32_t h0 = edge_half_[e];
+    const double len = mesh_.Length(h0);
+    const double ra = radius[mesh_.From(h0)], rb = radius[mesh_.To(h0)];
+    for (uint32_t i = 0; i < count_a[e]; ++i) param_[at++] = ra * std::pow(lambda[e], i) / len;
+    param_[at++] = 0.5;
+    for (uint32_t i = count_b[e]; i-- > 0;) param_[at++] = 1 - rb * std::pow(lambda[e], i) / len;
+  }
+  first_[ne] = at;
+  // Implicit edge count: per passable face, node pairs on different edges (Steiner to Steiner and
+  // Steiner to the opposite vertex); per passable edge, its chain.
+  for (uint32_t f = 0; f < nf; ++f) {
+    if (!std::isfinite(FaceWeight(f))) continue;
+    uint64_t k[3];
+    for (int j = 0; j < 3; ++j) {
+      const uint32_t e = edge_of_half_[3 * f + j];
+      k[j] = first_[e + 1] - first_[e];
+    }
+    graph_edges_ += k[0] * k[1] + k[1] * k[2] + k[2] * k[0] + k[0] + k[1] + k[2];
+  }
+  for (uint32_t e = 0; e < ne; ++e) {
+    if (std::isfinite(edge_weight_[e])) graph_edges_ += first_[e + 1] - first_[e] + 1;
+  }
+  return absl::OkStatus();
+}
+
+// A source or target resolved onto the mesh.
+struct Located {
+  SurfacePoint canonical;
+  Vec pos{};                         // internal (recentred) coordinates
+  std::vector<uint32_t> vertices;    // kVertex: the internal copies
+  std::vector<uint32_t> half_edges;  // kEdge: one per face on the edge
+  uint32_t face = kNoIndex;          // kFace
+};
+
+absl::StatusOr<Located> Locate(const TriangleMesh& mesh, const SurfacePoint& p) {
+  if (absl::Status s = ValidateSurfacePoint(mesh, p); !s.ok()) return s;
+  Located out;
+  out.canonical = CanonicalPoint(mesh, p);
+  const SurfacePoint& c = out.canonical;
+  switch (c.kind) {
+    case SurfacePoint::Kind::kVertex:
+      InternalCopies(mesh, c.vertex, &out.vertices);
+      out.pos = mesh.Position(c.vertex);
+      break;
+    case SurfacePoint::Kind::kEdge: {
+      HalfEdgesOfFileEdge(mesh, c.edge_from, c.edge_to, &out.half_edges);
+      if (out.half_edges.empty()) {
+        return absl::InvalidArgumentError(
+            absl::StrFormat("point %s: the mesh has no edge between vertices %d and %d",
+                            SurfacePointToString(p), c.edge_from, c.edge_to));
+      }
+      const uint32_t h = out.half_edges[0];
+      const bool forward = mesh.FileVertex(mesh.From(h)) == c.edge_from;
+      const Vec a = mesh.Position(forward ? mesh.From(h) : mesh.To(h));
+      const Vec b = mesh.Position(forward ? mesh.To(h) : mesh.From(h));
+      out.pos = SteinerGraph::Lerp(a, b, c.t);
+      break;
+    }
+    case SurfacePoint::Kind::kFace: {
+      out.face = c.face;
+      std::array<double, 3> ib = c.bary;
+      mesh.SwapCornerOrder(c.face, &ib);
+      out.pos = {0, 0, 0};
+      for (int k = 0; k < 3; ++k) {
+        const Vec q = mesh.Position(mesh.FaceVertex(c.face, k));
+        for (int j = 0; j < 3; ++j) out.pos[j] += ib[k] * q[j];
+      }
+      break;
+    }
+    case SurfacePoint::Kind::kPosition:
+      break;  // rejected by ValidateSurfacePoint
+  }
+  return out;
+}
+
+// Calls fn(node, weight) for every node a point links to straight (the weight of the face or
+// edge the segment runs in; a node may come more than once). A vertex point links to its copies
+// with weight 0.
+template <typename Fn>
+void ForEachLink(const SteinerGraph& g, const Located& p, Fn&& fn) {
+  const TriangleMesh& mesh = g.mesh();
+  auto edge_nodes = [&](uint32_t h, double w) {
+    const uint32_t e = g.EdgeOfHalf(h);
+    for (uint32_t n = g.First(e); n < g.End(e); ++n) fn(n, w);
+  };
+  auto face_nodes = [&](uint32_t h) {  // the face of h, except the open edge h
+    const double w = g.FaceWeight(TriangleMesh::FaceOf(h));
+    if (!std::isfinite(w)) return;
+    edge_nodes(TriangleMesh::Next(h), w);
+    edge_nodes(TriangleMesh::Prev(h), w);
+    fn(mesh.Opposite(h), w);
+  };
+  switch (p.canonical.kind) {
+    case SurfacePoint::Kind::kVertex:
+      for (const uint32_t v : p.vertices) fn(v, 0.0);
+      break;
+    case SurfacePoint::Kind::kEdge:
+      for (const uint32_t h : p.half_edges) {
+        const double we = g.EdgeWeight(g.EdgeOfHalf(h));
+        if (std::isfinite(we)) {
+          edge_nodes(h, we);
+          fn(mesh.From(h), we);
+          fn(mesh.To(h), we);
+        }
+        face_nodes(h);
+      }
+      break;
+    case SurfacePoint::Kind::kFace: {
+      const double w = g.FaceWeight(p.face);
+      if (!std::isfinite(w)) break;
+      for (int k = 0; k < 3; ++k) {
+        edge_nodes(3 * p.face + k, w);
+        fn(mesh.FaceVertex(p.face, k), w);
+      }
+      break;
+    }
+    case SurfacePoint::Kind::kPosition:
+      break;
+  }
+}
+
+// The cost of the straight segment between two points when they share a face or an edge (+inf
+// otherwise).
+double DirectCost(const SteinerGraph& g, const Located& a, const Located& b) {
+  const TriangleMesh& mesh = g.mesh();
+  // Faces and edges holding each point.
+  auto supports = [&](const Located& p, std::vector<uint32_t>* faces,
+                      std::vector<uint32_t>* edges) {
+    switch (p.canonical.kind) {
+      case SurfacePoint::Kind::kVertex:
+        for (const uint32_t v : p.vertices) {
+          for (const uint32_t* c = mesh.CornersBegin(v); c != mesh.CornersEnd(v); ++c) {
+            faces->push_back(TriangleMesh::FaceOf(*c));
+            edges->push_back(g.EdgeOfHalf(*c));
+            edges->push_back(g.EdgeOfHalf(TriangleMesh::Prev(*c)));
+          }
+        }
+        break;
+      case SurfacePoint::Kind::kEdge:
+        for (const uint32_t h : p.half_edges) {
+          faces->push_back(TriangleMesh::FaceOf(h));
+          edges->push_back(g.EdgeOfHalf(h));
+        }
+        break;
+      case SurfacePoint::Kind::kFace:
+        faces->push_back(p.face);
+        break;
+      case SurfacePoint::Kind::kPosition:
+        break;
+    }
+  };
+  std::vector<uint32_t> fa, ea, fb, eb;
+  supports(a, &fa, &ea);
+  supports(b, &fb, &eb);
+  double w = kInf;
+  for (const uint32_t f : fa) {
+    if (std::find(fb.begin(), fb.end(), f) != fb.end()) w = std::min(w, g.FaceWeight(f));
+  }
+  for (const uint32_t e : ea) {
+    if (std::find(eb.begin(), eb.end(), e) != eb.end()) w = std::min(w, g.EdgeWeight(e));
+  }
+  return std::isfinite(w) ? w * Dist(a.pos, b.pos) : kInf;
+}
+
+// Dijkstra over the implicit graph: an indexed binary heap (decrease-key) keyed by cost, ties by
+// node id.
+class Search {
+ public:
+  explicit Search(const SteinerGraph& g)
+      : g_(g),
+        mesh_(g.mesh()),
+        cost_(g.node_count(), kInf),
+        label_(g.node_count(), kNoIndex),
+        parent_(g.node_count(), kNoIndex),
+        slot_(g.node_count(), kNoIndex) {}
+
+  void Offer(uint32_t node, double cost, uint32_t label, uint32_t parent) {
+    ++relaxations_;
+    if (!(cost < cost_[node])) return;
+    cost_[node] = cost;
+    label_[node] = label;
+    parent_[node] = parent;
+    if (slot_[node] == kNoIndex) {
+      slot_[node] = static_cast<uint32_t>(heap_.size());
+      heap_.push_back(node);
+    }
+    SiftUp(slot_[node]);
+  }
+
+  void Seed(const Located& p, uint32_t label) {
+    const uint32_t parent =
+        p.canonical.kind == SurfacePoint::Kind::kVertex ? kFromSourceVertex : kFromSourcePoint;
+    ForEachLink(g_, p, [&](uint32_t n, double w) {
+      Offer(n, w == 0 ? 0.0 : w * Dist(p.pos, g_.Pos(n)), label, parent);
+    });
+  }
+
+  // Runs until the heap is empty, the next cost exceeds max_distance, or stop(cost) says so;
+  // settled(node) is called after each node is settled.
+  template <typename Stop, typename Settled>
+  absl::Status Run(const WeightedOptions& options, Stop&& stop, Settled&& settled) {
+    uint32_t polls = 0;
+    while (!heap_.empty()) {
+      const uint32_t u = heap_[0];
+      const double d = cost_[u];
+      if (d > options.max_distance || stop(d)) break;
+      PopTop();
+      ++settled_;
+      if (++polls == 4096) {
+        polls = 0;
+        if (options.cancel != nullptr && options.cancel->IsCancelled()) {
+          return absl::CancelledError("weighted solve cancelled");
+        }
+      }
+      Settle(u, d);
+      settled(u);
+    }
+    peak_heap_ = std::max<uint64_t>(peak_heap_, heap_.capacity());
+    return absl::OkStatus();
+  }
+
+  double cost(uint32_t n) const { return cost_[n]; }
+  uint32_t label(uint32_t n) const { return label_[n]; }
+  uint32_t parent(uint32_t n) const { return parent_[n]; }
+  // Nodes beyond max_distance (offered but not settled) become unreachable.
+  void ClampTo(double max_distance) {
+    for (size_t n = 0; n < cost_.size(); ++n) {
+      if (cost_[n] > max_distance) {
+        cost_[n] = kInf;
+        label_[n] = kNoIndex;
+        parent_[n] = kNoIndex;
+      }
+    }
+  }
+
+  WeightedStats Stats(double ms) const {
+    WeightedStats s;
+    s.nodes_settled = settled_;
+    s.edge_relaxations = relaxations_;
+    s.peak_bytes = g_.bytes() + cost_.size() * (sizeof(double) + 3 * sizeof(uint32_t)) +
+                   peak_heap_ * sizeof(uint32_t);
+    s.solve_ms = ms;
+    return s;
+  }
+
+ private:
+  bool Less(uint32_t a, uint32_t b) const {
+    return cost_[a] < cost_[b] || (cost_[a] == cost_[b] && a < b);
+  }
+  void SiftUp(uint32_t i) {
+    const uint32_t n = heap_[i];
+    while (i > 0) {
+      const uint32_t p = (i - 1) / 2;
+      if (!Less(n, heap_[p])) break;
+      heap_[i] = heap_[p];
+      slot_[heap_[i]] = i;
+      i = p;
+    }
+    heap_[i] = n;
+    slot_[n] = i;
+  }
+  void PopTop() {
+    peak_heap_ = std::max<uint64_t>(peak_heap_, heap_.size());
+    slot_[heap_[0]] = kNoIndex - 1;  // settled: never re-entered (costs only decrease before)
+    const uint32_t last = heap_.back();
+    heap_.pop_back();
+    if (heap_.empty()) return;
+    const uint32_t size = static_cast<uint32_t>(heap_.size());
+    uint32_t i = 0;
+    while (true) {
+      uint32_t c = 2 * i + 1;
+      if (c >= size) break;
+      if (c + 1 < size && Less(heap_[c + 1], heap_[c])) ++c;
+      if (!Less(heap_[c], last)) break;
+      heap_[i] = heap_[c];
+      slot_[heap_[i]] = i;
+      i = c;
+    }
+    heap_[i] = last;
+    slot_[last] = i;
+  }
+
+  // Relaxes the Steiner nodes of edge e from point p at weight w.
+  void RelaxEdge(uint32_t e, const Vec& p, double base, double w, uint32_t label, uint32_t from) {
+    const uint32_t begin = g_.First(e), end = g_.End(e);
+    if (begin == end) return;
+    const uint32_t h = g_.EdgeHalf(e);
+    const Vec a = mesh_.Position(mesh_.From(h)), b = mesh_.Position(mesh_.To(h));
+    const double ax = a[0] - p[0], ay = a[1] - p[1], az = a[2] - p[2];
+    const double dx = b[0] - a[0], dy = b[1] - a[1], dz = b[2] - a[2];
+    for (uint32_t n = begin; n < end; ++n) {
+      if (slot_[n] == kNoIndex - 1) continue;  // settled
+      const double s = g_.Param(n);
+      const double x = ax + s * dx, y = ay + s * dy, z = az + s * dz;
+      Offer(n, base + w * std::sqrt(x * x + y * y + z * z), label, from);
+    }
+  }
+  void RelaxNode(uint32_t n, const Vec& p, double base, double w, uint32_t label, uint32_t from) {
+    if (slot_[n] == kNoIndex - 1) return;
+    Offer(n, base + w * Dist(p, g_.Pos(n)), label, from);
+  }
+
+  void Settle(uint32_t u, double d) {
+    const Vec p = g_.Pos(u);
+    const uint32_t lab = label_[u];
+    if (u < g_.nv()) {
+      for (const uint32_t* c = mesh_.CornersBegin(u); c != mesh_.CornersEnd(u); ++c) {
+        // Along the two edges at u: the nearest node.
+        for (const uint32_t h : {*c, TriangleMesh::Prev(*c)}) {
+          const uint32_t e = g_.EdgeOfHalf(h);
+          const double we = g_.EdgeWeight(e);
+          if (!std::isfinite(we)) continue;
+          uint32_t next;
+          if (g_.First(e) == g_.End(e)) {
+            next = mesh_.From(h) == u ? mesh_.To(h) : mesh_.From(h);
+          } else {
+            next = mesh_.From(g_.EdgeHalf(e)) == u ? g_.First(e) : g_.End(e) - 1;
+          }
+          RelaxNode(next, p, d, we, lab, u);
+        }
+        // Across the face: the opposite edge's Steiner points.
+        const double wf = g_.FaceWeight(TriangleMesh::FaceOf(*c));
+        if (std::isfinite(wf)) {
+          RelaxEdge(g_.EdgeOfHalf(TriangleMesh::Next(*c)), p, d, wf, lab, u);
+        }
+      }
+      return;
+    }
+    const uint32_t e = g_.EdgeOfNode(u);
+    const uint32_t h0 = g_.EdgeHalf(e);
+    const double we = g_.EdgeWeight(e);
+    RelaxNode(u == g_.First(e) ? mesh_.From(h0) : u - 1, p, d, we, lab, u);
+    RelaxNode(u + 1 == g_.End(e) ? mesh_.To(h0) : u + 1, p, d, we, lab, u);
+    for (const uint32_t h : {h0, mesh_.Twin(h0)}) {
+      if (h == kNoIndex) continue;
+      const double wf = g_.FaceWeight(TriangleMesh::FaceOf(h));
+      if (!std::isfinite(wf)) continue;
+      RelaxEdge(g_.EdgeOfHalf(TriangleMesh::Next(h)), p, d, wf, lab, u);
+      RelaxEdge(g_.EdgeOfHalf(TriangleMesh::Prev(h)), p, d, wf, lab, u);
+      RelaxNode(mesh_.Opposite(h), p, d, wf, lab, u);
+    }
+  }
+
+  const SteinerGraph& g_;
+  const TriangleMesh& mesh_;
+  std::vector<double> cost_;
+  std::vector<uint32_t> label_, parent_, slot_;
+  std::vector<uint32_t> heap_;
+  uint64_t settled_ = 0, relaxations_ = 0, peak_heap_ = 0;
+};
+
+double Elapsed(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+// Resolves the points (errors name the point as given).
+absl::Status Prepare(const TriangleMesh& mesh, const std::vector<SurfacePoint>& points,
+                     std::vector<Located>* located) {
+  for (const SurfacePoint& p : points) {
+    absl::StatusOr<Located> l = Locate(mesh, p);
+    if (!l.ok()) return l.status();
+    located->push_back(*std::move(l));
+  }
+  return absl::OkStatus();
+}
+
+// The best (cost, node) over the links of point t; node kNoIndex when the best is none.
+std::pair<double, uint32_t> BestLink(const SteinerGraph& g, const Search& search,
+                                     const Located& t) {
+  double best = kInf;
+  uint32_t node = kNoIndex;
+  ForEachLink(g, t, [&](uint32_t n, double w) {
+    const double c = search.cost(n);
+    if (!std::isfinite(c)) return;
+    const double total = w == 0 ? c : c + w * Dist(t.pos, g.Pos(n));
+    if (total < best || (total == best && n < node)) {
+      best = total;
+      node = n;
+    }
+  });
+  return {best, node};
+}
+
+PathPoint NodePoint(const SteinerGraph& g, uint32_t n) {
+  const TriangleMesh& mesh = g.mesh();
+  PathPoint pp;
+  const Vec p = g.Pos(n);
+  for (int k = 0; k < 3; ++k) pp.position[k] = p[k] + mesh.Center()[k];
+  if (n < g.nv()) {
+    pp.where = SurfacePoint::AtVertex(mesh.FileVertex(n));
+  } else {
+    const uint32_t h = g.EdgeHalf(g.EdgeOfNode(n));
+    pp.where =
+        CanonicalEdgePoint(mesh.FileVertex(mesh.From(h)), mesh.FileVertex(mesh.To(h)), g.Param(n));
+  }
+  return pp;
+}
+
+PathPoint LocatedPoint(const TriangleMesh& mesh, const Located& l) {
+  PathPoint pp;
+  for (int k = 0; k < 3; ++k) pp.position[k] = l.pos[k] + mesh.Center()[k];
+  pp.where = l.canonical;
+  return pp;
+}
+
+}  // namespace
+
+absl::Status ValidateWeightedOptions(const TriangleMesh& mesh, const WeightedOptions& options) {
+  if (!(options.epsilon > 0 && options.epsilon < 1)) {
+    return OptionError("epsilon", absl::StrFormat("must be in (0, 1), got %g", options.epsilon));
+  }
+  if (!(options.max_distance > 0)) {
+    return OptionError("max_distance",
+                       absl::StrFormat("must be > 0, got %g", options.max_distance));
+  }
+  const std::vector<double>& w = options.face_weight;
+  if (!w.empty() && w.size() != mesh.face_count()) {
+    return OptionError("face_weight", absl::StrFormat("must have one weight per face (%d), got %d",
+                                                      mesh.face_count(), w.size()));
+  }
+  for (size_t f = 0; f < w.size(); ++f) {
+    if (!(w[f] > 0)) {  // also NaN
+      return OptionError(absl::StrFormat("face_weight[%d]", f),
+                         absl::StrFormat("must be > 0 (or +inf: impassable), got %g", w[f]));
+    }
+  }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<WeightedField> ComputeWeightedField(const TriangleMesh& mesh,
+                                                   const std::vector<SurfacePoint>& sources,
+                                                   const WeightedOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  if (absl::Status s = ValidateWeightedOptions(mesh, options); !s.ok()) return s;
+  if (sources.empty()) return absl::InvalidArgumentError("no sources given");
+  std::vector<Located> located;
+  if (absl::Status s = Prepare(mesh, sources, &located); !s.ok()) return s;
+  SteinerGraph g(mesh, options);
+  if (absl::Status s = g.Build(options.epsilon, options.max_steiner_points); !s.ok()) return s;
+  Search search(g);
+  for (uint32_t i = 0; i < located.size(); ++i) search.Seed(located[i], i);
+  if (absl::Status s = search.Run(
+          options, [](double) { return false; }, [](uint32_t) {});
+      !s.ok()) {
+    return s;
+  }
+  search.ClampTo(options.max_distance);
+  WeightedField field;
+  field.cost.assign(mesh.file_vertex_count(), kInf);
+  field.source.assign(mesh.file_vertex_count(), kNoIndex);
+  for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+    const uint32_t fv = mesh.FileVertex(v);
+    if (search.cost(v) < field.cost[fv]) {
+      field.cost[fv] = search.cost(v);
+      field.source[fv] = search.label(v);
+    }
+  }
+  field.steiner_points = g.steiner_points();
+  field.graph_edges = g.graph_edges();
+  field.epsilon = options.epsilon;
+  field.stats = search.Stats(Elapsed(start));
+  return field;
+}
+
+absl::StatusOr<WeightedCosts> ComputeWeightedCostsAt(const TriangleMesh& mesh,
+                                                     const std::vector<SurfacePoint>& sources,
+                                                     const std::vector<SurfacePoint>& targets,
+                                                     const WeightedOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  if (absl::Status s = ValidateWeightedOptions(mesh, options); !s.ok()) return s;
+  if (sources.empty()) return absl::InvalidArgumentError("no sources given");
+  std::vector<Located> from, to;
+  if (absl::Status s = Prepare(mesh, sources, &from); !s.ok()) return s;
+  if (absl::Status s = Prepare(mesh, targets, &to); !s.ok()) return s;
+  SteinerGraph g(mesh, options);
+  if (absl::Status s = g.Build(options.epsilon, options.max_steiner_points); !s.ok()) return s;
+  Search search(g);
+  for (uint32_t i = 0; i < from.size(); ++i) search.Seed(from[i], i);
+  if (absl::Status s = search.Run(
+          options, [](double) { return false; }, [](uint32_t) {});
+      !s.ok()) {
+    return s;
+  }
+  search.ClampTo(options.max_distance);
+  WeightedCosts out;
+  out.cost.assign(to.size(), kInf);
+  out.source.assign(to.size(), kNoIndex);
+  for (size_t t = 0; t < to.size(); ++t) {
+    const auto [c, n] = BestLink(g, search, to[t]);
+    if (n != kNoIndex) {
+      out.cost[t] = c;
+      out.source[t] = search.label(n);
+    }
+    for (uint32_t s = 0; s < from.size(); ++s) {
+      const double direct = DirectCost(g, from[s], to[t]);
+      if (direct < out.cost[t]) {
+        out.cost[t] = direct;
+        out.source[t] = s;
+      }
+    }
+    if (out.cost[t] > options.max_distance) {
+      out.cost[t] = kInf;
+      out.source[t] = kNoIndex;
+    }
+  }
+  out.steiner_points = g.steiner_points();
+  out.stats = search.Stats(Elapsed(start));
+  return out;
+}
+
+absl::StatusOr<WeightedPath> ComputeWeightedPath(const TriangleMesh& mesh, const SurfacePoint& from,
+                                                 const SurfacePoint& to,
+                                                 const WeightedOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  if (absl::Status s = ValidateWeightedOptions(mesh, options); !s.ok()) return s;
+  std::vector<Located> pts;
+  if (absl::Status s = Prepare(mesh, {from, to}, &pts); !s.ok()) return s;
+  const Located& src = pts[0];
+  const Located& dst = pts[1];
+  SteinerGraph g(mesh, options);
+  if (absl::Status s = g.Build(options.epsilon, options.max_steiner_points); !s.ok()) return s;
+  Search search(g);
+  search.Seed(src, 0);
+  // The weight of the straight link from each node to the target (the cheapest of its links).
+  std::vector<std::pair<uint32_t, double>> links;
+  ForEachLink(g, dst, [&](uint32_t n, double w) { links.emplace_back(n, w); });
+  std::sort(links.begin(), links.end());
+  const double direct = DirectCost(g, src, dst);
+  double best = direct;
+  if (absl::Status s = search.Run(
+          options, [&](double key) { return key >= best; },
+          [&](uint32_t u) {
+            auto it =
+                std::lower_bound(links.begin(), links.end(), std::pair<uint32_t, double>(u, -kInf));
+            for (; it != links.end() && it->first == u; ++it) {
+              const double w = it->second;
+              best = std::min(best, search.cost(u) + (w == 0 ? 0 : w * Dist(dst.pos, g.Pos(u))));
+            }
+          });
+      !s.ok()) {
+    return s;
+  }
+  auto [cost, node] = BestLink(g, search, dst);
+  WeightedPath path;
+  if (direct <= cost) {
+    cost = direct;
+    node = kNoIndex;
+  }
+  if (!std::isfinite(cost) || cost > options.max_distance) {
+    return absl::NotFoundError(absl::StrFormat("point %s cannot be reached from %s%s",
+                                               SurfacePointToString(to), SurfacePointToString(from),
+                                               std::isfinite(cost) ? " within max_distance" : ""));
+  }
+  path.cost = cost;
+  // Backwards from the target, then reversed.
+  path.points.push_back(LocatedPoint(mesh, dst));
+  uint32_t parent = kFromSourcePoint;
+  while (node != kNoIndex) {
+    if (!(dst.canonical.kind == SurfacePoint::Kind::kVertex && search.cost(node) == cost &&
+          path.points.size() == 1 && node < g.nv() &&
+          mesh.FileVertex(node) == dst.canonical.vertex)) {
+      path.points.push_back(NodePoint(g, node));
+    }
+    parent = search.parent(node);
+    node = parent >= kFromSourcePoint ? kNoIndex : parent;
+  }
+  if (parent == kFromSourcePoint) path.points.push_back(LocatedPoint(mesh, src));
+  std::reverse(path.points.begin(), path.points.end());
+  path.steiner_points = g.steiner_points();
+  path.stats = search.Stats(Elapsed(start));
+  return path;
+}
+
+}  // namespace geodex

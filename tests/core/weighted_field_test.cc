@@ -1,0 +1,374 @@
+// The weighted (travel cost) engine: costs within [true, (1 + epsilon) true] on planes (Euclidean
+// and Snell's-law optima), on real meshes (the exact engine), around impassable walls; scaling,
+// option errors, limits, cancellation and determinism.
+
+#include "geodex/weighted_field.h"
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "geodex/geodesic_solver.h"
+#include "geodex/limits.h"
+#include "gtest/gtest.h"
+#include "util/mesh_factory.h"
+#include "util/test_meshes.h"
+
+namespace geodex {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+TriangleMesh BuildMesh(const MeshData& data) {
+  absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(data);
+  EXPECT_TRUE(mesh.ok()) << mesh.status();
+  return *std::move(mesh);
+}
+
+// The centroid of file face f.
+Vec3 Centroid(const MeshData& data, uint32_t f) {
+  Vec3 c{0, 0, 0};
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 p = VertexPosition(data, data.faces[3 * f + k]);
+    for (int j = 0; j < 3; ++j) c[j] += p[j] / 3;
+  }
+  return c;
+}
+
+// Every cost within [d (1 - 1e-12), (1 + eps) d] of the reference; returns the largest ratio.
+double CheckBound(const std::vector<double>& cost, const std::vector<double>& reference,
+                  double eps) {
+  double worst = 1;
+  for (size_t v = 0; v < cost.size(); ++v) {
+    const double d = reference[v];
+    if (d == 0) {
+      EXPECT_EQ(cost[v], 0) << "vertex " << v;
+      continue;
+    }
+    EXPECT_GE(cost[v], d * (1 - 1e-12)) << "vertex " << v;
+    EXPECT_LE(cost[v], d * (1 + eps)) << "vertex " << v;
+    worst = std::max(worst, cost[v] / d);
+  }
+  return worst;
+}
+
+class WeightedFieldPlaneTest : public testing::TestWithParam<double> {};
+
+TEST_P(WeightedFieldPlaneTest, EuclideanOnAGrid) {
+  const double eps = GetParam();
+  GridSpec spec;
+  spec.cells_x = spec.cells_y = eps < 0.05 ? 6 : 12;
+  spec.alternate_diagonals = true;
+  const MeshData data = MakeGrid(spec);
+  const TriangleMesh mesh = BuildMesh(data);
+  WeightedOptions options;
+  options.epsilon = eps;
+  for (const uint32_t s : {0u, static_cast<uint32_t>(data.vertex_count() / 2)}) {
+    absl::StatusOr<WeightedField> field =
+        ComputeWeightedField(mesh, {SurfacePoint::AtVertex(s)}, options);
+    ASSERT_TRUE(field.ok()) << field.status();
+    std::vector<double> euclid;
+    for (uint32_t v = 0; v < data.vertex_count(); ++v) {
+      euclid.push_back(Distance3(VertexPosition(data, s), VertexPosition(data, v)));
+    }
+    const double worst = CheckBound(field->cost, euclid, eps);
+    EXPECT_GT(field->steiner_points, 0u);
+    std::printf("eps %g source %u: %llu Steiner points, worst ratio 1 + %.3g\n", eps, s,
+                static_cast<unsigned long long>(field->steiner_points), worst - 1);
+  }
+}
+
+TEST_P(WeightedFieldPlaneTest, TwentyDegreesOffTheAxesOnAJitteredGrid) {
+  const double eps = GetParam();
+  GridSpec spec;
+  spec.cells_x = spec.cells_y = eps < 0.05 ? 6 : 10;
+  spec.jitter = 0.15;
+  const MeshData data = MakeGrid(spec);
+  const TriangleMesh mesh = BuildMesh(data);
+  WeightedOptions options;
+  options.epsilon = eps;
+  // Targets along a ray 20 degrees off the x axis from vertex 0, as face points (located by the
+  // test: the face whose barycentrics are all >= 0).
+  std::vector<SurfacePoint> targets;
+  std::vector<double> expected;
+  const double angle = 20 * M_PI / 180;
+  for (double r = 0.15; r < 1.0; r += 0.2) {
+    const Vec2 p{r * std::cos(angle), r * std::sin(angle)};
+    for (uint32_t f = 0; f < data.face_count(); ++f) {
+      const Vec3 a = VertexPosition(data, data.faces[3 * f]);
+      const Vec3 b = VertexPosition(data, data.faces[3 * f + 1]);
+      const Vec3 c = VertexPosition(data, data.faces[3 * f + 2]);
+      const double det = (b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]);
+      const double l1 = ((p[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (p[1] - a[1])) / det;
+      const double l2 = ((b[0] - a[0]) * (p[1] - a[1]) - (p[0] - a[0]) * (b[1] - a[1])) / det;
+      if (l1 >= 0 && l2 >= 0 && l1 + l2 <= 1) {
+        targets.push_back(SurfacePoint::InFace(f, 1 - l1 - l2, l1, l2));
+        expected.push_back(r);
+        break;
+      }
+    }
+  }
+  ASSERT_EQ(targets.size(), 5u);
+  absl::StatusOr<WeightedCosts> costs =
+      ComputeWeightedCostsAt(mesh, {SurfacePoint::AtVertex(0)}, targets, options);
+  ASSERT_TRUE(costs.ok()) << costs.status();
+  CheckBound(costs->cost, expected, eps);
+  absl::StatusOr<WeightedField> field =
+      ComputeWeightedField(mesh, {SurfacePoint::AtVertex(0)}, options);
+  ASSERT_TRUE(field.ok()) << field.status();
+  std::vector<double> euclid;
+  for (uint32_t v = 0; v < data.vertex_count(); ++v) {
+    euclid.push_back(Distance3(VertexPosition(data, 0), VertexPosition(data, v)));
+  }
+  CheckBound(field->cost, euclid, eps);
+}
+
+INSTANTIATE_TEST_SUITE_P(WeightedFieldEpsilons, WeightedFieldPlaneTest, testing::Values(0.1, 0.01));
+
+TEST(WeightedFieldTest, RealMeshesAgainstTheExactEngine) {
+  for (const char* name : {"knight.off", "bunny-npm.off"}) {
+    absl::StatusOr<TriangleMesh> mesh = LoadTestMesh(name);
+    ASSERT_TRUE(mesh.ok()) << mesh.status();
+    const std::vector<SurfacePoint> sources{SurfacePoint::AtVertex(7)};
+    absl::StatusOr<DistanceField> exact = ComputeDistanceField(*mesh, sources);
+    ASSERT_TRUE(exact.ok()) << exact.status();
+    for (const double eps : {0.1, 0.03}) {
+      WeightedOptions options;
+      options.epsilon = eps;
+      absl::StatusOr<WeightedField> field = ComputeWeightedField(*mesh, sources, options);
+      ASSERT_TRUE(field.ok()) << field.status();
+      const double worst = CheckBound(field->cost, exact->distance, eps);
+      std::printf("%s eps %g: %llu Steiner points, %.0f ms, worst ratio 1 + %.3g\n", name, eps,
+                  static_cast<unsigned long long>(field->steiner_points), field->stats.solve_ms,
+                  worst - 1);
+    }
+  }
+}
+
+TEST(WeightedFieldTest, FrictionTwoDoublesEveryCost) {
+  absl::StatusOr<TriangleMesh> mesh = LoadTestMesh("knight.off");
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  WeightedOptions one, two;
+  one.epsilon = two.epsilon = 0.1;
+  two.face_weight.assign(mesh->face_count(), 2.0);
+  const std::vector<SurfacePoint> sources{SurfacePoint::AtVertex(3),
+                                          SurfacePoint::InFace(100, 0.2, 0.3, 0.5)};
+  absl::StatusOr<WeightedField> a = ComputeWeightedField(*mesh, sources, one);
+  absl::StatusOr<WeightedField> b = ComputeWeightedField(*mesh, sources, two);
+  ASSERT_TRUE(a.ok() && b.ok());
+  for (size_t v = 0; v < a->cost.size(); ++v) {
+    EXPECT_EQ(b->cost[v], 2 * a->cost[v]) << "vertex " << v;
+    EXPECT_EQ(b->source[v], a->source[v]) << "vertex " << v;
+  }
+}
+
+// Minimises f over [lo, hi] (unimodal) by golden-section search; returns the argmin.
+template <typename F>
+double GoldenSection(F f, double lo, double hi) {
+  const double g = (std::sqrt(5.0) - 1) / 2;
+  double a = lo, b = hi;
+  for (int i = 0; i < 200; ++i) {
+    const double c = b - g * (b - a), d = a + g * (b - a);
+    if (f(c) < f(d)) {
+      b = d;
+    } else {
+      a = c;
+    }
+  }
+  return (a + b) / 2;
+}
+
+TEST(WeightedFieldTest, SnellsLawAcrossAFrictionFourHalfPlane) {
+  GridSpec spec;
+  spec.cells_x = 10;
+  spec.cells_y = 5;
+  spec.width = 2;
+  spec.height = 1;
+  spec.alternate_diagonals = true;
+  const MeshData data = MakeGrid(spec);
+  const TriangleMesh mesh = BuildMesh(data);
+  const double eps = 0.03;
+  WeightedOptions options;
+  options.epsilon = eps;
+  for (uint32_t f = 0; f < data.face_count(); ++f) {
+    options.face_weight.push_back(Centroid(data, f)[0] > 1 ? 4.0 : 1.0);
+  }
+  const uint32_t s = 1 * 11 + 1, t = 4 * 11 + 8;  // (0.2, 0.2) and (1.6, 0.8)
+  const Vec3 ps = VertexPosition(data, s), pt = VertexPosition(data, t);
+  auto cost = [&](double y) {
+    return std::hypot(1 - ps[0], y - ps[1]) + 4 * std::hypot(pt[0] - 1, pt[1] - y);
+  };
+  const double y_best = GoldenSection(cost, 0, 1);
+  const double best = cost(y_best);
+  absl::StatusOr<WeightedPath> path =
+      ComputeWeightedPath(mesh, SurfacePoint::AtVertex(s), SurfacePoint::AtVertex(t), options);
+  ASSERT_TRUE(path.ok()) << path.status();
+  EXPECT_GE(path->cost, best * (1 - 1e-12));
+  EXPECT_LE(path->cost, best * (1 + eps));
+  // The polyline costs what the engine says, and crosses x = 1 near the optimum.
+  ASSERT_GE(path->points.size(), 2u);
+  EXPECT_EQ(path->points.front().where.vertex, s);
+  EXPECT_EQ(path->points.back().where.vertex, t);
+  double sum = 0, y_cross = -1;
+  for (size_t i = 0; i + 1 < path->points.size(); ++i) {
+    const auto& a = path->points[i].position;
+    const auto& b = path->points[i + 1].position;
+    const double mid = (a[0] + b[0]) / 2;
+    const bool along_boundary = std::abs(a[0] - 1) < 1e-12 && std::abs(b[0] - 1) < 1e-12;
+    sum +=
+        (along_boundary || mid < 1 ? 1.0 : 4.0) * Distance3({a[0], a[1], a[2]}, {b[0], b[1], b[2]});
+    if (std::abs(a[0] - 1) < 1e-12 && y_cross < 0) y_cross = a[1];
+  }
+  EXPECT_NEAR(sum, path->cost, 1e-12 * path->cost);
+  EXPECT_NEAR(y_cross, y_best, 0.05);
+  std::printf("Snell: optimum %.6f at y %.4f, engine %.6f (1 + %.3g), crossing y %.4f\n", best,
+              y_best, path->cost, path->cost / best - 1, y_cross);
+}
+
+TEST(WeightedFieldTest, ImpassableWallIsGoneAroundThroughItsGap) {
+  GridSpec spec;
+  spec.cells_x = spec.cells_y = 20;
+  const MeshData data = MakeGrid(spec);
+  const TriangleMesh mesh = BuildMesh(data);
+  WeightedOptions options;
+  options.epsilon = 0.05;
+  for (uint32_t f = 0; f < data.face_count(); ++f) {
+    const Vec3 c = Centroid(data, f);
+    const bool wall = c[0] > 0.45 && c[0] < 0.55 && c[1] < 0.8;
+    options.face_weight.push_back(wall ? kInf : 1.0);
+  }
+  const uint32_t s = 4 * 21 + 4, t = 4 * 21 + 16;  // (0.2, 0.2) and (0.8, 0.2)
+  const double detour = 2 * 0.65 + 0.1;            // via (0.45, 0.8) and (0.55, 0.8)
+  absl::StatusOr<WeightedCosts> costs = ComputeWeightedCostsAt(
+      mesh, {SurfacePoint::AtVertex(s)}, {SurfacePoint::AtVertex(t)}, options);
+  ASSERT_TRUE(costs.ok()) << costs.status();
+  EXPECT_GE(costs->cost[0], detour * (1 - 1e-12));
+  EXPECT_LE(costs->cost[0], detour * (1 + options.epsilon));
+  absl::StatusOr<WeightedPath> path =
+      ComputeWeightedPath(mesh, SurfacePoint::AtVertex(s), SurfacePoint::AtVertex(t), options);
+  ASSERT_TRUE(path.ok()) << path.status();
+  EXPECT_EQ(path->cost, costs->cost[0]);
+  for (const PathPoint& p : path->points) {
+    const bool inside =
+        p.position[0] > 0.45 + 1e-12 && p.position[0] < 0.55 - 1e-12 && p.position[1] < 0.8 - 1e-12;
+    EXPECT_FALSE(inside) << p.position[0] << " " << p.position[1];
+  }
+}
+
+TEST(WeightedFieldTest, EnclosedRegionIsUnreachable) {
+  GridSpec spec;
+  spec.cells_x = spec.cells_y = 20;
+  const MeshData data = MakeGrid(spec);
+  const TriangleMesh mesh = BuildMesh(data);
+  WeightedOptions options;
+  options.epsilon = 0.1;
+  for (uint32_t f = 0; f < data.face_count(); ++f) {
+    const Vec3 c = Centroid(data, f);
+    const int i = static_cast<int>(c[0] * 20), j = static_cast<int>(c[1] * 20);
+    const bool ring =
+        i >= 5 && i <= 14 && j >= 5 && j <= 14 && (i == 5 || i == 14 || j == 5 || j == 14);
+    options.face_weight.push_back(ring ? kInf : 1.0);
+  }
+  absl::StatusOr<WeightedField> field =
+      ComputeWeightedField(mesh, {SurfacePoint::AtVertex(10 * 21 + 10)}, options);
+  ASSERT_TRUE(field.ok()) << field.status();
+  EXPECT_EQ(field->cost[0], kInf);
+  EXPECT_EQ(field->source[0], 0xffffffffu);
+  EXPECT_LT(field->cost[8 * 21 + 8], kInf);
+  absl::StatusOr<WeightedPath> path = ComputeWeightedPath(
+      mesh, SurfacePoint::AtVertex(10 * 21 + 10), SurfacePoint::AtVertex(0), options);
+  EXPECT_EQ(path.status().code(), absl::StatusCode::kNotFound);
+}
+
+TEST(WeightedFieldTest, BadOptionsAreNamed) {
+  const TriangleMesh mesh = BuildMesh(MakeGrid(GridSpec{}));
+  const std::vector<SurfacePoint> sources{SurfacePoint::AtVertex(0)};
+  auto option_of = [&](const WeightedOptions& o) {
+    absl::StatusOr<WeightedField> f = ComputeWeightedField(mesh, sources, o);
+    EXPECT_EQ(f.status().code(), absl::StatusCode::kInvalidArgument);
+    return InvalidOptionOf(f.status());
+  };
+  for (const double eps : {0.0, -0.1, 1.0, std::nan("")}) {
+    WeightedOptions o;
+    o.epsilon = eps;
+    EXPECT_EQ(option_of(o), "epsilon") << eps;
+  }
+  WeightedOptions o;
+  o.max_distance = 0;
+  EXPECT_EQ(option_of(o), "max_distance");
+  for (const double w : {0.0, -1.0, std::nan("")}) {
+    WeightedOptions bad;
+    bad.face_weight.assign(mesh.face_count(), 1.0);
+    bad.face_weight[7] = w;
+    EXPECT_EQ(option_of(bad), "face_weight[7]") << w;
+  }
+  WeightedOptions short_list;
+  short_list.face_weight.assign(mesh.face_count() - 1, 1.0);
+  EXPECT_EQ(option_of(short_list), "face_weight");
+  EXPECT_EQ(ComputeWeightedField(mesh, {}, WeightedOptions{}).status().code(),
+            absl::StatusCode::kInvalidArgument);
+  EXPECT_EQ(
+      ComputeWeightedField(mesh, {SurfacePoint::AtVertex(1000)}, WeightedOptions{}).status().code(),
+      absl::StatusCode::kInvalidArgument);
+}
+
+TEST(WeightedFieldTest, SteinerPointLimitAndCancel) {
+  const TriangleMesh mesh = BuildMesh(MakeGrid(GridSpec{}));
+  WeightedOptions o;
+  o.epsilon = 0.1;
+  absl::StatusOr<WeightedField> full = ComputeWeightedField(mesh, {SurfacePoint::AtVertex(0)}, o);
+  ASSERT_TRUE(full.ok());
+  o.max_steiner_points = full->steiner_points - 1;
+  absl::StatusOr<WeightedField> limited =
+      ComputeWeightedField(mesh, {SurfacePoint::AtVertex(0)}, o);
+  EXPECT_EQ(limited.status().code(), absl::StatusCode::kResourceExhausted);
+  EXPECT_EQ(ExceededLimit(limited.status()), Limit::kSteinerPoints);
+  o.max_steiner_points = full->steiner_points;
+  EXPECT_TRUE(ComputeWeightedField(mesh, {SurfacePoint::AtVertex(0)}, o).ok());
+  CancelToken cancel;
+  cancel.Cancel();
+  o.cancel = &cancel;
+  EXPECT_EQ(ComputeWeightedField(mesh, {SurfacePoint::AtVertex(0)}, o).status().code(),
+            absl::StatusCode::kCancelled);
+}
+
+TEST(WeightedFieldTest, MaxDistanceStopsTheSearch) {
+  const MeshData data = MakeGrid(GridSpec{});
+  const TriangleMesh mesh = BuildMesh(data);
+  WeightedOptions o;
+  o.epsilon = 0.1;
+  o.max_distance = 0.5;
+  absl::StatusOr<WeightedField> f = ComputeWeightedField(mesh, {SurfacePoint::AtVertex(0)}, o);
+  ASSERT_TRUE(f.ok());
+  for (uint32_t v = 0; v < data.vertex_count(); ++v) {
+    if (f->cost[v] < kInf) {
+      EXPECT_LE(f->cost[v], 0.5);
+    }
+    const double d = Distance3(VertexPosition(data, 0), VertexPosition(data, v));
+    if (d * (1 + o.epsilon) < 0.5) {
+      EXPECT_LT(f->cost[v], kInf) << v;
+    }
+    if (d > 0.5) {
+      EXPECT_EQ(f->cost[v], kInf) << v;
+    }
+  }
+}
+
+TEST(WeightedFieldTest, DeterministicBitForBit) {
+  absl::StatusOr<TriangleMesh> mesh = LoadTestMesh("knight.off");
+  ASSERT_TRUE(mesh.ok());
+  WeightedOptions o;
+  o.epsilon = 0.1;
+  for (uint32_t f = 0; f < mesh->face_count(); ++f) o.face_weight.push_back(1 + (f * 37 % 11));
+  const std::vector<SurfacePoint> sources{
+      SurfacePoint::AtVertex(0),
+      SurfacePoint::OnEdge(mesh->FaceVertex(5, 0), mesh->FaceVertex(5, 1), 0.3)};
+  absl::StatusOr<WeightedField> a = ComputeWeightedField(*mesh, sources, o);
+  absl::StatusOr<WeightedField> b = ComputeWeightedField(*mesh, sources, o);
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_EQ(a->cost, b->cost);
+  EXPECT_EQ(a->source, b->source);
+}
+
+}  // namespace
+}  // namespace geodex
