@@ -42,7 +42,7 @@ inline const char* FlagOfLimit(Limit limit) {
       return "max_windows";
     case Limit::kDemCells:
       return "max_dem_cells";
-    case Limit::kSteinerPoints:
+    case Limit::kSteinerPoints:  // no geodexd request runs the weighted engine yet (issue 35)
       return "max_steiner_points";
   }
   return "unknown";
