@@ -14,6 +14,7 @@
 
 #include "absl/strings/ascii.h"
 #include "absl/strings/match.h"
+#include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
@@ -66,6 +67,42 @@ TransformPtr MakeTransform(const OGRSpatialReference& from, const OGRSpatialRefe
   PrepareGdal();  // PROJ's network off before any transformation is made
   return TransformPtr(OGRCreateCoordinateTransformation(&from, &to),
                       &OGRCoordinateTransformation::DestroyCT);
+}
+
+// A CRS that carries an EPSG code must be the kind of CRS PROJ knows under that code: PROJ 9.1
+// looks the code up when it builds a transformation, and dereferences null when a file's geographic
+// CRS says it is EPSG:4342, a geocentric CRS (found by dem_fuzzer; tests/data/bad_bound_crs.tif).
+// The CRS itself and, for a projected CRS, its base are checked. "" when it is consistent.
+std::string InconsistentCrsId(const OGRSpatialReference& srs) {
+  auto kind = [](const OGRSpatialReference& crs) -> std::string {
+    if (crs.IsCompound()) return "compound";
+    if (crs.IsProjected()) return "projected";
+    if (crs.IsGeocentric()) return "geocentric";
+    if (crs.IsGeographic()) return "geographic";
+    if (crs.IsLocal()) return "engineering";
+    return "other";
+  };
+  for (const char* node : {static_cast<const char*>(nullptr), "GEOGCS"}) {
+    const char* authority = srs.GetAuthorityName(node);
+    const char* code = srs.GetAuthorityCode(node);
+    if (authority == nullptr || code == nullptr || !EQUAL(authority, "EPSG")) continue;
+    int number = 0;
+    if (!absl::SimpleAtoi(code, &number) || number <= 0) {
+      return absl::StrCat("its CRS carries the code EPSG:", std::string(code).substr(0, 20),
+                          ", which is not a number");
+    }
+    OGRSpatialReference known;
+    if (known.importFromEPSG(number) != OGRERR_NONE) {
+      return absl::StrCat("its CRS carries the code EPSG:", number, ", which PROJ does not know");
+    }
+    const std::string claimed =
+        node == nullptr ? kind(srs) : (srs.IsProjected() ? "geographic" : kind(srs));
+    if (kind(known) != claimed) {
+      return absl::StrCat("its ", claimed, " CRS carries the code EPSG:", number, ", a ",
+                          kind(known), " CRS");
+    }
+  }
+  return "";
 }
 
 // A reprojected DEM's file CRS to its mesh CRS (the UTM zone), or back; null when either CRS does
@@ -545,6 +582,9 @@ absl::StatusOr<Dem> Dem::ReadGeoTiffBytes(const std::string& bytes, const std::s
   // Its CRS may carry PROJ text (a PROJ4 extension, a user-defined citation) naming grid files or
   // +init files, which PROJ would open on the server: refused.
   if (const OGRSpatialReference* srs = ds->GetSpatialRef(); srs != nullptr) {
+    if (std::string why = InconsistentCrsId(*srs); !why.empty()) {
+      return absl::InvalidArgumentError(absl::StrCat(name, ": ", why));
+    }
     char* proj4 = nullptr;
     srs->exportToProj4(&proj4);
     const std::string text = proj4 != nullptr ? proj4 : "";
@@ -641,6 +681,7 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
   }
   const OGRSpatialReference* file_srs = ds->GetSpatialRef();
   if (file_srs == nullptr || file_srs->IsEmpty()) return bad("no coordinate reference system");
+  if (std::string why = InconsistentCrsId(*file_srs); !why.empty()) return bad(why);
   OGRSpatialReference file_crs(*file_srs);
   file_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
   info.file_crs_name = file_crs.GetName() != nullptr ? file_crs.GetName() : "";

@@ -32,6 +32,11 @@ void PrepareGdal() {
     CPLSetConfigOption("CPL_VSIL_CURL_ALLOWED_EXTENSIONS", ".geodex-network-access-is-disabled");
     CPLSetConfigOption("GDAL_VRT_ENABLE_PYTHON", "NO");
     CPLSetConfigOption("GDAL_HTTP_TIMEOUT", "1");  // belt and braces, should anything still fetch
+    // exportToProj4 (the upload check for PROJ text naming files) would otherwise ask PROJ for a
+    // bound CRS to WGS 84 first, and PROJ 9.1 dereferences null there on some malformed GeoTIFF
+    // CRSs (found by dem_fuzzer; tests/data/bad_bound_crs.tif). geodex wants the CRS's own PROJ
+    // text, not an added +towgs84, so the step is skipped for every export.
+    CPLSetConfigOption("OSR_ADD_TOWGS84_ON_EXPORT_TO_PROJ4", "NO");
     CPLHTTPSetFetchCallback(RefuseFetch, nullptr);
     OSRSetPROJEnableNetwork(FALSE);
     GDALAllRegister();

@@ -23,6 +23,7 @@
 #include "gtest/gtest.h"
 #include "ogr_spatialref.h"
 #include "ogrsf_frmts.h"
+#include "util/test_meshes.h"
 
 namespace geodex::terrain {
 namespace {
@@ -517,6 +518,24 @@ TEST_F(DemTest, BytesAndStoredMeshGiveTheSameDem) {
             absl::StatusCode::kResourceExhausted);
   small.max_cells = 900;
   EXPECT_TRUE(Dem::ReadGeoTiffBytes(Slurp(path), "big.tif", small).ok());
+}
+
+// An upload whose geographic CRS carries EPSG:4342, a geocentric CRS's code (found by dem_fuzzer:
+// PROJ 9.1 dereferenced null building a transformation from it, or a bound CRS for the check of
+// PROJ text naming files), is refused with the code named, by both readers, before PROJ sees it.
+TEST_F(DemTest, ACrsWithAnotherKindsCodeIsRefusedNotACrash) {
+  const std::string path = TestDataPath("bad_bound_crs.tif");
+  const std::string bytes = Slurp(path);
+  ASSERT_GT(bytes.size(), 100u) << path;
+  for (const absl::StatusOr<Dem>& dem :
+       {Dem::ReadGeoTiffBytes(bytes, "upload.tif"), Dem::Read(path)}) {
+    ASSERT_FALSE(dem.ok());
+    EXPECT_EQ(dem.status().code(), absl::StatusCode::kInvalidArgument) << dem.status();
+    EXPECT_NE(
+        dem.status().message().find("geographic CRS carries the code EPSG:4342, a geocentric"),
+        std::string::npos)
+        << dem.status();
+  }
 }
 
 // The same for a geographic grid (the mesh in UTM): cells are found by projecting back.
