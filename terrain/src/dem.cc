@@ -115,7 +115,12 @@ TransformPtr FileMeshTransform(const DemInfo& info, bool to_mesh) {
   }
   file_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
   mesh_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  return to_mesh ? MakeTransform(file_crs, mesh_crs) : MakeTransform(mesh_crs, file_crs);
+  // Back is the forward operation inverted, never a second search: between datums (WGS 72 to
+  // WGS 84's UTM) PROJ may pick another operation each way, and a stored DEM's vertices would not
+  // land back on its cell centres (found by dem_fuzzer).
+  TransformPtr forward = MakeTransform(file_crs, mesh_crs);
+  if (to_mesh || forward == nullptr) return forward;
+  return TransformPtr(forward->GetInverse(), &OGRCoordinateTransformation::DestroyCT);
 }
 
 // Metres per unit of a band's height unit; 0 when the unit is not one geodex knows.
@@ -716,13 +721,14 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
     OGRSpatialReference utm;
     utm.importFromEPSG((lat >= 0 ? 32600 : 32700) + zone);
     utm.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-    to_mesh = MakeTransform(file_crs, utm);
-    if (to_mesh == nullptr) {
-      return bad(absl::StrCat("cannot project to UTM (", QuietGdal::LastMessage(), ")"));
-    }
     info.reprojected = true;
     info.mesh_crs_name = utm.GetName() != nullptr ? utm.GetName() : "";
     info.mesh_crs_wkt = WktOf(utm);
+    // From the stored texts, as a stored DEM rebuilds it (Dem::FromMesh): the same operation.
+    to_mesh = FileMeshTransform(info, /*to_mesh=*/true);
+    if (to_mesh == nullptr) {
+      return bad(absl::StrCat("cannot project to UTM (", QuietGdal::LastMessage(), ")"));
+    }
   } else if (file_crs.IsProjected() || file_crs.IsLocal()) {
     info.horizontal_scale = file_crs.GetLinearUnits();
     if (!(info.horizontal_scale > 0)) return bad("the CRS has no linear unit");
@@ -1027,6 +1033,30 @@ absl::StatusOr<Dem> Dem::FromMesh(MeshData mesh, DemInfo info) {
       ys[v] /= info.horizontal_scale;
     }
   }
+  // Reprojected, which cell centre a vertex is at is decided in the mesh's metres: its nearest
+  // centre, projected forward as the reader projected it, must be where the vertex is (0.1 mm).
+  // The way back only finds the candidate: between datums (WGS 72 to WGS 84's UTM) PROJ's 2D
+  // round trip is off by up to 1e-10 degrees, a thousandth of the finest cell the reader takes.
+  std::vector<char> at_centre(n, 0);
+  if (info.reprojected) {
+    std::vector<double> cx(n), cy(n);
+    for (size_t v = 0; v < n; ++v) {
+      const double u = (xs[v] - gt[0]) / gt[1] - 0.5, w = (ys[v] - gt[3]) / gt[5] - 0.5;
+      cx[v] = gt[0] + (std::round(u) + 0.5) * gt[1];
+      cy[v] = gt[3] + (std::round(w) + 0.5) * gt[5];
+    }
+    QuietGdal quiet;
+    TransformPtr forward = FileMeshTransform(info, /*to_mesh=*/true);
+    std::vector<int> ok(n);
+    if (forward == nullptr || (n > 0 && !forward->Transform(static_cast<int>(n), cx.data(),
+                                                            cy.data(), nullptr, ok.data()))) {
+      return bad("its cell centres do not project to the mesh's CRS");
+    }
+    for (size_t v = 0; v < n; ++v) {
+      at_centre[v] = ok[v] && std::abs(cx[v] - mesh.positions[3 * v]) < 1e-4 &&
+                     std::abs(cy[v] - mesh.positions[3 * v + 1]) < 1e-4;
+    }
+  }
   Dem dem;
   dem.vertex_of_cell_.assign(size_t{W} * H, kNoVertex);
   // The cells' vertices come first, in row order; after them, a barrier cut's (at no cell centre).
@@ -1035,9 +1065,10 @@ absl::StatusOr<Dem> Dem::FromMesh(MeshData mesh, DemInfo info) {
   for (size_t v = 0; v < n; ++v) {
     const double u = (xs[v] - gt[0]) / gt[1] - 0.5, w = (ys[v] - gt[3]) / gt[5] - 0.5;
     const double i = std::round(u), j = std::round(w);
-    // A cell centre to far better than a cell (projections round-trip to ~1e-9 of one).
-    const bool centre =
-        std::abs(u - i) < 1e-6 && std::abs(w - j) < 1e-6 && i >= 0 && j >= 0 && i < W && j < H;
+    // A cell centre to far better than a cell (in the file's own units, exact to ~1e-12 of one).
+    const bool near =
+        info.reprojected ? at_centre[v] != 0 : std::abs(u - i) < 1e-6 && std::abs(w - j) < 1e-6;
+    const bool centre = near && i >= 0 && j >= 0 && i < W && j < H;
     const size_t cell = centre ? static_cast<size_t>(j) * W + static_cast<size_t>(i) : 0;
     if (!centre || (v > 0 && cell <= previous)) {
       if (v == 0) return bad("vertex 0 is not at a cell centre");
@@ -1050,13 +1081,16 @@ absl::StatusOr<Dem> Dem::FromMesh(MeshData mesh, DemInfo info) {
   }
   for (size_t v = cells; v < n; ++v) {  // a cut's vertices lie within the grid, at no cell centre
     const double u = (xs[v] - gt[0]) / gt[1] - 0.5, w = (ys[v] - gt[3]) / gt[5] - 0.5;
-    if (!(u >= -1e-6 && w >= -1e-6 && u <= W - 1 + 1e-6 && w <= H - 1 + 1e-6)) {
+    const double slack = info.reprojected ? 1e-2 : 1e-6;  // the way back's error, as above
+    if (!(u >= -slack && w >= -slack && u <= W - 1 + slack && w <= H - 1 + slack)) {
       return bad(absl::StrCat("vertex ", v, " is outside the grid"));
     }
     // On the grid a cut's vertex is at a cell centre only as a copy of that cell's vertex (a line
     // barrier's two sides); on a TIN also where a hole's outline turns (most cells are no vertex).
-    if (info.z_tolerance == 0 && std::abs(u - std::round(u)) < 1e-6 &&
-        std::abs(w - std::round(w)) < 1e-6) {
+    const bool near =
+        info.reprojected ? at_centre[v] != 0
+                         : std::abs(u - std::round(u)) < 1e-6 && std::abs(w - std::round(w)) < 1e-6;
+    if (info.z_tolerance == 0 && near) {
       const size_t cell =
           static_cast<size_t>(std::round(w)) * W + static_cast<size_t>(std::round(u));
       const uint32_t original =

@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <string>
 
 #include "cpl_conv.h"
@@ -30,7 +31,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   absl::StatusOr<Dem> dem = Dem::ReadGeoTiffBytes(bytes, "fuzz.tif", options);
   if (!dem.ok()) return 0;
   absl::StatusOr<Dem> stored = Dem::FromMesh(dem->mesh(), dem->info());
-  if (!stored.ok()) __builtin_trap();  // a mesh the reader made must come back
+  if (!stored.ok()) {
+    fprintf(stderr, "STORED: %s\n", std::string(stored.status().message()).c_str());
+    __builtin_trap();
+  }  // a mesh the reader made must come back
   const auto& gt = dem->info().geotransform;
   const double w = dem->info().grid_width, h = dem->info().grid_height;
   for (double u : {0.5, w / 2, w - 0.5}) {
