@@ -83,7 +83,10 @@ class LocalBackend final : public Backend {
   absl::StatusOr<const DistanceField*> Field(const FieldQuery& query) override {
     absl::StatusOr<const DistanceField*> f = CachedField(query.sources, query.options);
     if (!f.ok()) return f.status();
-    ComputeFieldProducts(loaded_->mesh, *field_, query, field_.get());
+    if (absl::Status s = ComputeFieldProducts(loaded_->mesh, *field_, query, field_.get());
+        !s.ok()) {
+      return s;
+    }
     return field_.get();
   }
 

@@ -50,7 +50,11 @@ absl::StatusOr<MessageStream<v1::ComputeDistanceFieldResponse>> RunComputeDistan
   };
   auto state = std::make_shared<State>();
   state->solved = *std::move(solved);
-  ComputeFieldProducts(*state->solved.mesh->mesh, *state->solved.field, query, &state->products);
+  if (absl::Status s = ComputeFieldProducts(*state->solved.mesh->mesh, *state->solved.field, query,
+                                            &state->products);
+      !s.ok()) {
+    return FieldError("options.travel", s.message());  // directions with a travel cost
+  }
   api::FieldEncoding encoding;
   encoding.f32 = request.value_type() == v1::VALUE_TYPE_FLOAT32;
   encoding.labels = !request.omit_labels();

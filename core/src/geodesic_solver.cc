@@ -12,6 +12,7 @@
 #include "ich/ich_solver.h"
 #include "mesh_lookup.h"
 #include "source_resolver.h"
+#include "travel_queries.h"
 
 namespace geodex {
 namespace {
@@ -36,6 +37,15 @@ absl::Status ValidateGeodesicOptions(const GeodesicOptions& options) {
     return OptionError("max_distance",
                        absl::StrFormat("must be > 0, got %g", options.max_distance));
   }
+  if (options.travel.has_value()) {
+    if (absl::Status s = ValidateTravelCost(*options.travel); !s.ok()) return s;
+    if (options.lambda > 0 || options.method == Method::kDijkstra) {
+      return OptionError(
+          "travel",
+          "a travel cost is solved by the weighted engine, which takes no lambda and "
+          "no Dijkstra method (its precision is travel.epsilon)");
+    }
+  }
   return absl::OkStatus();
 }
 
@@ -49,6 +59,7 @@ absl::StatusOr<DistanceField> ComputeDistanceField(const TriangleMesh& mesh,
                                                    const GeodesicOptions& options) {
   if (sources.empty()) return absl::InvalidArgumentError("no sources given");
   if (absl::Status s = ValidateGeodesicOptions(options); !s.ok()) return s;
+  if (options.travel.has_value()) return ComputeTravelField(mesh, sources, options);
   SourceResolver resolver(mesh);
   for (uint32_t i = 0; i < sources.size(); ++i) {
     if (absl::Status s = resolver.Add(sources[i], i); !s.ok()) return s;

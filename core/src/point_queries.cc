@@ -22,6 +22,7 @@
 #include "mesh_lookup.h"
 #include "path_trace.h"
 #include "source_resolver.h"
+#include "travel_queries.h"
 
 namespace geodex {
 namespace {
@@ -152,6 +153,7 @@ absl::StatusOr<PathsQueryResult> ComputeShortestPaths(const TriangleMesh& mesh,
                                                       const PathQueryOptions& options) {
   if (absl::Status s = CheckOptions(options.solver); !s.ok()) return s;
   if (tos.empty()) return absl::InvalidArgumentError("paths need at least one target");
+  if (options.solver.travel.has_value()) return ComputeTravelPaths(mesh, from, tos, options.solver);
   absl::StatusOr<std::vector<ich::ResolvedSource>> sources = ResolveSources(mesh, {from});
   if (!sources.ok()) return sources.status();
   absl::StatusOr<std::vector<ich::ResolvedTarget>> targets = ResolveTargets(mesh, tos);
@@ -399,7 +401,20 @@ absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
     }
     absl::Status status = absl::OkStatus();
     SolveStats stats;
-    if (!columns.empty()) {
+    if (!columns.empty() && options.solver.travel.has_value()) {
+      // Travel times (direction-independent: the symmetric sweep holds) from the weighted engine.
+      std::vector<SurfacePoint> points;
+      for (size_t c : columns) points.push_back(solved_targets[c]);
+      PointQuery query{{sources[distinct[r]]}, std::move(points), options.solver};
+      absl::StatusOr<PointValues> values = ComputeTravelPointValues(mesh, query);
+      status = values.status();
+      if (values.ok()) {
+        double* row = &solved[r * cols];
+        for (size_t j = 0; j < columns.size(); ++j) row[columns[j]] = values->distance[j];
+        KeepKNearest(k, row, cols);
+        stats = values->stats;
+      }
+    } else if (!columns.empty()) {
       std::vector<ich::TargetResult> results;
       try {
         ich::IchSolver solver(mesh, options.solver);
@@ -449,6 +464,7 @@ absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
 
 absl::StatusOr<PointValues> ComputePointValues(const TriangleMesh& mesh, const PointQuery& query) {
   if (absl::Status s = CheckOptions(query.options); !s.ok()) return s;
+  if (query.options.travel.has_value()) return ComputeTravelPointValues(mesh, query);
   absl::StatusOr<std::vector<ich::ResolvedSource>> src = ResolveSources(mesh, query.sources);
   if (!src.ok()) return src.status();
   absl::StatusOr<std::vector<ich::ResolvedTarget>> resolved = ResolveTargets(mesh, query.points);

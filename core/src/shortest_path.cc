@@ -371,11 +371,16 @@ std::array<double, 3> TargetDirection(const TriangleMesh& mesh, const VertexPath
   return Unit(d);
 }
 
-void ComputeFieldProducts(const TriangleMesh& mesh, const DistanceField& field,
-                          const FieldQuery& query, DistanceField* out) {
+absl::Status ComputeFieldProducts(const TriangleMesh& mesh, const DistanceField& field,
+                                  const FieldQuery& query, DistanceField* out) {
+  if (query.directions && field.travel_epsilon > 0) {
+    return OptionError("travel",
+                       "geodesic directions are read off the exact engine; a travel cost has none");
+  }
   if (query.directions && out->direction.empty()) {
     out->direction = ComputeDirectionField(mesh, field);
   }
+  return absl::OkStatus();
 }
 
 }  // namespace geodex

@@ -301,7 +301,7 @@ TEST(ApiConvertTest, FieldRoundTripsThroughManyMessages) {
   absl::StatusOr<DistanceField> field = ComputeDistanceField(*mesh, query.sources, query.options);
   ASSERT_TRUE(field.ok());
   DistanceField products;
-  ComputeFieldProducts(*mesh, *field, query, &products);
+  ASSERT_TRUE(ComputeFieldProducts(*mesh, *field, query, &products).ok());
   ASSERT_EQ(products.direction.size(), field->distance.size());
   ASSERT_GT(std::count_if(field->distance.begin(), field->distance.end(),
                           [](double d) { return std::isinf(d); }),

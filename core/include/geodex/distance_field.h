@@ -57,6 +57,9 @@ struct DistanceField {
   // The geodesic direction per file vertex, when asked for (ComputeDirectionField in
   // geodex/shortest_path.h; geodexd's want_directions); empty otherwise.
   std::vector<std::array<double, 3>> direction;
+  // > 0: a travel-cost field (geodex/travel_cost.h): `distance` holds seconds from the weighted
+  // engine, within (1 + travel_epsilon) of the least times, and there are no origins to trace.
+  double travel_epsilon = 0;
 };
 
 }  // namespace geodex

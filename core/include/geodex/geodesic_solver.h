@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,7 @@
 #include "geodex/cancel.h"
 #include "geodex/distance_field.h"
 #include "geodex/surface_point.h"
+#include "geodex/travel_cost.h"
 #include "geodex/triangle_mesh.h"
 
 namespace geodex {
@@ -47,9 +49,13 @@ struct GeodesicOptions {
   // Ablation switches for tests and benchmarks; both are exact either way.
   bool use_filter = true;               // Lemma 2, the filter theorem
   bool use_one_angle_one_split = true;  // Lemma 1, Chen & Han
+  // Travel time instead of length (travel_cost.h): set, every answer is in seconds from the
+  // weighted engine, within (1 + travel->epsilon) of the least time.
+  std::optional<TravelCost> travel;
 };
 
-// The one check of the options every solve shares (lambda in [0, 1], max_distance > 0), made by
+// The one check of the options every solve shares (lambda in [0, 1], max_distance > 0, a travel
+// cost's values and what it cannot combine with: lambda > 0, Dijkstra), made by
 // every query; the CLI and geodexd call it too, before any work. An error is InvalidArgument
 // "must be ..., got X" naming the option as data: InvalidOptionOf gives its name ("lambda",
 // "max_distance"), which each front end spells its own way (--lambda, options.lambda).

@@ -55,8 +55,9 @@ struct FieldQuery {
 // The per-vertex products `query` asks for beyond distances and labels, from its solved `field`,
 // written to `out`'s product members only (`out` may be `field` itself, or another DistanceField
 // so that a shared, cached field stays untouched). Members already filled are kept.
-void ComputeFieldProducts(const TriangleMesh& mesh, const DistanceField& field,
-                          const FieldQuery& query, DistanceField* out);
+// InvalidArgument naming "travel" for directions on a travel-cost field (it has no origins).
+absl::Status ComputeFieldProducts(const TriangleMesh& mesh, const DistanceField& field,
+                                  const FieldQuery& query, DistanceField* out);
 
 }  // namespace geodex
 

@@ -60,6 +60,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "geodex/cancel.h"
+#include "geodex/geodesic_solver.h"
 #include "geodex/shortest_path.h"
 #include "geodex/surface_point.h"
 #include "geodex/triangle_mesh.h"
@@ -135,5 +136,12 @@ struct WeightedPath {
 absl::StatusOr<WeightedPath> ComputeWeightedPath(const TriangleMesh& mesh, const SurfacePoint& from,
                                                  const SurfacePoint& to,
                                                  const WeightedOptions& options);
+
+// The weighted engine's options for `options` (which carry a travel cost): the weights with every
+// face steeper than max_slope_deg made +inf, epsilon, max_distance in engine units (seconds /
+// SecondsPerMetre), the Steiner-point limit and the cancel token. Errors: InvalidArgument naming
+// "travel" for what the weighted engine does not do (lambda > 0, Dijkstra).
+absl::StatusOr<WeightedOptions> WeightedOptionsFor(const TriangleMesh& mesh,
+                                                   const GeodesicOptions& options);
 
 }  // namespace geodex

@@ -1,0 +1,168 @@
+#include "geodex/travel_cost.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "absl/strings/str_format.h"
+#include "geodex/geodesic_solver.h"
+#include "geodex/shortest_path.h"
+#include "geodex/triangle_mesh.h"
+#include "geodex/weighted_field.h"
+#include "travel_queries.h"
+
+namespace geodex {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+SolveStats StatsOf(const WeightedStats& w) {
+  SolveStats s;
+  s.edge_relaxations = w.edge_relaxations;
+  s.peak_bytes = w.peak_bytes;
+  s.solve_ms = w.solve_ms;
+  return s;
+}
+
+// Engine cost (weighted metres) to seconds; +inf stays.
+double Seconds(const TravelCost& travel, double cost) {
+  return cost == kInf ? kInf : cost * SecondsPerMetre(travel);
+}
+
+}  // namespace
+
+absl::Status ValidateTravelCost(const TravelCost& travel) {
+  if (!(travel.speed_kmh > 0) || !std::isfinite(travel.speed_kmh)) {
+    return OptionError("travel.speed_kmh",
+                       absl::StrFormat("must be > 0 and finite (km/h), got %g", travel.speed_kmh));
+  }
+  if (!(travel.epsilon > 0 && travel.epsilon < 1)) {
+    return OptionError("travel.epsilon",
+                       absl::StrFormat("must be in (0, 1), got %g", travel.epsilon));
+  }
+  if (!(travel.max_slope_deg >= 0 && travel.max_slope_deg <= 90)) {
+    return OptionError(
+        "travel.max_slope_deg",
+        absl::StrFormat("must be in (0, 90] degrees (0: no limit), got %g", travel.max_slope_deg));
+  }
+  return absl::OkStatus();
+}
+
+std::vector<double> FaceSlopesDeg(const TriangleMesh& mesh) {
+  std::vector<double> slope(mesh.face_count(), 0);
+  for (uint32_t f = 0; f < mesh.face_count(); ++f) {
+    const std::array<double, 3> a = mesh.Position(mesh.FaceVertex(f, 0)),
+                                b = mesh.Position(mesh.FaceVertex(f, 1)),
+                                c = mesh.Position(mesh.FaceVertex(f, 2));
+    const double ux = b[0] - a[0], uy = b[1] - a[1], uz = b[2] - a[2];
+    const double vx = c[0] - a[0], vy = c[1] - a[1], vz = c[2] - a[2];
+    const double nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;
+    const double horizontal = std::hypot(nx, ny);
+    if (horizontal == 0 && nz == 0) continue;  // degenerate: no slope
+    // The angle between the face and the x-y plane is the normal's angle from the z axis.
+    slope[f] = std::atan2(horizontal, std::abs(nz)) * 180 / M_PI;
+  }
+  return slope;
+}
+
+absl::StatusOr<WeightedOptions> WeightedOptionsFor(const TriangleMesh& mesh,
+                                                   const GeodesicOptions& options) {
+  if (absl::Status s = ValidateGeodesicOptions(options); !s.ok()) return s;
+  if (!options.travel.has_value()) {
+    return absl::InvalidArgumentError("WeightedOptionsFor needs options with a travel cost");
+  }
+  const TravelCost& travel = *options.travel;
+  WeightedOptions out;
+  out.epsilon = travel.epsilon;
+  out.max_steiner_points = travel.max_steiner_points;
+  out.cancel = options.cancel;
+  out.max_distance = options.max_distance / SecondsPerMetre(travel);
+  if (travel.face_weight != nullptr) out.face_weight = *travel.face_weight;
+  if (travel.max_slope_deg > 0 && travel.max_slope_deg < 90) {
+    if (out.face_weight.empty()) out.face_weight.assign(mesh.face_count(), 1.0);
+    if (out.face_weight.size() == mesh.face_count()) {  // else the engine names the count
+      const std::vector<double> slope = FaceSlopesDeg(mesh);
+      for (uint32_t f = 0; f < mesh.face_count(); ++f) {
+        if (slope[f] > travel.max_slope_deg) out.face_weight[f] = kInf;
+      }
+    }
+  }
+  return out;
+}
+
+absl::StatusOr<DistanceField> ComputeTravelField(const TriangleMesh& mesh,
+                                                 const std::vector<SurfacePoint>& sources,
+                                                 const GeodesicOptions& options) {
+  absl::StatusOr<WeightedOptions> weighted = WeightedOptionsFor(mesh, options);
+  if (!weighted.ok()) return weighted.status();
+  absl::StatusOr<WeightedField> w = ComputeWeightedField(mesh, sources, *weighted);
+  if (!w.ok()) return w.status();
+  DistanceField field;
+  field.sources = sources;
+  field.distance.resize(w->cost.size());
+  for (size_t v = 0; v < w->cost.size(); ++v) {
+    field.distance[v] = Seconds(*options.travel, w->cost[v]);
+  }
+  field.source = std::move(w->source);
+  // Every internal copy of a split vertex takes its file vertex's time (the weighted engine
+  // answers per file vertex): what isolines and Voronoi read.
+  field.internal_distance.resize(mesh.vertex_count());
+  field.internal_source.resize(mesh.vertex_count());
+  for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+    field.internal_distance[v] = field.distance[mesh.FileVertex(v)];
+    field.internal_source[v] = field.source[mesh.FileVertex(v)];
+  }
+  field.stats = StatsOf(w->stats);
+  field.travel_epsilon = options.travel->epsilon;
+  return field;
+}
+
+absl::StatusOr<PointValues> ComputeTravelPointValues(const TriangleMesh& mesh,
+                                                     const PointQuery& query) {
+  if (query.directions) {
+    return OptionError("travel",
+                       "geodesic directions are read off the exact engine; a travel cost has none");
+  }
+  absl::StatusOr<WeightedOptions> weighted = WeightedOptionsFor(mesh, query.options);
+  if (!weighted.ok()) return weighted.status();
+  absl::StatusOr<WeightedCosts> w =
+      ComputeWeightedCostsAt(mesh, query.sources, query.points, *weighted);
+  if (!w.ok()) return w.status();
+  PointValues out;
+  for (double c : w->cost) out.distance.push_back(Seconds(*query.options.travel, c));
+  out.source = std::move(w->source);
+  out.stats = StatsOf(w->stats);
+  return out;
+}
+
+absl::StatusOr<PathsQueryResult> ComputeTravelPaths(const TriangleMesh& mesh,
+                                                    const SurfacePoint& from,
+                                                    const std::vector<SurfacePoint>& tos,
+                                                    const GeodesicOptions& options) {
+  absl::StatusOr<WeightedOptions> weighted = WeightedOptionsFor(mesh, options);
+  if (!weighted.ok()) return weighted.status();
+  PathsQueryResult out;
+  out.distance.assign(tos.size(), kUnreachable);
+  out.paths.resize(tos.size());
+  for (size_t i = 0; i < tos.size(); ++i) {
+    absl::StatusOr<WeightedPath> path = ComputeWeightedPath(mesh, from, tos[i], *weighted);
+    if (absl::IsNotFound(path.status())) continue;  // unreachable: inf, no points
+    if (!path.ok()) return path.status();
+    out.distance[i] = Seconds(*options.travel, path->cost);
+    // The path's length stays a length (metres along the polyline); its time is the distance.
+    double length = 0;
+    for (size_t k = 1; k < path->points.size(); ++k) {
+      const auto& a = path->points[k - 1].position;
+      const auto& b = path->points[k].position;
+      length += std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                          (a[2] - b[2]) * (a[2] - b[2]));
+    }
+    out.paths[i].length = length;
+    out.paths[i].source = 0;
+    out.paths[i].points = std::move(path->points);
+    AddSolveStats(StatsOf(path->stats), &out.stats);
+  }
+  return out;
+}
+
+}  // namespace geodex

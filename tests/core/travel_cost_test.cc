@@ -1,0 +1,219 @@
+// Travel time through the public queries (geodex/travel_cost.h): a GeodesicOptions with a travel
+// cost makes fields, point values, paths, matrices and isolines speak seconds from the weighted
+// engine, within its bound; friction scales times; --max-slope blocks steep faces; what a travel
+// cost cannot do is a named error.
+
+#include "geodex/travel_cost.h"
+
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include "geodex/distance_matrix.h"
+#include "geodex/geodesic_solver.h"
+#include "geodex/geometry_queries.h"
+#include "geodex/shortest_path.h"
+#include "gtest/gtest.h"
+#include "util/mesh_factory.h"
+
+namespace geodex {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+TriangleMesh BuildMesh(const MeshData& data) {
+  absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(data);
+  EXPECT_TRUE(mesh.ok()) << mesh.status();
+  return *std::move(mesh);
+}
+
+GeodesicOptions Travel(double speed_kmh, double epsilon = 0.05) {
+  GeodesicOptions options;
+  options.travel = TravelCost{};
+  options.travel->speed_kmh = speed_kmh;
+  options.travel->epsilon = epsilon;
+  return options;
+}
+
+// A 10 m x 10 m plane: at 3.6 km/h (1 m/s) every time is the exact distance within the bound,
+// and at 7.2 km/h half of it; the field says it is a travel field and its bound.
+TEST(TravelCostTest, APlaneAtOneMetrePerSecondGivesDistancesInSeconds) {
+  GridSpec spec;
+  spec.cells_x = spec.cells_y = 8;
+  spec.width = spec.height = 10;
+  spec.jitter = 0.2;
+  const TriangleMesh mesh = BuildMesh(MakeGrid(spec));
+  const std::vector<SurfacePoint> sources = {SurfacePoint::AtVertex(0)};
+  absl::StatusOr<DistanceField> exact = ComputeDistanceField(mesh, sources);
+  ASSERT_TRUE(exact.ok()) << exact.status();
+  for (double speed : {3.6, 7.2}) {
+    absl::StatusOr<DistanceField> time = ComputeDistanceField(mesh, sources, Travel(speed));
+    ASSERT_TRUE(time.ok()) << time.status();
+    EXPECT_EQ(time->travel_epsilon, 0.05);
+    const double scale = 3.6 / speed;
+    for (size_t v = 0; v < exact->distance.size(); ++v) {
+      const double d = exact->distance[v] * scale;
+      EXPECT_GE(time->distance[v], d * (1 - 1e-12)) << v;
+      EXPECT_LE(time->distance[v], d * 1.05 + 1e-12) << v;
+      EXPECT_EQ(time->source[v], 0u);
+    }
+  }
+}
+
+// Friction 2 everywhere doubles every time, bit for bit, in the field, at points and in paths.
+TEST(TravelCostTest, FrictionTwoDoublesEveryTime) {
+  GridSpec spec;
+  spec.cells_x = spec.cells_y = 6;
+  spec.width = spec.height = 100;
+  spec.jitter = 0.25;
+  const TriangleMesh mesh = BuildMesh(MakeGrid(spec));
+  const std::vector<SurfacePoint> sources = {SurfacePoint::AtVertex(3)};
+  GeodesicOptions plain = Travel(5), doubled = Travel(5);
+  doubled.travel->face_weight = std::make_shared<std::vector<double>>(mesh.face_count(), 2.0);
+  absl::StatusOr<DistanceField> a = ComputeDistanceField(mesh, sources, plain);
+  absl::StatusOr<DistanceField> b = ComputeDistanceField(mesh, sources, doubled);
+  ASSERT_TRUE(a.ok() && b.ok()) << a.status() << b.status();
+  for (size_t v = 0; v < a->distance.size(); ++v) EXPECT_EQ(b->distance[v], 2 * a->distance[v]);
+  const SurfacePoint to = SurfacePoint::InFace(20, 0.2, 0.3, 0.5);
+  absl::StatusOr<PathQueryResult> pa = ComputeShortestPath(mesh, {sources[0], to, {plain}});
+  absl::StatusOr<PathQueryResult> pb = ComputeShortestPath(mesh, {sources[0], to, {doubled}});
+  ASSERT_TRUE(pa.ok() && pb.ok()) << pa.status() << pb.status();
+  EXPECT_EQ(pb->distance, 2 * pa->distance);
+  // The path's length is metres along it; at 5 km/h its time is length / (5 / 3.6).
+  EXPECT_NEAR(pa->distance, pa->path.length * 3.6 / 5, 1e-9 * pa->distance);
+  absl::StatusOr<PointValues> at = ComputePointValues(mesh, {sources, {to}, doubled});
+  ASSERT_TRUE(at.ok()) << at.status();
+  EXPECT_NEAR(at->distance[0], pb->distance, 1e-9 * pb->distance);
+}
+
+// A ridge: two 40-degree ramps meeting at the top, between flat ground on both sides. With a slope
+// limit of 45 degrees the far side is reached over the ridge; with 35 the ramps are cliffs and it
+// is cut off (the ramps span the whole width).
+TEST(TravelCostTest, MaxSlopeBlocksSteeperFaces) {
+  GridSpec spec;
+  spec.cells_x = 12;
+  spec.cells_y = 4;
+  spec.width = 12;
+  spec.height = 4;
+  MeshData data = MakeGrid(spec);
+  const double rise = std::tan(40 * M_PI / 180);
+  for (size_t v = 0; v < data.positions.size() / 3; ++v) {
+    const double x = data.positions[3 * v];
+    data.positions[3 * v + 2] = rise * std::max(0.0, 2 - std::abs(x - 6));  // ramps on 4 < x < 8
+  }
+  const TriangleMesh mesh = BuildMesh(data);
+  const std::vector<double> slope = FaceSlopesDeg(mesh);
+  double steepest = 0;
+  for (double s : slope) steepest = std::max(steepest, s);
+  EXPECT_NEAR(steepest, 40, 1e-9);
+  const std::vector<SurfacePoint> sources = {SurfacePoint::AtVertex(0)};  // x = 0
+  const uint32_t far = 12;                                              // x = 12, y = 0
+  GeodesicOptions climb = Travel(3.6, 0.1), cliff = Travel(3.6, 0.1);
+  climb.travel->max_slope_deg = 45;
+  cliff.travel->max_slope_deg = 35;
+  absl::StatusOr<DistanceField> a = ComputeDistanceField(mesh, sources, climb);
+  absl::StatusOr<DistanceField> b = ComputeDistanceField(mesh, sources, cliff);
+  ASSERT_TRUE(a.ok() && b.ok()) << a.status() << b.status();
+  // Over the ridge: 8 m of flat ground and two ramps of 2 / cos(40 deg) m each.
+  const double over = 8 + 2 * 2 / std::cos(40 * M_PI / 180);
+  EXPECT_GE(a->distance[far], over * (1 - 1e-12));
+  EXPECT_LE(a->distance[far], over * 1.1);
+  EXPECT_EQ(b->distance[far], kInf);
+  EXPECT_LT(b->distance[3], kInf);  // x = 3: before the ramps
+}
+
+// A matrix's entries are the point values of its rows; a symmetric matrix is symmetric.
+TEST(TravelCostTest, MatrixRowsArePointValues) {
+  GridSpec spec;
+  spec.cells_x = spec.cells_y = 5;
+  spec.width = spec.height = 50;
+  const TriangleMesh mesh = BuildMesh(MakeGrid(spec));
+  const std::vector<SurfacePoint> points = {SurfacePoint::AtVertex(0), SurfacePoint::AtVertex(17),
+                                            SurfacePoint::InFace(9, 0.3, 0.3, 0.4)};
+  MatrixOptions options;
+  options.solver = Travel(4);
+  options.threads = 1;
+  absl::StatusOr<DistanceMatrix> m = ComputeDistanceMatrix(mesh, points, points, options);
+  ASSERT_TRUE(m.ok()) << m.status();
+  for (size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(m->values[i * 3 + i], 0);
+    for (size_t j = 0; j < 3; ++j) EXPECT_EQ(m->values[i * 3 + j], m->values[j * 3 + i]);
+  }
+  absl::StatusOr<PointValues> row = ComputePointValues(mesh, {{points[0]}, points, options.solver});
+  ASSERT_TRUE(row.ok()) << row.status();
+  for (size_t j = 1; j < 3; ++j) EXPECT_EQ(m->values[j], row->distance[j]);
+}
+
+// Isolines in seconds: a 60 s line lies farther out than a 30 s one.
+TEST(TravelCostTest, IsolinesAreDrawnInSeconds) {
+  GridSpec spec;
+  spec.cells_x = spec.cells_y = 10;
+  spec.width = spec.height = 100;
+  const TriangleMesh mesh = BuildMesh(MakeGrid(spec));
+  IsolineQuery query;
+  query.sources = {SurfacePoint::AtVertex(0)};
+  query.options = Travel(3.6);
+  query.levels.levels = {30, 60};
+  absl::StatusOr<Isolines> lines = ComputeIsolines(mesh, query);
+  ASSERT_TRUE(lines.ok()) << lines.status();
+  ASSERT_EQ(lines->levels.size(), 2u);
+  // At 1 m/s from the corner, each line's points are `level` metres from it, within the bound
+  // (and the grid's linear interpolation of the field).
+  size_t points[2] = {0, 0};
+  for (const IsolinePolyline& line : lines->polylines) {
+    const size_t l = line.level == 30 ? 0 : 1;
+    for (const PathPoint& p : line.points) {
+      ++points[l];
+      const double r = std::hypot(p.position[0], p.position[1]);
+      EXPECT_LE(r, line.level * (1 + 1e-9));
+      EXPECT_GE(r, line.level / 1.05 - 0.5);
+    }
+  }
+  EXPECT_GT(points[0], 3u);
+  EXPECT_GT(points[1], points[0]);
+}
+
+TEST(TravelCostTest, BadValuesAndWhatATravelCostCannotDoAreNamedErrors) {
+  GridSpec spec;
+  const TriangleMesh mesh = BuildMesh(MakeGrid(spec));
+  const std::vector<SurfacePoint> sources = {SurfacePoint::AtVertex(0)};
+  auto option_of = [&](const GeodesicOptions& options) {
+    absl::Status s = ComputeDistanceField(mesh, sources, options).status();
+    EXPECT_EQ(s.code(), absl::StatusCode::kInvalidArgument) << s;
+    return InvalidOptionOf(s);
+  };
+  EXPECT_EQ(option_of(Travel(0)), "travel.speed_kmh");
+  EXPECT_EQ(option_of(Travel(-3)), "travel.speed_kmh");
+  EXPECT_EQ(option_of(Travel(kInf)), "travel.speed_kmh");
+  EXPECT_EQ(option_of(Travel(5, 0)), "travel.epsilon");
+  EXPECT_EQ(option_of(Travel(5, 1)), "travel.epsilon");
+  GeodesicOptions slope = Travel(5);
+  slope.travel->max_slope_deg = 91;
+  EXPECT_EQ(option_of(slope), "travel.max_slope_deg");
+  GeodesicOptions lambda = Travel(5);
+  lambda.lambda = 0.1;
+  EXPECT_EQ(option_of(lambda), "travel");
+  GeodesicOptions few = Travel(5);
+  few.travel->face_weight = std::make_shared<std::vector<double>>(3, 1.0);
+  EXPECT_EQ(option_of(few), "face_weight");
+  GeodesicOptions zero = Travel(5);
+  zero.travel->face_weight = std::make_shared<std::vector<double>>(mesh.face_count(), 1.0);
+  std::const_pointer_cast<std::vector<double>>(zero.travel->face_weight)->at(7) = 0;
+  EXPECT_EQ(option_of(zero), "face_weight[7]");
+
+  PointQuery directions{sources, {SurfacePoint::AtVertex(5)}, Travel(5)};
+  directions.directions = true;
+  EXPECT_EQ(InvalidOptionOf(ComputePointValues(mesh, directions).status()), "travel");
+  absl::StatusOr<DistanceField> field = ComputeDistanceField(mesh, sources, Travel(5));
+  ASSERT_TRUE(field.ok());
+  FieldQuery with_directions{sources, Travel(5), true};
+  DistanceField products;
+  EXPECT_EQ(InvalidOptionOf(ComputeFieldProducts(mesh, *field, with_directions, &products)),
+            "travel");
+  DelaunayQuery delaunay{sources, Travel(5)};
+  EXPECT_EQ(InvalidOptionOf(ComputeDelaunay(mesh, delaunay).status()), "travel");
+}
+
+}  // namespace
+}  // namespace geodex
