@@ -1,0 +1,36 @@
+#pragma once
+
+// Friction for travel cost (geodex/travel_cost.h): one multiplicative weight per face of a mesh,
+// from what GIS users draw or already have. Read under the same rules as barriers (no file or URL a
+// file names is opened; GeoJSON names its CRS only by an identifier).
+
+#include <string>
+#include <vector>
+
+#include "absl/status/statusor.h"
+#include "geodex/mesh_data.h"
+#include "geodex/terrain.h"
+
+namespace geodex::terrain {
+
+// Friction polygons: `geojson` is the text of a GeoJSON FeatureCollection (or Feature) of Polygons
+// and MultiPolygons, each with a numeric property "friction" (> 0; a barrier is better drawn as
+// one, but "inf" or a huge value works too), RFC 7946 WGS 84 unless it names its CRS, on a DEM's
+// mesh (`dem`: its map), or with `dem` null in the mesh's own x y. Each face takes the friction of
+// the polygon containing its centroid (the largest where polygons overlap) and 1 elsewhere: region
+// boundaries are as fine as the mesh (on a DEM, a cell). InvalidArgument starting with `name` for
+// text that is not GeoJSON polygons, a feature without a positive numeric friction, or polygons
+// that do not project to the mesh's CRS.
+absl::StatusOr<std::vector<double>> FrictionFromGeoJson(const MeshData& mesh,
+                                                        const std::string& geojson,
+                                                        const DemInfo* dem,
+                                                        const std::string& name);
+
+// A friction file for a DEM's mesh: GeoJSON polygons as above (a .geojson or .json path), or a
+// one-band raster GDAL reads (.tif, ...) in the DEM's CRS: each face takes the value of the cell
+// under its centroid; nodata is impassable (+inf). InvalidArgument starting with `name` for a
+// raster in another CRS, one not covering every face's centroid, or a value <= 0 (the cell named).
+absl::StatusOr<std::vector<double>> ReadFrictionFile(const MeshData& mesh, const std::string& path,
+                                                     const DemInfo& dem, const std::string& name);
+
+}  // namespace geodex::terrain
