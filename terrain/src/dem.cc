@@ -28,6 +28,7 @@
 #include "gdal_quiet.h"
 #include "geodex/adaptive_tin.h"
 #include "geodex/distance_matrix.h"
+#include "geodex/friction.h"
 #include "geodex/gis_formats.h"
 #include "geodex/limits.h"
 #include "geodex/point_distance.h"
@@ -1688,6 +1689,244 @@ absl::StatusOr<std::string> Dem::DistanceRasterBytes(const CellValues& cells) co
 
 absl::StatusOr<std::string> Dem::LabelRasterBytes(const CellValues& cells) const {
   return RasterBytes([&](const std::string& path) { return WriteLabelRaster(path, cells); });
+}
+
+// ---------------------------------------------------------------------------------------------
+// Friction (geodex/friction.h): beside the barrier reader, whose file and GeoJSON rules it shares.
+
+namespace {
+
+// Each face's centroid in the DEM file's CRS (`dem`), or in the mesh's x y (no `dem`).
+absl::StatusOr<std::vector<std::array<double, 2>>> FaceCentresInMap(const MeshData& mesh,
+                                                                    const DemInfo* dem,
+                                                                    const std::string& name) {
+  const size_t nf = mesh.faces.size() / 3;
+  std::vector<double> xs(nf), ys(nf);
+  for (size_t f = 0; f < nf; ++f) {
+    double x = 0, y = 0;
+    for (int k = 0; k < 3; ++k) {
+      x += mesh.positions[3 * size_t{mesh.faces[3 * f + k]}] / 3;
+      y += mesh.positions[3 * size_t{mesh.faces[3 * f + k]} + 1] / 3;
+    }
+    xs[f] = x;
+    ys[f] = y;
+  }
+  if (dem != nullptr && dem->reprojected) {
+    TransformPtr back = FileMeshTransform(*dem, /*to_mesh=*/false);
+    std::vector<int> ok(nf);
+    if (back == nullptr ||
+        (nf > 0 &&
+         !back->Transform(static_cast<int>(nf), xs.data(), ys.data(), nullptr, ok.data())) ||
+        std::find(ok.begin(), ok.end(), 0) != ok.end()) {
+      return absl::InvalidArgumentError(
+          absl::StrCat(name, ": the faces do not project back to the DEM's CRS"));
+    }
+  } else if (dem != nullptr) {
+    for (size_t f = 0; f < nf; ++f) {
+      xs[f] /= dem->horizontal_scale;
+      ys[f] /= dem->horizontal_scale;
+    }
+  }
+  std::vector<std::array<double, 2>> out(nf);
+  for (size_t f = 0; f < nf; ++f) out[f] = {xs[f], ys[f]};
+  return out;
+}
+
+// The friction polygons of a vector dataset, in `crs` (null: as they are), each face taking the
+// largest friction of the polygons containing its centroid, 1 elsewhere.
+absl::StatusOr<std::vector<double>> FrictionOfPolygons(GDALDataset& ds, const MeshData& mesh,
+                                                       const DemInfo* dem,
+                                                       const OGRSpatialReference* crs,
+                                                       const std::string& name) {
+  auto bad = [&](const std::string& why) {
+    return absl::InvalidArgumentError(absl::StrCat(name, ": ", why));
+  };
+  OGRSpatialReference wgs84;
+  wgs84.SetWellKnownGeogCS("WGS84");
+  wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  struct Region {
+    std::unique_ptr<OGRGeometry> shape;
+    OGREnvelope box;
+    double friction;
+  };
+  std::vector<Region> regions;
+  for (OGRLayer* layer : ds.GetLayers()) {
+    const OGRSpatialReference* layer_crs = layer->GetSpatialRef();
+    OGRSpatialReference from(layer_crs != nullptr ? *layer_crs : wgs84);
+    from.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    TransformPtr to_dem(nullptr, &OGRCoordinateTransformation::DestroyCT);
+    if (crs != nullptr) {
+      to_dem = MakeTransform(from, *crs);
+      if (to_dem == nullptr) {
+        return bad(
+            absl::StrCat("cannot project it to the DEM's CRS (", QuietGdal::LastMessage(), ")"));
+      }
+    }
+    const int field = layer->GetLayerDefn()->GetFieldIndex("friction");
+    const OGRFieldType type =
+        field >= 0 ? layer->GetLayerDefn()->GetFieldDefn(field)->GetType() : OFTString;
+    for (const auto& feature : *layer) {
+      const std::string which = absl::StrCat("feature ", feature->GetFID());
+      if (field < 0 || !feature->IsFieldSetAndNotNull(field) ||
+          (type != OFTReal && type != OFTInteger && type != OFTInteger64)) {
+        return bad(absl::StrCat(which, " has no numeric \"friction\" property"));
+      }
+      const double friction = feature->GetFieldAsDouble(field);
+      if (!(friction > 0)) {
+        return bad(absl::StrCat(which, ": friction must be > 0, got ", friction));
+      }
+      const OGRGeometry* g = feature->GetGeometryRef();
+      if (g == nullptr) return bad(absl::StrCat(which, " has no geometry"));
+      const OGRwkbGeometryType kind = wkbFlatten(g->getGeometryType());
+      if (kind != wkbPolygon && kind != wkbMultiPolygon) {
+        return bad(
+            absl::StrCat(which, " is a ", g->getGeometryName(), "; friction regions are polygons"));
+      }
+      std::unique_ptr<OGRGeometry> copy(g->clone());
+      if (to_dem != nullptr && copy->transform(to_dem.get()) != OGRERR_NONE) {
+        return bad(absl::StrCat("cannot project ", which, " to the DEM's CRS (",
+                                QuietGdal::LastMessage(), ")"));
+      }
+      Region r{std::move(copy), {}, friction};
+      r.shape->getEnvelope(&r.box);
+      regions.push_back(std::move(r));
+    }
+  }
+  if (regions.empty()) return bad("no friction polygon");
+  absl::StatusOr<std::vector<std::array<double, 2>>> centres = FaceCentresInMap(mesh, dem, name);
+  if (!centres.ok()) return centres.status();
+  std::vector<double> weight(centres->size(), 1.0);
+  std::vector<char> inside_any(centres->size(), 0);
+  OGRPoint point;
+  for (const Region& r : regions) {
+    for (size_t f = 0; f < centres->size(); ++f) {
+      const auto& [x, y] = (*centres)[f];
+      if (x < r.box.MinX || x > r.box.MaxX || y < r.box.MinY || y > r.box.MaxY) continue;
+      point.setX(x);
+      point.setY(y);
+      bool inside = false;
+      if (const OGRPolygon* p = dynamic_cast<const OGRPolygon*>(r.shape.get())) {
+        inside = p->IsPointOnSurface(&point);
+      } else if (const auto* m = dynamic_cast<const OGRMultiPolygon*>(r.shape.get())) {
+        for (const OGRPolygon* part : *m) inside = inside || part->IsPointOnSurface(&point);
+      }
+      if (!inside) continue;
+      weight[f] = inside_any[f] ? std::max(weight[f], r.friction) : r.friction;
+      inside_any[f] = 1;
+    }
+  }
+  return weight;
+}
+
+}  // namespace
+
+absl::StatusOr<std::vector<double>> FrictionFromGeoJson(const MeshData& mesh,
+                                                        const std::string& geojson,
+                                                        const DemInfo* dem,
+                                                        const std::string& name) {
+  QuietGdal quiet;
+  auto bad = [&](const std::string& why) {
+    return absl::InvalidArgumentError(absl::StrCat(name, ": ", why));
+  };
+  OGRSpatialReference file_crs;
+  if (dem != nullptr) {
+    if (file_crs.importFromWkt(dem->file_crs_wkt.c_str()) != OGRERR_NONE)
+      return bad("the DEM's CRS does not parse");
+    file_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  }
+  // As CutBarrierPolygons: the text in an in-memory file of its own, GeoJSON's driver alone.
+  const size_t first = geojson.find_first_not_of(" \t\r\n");
+  if (first == std::string::npos || geojson[first] != '{') {
+    return bad("not GeoJSON (a JSON object, starting with '{')");
+  }
+  CPLJSONDocument document;
+  if (!document.LoadMemory(geojson))
+    return bad(absl::StrCat("not GeoJSON (", QuietGdal::LastMessage(), ")"));
+  if (absl::Status crs = CheckGeoJsonCrs(document.GetRoot(), name); !crs.ok()) return crs;
+  MemFile text(".geojson", geojson);
+  if (!text.ok()) return absl::InternalError("GDAL cannot make an in-memory file");
+  const char* const drivers[] = {"GeoJSON", nullptr};
+  GDALDatasetUniquePtr ds(GDALDataset::FromHandle(GDALOpenEx(
+      text.path().c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, drivers, nullptr, nullptr)));
+  if (ds == nullptr) return bad(absl::StrCat("not GeoJSON (", QuietGdal::LastMessage(), ")"));
+  return FrictionOfPolygons(*ds, mesh, dem, dem != nullptr ? &file_crs : nullptr, name);
+}
+
+absl::StatusOr<std::vector<double>> ReadFrictionFile(const MeshData& mesh, const std::string& path,
+                                                     const DemInfo& dem, const std::string& name) {
+  QuietGdal quiet;
+  auto bad = [&](const std::string& why) {
+    return absl::InvalidArgumentError(absl::StrCat(name, ": ", why));
+  };
+  OGRSpatialReference file_crs;
+  if (file_crs.importFromWkt(dem.file_crs_wkt.c_str()) != OGRERR_NONE)
+    return bad("the DEM's CRS does not parse");
+  file_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  const GisFormat* format = GisFormatOf(path);
+  if (format == nullptr || format->kind != GisFileKind::kRaster) {  // polygons
+    absl::StatusOr<GDALDatasetUniquePtr> ds = OpenBarrierFile(path, name);
+    if (!ds.ok()) return ds.status();
+    return FrictionOfPolygons(**ds, mesh, &dem, &file_crs, name);
+  }
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) {
+    return absl::NotFoundError(absl::StrCat(name, ": cannot open: No such file or directory"));
+  }
+  // A raster: the drivers and side-car rules of Dem::Read.
+  const char* const drivers[] = {"GTiff",   "AAIGrid", "HFA",    "SRTMHGT",
+                                 "USGSDEM", "EHdr",    "netCDF", nullptr};
+  CPLStringList siblings = SideCarsOf(path);
+  GDALDatasetUniquePtr ds(GDALDataset::FromHandle(GDALOpenEx(
+      path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, drivers, nullptr, siblings.List())));
+  if (ds == nullptr) {
+    return bad(absl::StrCat("not a raster GDAL reads (", QuietGdal::LastMessage(), ")"));
+  }
+  if (ds->GetRasterCount() != 1) return bad("a friction raster has one band");
+  const OGRSpatialReference* crs = ds->GetSpatialRef();
+  if (crs == nullptr || crs->IsEmpty()) return bad("no coordinate reference system");
+  if (std::string why = InconsistentCrsId(*crs); !why.empty()) return bad(why);
+  if (!crs->IsSame(&file_crs)) {
+    return bad(absl::StrCat("its CRS (", crs->GetName() != nullptr ? crs->GetName() : "?",
+                            ") is not the DEM's (", dem.file_crs_name,
+                            "); reproject it first (gdalwarp -t_srs)"));
+  }
+  double gt[6];
+  if (ds->GetGeoTransform(gt) != CE_None || gt[2] != 0 || gt[4] != 0 || gt[1] == 0 || gt[5] == 0 ||
+      !std::all_of(gt, gt + 6, [](double v) { return std::isfinite(v); })) {
+    return bad("no north-up geotransform");
+  }
+  const int W = ds->GetRasterXSize(), H = ds->GetRasterYSize();
+  if (int64_t{W} * H > (int64_t{1} << 28)) {
+    return bad(absl::StrFormat("%dx%d cells: more than a friction raster may have (2^28)", W, H));
+  }
+  absl::StatusOr<std::vector<std::array<double, 2>>> centres = FaceCentresInMap(mesh, &dem, name);
+  if (!centres.ok()) return centres.status();
+  GDALRasterBand* band = ds->GetRasterBand(1);
+  std::vector<double> cells(size_t(W) * H);
+  if (band->RasterIO(GF_Read, 0, 0, W, H, cells.data(), W, H, GDT_Float64, 0, 0) != CE_None) {
+    return bad(absl::StrCat("cannot read its cells (", QuietGdal::LastMessage(), ")"));
+  }
+  int has_nodata = 0;
+  const double nodata = band->GetNoDataValue(&has_nodata);
+  std::vector<double> weight(centres->size());
+  for (size_t f = 0; f < centres->size(); ++f) {
+    const auto& [x, y] = (*centres)[f];
+    const double u = std::floor((x - gt[0]) / gt[1]), v = std::floor((y - gt[3]) / gt[5]);
+    if (!(u >= 0 && v >= 0 && u < W && v < H)) {
+      return bad(absl::StrFormat(
+          "it does not cover the DEM: face %d's centre (%.10g, %.10g) is outside it", f, x, y));
+    }
+    const double value = cells[static_cast<size_t>(v) * W + static_cast<size_t>(u)];
+    if ((has_nodata && value == nodata) || std::isnan(value)) {
+      weight[f] = std::numeric_limits<double>::infinity();  // no data: impassable
+    } else if (!(value > 0)) {
+      return bad(absl::StrFormat("cell (column %d, row %d) has friction %g; it must be > 0",
+                                 static_cast<int>(u), static_cast<int>(v), value));
+    } else {
+      weight[f] = value;
+    }
+  }
+  return weight;
 }
 
 }  // namespace geodex::terrain
