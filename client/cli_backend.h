@@ -110,6 +110,12 @@ std::unique_ptr<Backend> MakeLocalBackend();
 // nullptr when this geodex was built without gRPC.
 std::unique_ptr<Backend> MakeRemoteBackend(const std::string& target);
 
+// --face-weights FILE (one weight per face, a number a line, "inf" impassable) or --friction FILE
+// (on a DEM: polygons with a "friction" property, or a raster in the DEM's CRS; geodex/friction.h)
+// into options->travel, once MESH is open; nothing without a travel cost. Returns 0 or the exit
+// code after printing the one-line error (2 naming the flag; 3 when FILE cannot be read).
+int ResolveTravelWeights(Backend& backend, const Args& args, GeodesicOptions* options);
+
 // The exit code of a failed query, the same in both modes: a bad argument 2 (INVALID_ARGUMENT,
 // OUT_OF_RANGE), an unknown or unreadable mesh 3 (NOT_FOUND, DATA_LOSS), anything else 1
 // (cancelled, budget, unreachable target).

@@ -4,10 +4,12 @@
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <limits>
 #include <memory>
@@ -21,9 +23,11 @@
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_replace.h"
 #include "absl/strings/str_split.h"
+#include "absl/strings/strip.h"
 #include "cli_backend.h"
 #include "cli_common.h"
 #include "geodex/distance_matrix.h"
+#include "geodex/friction.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/gis_formats.h"
 #include "geodex/locate.h"
@@ -252,7 +256,50 @@ int QueryExitCode(const absl::Status& status) {
 }
 
 int FailQuery(const absl::Status& status) {
-  return Fail(QueryExitCode(status), InWrittenTerms(std::string(status.message())));
+  // A core option error names its option as data: say the flag.
+  const std::string option = InvalidOptionOf(status);
+  const std::string flag = option.empty() ? "" : FlagOfOption(option) + ": ";
+  return Fail(QueryExitCode(status), flag + InWrittenTerms(std::string(status.message())));
+}
+
+int ResolveTravelWeights(Backend& backend, const Args& args, GeodesicOptions* options) {
+  if (!options->travel.has_value()) return 0;
+  if (args.options.count("face-weights")) {
+    const std::string& path = args.options.at("face-weights");
+    std::ifstream in(path);
+    if (!in) {
+      return Fail(kExitInput,
+                  absl::StrCat("--face-weights ", path, ": cannot open: ", std::strerror(errno)));
+    }
+    auto weights = std::make_shared<std::vector<double>>();
+    std::string line;
+    for (size_t n = 1; std::getline(in, line); ++n) {
+      const absl::string_view text = absl::StripAsciiWhitespace(line);
+      if (text.empty() || text[0] == '#') continue;
+      double w = 0;
+      if (!absl::SimpleAtod(text, &w)) {
+        return Fail(kExitUsage, absl::StrFormat("--face-weights %s: line %d: '%s' is not a number",
+                                                path, n, text));
+      }
+      weights->push_back(w);
+    }
+    options->travel->face_weight = std::move(weights);  // count and values: core's check
+  } else if (args.options.count("friction")) {
+    const std::string& path = args.options.at("friction");
+    const terrain::Dem* dem = backend.Terrain();
+    if (dem == nullptr) {
+      return Fail(kExitUsage, absl::StrCat("--friction ", path,
+                                           ": friction maps need a DEM as MESH (on another mesh, "
+                                           "--face-weights FILE gives one weight per face)"));
+    }
+    absl::StatusOr<const MeshData*> data = backend.Geometry();
+    if (!data.ok()) return FailQuery(data.status());
+    absl::StatusOr<std::vector<double>> weights =
+        terrain::ReadFrictionFile(**data, path, dem->info(), absl::StrCat("--friction ", path));
+    if (!weights.ok()) return FailQuery(weights.status());
+    options->travel->face_weight = std::make_shared<std::vector<double>>(*std::move(weights));
+  }
+  return 0;
 }
 
 bool IsVectorPath(const Args& args) {
@@ -497,11 +544,45 @@ std::string FormatDistances(const std::vector<double>& distances,
   return text;
 }
 
+// How a travel-cost answer says what it is (seconds, approximate, its bound), as the geometry
+// commands say they are approximate: a first comment line of text output, leading members of a
+// JSON object. Both "" without a travel cost.
+std::string TravelTextHeader(const GeodesicOptions& options) {
+  if (!options.travel.has_value()) return "";
+  return absl::StrFormat(
+      "# travel time in seconds at %g km/h on friction 1; approximate: at most (1 + %g) x the "
+      "least time\n",
+      options.travel->speed_kmh, options.travel->epsilon);
+}
+std::string TravelJsonMembers(const GeodesicOptions& options) {
+  if (!options.travel.has_value()) return "";
+  return absl::StrFormat("\"unit\": \"s\", \"approximate\": true, \"epsilon\": %s, ",
+                         JsonNumber(options.travel->epsilon));
+}
+
 // `distances --at`: one line per point, "POINT<TAB>estimate D<TAB>exact D<TAB>source I" (I = -1
 // when unreachable) and with --directions "<TAB>direction X Y Z", or {"points": [{"point": SPEC,
 // "estimate": e, "exact": d, "source": i, "direction": [x, y, z] | null}, ...]}.
-std::string FormatAt(const std::vector<SurfacePoint>& points, const AtValues& v, bool json) {
-  std::string text = json ? "{\"points\": [" : "";
+// With a travel cost: "POINT<TAB>time_s T<TAB>source I" and {"unit": "s", ..., "points":
+// [{"point": SPEC, "time_s": t, "source": i}, ...]} (no unfolding estimate: it is geometry).
+std::string FormatAt(const std::vector<SurfacePoint>& points, const AtValues& v, bool json,
+                     const GeodesicOptions& options) {
+  const bool travel = options.travel.has_value();
+  std::string text =
+      json ? "{" + TravelJsonMembers(options) + "\"points\": [" : TravelTextHeader(options);
+  if (travel) {
+    for (size_t i = 0; i < points.size(); ++i) {
+      const uint32_t source = v.exact.source[i];
+      text += json ? absl::StrFormat("%s{\"point\": \"%s\", \"time_s\": %s, \"source\": %s}",
+                                     i ? ", " : "", SurfacePointToString(points[i]),
+                                     JsonNumber(v.exact.distance[i]),
+                                     source == kNoIndex ? "null" : absl::StrCat(source))
+                   : absl::StrFormat("%s\ttime_s %.17g\tsource %d\n",
+                                     SurfacePointToString(points[i]), v.exact.distance[i],
+                                     source == kNoIndex ? int64_t{-1} : int64_t{source});
+    }
+    return json ? text + "]}\n" : text;
+  }
   const std::vector<std::array<double, 3>>& direction = v.exact.direction;
   for (size_t i = 0; i < points.size(); ++i) {
     const uint32_t source = v.exact.source[i];
@@ -639,6 +720,7 @@ int RunDistances(Backend& backend, const Args& args) {
                 "--at SPEC (or --output X.tif for a raster)");
   }
   if (int code = OpenMesh(backend, args, args.positional[0], MeshBuildOptions{})) return code;
+  if (int code = ResolveTravelWeights(backend, args, &query.options)) return code;
   const terrain::Dem* dem = backend.Terrain();
   if ((raster || !labels_output.empty()) && dem == nullptr) {
     return Fail(kExitUsage, absl::StrCat(raster ? "--output " : "--labels-output ",
@@ -663,7 +745,7 @@ int RunDistances(Backend& backend, const Args& args) {
     absl::StatusOr<AtValues> values =
         backend.DistancesAt({sources, at, query.options, query.directions});
     if (!values.ok()) return FailQuery(values.status());
-    text = FormatAt(at, *values, json);
+    text = FormatAt(at, *values, json, query.options);
     if (IsVectorPath(args)) {  // Point features with the exact distance and the nearest source
       absl::StatusOr<const MeshData*> data = backend.Geometry();
       if (!data.ok()) return FailQuery(data.status());
@@ -702,7 +784,11 @@ int RunDistances(Backend& backend, const Args& args) {
     if (!written.ok()) return Fail(kExitUsage, std::string(written.message()));
     if (!raster) {
       text = json ? FormatDistancesJson((*field)->distance, (*field)->direction)
-                  : FormatDistances((*field)->distance, (*field)->direction);
+                  : TravelTextHeader(query.options) +
+                        FormatDistances((*field)->distance, (*field)->direction);
+      if (json && query.options.travel.has_value()) {  // {"unit": "s", ..., "time_s": [...]}
+        text = "{" + TravelJsonMembers(query.options) + "\"time_s\"" + text.substr(12);
+      }
     }
   }
   if (stats.solve_ms == 0) stats.solve_ms = MsSince(t_solve);
@@ -733,8 +819,10 @@ std::string SimplexText(const SurfacePoint& p) {
   return "?";
 }
 
-std::string FormatPath(const PathQueryResult& result) {
-  std::string text = absl::StrFormat("%.17g\n", result.distance);
+// With a travel cost, line 1 is the time in seconds after the header line, and JSON has "time_s"
+// beside the path's "length" in metres.
+std::string FormatPath(const PathQueryResult& result, const GeodesicOptions& options) {
+  std::string text = TravelTextHeader(options) + absl::StrFormat("%.17g\n", result.distance);
   for (const PathPoint& p : result.path.points) {
     text += absl::StrFormat("%.17g %.17g %.17g %s\n", p.position[0], p.position[1], p.position[2],
                             SimplexText(p.where));
@@ -742,8 +830,13 @@ std::string FormatPath(const PathQueryResult& result) {
   return text;
 }
 
-std::string FormatPathJson(const PathQueryResult& result) {
-  std::string text = "{\"length\": " + JsonNumber(result.distance) + ", \"points\": [";
+std::string FormatPathJson(const PathQueryResult& result, const GeodesicOptions& options) {
+  std::string text =
+      options.travel.has_value()
+          ? absl::StrCat("{", TravelJsonMembers(options),
+                         "\"time_s\": ", JsonNumber(result.distance),
+                         ", \"length\": ", JsonNumber(result.path.length), ", \"points\": [")
+          : "{\"length\": " + JsonNumber(result.distance) + ", \"points\": [";
   for (size_t i = 0; i < result.path.points.size(); ++i) {
     text += (i ? ", " : "") + PathPointJson(result.path.points[i]);
   }
@@ -787,6 +880,7 @@ int RunPath(Backend& backend, const Args& args) {
   }
   if (!GetSolverFlags(args, &options.solver, &error)) return Fail(kExitUsage, error);
   if (int code = OpenMesh(backend, args, args.positional[0], MeshBuildOptions{})) return code;
+  if (int code = ResolveTravelWeights(backend, args, &options.solver)) return code;
   SurfacePoint to;
   std::vector<SurfacePoint> froms;
   SnapReport snap;
@@ -817,7 +911,8 @@ int RunPath(Backend& backend, const Args& args) {
       return code;
     }
   } else {
-    const std::string text = json ? FormatPathJson(*result) : FormatPath(*result);
+    const std::string text =
+        json ? FormatPathJson(*result, options.solver) : FormatPath(*result, options.solver);
     if (int code = WriteOutput(args, text); code != kExitOk) return code;
   }
   if (args.options.count("stats")) {
@@ -890,6 +985,7 @@ int RunMatrix(Backend& backend, const Args& args) {
   RowProgress progress;
   options.on_row = [&progress](size_t done, size_t total) { progress.Update(done, total); };
   if (int code = OpenMesh(backend, args, args.positional[0], MeshBuildOptions{})) return code;
+  if (int code = ResolveTravelWeights(backend, args, &options.solver)) return code;
   std::vector<SurfacePoint> sources, targets;
   SnapReport snap;
   if (absl::Status s = ResolveOption(backend, args, "sources", &sources, &snap); !s.ok()) {
@@ -901,7 +997,9 @@ int RunMatrix(Backend& backend, const Args& args) {
   absl::StatusOr<DistanceMatrix> m = backend.Matrix({sources, targets, options});
   progress.Finish();
   if (!m.ok()) return FailQuery(m.status());
-  const std::string text = json ? FormatMatrixJson(*m) : FormatMatrix(*m);
+  const std::string text =
+      json ? "{" + TravelJsonMembers(options.solver) + FormatMatrixJson(*m).substr(1)
+           : TravelTextHeader(options.solver) + FormatMatrix(*m);
   std::fwrite(text.data(), 1, text.size(), stdout);
   if (args.options.count("stats")) {
     const std::string leading =

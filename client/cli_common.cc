@@ -18,6 +18,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
+#include "absl/strings/strip.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/mesh_io.h"
 #include "geodex/samples.h"
@@ -151,18 +152,64 @@ bool GetUint(const Args& args, const std::string& key, uint64_t* out, std::strin
   return true;
 }
 
+std::string FlagOfOption(const std::string& option) {
+  if (option == "travel" || option == "travel.speed_kmh") return "--speed";
+  if (option == "travel.epsilon") return "--cost-epsilon";
+  if (option == "travel.max_slope_deg") return "--max-slope";
+  if (absl::StartsWith(option, "face_weight")) return "--face-weights";  // or --friction's values
+  std::string flag = option;
+  std::replace(flag.begin(), flag.end(), '_', '-');
+  return "--" + flag;
+}
+
+namespace {
+
+// --speed constant:KMH and the cost flags that need it (the weights, read once the mesh is open,
+// come later: ResolveTravelWeights).
+bool GetTravelFlags(const Args& args, GeodesicOptions* options, std::string* error) {
+  if (!args.options.count("speed")) {
+    for (const std::string& flag : kTravelFlags) {
+      if (args.options.count(flag)) {
+        *error = absl::StrFormat("--%s: a travel cost needs --speed constant:KMH", flag);
+        return false;
+      }
+    }
+    return true;
+  }
+  const std::string& speed = args.options.at("speed");
+  TravelCost travel;
+  if (!absl::StartsWith(speed, "constant:") ||
+      !absl::SimpleAtod(speed.substr(9), &travel.speed_kmh)) {
+    *error = absl::StrFormat(
+        "--speed: '%s' is not constant:KMH (a speed in km/h on a face of friction 1)", speed);
+    return false;
+  }
+  if (!GetDouble(args, "cost-epsilon", &travel.epsilon, error) ||
+      !GetDouble(args, "max-slope", &travel.max_slope_deg, error) ||
+      !GetUint(args, "max-steiner-points", &travel.max_steiner_points, error)) {
+    return false;
+  }
+  if (args.options.count("friction") && args.options.count("face-weights")) {
+    *error = "--friction and --face-weights: give one (both set a weight per face)";
+    return false;
+  }
+  options->travel = travel;
+  return true;
+}
+
+}  // namespace
+
 // --lambda, --lambda-scale, --max-distance and --max-windows, shared by every command
-// that solves (distances, path, matrix, isolines, voronoi, delaunay).
+// that solves (distances, path, matrix, isolines, voronoi, delaunay), and the travel flags.
 bool GetSolverFlags(const Args& args, GeodesicOptions* options, std::string* error) {
   if (!GetDouble(args, "lambda", &options->lambda, error) ||
       !GetDouble(args, "max-distance", &options->max_distance, error) ||
-      !GetUint(args, "max-windows", &options->max_windows, error)) {
+      !GetUint(args, "max-windows", &options->max_windows, error) ||
+      !GetTravelFlags(args, options, error)) {
     return false;
   }
   if (absl::Status s = ValidateGeodesicOptions(*options); !s.ok()) {  // core's one check
-    std::string flag = InvalidOptionOf(s);
-    std::replace(flag.begin(), flag.end(), '_', '-');
-    *error = absl::StrFormat("--%s: %s", flag, s.message());
+    *error = absl::StrFormat("%s: %s", FlagOfOption(InvalidOptionOf(s)), s.message());
     return false;
   }
   if (args.options.count("lambda-scale")) {
@@ -183,12 +230,26 @@ bool GetLevels(const Args& args, const std::string& count_flag, IsolineOptions* 
                std::string* error) {
   if (args.options.count("levels")) {
     for (absl::string_view item : absl::StrSplit(args.options.at("levels"), ',')) {
+      // With a travel cost, levels are times: seconds, or with a unit (10min, 1.5h, 90s).
+      double unit = 1;
+      absl::string_view number = item;
+      for (const auto& [suffix, seconds] :
+           {std::pair<absl::string_view, double>{"min", 60}, {"h", 3600}, {"s", 1}}) {
+        if (absl::ConsumeSuffix(&number, suffix)) {
+          unit = seconds;
+          break;
+        }
+      }
       double level;
-      if (!absl::SimpleAtod(item, &level)) {
+      if (!absl::SimpleAtod(number, &level)) {
         *error = absl::StrFormat("--levels: '%s' is not a number", item);
         return false;
       }
-      options->levels.push_back(level);
+      if (number.size() != item.size() && !args.options.count("speed")) {
+        *error = absl::StrFormat("--levels: '%s' is a time; times need --speed constant:KMH", item);
+        return false;
+      }
+      options->levels.push_back(level * unit);
     }
   } else if (args.options.count(count_flag)) {
     if (!absl::SimpleAtoi(args.options.at(count_flag), &options->count)) {
@@ -213,7 +274,8 @@ bool CheckKnown(const Args& args, const std::set<std::string>& known, std::strin
     // --X-file (points from a file) goes with a command that takes --X.
     const bool file_of_known =
         absl::EndsWith(key, "-file") && known.count(key.substr(0, key.size() - 5));
-    if (!known.count(key) && !kMeshReadingFlags.count(key) && !file_of_known) {
+    const bool travel = known.count("lambda") && kTravelFlags.count(key);
+    if (!known.count(key) && !kMeshReadingFlags.count(key) && !file_of_known && !travel) {
       const std::string flag = args.options.count(key + "-file") ? key + "-file" : key;
       *error = absl::StrFormat("unknown option --%s (see geodex --help)", flag);
       return false;

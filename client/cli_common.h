@@ -61,7 +61,15 @@ void WarnIfBarrierSplits(const terrain::DemOptions& dem_options, uint64_t compon
 // of every command that takes a MESH, checked by MeshReadOptions (cli_backend.h).
 inline const std::set<std::string> kMeshReadingFlags = {
     "dem-step", "z-tolerance", "barrier-below", "barrier", "barrier-width", "crs"};
-// False with *error naming the first option neither in `known` nor in kMeshReadingFlags.
+// Travel time instead of length (geodex/travel_cost.h), taken by every command that takes --lambda:
+// --speed constant:KMH turns it on; the others need it.
+inline const std::set<std::string> kTravelFlags = {
+    "speed", "cost-epsilon", "max-slope", "friction", "face-weights", "max-steiner-points"};
+// The flag a core option error is about (InvalidOptionOf: "lambda", "travel.epsilon",
+// "face_weight[3]"), as the user typed it: "--lambda", "--cost-epsilon", "--face-weights".
+std::string FlagOfOption(const std::string& option);
+// False with *error naming the first option neither in `known` nor in kMeshReadingFlags (nor, for
+// a command that takes --lambda, kTravelFlags).
 bool CheckKnown(const Args& args, const std::set<std::string>& known, std::string* error);
 // --lambda, --lambda-scale, --max-distance and --max-windows into `options`, checked by core's
 // ValidateGeodesicOptions; false with *error naming the flag.

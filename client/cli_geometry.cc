@@ -39,12 +39,15 @@ struct Solved {
   std::vector<SurfacePoint> points;
 };
 
-// Opens the mesh on the backend, parses and resolves --`key`. Returns 0 or an exit code (after
+// Opens the mesh on the backend, parses and resolves --`key` (and the travel weights into
+// `options`). Returns 0 or an exit code (after
 // printing the one-line message).
-int Prepare(Backend& backend, const Args& args, const std::string& key, Solved* out) {
+int Prepare(Backend& backend, const Args& args, const std::string& key, Solved* out,
+            GeodesicOptions* options) {
   absl::StatusOr<std::vector<SurfacePoint>> points = ParseSpec(nullptr, key, args.options.at(key));
   if (!points.ok()) return Fail(kExitUsage, std::string(points.status().message()));
   if (int code = OpenMesh(backend, args, args.positional[0], MeshBuildOptions{})) return code;
+  if (int code = ResolveTravelWeights(backend, args, options)) return code;
   points = ParseSpec(&backend, key, args.options.at(key));  // map points onto the DEM
   if (!points.ok()) return FailQuery(points.status());
   if (absl::Status s = ResolvePoints(backend, args, key, &*points, nullptr); !s.ok()) {
@@ -259,7 +262,7 @@ int RunIsolines(Backend& backend, const Args& args) {
   if (!OutputFormat(args, &format, &error)) return Fail(kExitUsage, error);
   Solved s;
   absl::StatusOr<Isolines> iso;
-  if (int code = Prepare(backend, args, "sources", &s)) return code;
+  if (int code = Prepare(backend, args, "sources", &s, &query.options)) return code;
   query.sources = s.points;
   iso = backend.ComputeIsolines(query);
   if (!iso.ok()) return FailQuery(iso.status());
@@ -314,7 +317,7 @@ int RunVoronoi(Backend& backend, const Args& args) {
   if (!OutputFormat(args, &format, &error)) return Fail(kExitUsage, error);
   Solved s;
   absl::StatusOr<VoronoiDiagram> vd;
-  if (int code = Prepare(backend, args, "sites", &s)) return code;
+  if (int code = Prepare(backend, args, "sites", &s, &query.options)) return code;
   query.sites = s.points;
   vd = backend.ComputeVoronoi(query);
   if (!vd.ok()) return FailQuery(vd.status());
@@ -396,7 +399,7 @@ int RunDelaunay(Backend& backend, const Args& args) {
   if (!OutputFormat(args, &format, &error)) return Fail(kExitUsage, error);
   Solved s;
   absl::StatusOr<DelaunayTriangulation> dt;
-  if (int code = Prepare(backend, args, "sites", &s)) return code;
+  if (int code = Prepare(backend, args, "sites", &s, &query.options)) return code;
   query.sites = s.points;
   dt = backend.ComputeDelaunay(query);
   if (!dt.ok()) return FailQuery(dt.status());

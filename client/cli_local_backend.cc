@@ -3,6 +3,7 @@
 // geometry derived from it (render, isolines) solves once.
 
 #include <chrono>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -21,6 +22,12 @@ std::string Key(const std::vector<SurfacePoint>& sources, const GeodesicOptions&
   std::string key = absl::StrFormat("%d|%.17g|%d|%.17g|%d|%d|%d|", static_cast<int>(o.method),
                                     o.lambda, static_cast<int>(o.lambda_scale), o.max_distance,
                                     o.max_windows, o.use_filter, o.use_one_angle_one_split);
+  if (o.travel.has_value()) {  // a travel field is another field; its weights by address
+    absl::StrAppend(&key, absl::StrFormat("travel %.17g|%.17g|%.17g|%d|%p|", o.travel->speed_kmh,
+                                          o.travel->epsilon, o.travel->max_slope_deg,
+                                          o.travel->max_steiner_points,
+                                          static_cast<const void*>(o.travel->face_weight.get())));
+  }
   for (const SurfacePoint& p : sources) absl::StrAppend(&key, SurfacePointToString(p), ",");
   return key;
 }
@@ -91,6 +98,14 @@ class LocalBackend final : public Backend {
   }
 
   absl::StatusOr<AtValues> DistancesAt(const PointQuery& query) override {
+    if (query.options.travel.has_value()) {  // times only: the unfolding estimate is geometry
+      absl::StatusOr<PointValues> times = Reachable(ComputePointValues(loaded_->mesh, query));
+      if (!times.ok()) return times.status();
+      AtValues out;
+      out.exact = *std::move(times);
+      out.estimate.assign(query.points.size(), std::numeric_limits<double>::quiet_NaN());
+      return out;
+    }
     absl::StatusOr<const DistanceField*> field = CachedField(query.sources, query.options);
     if (!field.ok()) return field.status();
     AtValues out;

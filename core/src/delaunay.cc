@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "absl/strings/str_format.h"
+#include "geodex/geodesic_solver.h"
 
 namespace geodex {
 namespace {
@@ -107,6 +108,11 @@ void FindXlEdges(const DistanceField& field, const DelaunayEdge& e, size_t begin
 
 absl::StatusOr<DelaunayTriangulation> BuildDelaunay(const TriangleMesh& mesh,
                                                     const DistanceField& field) {
+  if (field.travel_epsilon > 0) {
+    return OptionError("travel",
+                       "the geodesic Delaunay triangulation is traced through the exact engine's "
+                       "origins; a travel cost has none (Voronoi regions and isolines work)");
+  }
   const uint32_t nv = mesh.vertex_count();
   if (field.internal_distance.size() != nv || field.internal_source.size() != nv ||
       field.internal_origin.size() != nv || field.distance.size() != mesh.file_vertex_count() ||

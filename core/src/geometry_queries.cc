@@ -22,11 +22,6 @@ absl::StatusOr<VoronoiDiagram> ComputeVoronoi(const TriangleMesh& mesh, const Vo
 
 absl::StatusOr<DelaunayTriangulation> ComputeDelaunay(const TriangleMesh& mesh,
                                                       const DelaunayQuery& query) {
-  if (query.options.travel.has_value()) {
-    return OptionError("travel",
-                       "the geodesic Delaunay triangulation is traced through the exact engine's "
-                       "origins; a travel cost has none (Voronoi regions and isolines work)");
-  }
   absl::StatusOr<DistanceField> field = ComputeDistanceField(mesh, query.sites, query.options);
   if (!field.ok()) return field.status();
   return BuildDelaunay(mesh, *field);

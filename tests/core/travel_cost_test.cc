@@ -108,7 +108,7 @@ TEST(TravelCostTest, MaxSlopeBlocksSteeperFaces) {
   for (double s : slope) steepest = std::max(steepest, s);
   EXPECT_NEAR(steepest, 40, 1e-9);
   const std::vector<SurfacePoint> sources = {SurfacePoint::AtVertex(0)};  // x = 0
-  const uint32_t far = 12;                                              // x = 12, y = 0
+  const uint32_t far = 12;                                                // x = 12, y = 0
   GeodesicOptions climb = Travel(3.6, 0.1), cliff = Travel(3.6, 0.1);
   climb.travel->max_slope_deg = 45;
   cliff.travel->max_slope_deg = 35;

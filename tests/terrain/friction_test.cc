@@ -140,11 +140,11 @@ TEST_F(DemTest, FrictionSlowsTravelAcrossItsBand) {
   options.travel = TravelCost{};
   options.travel->speed_kmh = 3.6;
   options.travel->epsilon = 0.05;
-  absl::StatusOr<DistanceField> plain = ComputeDistanceField(*mesh, {SurfacePoint::AtVertex(0)},
-                                                             options);
+  absl::StatusOr<DistanceField> plain =
+      ComputeDistanceField(*mesh, {SurfacePoint::AtVertex(0)}, options);
   options.travel->face_weight = std::make_shared<const std::vector<double>>(*w);
-  absl::StatusOr<DistanceField> slowed = ComputeDistanceField(*mesh, {SurfacePoint::AtVertex(0)},
-                                                              options);
+  absl::StatusOr<DistanceField> slowed =
+      ComputeDistanceField(*mesh, {SurfacePoint::AtVertex(0)}, options);
   ASSERT_TRUE(plain.ok() && slowed.ok()) << plain.status() << slowed.status();
   // Vertex 39: the north-east corner cell, 390 m east along the top row. The band's faces are
   // those whose centroids fall inside it: the first row's crossing is 100 m give or take a cell.
