@@ -285,7 +285,8 @@ int RunIsolines(Backend& backend, const Args& args) {
     absl::StatusOr<const DistanceField*> field = backend.Field({s.points, query.options, false});
     if (!field.ok()) return FailQuery(field.status());
     return WriteVectorOutput(backend, args,
-                             terrain::IsochroneFeatures(*s.data, (*field)->distance, iso->levels));
+                             terrain::IsochroneFeatures(*s.data, (*field)->distance, iso->levels,
+                                                        (*field)->travel_epsilon));
   }
   if (format == Format::kObj) return WriteOutput(args, Obj("isolines", lines));
   if (format == Format::kSvg)

@@ -65,6 +65,19 @@ SPEC: comma-separated points: 17 (vertex), e:V1:V2:T (the point (1-T)*V1 + T*V2 
       FlatGeobuf or CSV file (x,y columns in the DEM's CRS, or lon,lat), in its own CRS, added to
       --sources / --targets; messages name them as the file's features.
 
+Travel time (distances, path, matrix, isolines, voronoi; docs/travel.md): --speed constant:KMH
+      answers in SECONDS instead of metres, from the weighted engine, within (1 + E) of the
+      least time (--cost-epsilon E, default 0.01, in (0, 1)); a straight piece in a face takes
+      its 3D length x the face's friction / the speed. --friction FILE on a DEM: GeoJSON
+      polygons with a numeric "friction" property, or a raster in the DEM's CRS (nodata
+      impassable); each face takes the value under its centroid. --face-weights FILE: one
+      weight per face, a number a line (inf: impassable). --max-slope DEG: faces steeper than
+      DEG (from the x-y plane, z up) are impassable. --max-steiner-points N bounds the engine's
+      memory (about 32 bytes a point). Answers say so: a '# travel time in seconds ...' first
+      line, or JSON "unit": "s", "approximate": true, "epsilon", and "time_s" for values.
+      Isoline levels may carry a unit: --levels 10min,20min (s, min, h). Not with --lambda,
+      --directions or delaunay.
+
 --format json (distances, path, matrix, locate, info) prints one JSON object instead of text:
       distances {"distances": [...]} (or {"points": [...]} with --at), path {"length", "points"
       with each point's simplex}, matrix {"rows", "cols", "values"}; null for unreachable.

@@ -277,14 +277,16 @@ absl::StatusOr<std::string> GeoJsonText(const DemInfo& dem, const std::vector<Ge
 }
 
 std::vector<GeoFeature> IsochroneFeatures(const MeshData& mesh, const std::vector<double>& distance,
-                                          const std::vector<double>& levels) {
+                                          const std::vector<double>& levels,
+                                          double travel_epsilon) {
   std::vector<GeoFeature> features;
   for (double level : levels) {
     GeoFeature f;
     f.kind = GeoFeature::Kind::kArea;
     f.pieces = SublevelPieces(mesh, distance, level);
     f.exact_tiling = true;
-    f.properties = {{"level", level}, {"units", std::string("m")}};
+    f.properties = {{"level", level}, {"units", std::string(travel_epsilon > 0 ? "s" : "m")}};
+    if (travel_epsilon > 0) f.properties.push_back({"epsilon", travel_epsilon});
     features.push_back(std::move(f));
   }
   return features;

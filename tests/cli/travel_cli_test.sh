@@ -101,7 +101,7 @@ assert abs(b[1]['time_s'] - 85) < 1, b[1]"
 "$GEODEX" isolines "$F" --sources g:500195:4999855 --levels 1min,2min --speed constant:3.6 \
   --output "$tmp/iso.geojson" --crs native
 check "isochrones: exit 0" test $? -eq 0
-check "isochrones in minutes: valid polygons, area growing with the level" $PY -c "
+check "isochrones in minutes: valid polygons in seconds, area growing with the level" $PY -c "
 import json, math
 from osgeo import ogr
 f = json.load(open('$tmp/iso.geojson'))['features']
@@ -109,6 +109,7 @@ areas = {}
 for x in f:
     g = ogr.CreateGeometryFromJson(json.dumps(x['geometry']))
     assert g.IsValid(), x['properties']
+    assert x['properties']['units'] == 's' and x['properties']['epsilon'] == 0.01, x['properties']
     areas[x['properties']['level']] = areas.get(x['properties']['level'], 0) + g.GetArea()
 assert sorted(areas) == [60, 120], areas
 for r in (60, 120):

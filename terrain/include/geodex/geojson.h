@@ -51,9 +51,11 @@ absl::StatusOr<std::string> GeoJsonText(const DemInfo& dem, const std::vector<Ge
 
 // The features of each product, as the CLI and geodexd write them; x y z in the DEM's mesh.
 // Isochrones: per level, the area within that distance (`level`, `units` "m"), from the field's
-// vertex values on `mesh`.
+// vertex values on `mesh`. A travel-cost field (travel_epsilon > 0, geodex/travel_cost.h): levels
+// are times (`units` "s") and each feature says its bound (`epsilon`).
 std::vector<GeoFeature> IsochroneFeatures(const MeshData& mesh, const std::vector<double>& distance,
-                                          const std::vector<double>& levels);
+                                          const std::vector<double>& levels,
+                                          double travel_epsilon = 0);
 // Voronoi cells: one (Multi)Polygon per site (`site`, `area`), its whole faces and fragments.
 std::vector<GeoFeature> VoronoiFeatures(const MeshData& mesh, const VoronoiDiagram& diagram);
 // Delaunay edges: one 3D LineString per edge (`site_a`, `site_b`, `length`).
