@@ -139,6 +139,21 @@ TEST_F(TravelServiceTest, SolverOptionsRoundTrip) {
   EXPECT_FALSE(SolverOptionsFromProto(plain, 0, 0, "options")->travel.has_value());
   plain.mutable_travel()->set_speed_kmh(5);
   EXPECT_EQ(SolverOptionsFromProto(plain, 0, 0, "options")->travel->epsilon, TravelCost().epsilon);
+  // A field's bound rides in its first message and comes back through the client's assembler.
+  DistanceField field;
+  field.distance = {0, 1.5};
+  field.source = {0, 0};
+  field.travel_epsilon = 0.05;
+  v1::ComputeDistanceFieldResponse first, second;
+  api::FieldChunkToProto(field, DistanceField(), 0, 1, {}, &first);
+  api::FieldChunkToProto(field, DistanceField(), 1, 2, {}, &second);
+  EXPECT_EQ(first.travel_epsilon(), 0.05);
+  EXPECT_EQ(second.travel_epsilon(), 0);  // only in the first message
+  api::FieldAssembler assembler;
+  assembler.Add(first);
+  assembler.Add(second);
+  EXPECT_EQ(assembler.result().travel_epsilon, 0.05);
+  EXPECT_EQ(assembler.result().distance, field.distance);
   EXPECT_EQ(OptionFieldName("face_weight[7]"), "options.travel.face_weights[7]");
   EXPECT_EQ(OptionFieldName("travel.speed_kmh"), "options.travel.speed_kmh");
   EXPECT_EQ(OptionFieldName("lambda"), "options.lambda");
