@@ -18,18 +18,22 @@ void Append(std::string* out, const T& value) {
 using Weights = std::shared_ptr<const std::vector<double>>;
 
 // The SHA-256 of a travel cost's face weights. One request keys many fields with the same weights
-// (a matrix's rows, a batch's sources), so each thread remembers the last weights it hashed: the
-// same vector (the same control block, still alive) has the same digest.
+// (a matrix's rows, a batch's sources), and friction from the cache is one vector for many
+// requests, so each thread remembers the last weights it hashed: the same vector (the same
+// address under the same control block, still alive: immutable) has the same digest.
 std::array<uint8_t, 32> WeightsDigest(const Weights& weights) {
   thread_local std::weak_ptr<const std::vector<double>> last;
+  thread_local const std::vector<double>* last_address = nullptr;
   thread_local std::array<uint8_t, 32> last_digest{};
-  if (!last.expired() && !last.owner_before(weights) && !weights.owner_before(last)) {
+  if (!last.expired() && last_address == weights.get() && !last.owner_before(weights) &&
+      !weights.owner_before(last)) {
     return last_digest;
   }
   Sha256 sha;
   sha.Update(weights->data(), weights->size() * sizeof(double));
   last_digest = sha.Finish();
   last = weights;
+  last_address = weights.get();
   return last_digest;
 }
 

@@ -76,7 +76,13 @@ absl::StatusOr<std::shared_ptr<const std::vector<double>>> TravelWeights(
                                                        travel.face_weights().end());
   }
   if (travel.friction_geojson().empty()) return nullptr;
-  // Every face's centroid against the polygons: solve-lane work, never the quick lane's.
+  // Friction read before from the same text on this mesh is in the result cache (as a field's
+  // `distance`, like a matrix's values): a repeated request, and its cached field, need no
+  // reading. Otherwise every face's centroid goes against the polygons: solve-lane work.
+  const std::string key = absl::StrCat(mesh.id, "|friction|", Sha256Hex(travel.friction_geojson()));
+  if (std::shared_ptr<const DistanceField> hit = env.cache->Find(key)) {
+    return std::shared_ptr<const std::vector<double>>(hit, &hit->distance);
+  }
   if (env.quick) return SolveLaneNeeded();
   const std::string field = "options.travel.friction_geojson";
   // A DEM's mesh: its grid's exact file positions and its map; any other: its own x y.
@@ -93,7 +99,11 @@ absl::StatusOr<std::shared_ptr<const std::vector<double>>> TravelWeights(
     }
     return FieldError(field, message);
   }
-  return std::make_shared<const std::vector<double>>(*std::move(friction));
+  auto entry = std::make_shared<DistanceField>();
+  entry->distance = *std::move(friction);
+  std::shared_ptr<const DistanceField> weights = std::move(entry);
+  env.cache->Insert(key, weights);
+  return std::shared_ptr<const std::vector<double>>(weights, &weights->distance);
 }
 
 }  // namespace

@@ -22,7 +22,7 @@ struct ServiceLimits {
   uint64_t max_output_values = 100'000'000;       // --max_output_values
   uint64_t max_windows = 0;                       // --max_windows (per solve; 0 = unlimited)
   // Steiner points of one travel-cost solve (the weighted engine, about 32 bytes each: 50M is
-  // ~1.6 GiB); 0 = unlimited. --max_steiner_points
+  // about 1.6 GB); 0 = unlimited. --max_steiner_points
   uint64_t max_steiner_points = 50'000'000;
   // Largest unary response (LocatePoints, EstimateDistances, FindShortestPath): clients keep
   // gRPC's default 4 MiB receive limit. --max_unary_response_bytes

@@ -380,10 +380,15 @@ TEST_F(TravelServiceTest, FrictionPolygonsWeighTheirFaces) {
   ASSERT_TRUE(got.status.ok()) << got.status.error_message();
   EXPECT_EQ(got.travel_epsilon, 0.05);
   EXPECT_EQ(got.distances, want.distance);
-  // The same weights given as face_weights are the same field (from the cache).
+  // The same weights given as face_weights are the same field (from the cache), and so is the
+  // same text again (its friction cached too: answered without reading the polygons).
   Field same = ReadField(FieldRequestOf(options));
   EXPECT_TRUE(same.cached);
   EXPECT_EQ(same.distances, want.distance);
+  Field again = ReadField(request);
+  ASSERT_TRUE(again.status.ok()) << again.status.error_message();
+  EXPECT_TRUE(again.cached);
+  EXPECT_EQ(again.distances, want.distance);
 
   // Text that is not friction polygons names the field.
   request.mutable_options()->mutable_travel()->set_friction_geojson("{not json");
