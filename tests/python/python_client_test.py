@@ -295,6 +295,16 @@ class PythonClientTest(unittest.TestCase):
         self.assertEqual(cells[10, 12], -1)  # the slot
         alone = self.client.distance_field("meshes/slope", [source]).distances
         self.assertEqual(float(cells[0, 0]), float(numpy.float32(alone[0])))  # float32 cells
+        self.assertEqual(raster.travel_epsilon, 0.0)
+        # With a travel cost the raster holds seconds and says its bound.
+        walk = geodex.Travel(speed_kmh=3.6, epsilon=0.1)
+        timed = self.client.export_gis("meshes/slope", "distance_raster", [source], travel=walk)
+        self.assertEqual(timed.travel_epsilon, 0.1)
+        times = self.client.distance_field("meshes/slope", [source], travel=walk).distances
+        gdal.FileFromMemBuffer("/vsimem/py-export-t.tif", timed)
+        timed_cells = gdal.Open("/vsimem/py-export-t.tif").ReadAsArray()
+        gdal.Unlink("/vsimem/py-export-t.tif")
+        self.assertEqual(float(timed_cells[0, 0]), float(numpy.float32(times[0])))
         coarse = self.client.upload(tif, dem_step=2)
         self.assertEqual(coarse.terrain.grid_width, 15)
         self.assertNotEqual(coarse.name, mesh.name)
