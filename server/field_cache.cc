@@ -1,6 +1,9 @@
 #include "field_cache.h"
 
+#include <array>
 #include <cstring>
+
+#include "geodex/mesh_id.h"
 
 namespace geodex::server {
 namespace {
@@ -12,6 +15,28 @@ void Append(std::string* out, const T& value) {
   out->append(reinterpret_cast<const char*>(&value), sizeof value);
 }
 
+using Weights = std::shared_ptr<const std::vector<double>>;
+
+// The SHA-256 of a travel cost's face weights. One request keys many fields with the same weights
+// (a matrix's rows, a batch's sources), and friction from the cache is one vector for many
+// requests, so each thread remembers the last weights it hashed: the same vector (the same
+// address under the same control block, still alive: immutable) has the same digest.
+std::array<uint8_t, 32> WeightsDigest(const Weights& weights) {
+  thread_local std::weak_ptr<const std::vector<double>> last;
+  thread_local const std::vector<double>* last_address = nullptr;
+  thread_local std::array<uint8_t, 32> last_digest{};
+  if (!last.expired() && last_address == weights.get() && !last.owner_before(weights) &&
+      !weights.owner_before(last)) {
+    return last_digest;
+  }
+  Sha256 sha;
+  sha.Update(weights->data(), weights->size() * sizeof(double));
+  last_digest = sha.Finish();
+  last = weights;
+  last_address = weights.get();
+  return last_digest;
+}
+
 }  // namespace
 
 std::string FieldCacheKey(const std::string& mesh_id, const std::vector<SurfacePoint>& sources,
@@ -20,6 +45,21 @@ std::string FieldCacheKey(const std::string& mesh_id, const std::vector<SurfaceP
   Append(&key, options.lambda);
   Append(&key, static_cast<int>(options.lambda_scale));
   Append(&key, options.max_distance);
+  // A travel field is never another field: a marker byte, then its speed, bound, slope limit and
+  // weights (by their SHA-256; the friction polygons count by the weights they made).
+  Append(&key, static_cast<uint8_t>(options.travel.has_value()));
+  if (options.travel) {
+    const TravelCost& travel = *options.travel;
+    Append(&key, travel.speed_kmh);
+    Append(&key, travel.epsilon);
+    Append(&key, travel.max_slope_deg);
+    const bool weighted = travel.face_weight != nullptr;
+    Append(&key, static_cast<uint8_t>(weighted));
+    if (weighted) {
+      Append(&key, travel.face_weight->size());
+      Append(&key, WeightsDigest(travel.face_weight));
+    }
+  }
   Append(&key, sources.size());
   for (const SurfacePoint& p : sources) {
     Append(&key, static_cast<uint8_t>(p.kind));

@@ -19,7 +19,9 @@
 
 namespace geodex::server {
 
-// The key of a field: mesh id, every source bit for bit, lambda, its scale and max_distance.
+// The key of a field: mesh id, every source bit for bit, lambda, its scale, max_distance and the
+// travel cost (none, or its speed, epsilon, slope limit and the SHA-256 of its face weights): a
+// travel field is never served for a plain request, nor for another travel cost.
 std::string FieldCacheKey(const std::string& mesh_id, const std::vector<SurfacePoint>& sources,
                           const GeodesicOptions& options);
 

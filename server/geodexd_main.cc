@@ -71,6 +71,9 @@ ABSL_FLAG(uint64_t, max_unary_response_bytes, 4 << 20,
           "Largest unary response (clients keep gRPC's default 4 MiB receive limit)");
 ABSL_FLAG(uint32_t, stream_chunk_bytes, 1 << 20, "Approximate size of one streamed result message");
 ABSL_FLAG(uint64_t, max_windows, 0, "Window budget per solve (0 = unlimited)");
+ABSL_FLAG(uint64_t, max_steiner_points, 50'000'000,
+          "Most Steiner points of one travel-cost solve (SolverOptions.travel; about 32 bytes "
+          "each; 0 = unlimited)");
 ABSL_FLAG(int32_t, max_receive_message_bytes, 4 << 20,
           "Largest single request message (uploads are chunked below this)");
 ABSL_FLAG(double, shutdown_grace_seconds, 10,
@@ -152,6 +155,7 @@ int main(int argc, char** argv) {
   options.limits.max_unary_response_bytes = absl::GetFlag(FLAGS_max_unary_response_bytes);
   options.limits.stream_chunk_bytes = absl::GetFlag(FLAGS_stream_chunk_bytes);
   options.limits.max_windows = absl::GetFlag(FLAGS_max_windows);
+  options.limits.max_steiner_points = absl::GetFlag(FLAGS_max_steiner_points);
   const double grace = absl::GetFlag(FLAGS_shutdown_grace_seconds);
   if (!(grace >= 0 && grace <= 24 * 3600)) {
     spdlog::error("--shutdown_grace_seconds={}: must be between 0 and 86400", grace);
@@ -182,7 +186,7 @@ int main(int argc, char** argv) {
       "pool_threads={} quick_threads={} "
       "queue_capacity={} max_upload_bytes={} max_vertices={} max_faces={} max_dem_cells={} "
       "max_sources={} "
-      "max_targets={} max_levels={} max_output_values={} max_windows={} "
+      "max_targets={} max_levels={} max_output_values={} max_windows={} max_steiner_points={} "
       "max_unary_response_bytes={} stream_chunk_bytes={} shutdown_grace_seconds={}",
       options.replica_name, options.listen, options.data_dir.empty() ? "(none)" : options.data_dir,
       options.samples, options.mesh_budget_bytes, options.result_cache_bytes,
@@ -190,8 +194,8 @@ int main(int argc, char** argv) {
       options.limits.max_upload_bytes, options.limits.max_vertices, options.limits.max_faces,
       options.limits.max_dem_cells, options.limits.max_sources, options.limits.max_targets,
       options.limits.max_levels, options.limits.max_output_values, options.limits.max_windows,
-      options.limits.max_unary_response_bytes, options.limits.stream_chunk_bytes,
-      absl::GetFlag(FLAGS_shutdown_grace_seconds));
+      options.limits.max_steiner_points, options.limits.max_unary_response_bytes,
+      options.limits.stream_chunk_bytes, absl::GetFlag(FLAGS_shutdown_grace_seconds));
   if ((*server)->metrics().port() != 0) {
     const std::string& listen = options.metrics_listen;
     spdlog::info("metrics on http://{}:{}/metrics", listen.substr(0, listen.rfind(':')),

@@ -163,8 +163,19 @@ absl::StatusOr<SurfacePoint> ResolvePoint(const StoredMesh& mesh, const v1::Surf
   return out;
 }
 
+std::string OptionFieldName(const std::string& option, const std::string& field) {
+  // The weighted engine's names (weighted_field.h): it runs only under a travel cost.
+  constexpr absl::string_view kWeight = "face_weight";
+  if (absl::StartsWith(option, kWeight)) {
+    return absl::StrCat(field, ".travel.face_weights", option.substr(kWeight.size()));
+  }
+  if (option == "epsilon") return absl::StrCat(field, ".travel.epsilon");
+  return absl::StrCat(field, ".", option);
+}
+
 absl::StatusOr<GeodesicOptions> SolverOptionsFromProto(const v1::SolverOptions& options,
                                                        uint64_t max_windows,
+                                                       uint64_t max_steiner_points,
                                                        const std::string& field) {
   GeodesicOptions out;
   out.lambda = options.lambda();
@@ -181,8 +192,21 @@ absl::StatusOr<GeodesicOptions> SolverOptionsFromProto(const v1::SolverOptions& 
                         absl::StrCat("unknown value ", options.lambda_scale()));
   }
   if (options.has_max_distance()) out.max_distance = options.max_distance();
+  if (options.has_travel()) {
+    const v1::TravelCost& t = options.travel();
+    TravelCost travel;
+    travel.speed_kmh = t.speed_kmh();
+    if (t.has_epsilon()) travel.epsilon = t.epsilon();
+    travel.max_slope_deg = t.max_slope_deg();
+    travel.max_steiner_points = max_steiner_points;
+    out.travel = std::move(travel);
+    if (!t.face_weights().empty() && !t.friction_geojson().empty()) {
+      return FieldError(absl::StrCat(field, ".travel.friction_geojson"),
+                        "give at most one of face_weights and friction_geojson");
+    }
+  }
   if (absl::Status s = ValidateGeodesicOptions(out); !s.ok()) {  // core's one check
-    return FieldError(absl::StrCat(field, ".", InvalidOptionOf(s)), s.message());
+    return FieldError(OptionFieldName(InvalidOptionOf(s), field), s.message());
   }
   out.max_windows = max_windows;
   return out;

@@ -56,9 +56,20 @@ using api::PositionToProto;
 using api::StatsToProto;
 using api::SurfacePointToProto;
 
-// Solver options (lambda, lambda_scale, max_distance); `max_windows` comes from the server limit.
+// The request field of a core option error (InvalidOptionOf) under the options field `field`:
+// "lambda" -> "options.lambda", "travel.speed_kmh" -> "options.travel.speed_kmh", "travel" ->
+// "options.travel", and the weighted engine's "epsilon", "face_weight", "face_weight[7]" ->
+// "options.travel.epsilon", "options.travel.face_weights", "options.travel.face_weights[7]".
+std::string OptionFieldName(const std::string& option, const std::string& field = "options");
+
+// Solver options (lambda, lambda_scale, max_distance, and the travel cost's own values: speed,
+// epsilon, slope limit), checked by core's ValidateGeodesicOptions, errors naming the field
+// ("options.travel.speed_kmh"). `max_windows` and `max_steiner_points` come from the server's
+// limits. The travel cost's face weights need the mesh: query_support.h's Options resolves them
+// (face_weights, friction_geojson); here only "at most one of them" is checked.
 absl::StatusOr<GeodesicOptions> SolverOptionsFromProto(const v1::SolverOptions& options,
                                                        uint64_t max_windows,
+                                                       uint64_t max_steiner_points,
                                                        const std::string& field);
 
 }  // namespace geodex::server

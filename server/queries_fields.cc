@@ -173,6 +173,7 @@ struct MatrixStreamState {
   SolveStats stats;
   bool cached = false;
   std::vector<double> snap_distances;      // sent in the first message
+  double travel_epsilon = 0;               // sent in the first message
   size_t next = 0;                         // the next value to send
   bool sent = false;                       // a message went out (an empty matrix still gets one)
   double progress = 0, progress_sent = 0;  // fraction of the solves done; the last one sent
@@ -193,8 +194,10 @@ Produced NextMatrixMessage(MatrixStreamState& state, bool f32, bool want_stats, 
   const size_t begin = state.next, end = std::min(ready, begin + chunk);
   api::MatrixChunkToProto(state.rows, state.cols, state.values, begin, end, f32, out);
   out->set_progress(progress);
-  if (!state.sent)
+  if (!state.sent) {
     out->mutable_snap_distances()->Add(state.snap_distances.begin(), state.snap_distances.end());
+    out->set_travel_epsilon(state.travel_epsilon);
+  }
   state.progress_sent = progress;
   if (end == n && want_stats) {
     StatsToProto(state.stats, out->mutable_stats());
@@ -229,7 +232,7 @@ absl::StatusOr<MessageStream<v1::ComputeDistanceMatrixResponse>> RunComputeDista
         absl::StrCat("the matrix has ", sources->size(), " x ", targets->size(), " = ", values,
                      " values, over --max_output_values=", env.limits->max_output_values));
   }
-  absl::StatusOr<GeodesicOptions> solver = Options(env, request.options());
+  absl::StatusOr<GeodesicOptions> solver = Options(env, **mesh, request.options());
   if (!solver.ok()) return solver.status();
 
   // Reuse (issue 19): a repeated matrix is one cache entry (values as a DistanceField); otherwise
@@ -247,6 +250,7 @@ absl::StatusOr<MessageStream<v1::ComputeDistanceMatrixResponse>> RunComputeDista
   state->rows = sources->size();
   state->cols = targets->size();
   state->snap_distances = std::move(snaps->distances);
+  state->travel_epsilon = TravelEpsilon(*solver);
   const bool f32 = request.value_type() == v1::VALUE_TYPE_FLOAT32;
   const bool want_stats = request.want_stats();
   const size_t chunk = std::max<size_t>(1, env.limits->stream_chunk_bytes / (f32 ? 4 : 8));

@@ -49,6 +49,7 @@ absl::StatusOr<MessageStream<v1::ComputeIsolinesResponse>> RunComputeIsolines(
 
   std::vector<v1::ComputeIsolinesResponse> messages =
       api::IsolinesToProto(*isolines, env.limits->stream_chunk_bytes);
+  messages.front().set_travel_epsilon(solved->field->travel_epsilon);
   return Streamed(std::move(messages), *solved, request.want_stats());
 }
 
@@ -62,11 +63,13 @@ absl::StatusOr<MessageStream<v1::ComputeVoronoiResponse>> RunComputeVoronoi(
 
   std::vector<v1::ComputeVoronoiResponse> messages = api::VoronoiToProto(
       *diagram, solved->sources, request.omit_cell_faces(), env.limits->stream_chunk_bytes);
+  messages.front().set_travel_epsilon(solved->field->travel_epsilon);
   return Streamed(std::move(messages), *solved, request.want_stats());
 }
 
 absl::StatusOr<MessageStream<v1::ComputeDelaunayResponse>> RunComputeDelaunay(
     const QueryEnv& env, const v1::ComputeDelaunayRequest& request) {
+  if (absl::Status s = RefuseTravel(request.options(), kDelaunayNeedsOrigins); !s.ok()) return s;
   absl::StatusOr<SolvedField> solved =
       SolveField(env, request.mesh(), request.sources(), request.options(), SnapsOf(request));
   if (!solved.ok()) return solved.status();

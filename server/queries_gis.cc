@@ -51,12 +51,11 @@ std::string SpecOf(const v1::SurfacePoint& p) {
 }
 
 // The file, cut into messages of at most --stream_chunk_bytes (the request points' snap
-// distances in the first); a file over 8 bytes per --max_output_values is refused.
-absl::StatusOr<MessageStream<v1::ExportGisResponse>> FileStream(const std::string& bytes,
-                                                                const char* media_type,
-                                                                uint32_t chunk_bytes,
-                                                                uint64_t max_output_values,
-                                                                const PointSnaps& snaps) {
+// distances and the travel cost's bound in the first); a file over 8 bytes per
+// --max_output_values is refused.
+absl::StatusOr<MessageStream<v1::ExportGisResponse>> FileStream(
+    const std::string& bytes, const char* media_type, uint32_t chunk_bytes,
+    uint64_t max_output_values, const PointSnaps& snaps, double travel_epsilon) {
   if (bytes.size() / 8 > max_output_values) {
     return ServerLimitError(
         "max_output_values",
@@ -69,6 +68,7 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> FileStream(const std::strin
     if (offset == 0) {
       m.set_media_type(media_type);
       SnapsToProto(snaps, &m);
+      m.set_travel_epsilon(travel_epsilon);
     }
     m.set_data(bytes.substr(offset, chunk_bytes));
   }
@@ -91,15 +91,20 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
   const terrain::Dem& dem = *(*found)->dem;
   absl::StatusOr<PointSnaps> snaps = SnapsOf(request);
   if (!snaps.ok()) return snaps.status();
+  if (product == v1::GIS_PRODUCT_DELAUNAY) {
+    if (absl::Status s = RefuseTravel(request.options(), kDelaunayNeedsOrigins); !s.ok()) return s;
+  }
   const uint32_t chunk = env.limits->stream_chunk_bytes;
   const char* kGeoJson = "application/geo+json";
+  double travel_epsilon = 0;  // set once the options are resolved
   auto geojson_of = [&](const terrain::Dem& on, const std::vector<terrain::GeoFeature>& features)
       -> absl::StatusOr<MessageStream<v1::ExportGisResponse>> {
     if (env.cancel->IsCancelled()) return absl::CancelledError("export cancelled");
     absl::StatusOr<std::string> text =
         terrain::GeoJsonText(on.info(), features, request.native_crs());
     if (!text.ok()) return text.status();
-    return FileStream(*text, kGeoJson, chunk, env.limits->max_output_values, *snaps);
+    return FileStream(*text, kGeoJson, chunk, env.limits->max_output_values, *snaps,
+                      travel_epsilon);
   };
   auto geojson = [&](const std::vector<terrain::GeoFeature>& features) {
     return geojson_of(dem, features);
@@ -107,8 +112,9 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
 
   if (product == v1::GIS_PRODUCT_PATH || product == v1::GIS_PRODUCT_POINTS) {
     const StoredMesh& mesh = **found;
-    absl::StatusOr<GeodesicOptions> solver = Options(env, request.options());
+    absl::StatusOr<GeodesicOptions> solver = Options(env, mesh, request.options());
     if (!solver.ok()) return solver.status();
+    travel_epsilon = TravelEpsilon(*solver);
     if (product == v1::GIS_PRODUCT_PATH) {
       if (request.sources_size() != 1 || request.points_size() != 1) {
         return FieldError(request.sources_size() != 1 ? "sources" : "points",
@@ -157,6 +163,7 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
       SolveField(env, request.mesh(), request.sources(), request.options(), *snaps);
   if (!solved.ok()) return solved.status();
   *snaps = solved->snaps;  // the sources' distances, for the file's first message
+  travel_epsilon = solved->field->travel_epsilon;
   const TriangleMesh& mesh = *solved->mesh->mesh;
   const DistanceField& field = *solved->field;
   // The mesh the field was solved on (the name was looked up again: it may name another mesh now).
@@ -184,16 +191,15 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
     case v1::GIS_PRODUCT_DISTANCE_RASTER:
     case v1::GIS_PRODUCT_LABEL_RASTER: {
       // The used grid's cells (on a TIN: solved exactly at the point below each centre).
-      absl::StatusOr<GeodesicOptions> solver = Options(env, request.options());
-      if (!solver.ok()) return solver.status();
       absl::StatusOr<terrain::CellValues> cells =
-          terrain::SampleCells(grid, field, &mesh, &*solver);
-      if (!cells.ok()) return cells.status();
+          terrain::SampleCells(grid, field, &mesh, &solved->options);
+      if (!cells.ok()) return NameSolveError(cells.status(), "sources");
       absl::StatusOr<std::string> tiff = product == v1::GIS_PRODUCT_DISTANCE_RASTER
                                              ? grid.DistanceRasterBytes(*cells)
                                              : grid.LabelRasterBytes(*cells);
       if (!tiff.ok()) return tiff.status();
-      return FileStream(*tiff, "image/tiff", chunk, env.limits->max_output_values, *snaps);
+      return FileStream(*tiff, "image/tiff", chunk, env.limits->max_output_values, *snaps,
+                        travel_epsilon);
     }
     default:
       break;

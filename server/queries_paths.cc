@@ -38,11 +38,13 @@ absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPath
   absl::StatusOr<SurfacePoint> to = ResolvePoint(**mesh, request.to(), "to", &*snaps);
   if (!to.ok()) return to.status();
   SnapsToProto(*snaps, response);
-  absl::StatusOr<GeodesicOptions> solver = Options(env, request.options());
+  absl::StatusOr<GeodesicOptions> solver = Options(env, **mesh, request.options());
   if (!solver.ok()) return solver.status();
+  response->set_travel_epsilon(TravelEpsilon(*solver));
   // From a cached field of `from` a path to a vertex is a trace, not a solve; the second query
   // from the same point solves (and caches) the full field so that the following ones reuse it.
-  if (to->kind == SurfacePoint::Kind::kVertex && env.cache->enabled()) {
+  // (A travel field has no origins to trace: a travel path is always its own solve.)
+  if (to->kind == SurfacePoint::Kind::kVertex && env.cache->enabled() && !solver->travel) {
     const std::string key = FieldCacheKey((*mesh)->id, {*from}, *solver);
     std::shared_ptr<const DistanceField> field = env.cache->Find(key);
     bool cached = field != nullptr;
@@ -101,8 +103,9 @@ absl::Status RunFindShortestPaths(const QueryEnv& env, const v1::FindShortestPat
                             absl::StrCat("pairs: ", request.pairs_size(),
                                          " pairs, over --max_targets=", env.limits->max_targets));
   }
-  absl::StatusOr<GeodesicOptions> solver = Options(env, request.options());
+  absl::StatusOr<GeodesicOptions> solver = Options(env, **mesh, request.options());
   if (!solver.ok()) return solver.status();
+  response->set_travel_epsilon(TravelEpsilon(*solver));
   absl::StatusOr<PointSnaps> rule = SnapsOf(request);
   if (!rule.ok()) return rule.status();
   // Group the pairs by their source point (bit for bit), in order of first appearance.
@@ -126,7 +129,9 @@ absl::Status RunFindShortestPaths(const QueryEnv& env, const v1::FindShortestPat
     }
     groups[it->second].push_back(static_cast<size_t>(i));
     tos.push_back(*to);
-    SnapsToProto(snaps, response->add_paths());
+    v1::FindShortestPathResponse* path = response->add_paths();
+    SnapsToProto(snaps, path);
+    path->set_travel_epsilon(response->travel_epsilon());
   }
   PathQueryOptions options;
   options.solver = *solver;
@@ -176,8 +181,15 @@ absl::Status RunEstimateDistances(const QueryEnv& env, const v1::EstimateDistanc
                       "needs mode EXACT or BOTH (directions come from the exact solve)");
   }
   if (exact && env.quick) return SolveLaneNeeded();
-  absl::StatusOr<GeodesicOptions> solver = Options(env, request.options());
+  if (estimate) {  // the unfolding reads the exact engine's metres
+    absl::Status s = RefuseTravel(request.options(),
+                                  "the unfolding estimate (mode ESTIMATE, BOTH) unfolds the exact "
+                                  "engine's metres (ask mode EXACT)");
+    if (!s.ok()) return s;
+  }
+  absl::StatusOr<GeodesicOptions> solver = Options(env, **mesh, request.options());
   if (!solver.ok()) return solver.status();
+  response->set_travel_epsilon(TravelEpsilon(*solver));
   if (estimate) {
     bool cached = false;
     absl::StatusOr<std::shared_ptr<const DistanceField>> field =

@@ -12,9 +12,11 @@
 
 #include "absl/strings/cord.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/strip.h"
 #include "field_cache.h"
 #include "geodex/delaunay.h"
 #include "geodex/distance_matrix.h"
+#include "geodex/friction.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/isolines.h"
 #include "geodex/mesh_id.h"
@@ -58,18 +60,85 @@ absl::StatusOr<std::vector<SurfacePoint>> ResolveSources(const QueryEnv& env,
   return ResolvePoints(mesh, sources, "sources", env.limits->max_sources, "max_sources", snaps);
 }
 
-absl::StatusOr<GeodesicOptions> Options(const QueryEnv& env, const v1::SolverOptions& options) {
-  absl::StatusOr<GeodesicOptions> out =
-      SolverOptionsFromProto(options, env.limits->max_windows, "options");
-  if (out.ok()) out->cancel = env.cancel;
+namespace {
+
+// A travel cost's face weights on `mesh`: null (every face 1), the request's face_weights, or the
+// friction of its GeoJSON polygons.
+absl::StatusOr<std::shared_ptr<const std::vector<double>>> TravelWeights(
+    const QueryEnv& env, const StoredMesh& mesh, const v1::TravelCost& travel) {
+  if (!travel.face_weights().empty()) {
+    if (static_cast<uint64_t>(travel.face_weights_size()) != mesh.face_count) {
+      return FieldError("options.travel.face_weights",
+                        absl::StrCat(travel.face_weights_size(), " weights, but the mesh has ",
+                                     mesh.face_count, " faces: give one per face, in order"));
+    }
+    return std::make_shared<const std::vector<double>>(travel.face_weights().begin(),
+                                                       travel.face_weights().end());
+  }
+  if (travel.friction_geojson().empty()) return nullptr;
+  // Friction read before from the same text on this mesh is in the result cache (as a field's
+  // `distance`, like a matrix's values): a repeated request, and its cached field, need no
+  // reading. Otherwise every face's centroid goes against the polygons: solve-lane work.
+  const std::string key = absl::StrCat(mesh.id, "|friction|", Sha256Hex(travel.friction_geojson()));
+  if (std::shared_ptr<const DistanceField> hit = env.cache->Find(key)) {
+    return std::shared_ptr<const std::vector<double>>(hit, &hit->distance);
+  }
+  if (env.quick) return SolveLaneNeeded();
+  const std::string field = "options.travel.friction_geojson";
+  // A DEM's mesh: its grid's exact file positions and its map; any other: its own x y.
+  MeshData own;
+  if (mesh.dem == nullptr) own = mesh.mesh->ToMeshData();
+  const MeshData& data = mesh.dem != nullptr ? mesh.dem->mesh() : own;
+  absl::StatusOr<std::vector<double>> friction = terrain::FrictionFromGeoJson(
+      data, travel.friction_geojson(), mesh.terrain ? &*mesh.terrain : nullptr, field);
+  if (!friction.ok()) {
+    absl::string_view message = friction.status().message();
+    absl::ConsumePrefix(&message, absl::StrCat(field, ": "));  // FieldError names it
+    if (friction.status().code() != absl::StatusCode::kInvalidArgument) {
+      return absl::Status(friction.status().code(), absl::StrCat(field, ": ", message));
+    }
+    return FieldError(field, message);
+  }
+  auto entry = std::make_shared<DistanceField>();
+  entry->distance = *std::move(friction);
+  std::shared_ptr<const DistanceField> weights = std::move(entry);
+  env.cache->Insert(key, weights);
+  return std::shared_ptr<const std::vector<double>>(weights, &weights->distance);
+}
+
+}  // namespace
+
+absl::StatusOr<GeodesicOptions> Options(const QueryEnv& env, const StoredMesh& mesh,
+                                        const v1::SolverOptions& options) {
+  absl::StatusOr<GeodesicOptions> out = SolverOptionsFromProto(
+      options, env.limits->max_windows, env.limits->max_steiner_points, "options");
+  if (!out.ok()) return out;
+  out->cancel = env.cancel;
+  if (out->travel) {
+    absl::StatusOr<std::shared_ptr<const std::vector<double>>> weights =
+        TravelWeights(env, mesh, options.travel());
+    if (!weights.ok()) return weights.status();
+    out->travel->face_weight = *std::move(weights);
+  }
   return out;
 }
 
-// Core's InvalidArgument from a solve concerns the points (e.g. two sources on one vertex of
-// different components is fine, but a point on a degenerate face is not): name the field.
+absl::Status RefuseTravel(const v1::SolverOptions& options, absl::string_view why) {
+  if (!options.has_travel()) return absl::OkStatus();
+  return FieldError("options.travel",
+                    absl::StrCat(why,
+                                 "; a travel cost has none (fields, paths, matrices, exact "
+                                 "point values, isolines and Voronoi work)"));
+}
+
+// Core's InvalidArgument from a solve: an option's names the option's field (the weighted
+// engine's face weights, a travel cost with directions); any other concerns the points (e.g. a
+// point on a degenerate face): name `field`.
 absl::Status NameSolveError(const absl::Status& status, const char* field) {
   if (status.code() == absl::StatusCode::kInvalidArgument) {
-    return FieldError(field, status.message());
+    const std::string option = InvalidOptionOf(status);
+    return FieldError(option.empty() ? std::string(field) : OptionFieldName(option),
+                      status.message());
   }
   return status;
 }
@@ -135,8 +204,9 @@ absl::StatusOr<SolvedField> SolveField(const QueryEnv& env, const std::string& m
       ResolveSources(env, *out.mesh, sources, &out.snaps);
   if (!resolved.ok()) return resolved.status();
   out.sources = *std::move(resolved);
-  absl::StatusOr<GeodesicOptions> solver = Options(env, options);
+  absl::StatusOr<GeodesicOptions> solver = Options(env, *out.mesh, options);
   if (!solver.ok()) return solver.status();
+  out.options = *solver;
   absl::StatusOr<std::shared_ptr<const DistanceField>> field =
       CachedField(env, *out.mesh, out.sources, *solver, &out.cached);
   if (!field.ok()) return field.status();

@@ -37,9 +37,26 @@ template <typename Response>
 void SnapsToProto(const PointSnaps& snaps, Response* out) {
   out->mutable_snap_distances()->Add(snaps.distances.begin(), snaps.distances.end());
 }
-// The request's solver options with the server's window budget and the call's cancel token.
-absl::StatusOr<GeodesicOptions> Options(const QueryEnv& env, const v1::SolverOptions& options);
-// Core's InvalidArgument from a solve concerns the points: name the field.
+// The request's solver options on `mesh`, the one place every query gets them: validated
+// (SolverOptionsFromProto), with the server's window and Steiner-point budgets, the call's cancel
+// token, and a travel cost's face weights resolved against the mesh: face_weights (exactly one
+// per face; their values the engine checks, NameSolveError naming them) or friction_geojson
+// (terrain's FrictionFromGeoJson: in the DEM's map on a DEM's mesh, else in the mesh's x y).
+absl::StatusOr<GeodesicOptions> Options(const QueryEnv& env, const StoredMesh& mesh,
+                                        const v1::SolverOptions& options);
+// What an answer's travel_epsilon says: 0 for exact metres, else the travel cost's bound.
+inline double TravelEpsilon(const GeodesicOptions& options) {
+  return options.travel ? options.travel->epsilon : 0;
+}
+// INVALID_ARGUMENT naming options.travel for a product a travel cost cannot give, before any
+// solve (`why`: what the product needs, "the geodesic Delaunay triangulation is traced through the
+// exact engine's origins"); OK without a travel cost.
+absl::Status RefuseTravel(const v1::SolverOptions& options, absl::string_view why);
+inline constexpr absl::string_view kDelaunayNeedsOrigins =
+    "the geodesic Delaunay triangulation is traced through the exact engine's origins";
+// Core's InvalidArgument from a solve: an option's (InvalidOptionOf) names that option's request
+// field (OptionFieldName: "options.travel.face_weights[7]"); any other concerns the points: name
+// `field`.
 absl::Status NameSolveError(const absl::Status& status, const char* field);
 absl::Status CheckFieldSize(const QueryEnv& env, const StoredMesh& mesh);
 absl::Status CheckUnaryResponseSize(const QueryEnv& env, const google::protobuf::Message& response,
@@ -60,7 +77,9 @@ struct SolvedField {
   std::vector<SurfacePoint> sources;
   std::shared_ptr<const DistanceField> field;
   bool cached = false;
-  PointSnaps snaps;  // the sources' snap distances
+  PointSnaps snaps;         // the sources' snap distances
+  GeodesicOptions options;  // the request's, as Options resolved them (field->travel_epsilon > 0
+                            // for a travel cost)
 };
 // `snaps` is the request's rule (SnapsOf); the result's `snaps` carries the sources' distances.
 absl::StatusOr<SolvedField> SolveField(const QueryEnv& env, const std::string& mesh_name,

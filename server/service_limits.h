@@ -21,6 +21,9 @@ struct ServiceLimits {
   uint32_t max_levels = 1'000;                    // --max_levels (isolines)
   uint64_t max_output_values = 100'000'000;       // --max_output_values
   uint64_t max_windows = 0;                       // --max_windows (per solve; 0 = unlimited)
+  // Steiner points of one travel-cost solve (the weighted engine, about 32 bytes each: 50M is
+  // about 1.6 GB); 0 = unlimited. --max_steiner_points
+  uint64_t max_steiner_points = 50'000'000;
   // Largest unary response (LocatePoints, EstimateDistances, FindShortestPath): clients keep
   // gRPC's default 4 MiB receive limit. --max_unary_response_bytes
   uint64_t max_unary_response_bytes = 4 << 20;
@@ -42,7 +45,7 @@ inline const char* FlagOfLimit(Limit limit) {
       return "max_windows";
     case Limit::kDemCells:
       return "max_dem_cells";
-    case Limit::kSteinerPoints:  // no geodexd request runs the weighted engine yet (issue 35)
+    case Limit::kSteinerPoints:  // a travel cost's solve (SolverOptions.travel)
       return "max_steiner_points";
   }
   return "unknown";

@@ -158,6 +158,17 @@ void SolverOptionsToProto(const GeodesicOptions& options, v1::SolverOptions* out
   out->set_lambda_scale(options.lambda_scale == LambdaScale::kMeanEdge ? v1::LAMBDA_SCALE_MEAN_EDGE
                                                                        : v1::LAMBDA_SCALE_MAX_EDGE);
   if (std::isfinite(options.max_distance)) out->set_max_distance(options.max_distance);
+  if (options.travel) {
+    const TravelCost& travel = *options.travel;
+    v1::TravelCost* t = out->mutable_travel();
+    t->set_speed_kmh(travel.speed_kmh);
+    t->set_epsilon(travel.epsilon);
+    t->set_max_slope_deg(travel.max_slope_deg);
+    if (travel.face_weight != nullptr) {
+      t->mutable_face_weights()->Add(travel.face_weight->begin(), travel.face_weight->end());
+    }
+    // max_steiner_points is the server's (--max_steiner_points), not the request's.
+  }
 }
 
 void PointQueryToProto(const PointQuery& query, v1::EstimateDistancesRequest* out) {
@@ -219,6 +230,7 @@ void FieldChunkToProto(const DistanceField& field, const DistanceField& products
   out->set_offset(begin);
   if (begin == 0) {
     for (const SurfacePoint& p : field.sources) SurfacePointToProto(p, out->add_resolved_sources());
+    out->set_travel_epsilon(field.travel_epsilon);
   }
   if (encoding.f32) {
     auto* values = out->mutable_distances_f32();
@@ -242,6 +254,7 @@ void FieldChunkToProto(const DistanceField& field, const DistanceField& products
 
 void FieldAssembler::Add(const v1::ComputeDistanceFieldResponse& message) {
   if (message.offset() == 0) {
+    field_.travel_epsilon = message.travel_epsilon();
     field_.distance.reserve(message.vertex_count());
     field_.source.reserve(message.vertex_count());
     for (const auto& p : message.resolved_sources()) {

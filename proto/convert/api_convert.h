@@ -36,8 +36,10 @@ SolveStats StatsFromProto(const v1::SolveStats& stats);
 void MeshSummaryToProto(const MeshSummary& summary, v1::Mesh* out);
 MeshSummary MeshSummaryFromProto(const v1::Mesh& mesh);
 
-// The request's solver options: lambda, its scale and max_distance (the server's conversion back,
-// with validation and its window limit, is server/proto_convert.h's SolverOptionsFromProto).
+// The request's solver options: lambda, its scale, max_distance and the travel cost (its face
+// weights as face_weights; the Steiner-point limit is the server's flag). The server's conversion
+// back, with validation, its limits and the mesh's friction, is server/proto_convert.h's
+// SolverOptionsFromProto with query_support.h's Options.
 void SolverOptionsToProto(const GeodesicOptions& options, v1::SolverOptions* out);
 
 // EstimateDistances' exact part, carried whole: the query into the request (its sources, points
@@ -62,11 +64,12 @@ struct FieldEncoding {
 size_t FieldBytesPerVertex(const FieldEncoding& encoding, const DistanceField& products);
 // Vertices [begin, end) of `field` into one message, with the members `products` holds
 // (ComputeFieldProducts) for them; the first message (begin == 0) also carries the resolved
-// sources. Stats are the caller's (the last message).
+// sources and the field's travel_epsilon. Stats are the caller's (the last message).
 void FieldChunkToProto(const DistanceField& field, const DistanceField& products, size_t begin,
                        size_t end, const FieldEncoding& encoding,
                        v1::ComputeDistanceFieldResponse* out);
-// The messages, in order, back into one DistanceField (float32 distances widened).
+// The messages, in order, back into one DistanceField (float32 distances widened; the first
+// message's travel_epsilon into DistanceField::travel_epsilon).
 class FieldAssembler {
  public:
   using Message = v1::ComputeDistanceFieldResponse;  // what it is fed, one stream message at a time

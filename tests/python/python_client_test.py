@@ -295,6 +295,16 @@ class PythonClientTest(unittest.TestCase):
         self.assertEqual(cells[10, 12], -1)  # the slot
         alone = self.client.distance_field("meshes/slope", [source]).distances
         self.assertEqual(float(cells[0, 0]), float(numpy.float32(alone[0])))  # float32 cells
+        self.assertEqual(raster.travel_epsilon, 0.0)
+        # With a travel cost the raster holds seconds and says its bound.
+        walk = geodex.Travel(speed_kmh=3.6, epsilon=0.1)
+        timed = self.client.export_gis("meshes/slope", "distance_raster", [source], travel=walk)
+        self.assertEqual(timed.travel_epsilon, 0.1)
+        times = self.client.distance_field("meshes/slope", [source], travel=walk).distances
+        gdal.FileFromMemBuffer("/vsimem/py-export-t.tif", timed)
+        timed_cells = gdal.Open("/vsimem/py-export-t.tif").ReadAsArray()
+        gdal.Unlink("/vsimem/py-export-t.tif")
+        self.assertEqual(float(timed_cells[0, 0]), float(numpy.float32(times[0])))
         coarse = self.client.upload(tif, dem_step=2)
         self.assertEqual(coarse.terrain.grid_width, 15)
         self.assertNotEqual(coarse.name, mesh.name)
@@ -565,6 +575,84 @@ class ControlLoopTest(unittest.TestCase):
                          got["matrix"].snap_distances.tolist())
         for name in ("path", "paths", "isolines", "voronoi", "delaunay", "locate"):
             self.assertEqual(want[name], got[name], name)
+
+    def test_travel_answers_in_seconds_from_both_clients(self):
+        from geodex.aio import AsyncGeodexClient
+        sync = self.client(timeout=120)
+        mesh = sync.upload(bumpy_grid(21))  # 800 faces
+        # 3.6 km/h is 1 m/s: on weights 1 a time is the length in metres, within the bound.
+        walk = geodex.Travel(speed_kmh=3.6, epsilon=0.05)
+        weights = [1.0 + (f % 2) for f in range(mesh.face_count)]
+        heavy = geodex.Travel(speed_kmh=3.6, epsilon=0.05, face_weights=weights)
+        sources, targets = [vertex(0), vertex(220)], [vertex(440), vertex(17), vertex(300)]
+        plain = sync.distance_field(mesh.name, sources)
+        self.assertEqual(plain.travel_epsilon, 0.0)
+        field = sync.distance_field(mesh.name, sources, travel=walk)
+        self.assertEqual(field.travel_epsilon, 0.05)
+        for metres, seconds in zip(plain.distances.tolist(), field.distances.tolist()):
+            self.assertGreaterEqual(seconds, metres * (1 - 1e-9))
+            self.assertLessEqual(seconds, metres * 1.05 + 1e-12)
+        faster = sync.distance_field(mesh.name, sources, travel=geodex.Travel(7.2, epsilon=0.05))
+        numpy.testing.assert_allclose(faster.distances, field.distances / 2, rtol=1e-12)
+        weighted = sync.distance_field(mesh.name, sources, travel=heavy)
+        self.assertGreater(weighted.distances.sum(), field.distances.sum())
+        # A path, a matrix and exact point values in seconds, consistent with the field.
+        path = sync.shortest_path(mesh.name, vertex(0), vertex(440), travel=walk)
+        self.assertEqual(path.travel_epsilon, 0.05)
+        self.assertGreater(len(path.points), 1)
+        exact = sync.shortest_path(mesh.name, vertex(0), vertex(440))
+        self.assertEqual(exact.travel_epsilon, 0.0)
+        self.assertGreaterEqual(path.length, exact.length * (1 - 1e-9))
+        self.assertLessEqual(path.length, exact.length * 1.05)
+        matrix = sync.distance_matrix(mesh.name, sources, targets, travel=walk)
+        self.assertEqual(matrix.travel_epsilon, 0.05)
+        self.assertEqual(sync.distance_matrix(mesh.name, sources, targets).travel_epsilon, 0.0)
+        metres = sync.distance_matrix(mesh.name, sources, targets)
+        self.assertTrue(numpy.all(matrix >= metres * (1 - 1e-9)))
+        self.assertTrue(numpy.all(matrix <= metres * 1.05))
+        points = sync.point_distances(mesh.name, sources, targets, travel=walk)
+        self.assertEqual(points.travel_epsilon, 0.05)
+        self.assertEqual(len(points.estimates), 0)  # the unfolding estimate is of metres
+        numpy.testing.assert_allclose(points.exact, matrix.min(axis=0), rtol=1e-12)
+        paths = sync.shortest_paths(mesh.name, [(vertex(0), vertex(440))], travel=walk)
+        self.assertEqual((paths[0].length, paths[0].travel_epsilon), (path.length, 0.05))
+        isolines = sync.isolines(mesh.name, sources, count=4, travel=walk)
+        self.assertEqual(isolines.travel_epsilon, 0.05)
+        self.assertEqual(sync.voronoi(mesh.name, sources, travel=walk).travel_epsilon, 0.05)
+        # What a travel cost cannot do, and a bad value, name the field.
+        with self.assertRaises(geodex.InvalidArgumentError) as error:
+            sync.delaunay(mesh.name, sources, travel=walk)
+        self.assertEqual(error.exception.field, "options.travel")
+        with self.assertRaises(geodex.InvalidArgumentError) as error:
+            sync.distance_field(mesh.name, sources, travel=geodex.Travel(speed_kmh=0))
+        self.assertEqual(error.exception.field, "options.travel.speed_kmh")
+        with self.assertRaises(geodex.InvalidArgumentError) as error:
+            sync.distance_field(mesh.name, sources,
+                                travel=geodex.Travel(3.6, face_weights=weights[:-1]))
+        self.assertEqual(error.exception.field, "options.travel.face_weights")
+        # Friction polygons in the mesh's x y: the left half at friction 2.
+        half = {"type": "FeatureCollection", "features": [{
+            "type": "Feature", "properties": {"friction": 2},
+            "geometry": {"type": "Polygon",
+                         "coordinates": [[[-1, -1], [0.5, -1], [0.5, 2], [-1, 2], [-1, -1]]]}}]}
+        rough = sync.distance_field(mesh.name, sources,
+                                    travel=geodex.Travel(3.6, epsilon=0.05, friction_geojson=half))
+        self.assertEqual(rough.travel_epsilon, 0.05)
+        self.assertGreater(rough.distances.sum(), field.distances.sum())
+
+        async def run():
+            async with AsyncGeodexClient("127.0.0.1:" + self.port, timeout=120) as client:
+                return (await client.distance_field(mesh.name, sources, travel=walk),
+                        await client.shortest_path(mesh.name, vertex(0), vertex(440),
+                                                   travel=walk),
+                        await client.distance_matrix(mesh.name, sources, targets, travel=walk))
+        a_field, a_path, a_matrix = asyncio.run(run())
+        self.assertEqual(a_field.distances.tobytes(), field.distances.tobytes())
+        self.assertEqual(a_field.travel_epsilon, 0.05)
+        self.assertEqual(a_path, path)
+        self.assertEqual(a_path.travel_epsilon, 0.05)
+        self.assertEqual(a_matrix.tobytes(), matrix.tobytes())
+        self.assertEqual(a_matrix.travel_epsilon, 0.05)
 
     def test_bad_names_are_typed_errors(self):
         client = self.client(timeout=60)

@@ -24,6 +24,7 @@
 #include "cpl_vsi.h"
 #include "gdal_priv.h"
 #include "geodex/distance_field.h"
+#include "geodex/friction.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/geodex_client.h"
 #include "geodex/mesh_id.h"
@@ -662,6 +663,92 @@ TEST_F(TerrainServiceTest, AdaptiveTinUploadIsTheClisTin) {
   testing::UploadResult bad = UploadDem(bytes_, "bad", v1::MESH_FORMAT_GEOTIFF, "slot.tif", 0, -1);
   EXPECT_EQ(bad.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_EQ(BadField(bad.status), "metadata.dem.z_tolerance") << bad.status.error_message();
+}
+
+// Travel time on a DEM's mesh with friction polygons in the DEM's map (named CRS): the field is
+// core's with the weights terrain reads from the same text, and ExportGis's files say their bound.
+TEST_F(TerrainServiceTest, TravelWithFrictionInTheDemsMap) {
+  StartServer();
+  ASSERT_TRUE(UploadDem(bytes_, "slot").status.ok());
+  // Friction 3 on the western third (x < 500100), in UTM 33N metres.
+  const std::string friction_text = R"({"type": "FeatureCollection",
+      "crs": {"type": "name", "properties": {"name": "EPSG:32633"}},
+      "features": [{"type": "Feature", "properties": {"friction": 3},
+        "geometry": {"type": "Polygon", "coordinates": [[[499900, 4999600], [500100, 4999600],
+          [500100, 5000100], [499900, 5000100], [499900, 4999600]]]}}]})";
+  absl::StatusOr<terrain::Dem> local = terrain::Dem::Read(tif_);
+  ASSERT_TRUE(local.ok()) << local.status();
+  absl::StatusOr<std::vector<double>> weights =
+      terrain::FrictionFromGeoJson(local->mesh(), friction_text, &local->info(), "friction");
+  ASSERT_TRUE(weights.ok()) << weights.status();
+  absl::StatusOr<TriangleMesh> built = TriangleMesh::Build(local->mesh());
+  absl::StatusOr<SurfacePoint> source = local->DropMapPoint(500205, 4999845);
+  ASSERT_TRUE(built.ok() && source.ok());
+  GeodesicOptions options;
+  options.travel = TravelCost{};
+  options.travel->speed_kmh = 5;
+  options.travel->epsilon = 0.1;
+  options.travel->face_weight = std::make_shared<const std::vector<double>>(*weights);
+  absl::StatusOr<DistanceField> want = ComputeDistanceField(*built, {*source}, options);
+  ASSERT_TRUE(want.ok()) << want.status();
+
+  v1::TravelCost travel;
+  travel.set_speed_kmh(5);
+  travel.set_epsilon(0.1);
+  travel.set_friction_geojson(friction_text);
+  v1::ComputeDistanceFieldRequest request;
+  request.set_mesh("meshes/slot");
+  request.add_sources()->mutable_map_point()->set_x(500205);
+  request.mutable_sources(0)->mutable_map_point()->set_y(4999845);
+  *request.mutable_options()->mutable_travel() = travel;
+  std::vector<double> got;
+  double travel_epsilon = -1;
+  {
+    grpc::ClientContext context;
+    context.set_deadline(testing::In(120));
+    auto reader = stub_->ComputeDistanceField(&context, request);
+    v1::ComputeDistanceFieldResponse message;
+    while (reader->Read(&message)) {
+      if (message.offset() == 0) travel_epsilon = message.travel_epsilon();
+      got.insert(got.end(), message.distances_f64().begin(), message.distances_f64().end());
+    }
+    grpc::Status status = reader->Finish();
+    ASSERT_TRUE(status.ok()) << status.error_message();
+  }
+  EXPECT_EQ(travel_epsilon, 0.1);
+  EXPECT_EQ(got, want->distance);
+
+  // ExportGis: isochrones of the travel times carry the bound; Delaunay is refused.
+  v1::ExportGisRequest gis;
+  gis.set_mesh("meshes/slot");
+  *gis.mutable_sources() = request.sources();
+  *gis.mutable_options()->mutable_travel() = travel;
+  gis.set_product(v1::GIS_PRODUCT_ISOCHRONES);
+  gis.set_count(3);
+  {
+    grpc::ClientContext context;
+    context.set_deadline(testing::In(120));
+    auto reader = stub_->ExportGis(&context, gis);
+    v1::ExportGisResponse message;
+    std::vector<double> bounds;
+    while (reader->Read(&message)) bounds.push_back(message.travel_epsilon());
+    grpc::Status status = reader->Finish();
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    ASSERT_FALSE(bounds.empty());
+    EXPECT_EQ(bounds.front(), 0.1);
+  }
+  gis.set_product(v1::GIS_PRODUCT_DELAUNAY);
+  {
+    grpc::ClientContext context;
+    context.set_deadline(testing::In(120));
+    auto reader = stub_->ExportGis(&context, gis);
+    v1::ExportGisResponse message;
+    while (reader->Read(&message)) {
+    }
+    grpc::Status status = reader->Finish();
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_EQ(BadField(status), "options.travel") << status.error_message();
+  }
 }
 
 // ExportGis: the files the CLI writes, made by geodexd from a stored DEM's mesh.

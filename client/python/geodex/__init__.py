@@ -23,12 +23,12 @@ from .errors import (CancelledError, DataLossError, DeadlineExceededError,  # no
 from .points import edge_point, face_point, lon_lat, map_point, position, vertex  # noqa: E402
 from ._plans import SnapWarning  # noqa: E402
 from .results import (Delaunay, DistanceMatrix, Field, GisFile, Isolines, Located,  # noqa: E402
-                      Mesh, Path, PathPoint, PointDistances, RetryPolicy, Voronoi)
+                      Mesh, Path, PathPoint, PointDistances, RetryPolicy, Travel, Voronoi)
 
-__version__ = "0.2.0"
+__version__ = "0.3.0"
 __all__ = [
-    "GeodexClient", "RetryPolicy", "Mesh", "vertex", "edge_point", "face_point", "position",
-    "map_point", "lon_lat", "Field", "Path", "PathPoint", "Located", "PointDistances",
+    "GeodexClient", "RetryPolicy", "Travel", "Mesh", "vertex", "edge_point", "face_point",
+    "position", "map_point", "lon_lat", "Field", "Path", "PathPoint", "Located", "PointDistances",
     "DistanceMatrix", "GisFile", "Isolines", "Voronoi", "Delaunay", "SnapWarning", "GeodexError",
     "InvalidArgumentError", "NotFoundError", "UnreachableError", "ResourceExhaustedError",
     "UnauthenticatedError", "UnavailableError", "DeadlineExceededError", "CancelledError",

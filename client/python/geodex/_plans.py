@@ -18,7 +18,7 @@ import numpy as np
 from . import _wire
 from .errors import DeadlineExceededError, from_rpc_error
 from .results import (Delaunay, DistanceMatrix, Field, GisFile, Isolines, Located, Mesh, Path,
-                      PointDistances, RetryPolicy, Voronoi)
+                      PointDistances, RetryPolicy, Travel, Voronoi)
 from .v1 import geodex_pb2 as pb
 
 CHUNK_BYTES = 1 << 20
@@ -154,7 +154,9 @@ def _point_names(*groups) -> List[str]:
 class Plans:
     """The API. Each public method documented here is a plan; the clients turn every plan into a
     method of the same name and signature (`timeout=` bounds the whole call, retries included;
-    `max_snap=` refuses positions farther than that from the surface, checked by the server)."""
+    `max_snap=` refuses positions farther than that from the surface, checked by the server;
+    `travel=` (a geodex.Travel) on every query with solver options answers in travel-time
+    seconds within the result's `travel_epsilon`)."""
 
     _PLANS = ("health", "upload", "get_mesh", "list_meshes", "derive_mesh", "delete_mesh",
               "export_gis", "distance_field", "shortest_path", "shortest_paths",
@@ -315,7 +317,7 @@ class Plans:
     def export_gis(self, mesh: str, product: str, sources: Sequence, points: Sequence = (),
                    levels: Sequence[float] = (), count: int = 0, native_crs: bool = False,
                    max_snap: Optional[float] = None, timeout: Optional[float] = None,
-                   **options) -> Plan[GisFile]:
+                   travel: Optional[Travel] = None, **options) -> Plan[GisFile]:
         """A GIS file of a DEM's mesh, as the CLI writes it with --output FILE.geojson / FILE.tif:
         its bytes (a GisFile: bytes with `media_type` and `snap_distances`). `product`:
         "isochrones" (levels or count), "voronoi", "delaunay", "path" (sources[0] to points[0]),
@@ -324,11 +326,12 @@ class Plans:
         request = self._max_snap(pb.ExportGisRequest(
             mesh=mesh, product=_wire.enum_value(pb.GisProduct, "GIS_PRODUCT_", product, "product"),
             sources=sources, points=points, levels=levels, count=count, native_crs=native_crs,
-            options=_wire.solver_options(options)), max_snap)
+            options=_wire.solver_options(options, travel)), max_snap)
         messages = yield Rpc("ExportGis", request, pb.ExportGisResponse, stream=True, mesh=mesh)
         out = GisFile(b"".join(m.data for m in messages))
         out.media_type = messages[0].media_type if messages else ""
         out.snap_distances = _snaps(messages[0]) if messages else np.zeros(0)
+        out.travel_epsilon = messages[0].travel_epsilon if messages else 0.0
         yield from self._warn_far_snaps(mesh, out.snap_distances,
                                         _point_names(("sources", len(sources)),
                                                      ("points", len(points))))
@@ -338,15 +341,17 @@ class Plans:
 
     def distance_field(self, mesh: str, sources: Sequence, want_stats: bool = False,
                        want_directions: bool = False, max_snap: Optional[float] = None,
-                       timeout: Optional[float] = None, **options) -> Plan[Field]:
+                       timeout: Optional[float] = None, travel: Optional[Travel] = None,
+                       **options) -> Plan[Field]:
         """Field(distances, labels, stats, directions) for every vertex, as numpy arrays read
         from the streamed chunks (`snap_distances`: one per source). `options`: SolverOptions
         fields (lambda_, lambda_scale, max_distance)."""
         request = self._max_snap(pb.ComputeDistanceFieldRequest(
-            mesh=mesh, sources=sources, options=_wire.solver_options(options),
+            mesh=mesh, sources=sources, options=_wire.solver_options(options, travel),
             want_stats=want_stats, want_directions=want_directions), max_snap)
         raws = yield Rpc("ComputeDistanceField", request, None, stream=True, mesh=mesh)
         distances, labels, directions, stats, snaps = [], [], [], None, np.zeros(0)
+        travel_epsilon = 0.0
         for k, raw in enumerate(raws):
             arrays, rest = _wire.split_packed(raw, {3: "<f8", 5: "<u4", 8: "<f8", 9: "<f8"})
             head = pb.ComputeDistanceFieldResponse.FromString(rest)
@@ -357,42 +362,44 @@ class Plans:
             directions.append(arrays[8])
             if k == 0:
                 snaps = arrays[9]
+                travel_epsilon = head.travel_epsilon
             if head.HasField("stats"):
                 stats = head.stats
         yield from self._warn_far_snaps(mesh, snaps, _point_names(("sources", len(sources))))
         return Field(np.concatenate(distances) if distances else np.zeros(0),
                      np.concatenate(labels) if labels else np.zeros(0, "<u4"), stats,
                      (np.concatenate(directions) if directions else np.zeros(0)).reshape(-1, 3),
-                     snaps)
+                     snaps, travel_epsilon)
 
     def shortest_path(self, mesh: str, start, end, want_stats: bool = False,
                       max_snap: Optional[float] = None, timeout: Optional[float] = None,
-                      **options) -> Plan[Path]:
+                      travel: Optional[Travel] = None, **options) -> Plan[Path]:
         """The exact shortest path: Path(length, [PathPoint(position, simplex), ...]), with the
         solve's stats when `want_stats` and the snap distances of (start, end). An unreachable
         end raises UnreachableError."""
         request = self._max_snap(pb.FindShortestPathRequest(
-            mesh=mesh, to=end, options=_wire.solver_options(options), want_stats=want_stats,
+            mesh=mesh, to=end, options=_wire.solver_options(options, travel), want_stats=want_stats,
             **{"from": start}), max_snap)
         response = yield Rpc("FindShortestPath", request, pb.FindShortestPathResponse, mesh=mesh)
         path = Path(response.distance, _wire.path_points(response.points),
-                    response.stats if response.HasField("stats") else None, _snaps(response))
+                    response.stats if response.HasField("stats") else None, _snaps(response),
+                    response.travel_epsilon)
         yield from self._warn_far_snaps(mesh, path.snap_distances, ["start", "end"])
         return path
 
     def shortest_paths(self, mesh: str, pairs: Sequence[Tuple[Any, Any]],
                        max_snap: Optional[float] = None, timeout: Optional[float] = None,
-                       **options) -> Plan[List[Path]]:
+                       travel: Optional[Travel] = None, **options) -> Plan[List[Path]]:
         """Many exact shortest paths in one call, [(start, end), ...] -> [Path, ...]; pairs from
         the same start share one solve. An unreachable end gives Path(inf, [])."""
         request = self._max_snap(pb.FindShortestPathsRequest(
             mesh=mesh, pairs=[pb.ShortestPathPair(to=end, **{"from": start})
                               for start, end in pairs],
-            options=_wire.solver_options(options)), max_snap)
+            options=_wire.solver_options(options, travel)), max_snap)
         response = yield Rpc("FindShortestPaths", request, pb.FindShortestPathsResponse,
                              mesh=mesh)
-        paths = [Path(p.distance, _wire.path_points(p.points), None, _snaps(p))
-                 for p in response.paths]
+        paths = [Path(p.distance, _wire.path_points(p.points), None, _snaps(p),
+                      response.travel_epsilon) for p in response.paths]
         names = ["pairs[%d].%s" % (i, end) for i in range(len(paths)) for end in ("from", "to")]
         all_snaps = (np.concatenate([p.snap_distances for p in paths]) if paths
                      else np.zeros(0))
@@ -402,7 +409,7 @@ class Plans:
     def distance_matrix(self, mesh: str, sources: Sequence, targets: Sequence, k_nearest: int = 0,
                         on_progress: Optional[Callable[[int, int, float], None]] = None,
                         max_snap: Optional[float] = None, timeout: Optional[float] = None,
-                        **options) -> Plan[DistanceMatrix]:
+                        travel: Optional[Travel] = None, **options) -> Plan[DistanceMatrix]:
         """Exact distances as a (sources x targets) float64 array (a DistanceMatrix: a numpy
         array with `snap_distances`, the sources' then the targets'). `k_nearest` keeps only each
         source's k nearest targets (the rest are inf). The server streams rows as they finish:
@@ -411,14 +418,16 @@ class Plans:
         has solved `fraction_solved` of the matrix)."""
         request = self._max_snap(pb.ComputeDistanceMatrixRequest(
             mesh=mesh, sources=sources, targets=targets, k_nearest=k_nearest,
-            options=_wire.solver_options(options)), max_snap)
-        state = {"values": [], "rows": 0, "cols": 0, "received": 0, "snaps": np.zeros(0)}
+            options=_wire.solver_options(options, travel)), max_snap)
+        state = {"values": [], "rows": 0, "cols": 0, "received": 0, "snaps": np.zeros(0),
+                 "travel_epsilon": 0.0}
 
         def on_message(raw):
             arrays, rest = _wire.split_packed(raw, {4: "<f8", 8: "<f8"})
             head = pb.ComputeDistanceMatrixResponse.FromString(rest)
             if head.offset == 0 and not state["values"]:
                 state["snaps"] = arrays[8]
+                state["travel_epsilon"] = head.travel_epsilon
             if head.offset != state["received"]:
                 raise _wire.invalid("the matrix's rows arrived out of order", "")
             state["rows"], state["cols"] = head.rows, head.cols
@@ -435,6 +444,7 @@ class Plans:
         flat = np.concatenate(state["values"]) if state["values"] else np.zeros(0)
         matrix = flat.reshape(state["rows"], state["cols"]).view(DistanceMatrix)
         matrix.snap_distances = state["snaps"]
+        matrix.travel_epsilon = state["travel_epsilon"]
         yield from self._warn_far_snaps(mesh, matrix.snap_distances,
                                         _point_names(("sources", len(sources)),
                                                      ("targets", len(targets))))
@@ -442,21 +452,25 @@ class Plans:
 
     def point_distances(self, mesh: str, sources: Sequence, points: Sequence,
                         want_directions: bool = False, max_snap: Optional[float] = None,
-                        timeout: Optional[float] = None, **options) -> Plan[PointDistances]:
+                        timeout: Optional[float] = None, travel: Optional[Travel] = None,
+                        **options) -> Plan[PointDistances]:
         """Distances at surface points: PointDistances(estimates, estimate_labels, exact,
         exact_labels, directions): the paper's section-4 estimate from the field, and the exact
         value; with want_directions, each point's unit direction (x, y, z) along its shortest path
-        towards its nearest source ((0, 0, 0) at a source, NaN where unreachable)."""
+        towards its nearest source ((0, 0, 0) at a source, NaN where unreachable). With `travel`,
+        the exact travel times only (the unfolding estimate is of metres: `estimates` empty)."""
+        mode = pb.POINT_DISTANCE_MODE_BOTH if travel is None else pb.POINT_DISTANCE_MODE_EXACT
         request = self._max_snap(pb.EstimateDistancesRequest(
-            mesh=mesh, sources=sources, points=points, mode=pb.POINT_DISTANCE_MODE_BOTH,
-            options=_wire.solver_options(options), want_directions=want_directions), max_snap)
+            mesh=mesh, sources=sources, points=points, mode=mode,
+            options=_wire.solver_options(options, travel), want_directions=want_directions),
+            max_snap)
         r = yield Rpc("EstimateDistances", request, pb.EstimateDistancesResponse, mesh=mesh)
         out = PointDistances(np.array(r.estimates, dtype=np.float64),
                              np.array(r.estimate_labels, dtype=np.uint32),
                              np.array(r.exact, dtype=np.float64),
                              np.array(r.exact_labels, dtype=np.uint32),
                              np.array(r.exact_directions, dtype=np.float64).reshape(-1, 3),
-                             _snaps(r))
+                             _snaps(r), r.travel_epsilon)
         yield from self._warn_far_snaps(mesh, out.snap_distances,
                                         _point_names(("sources", len(sources)),
                                                      ("points", len(points))))
@@ -476,12 +490,13 @@ class Plans:
 
     def isolines(self, mesh: str, sources: Sequence, levels: Optional[Sequence[float]] = None,
                  count: int = 0, max_snap: Optional[float] = None,
-                 timeout: Optional[float] = None, **options) -> Plan[Isolines]:
+                 timeout: Optional[float] = None, travel: Optional[Travel] = None,
+                 **options) -> Plan[Isolines]:
         """Approximate isolines of the field of `sources` (paper section 6.1) at `levels`, or at
         `count` - 1 evenly spaced levels: Isolines(levels, [(level, closed, [PathPoint])])."""
         request = self._max_snap(pb.ComputeIsolinesRequest(
             mesh=mesh, sources=sources, levels=levels or [], count=count,
-            options=_wire.solver_options(options)), max_snap)
+            options=_wire.solver_options(options, travel)), max_snap)
         messages = yield Rpc("ComputeIsolines", request, pb.ComputeIsolinesResponse, stream=True,
                              mesh=mesh)
         all_levels, pieces = [], []
@@ -491,15 +506,16 @@ class Plans:
         snaps = _snaps(messages[0]) if messages else np.zeros(0)
         yield from self._warn_far_snaps(mesh, snaps, _point_names(("sources", len(sources))))
         return Isolines(all_levels, _wire.reassemble(pieces, lambda p: (p.level, p.closed, [])),
-                        snaps)
+                        snaps, messages[0].travel_epsilon if messages else 0.0)
 
     def voronoi(self, mesh: str, sites: Sequence, max_snap: Optional[float] = None,
-                timeout: Optional[float] = None, **options) -> Plan[Voronoi]:
+                timeout: Optional[float] = None, travel: Optional[Travel] = None,
+                **options) -> Plan[Voronoi]:
         """The approximate Voronoi diagram: Voronoi({site: area}, [(site_a, site_b, [PathPoint])],
         [(a, b)]), with boundaries reassembled from their streamed pieces."""
         request = self._max_snap(pb.ComputeVoronoiRequest(
             mesh=mesh, sources=sites, omit_cell_faces=True,
-            options=_wire.solver_options(options)), max_snap)
+            options=_wire.solver_options(options, travel)), max_snap)
         messages = yield Rpc("ComputeVoronoi", request, pb.ComputeVoronoiResponse, stream=True,
                              mesh=mesh)
         areas, pieces, adjacency = {}, [], []
@@ -511,14 +527,16 @@ class Plans:
         snaps = _snaps(messages[0]) if messages else np.zeros(0)
         yield from self._warn_far_snaps(mesh, snaps, _point_names(("sites", len(sites))))
         return Voronoi(areas, _wire.reassemble(pieces, lambda p: (p.site_a, p.site_b, [])),
-                       adjacency, snaps)
+                       adjacency, snaps, messages[0].travel_epsilon if messages else 0.0)
 
     def delaunay(self, mesh: str, sites: Sequence, max_snap: Optional[float] = None,
-                 timeout: Optional[float] = None, **options) -> Plan[Delaunay]:
+                 timeout: Optional[float] = None, travel: Optional[Travel] = None,
+                 **options) -> Plan[Delaunay]:
         """The approximate Delaunay triangulation (paper sections 6.3-6.4):
-        Delaunay([(site_a, site_b, length, [PathPoint])], [(a, b, c)])."""
+        Delaunay([(site_a, site_b, length, [PathPoint])], [(a, b, c)]). Exact engine only:
+        `travel` is refused (InvalidArgumentError naming options.travel)."""
         request = self._max_snap(pb.ComputeDelaunayRequest(
-            mesh=mesh, sources=sites, options=_wire.solver_options(options)), max_snap)
+            mesh=mesh, sources=sites, options=_wire.solver_options(options, travel)), max_snap)
         messages = yield Rpc("ComputeDelaunay", request, pb.ComputeDelaunayResponse, stream=True,
                              mesh=mesh)
         pieces, triangles = [], []

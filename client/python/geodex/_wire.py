@@ -5,8 +5,10 @@ from typing import Dict
 import grpc
 import numpy as np
 
+import json
+
 from .errors import InvalidArgumentError
-from .results import PathPoint
+from .results import PathPoint, Travel
 from .v1 import geodex_pb2 as pb
 
 
@@ -75,13 +77,39 @@ def invalid(message, field):
     return InvalidArgumentError(grpc.StatusCode.INVALID_ARGUMENT, message, field=field)
 
 
-def solver_options(options):
-    """SolverOptions from keyword arguments; lambda is spelled `lambda_` (or options={...}).
-    An unknown name is an InvalidArgumentError naming it and the valid ones."""
+def travel_cost(travel) -> "pb.TravelCost":
+    """A geodex.Travel (or a dict of its fields, or a TravelCost message) as a TravelCost."""
+    if isinstance(travel, pb.TravelCost):
+        return travel
+    if isinstance(travel, dict):
+        travel = Travel(**travel)
+    if not isinstance(travel, Travel):
+        raise invalid("travel: expected a geodex.Travel, got %r" % (travel,), "options.travel")
+    out = pb.TravelCost(speed_kmh=travel.speed_kmh, max_slope_deg=travel.max_slope_deg)
+    if travel.epsilon is not None:
+        out.epsilon = travel.epsilon
+    if travel.face_weights is not None:
+        out.face_weights.extend(np.asarray(travel.face_weights, dtype=np.float64).tolist())
+    if travel.friction_geojson is not None:
+        text = travel.friction_geojson
+        out.friction_geojson = text if isinstance(text, str) else json.dumps(text)
+    return out
+
+
+def solver_options(options, travel=None):
+    """SolverOptions from keyword arguments; lambda is spelled `lambda_` (or options={...});
+    `travel` (a geodex.Travel) becomes options.travel. An unknown name is an
+    InvalidArgumentError naming it and the valid ones."""
     solver = dict(options.pop("options", {}))
     if "lambda_" in options:
         solver["lambda"] = options.pop("lambda_")
     solver.update(options)
+    if travel is None:
+        travel = solver.pop("travel", None)
+    else:
+        solver.pop("travel", None)
+    if travel is not None:
+        solver["travel"] = travel_cost(travel)
     valid = [f.name for f in pb.SolverOptions.DESCRIPTOR.fields]
     for name in solver:
         if name not in valid:

@@ -3,10 +3,13 @@ tuple of its main fields (`length, points = client.shortest_path(...)`).
 
 Every answer to a request that takes points carries `snap_distances`: how far each request point
 moved onto the surface, in request order (numpy float64; 0 for vertices, edge and face points and
-map points). The fields marked "not unpacked" are left out of tuple unpacking.
+map points). Every answer with distances carries `travel_epsilon`: 0.0 when they are exact metres,
+> 0 when the request's `travel=` made them travel times in seconds, each within
+(1 + travel_epsilon) of the least time. The fields marked "not unpacked" are left out of tuple
+unpacking.
 """
 import dataclasses
-from typing import Any, Dict, List, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -19,6 +22,32 @@ def _extra(default=None):
 def _no_snaps():
     return dataclasses.field(default_factory=lambda: np.zeros(0), compare=False, repr=False,
                              metadata={"unpack": False})
+
+
+def _exact():
+    """travel_epsilon: 0.0 (exact metres) unless the answer is a travel time."""
+    return dataclasses.field(default=0.0, compare=False, metadata={"unpack": False})
+
+
+@dataclasses.dataclass
+class Travel:
+    """Travel time instead of length (geodex.v1.TravelCost, docs/travel.md), the `travel=` of
+    every query that takes solver options: its answers are then in SECONDS, each at least the
+    least travel time and at most (1 + epsilon) times it (the answer's `travel_epsilon`).
+
+    `speed_kmh`: the speed on a face of weight 1 (km/h, > 0). `epsilon`: the bound, in (0, 1)
+    (None: the server's 0.01). `max_slope_deg`: faces steeper than this (degrees from the x-y
+    plane) are impassable (0: no limit). `face_weights`: one friction per face of the mesh, in
+    order (> 0, inf impassable; None: 1). `friction_geojson`: GeoJSON polygons (text or a dict)
+    with a numeric "friction" property; each face takes the friction of the polygon holding its
+    centroid (WGS 84 on a DEM's mesh unless the GeoJSON names its CRS, else the mesh's x y). At
+    most one of face_weights and friction_geojson. Not with want_directions, delaunay() or the
+    unfolding estimates (point_distances() then returns exact values only)."""
+    speed_kmh: float
+    epsilon: Optional[float] = None
+    max_slope_deg: float = 0.0
+    face_weights: Optional[Sequence[float]] = None
+    friction_geojson: Union[None, str, Dict[str, Any]] = None
 
 
 class _Unpacks:
@@ -44,6 +73,7 @@ class Path(_Unpacks):
     points: List[PathPoint]
     stats: Any = _extra()
     snap_distances: np.ndarray = _no_snaps()
+    travel_epsilon: float = _exact()
 
 
 @dataclasses.dataclass(eq=False)
@@ -52,22 +82,26 @@ class Field(_Unpacks):
     source's index (uint32), the solve's stats (with want_stats, else None), and with
     want_directions the geodesic direction field, shape (n, 3): per vertex the unit tangent
     towards the nearest source, (0, 0, 0) at a source, NaN where unreachable (shape (0, 3)
-    otherwise). `snap_distances`: one per source (not unpacked)."""
+    otherwise). `snap_distances`: one per source, and `travel_epsilon` (not unpacked)."""
     distances: np.ndarray
     labels: np.ndarray
     stats: Any
     directions: np.ndarray
     snap_distances: np.ndarray = _no_snaps()
+    travel_epsilon: float = _exact()
 
 
 class DistanceMatrix(np.ndarray):
     """A (sources x targets) float64 numpy array of exact distances (inf where unreachable or
-    beyond k_nearest / max_distance), with `snap_distances`: the sources', then the targets'."""
+    beyond k_nearest / max_distance), with `snap_distances`: the sources', then the targets';
+    and `travel_epsilon` (> 0: travel times in seconds within that bound)."""
 
     snap_distances: np.ndarray
+    travel_epsilon: float
 
     def __array_finalize__(self, obj):
         self.snap_distances = getattr(obj, "snap_distances", np.zeros(0))
+        self.travel_epsilon = getattr(obj, "travel_epsilon", 0.0)
 
 
 @dataclasses.dataclass
@@ -91,6 +125,7 @@ class PointDistances(_Unpacks):
     exact_labels: np.ndarray
     directions: np.ndarray
     snap_distances: np.ndarray = _no_snaps()
+    travel_epsilon: float = _exact()
 
 
 @dataclasses.dataclass
@@ -100,6 +135,7 @@ class Isolines(_Unpacks):
     levels: List[float]
     lines: list
     snap_distances: np.ndarray = _no_snaps()
+    travel_epsilon: float = _exact()
 
 
 @dataclasses.dataclass
@@ -110,6 +146,7 @@ class Voronoi(_Unpacks):
     boundaries: list
     adjacency: List[Tuple[int, int]]
     snap_distances: np.ndarray = _no_snaps()
+    travel_epsilon: float = _exact()
 
 
 @dataclasses.dataclass
@@ -122,11 +159,13 @@ class Delaunay(_Unpacks):
 
 
 class GisFile(bytes):
-    """A GIS file's bytes (GeoJSON text or a GeoTIFF), with its `media_type` and the
-    `snap_distances` of the request's sources, then points."""
+    """A GIS file's bytes (GeoJSON text or a GeoTIFF), with its `media_type`, the
+    `snap_distances` of the request's sources, then points, and `travel_epsilon` (> 0: its
+    distances are travel times in seconds within that bound)."""
 
     media_type: str
     snap_distances: np.ndarray
+    travel_epsilon: float = 0.0
 
 
 @dataclasses.dataclass

@@ -1,0 +1,512 @@
+// Travel cost through geodexd (SolverOptions.travel): fields, paths, matrices and isolines equal
+// core's answers bit for bit and say their bound (travel_epsilon); the result cache never serves a
+// travel field for a plain request or another travel cost; errors name the option's field; the
+// Steiner-point budget is a server flag.
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "geodex/distance_matrix.h"
+#include "geodex/friction.h"
+#include "geodex/geodesic_solver.h"
+#include "geodex/geometry_queries.h"
+#include "geodex/isolines.h"
+#include "geodex/shortest_path.h"
+#include "geometry_convert.h"
+#include "proto_convert.h"
+#include "server_test_util.h"
+#include "service_limits.h"
+
+namespace geodex::server {
+namespace {
+
+using testing::BadField;
+using testing::BuildLocal;
+using testing::Contains;
+using testing::GridOff;
+using testing::In;
+using testing::Upload;
+
+bool BitEqual(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+template <typename Response, typename Request, typename Method>
+grpc::Status ReadAll(Method method, const Request& request, std::vector<Response>* out) {
+  grpc::ClientContext context;
+  context.set_deadline(In(300));
+  auto reader = method(&context, request);
+  Response response;
+  while (reader->Read(&response)) out->push_back(response);
+  return reader->Finish();
+}
+
+// The ErrorInfo of a status's details (reason, metadata).
+google::rpc::ErrorInfo Info(const grpc::Status& status) {
+  google::rpc::Status details;
+  google::rpc::ErrorInfo info;
+  EXPECT_TRUE(details.ParseFromString(status.error_details())) << status.error_message();
+  for (const auto& any : details.details()) {
+    if (any.UnpackTo(&info)) return info;
+  }
+  return info;
+}
+
+class TravelServiceTest : public testing::ServerFixture {
+ protected:
+  void SetUp() override {
+    ServerOptions options;
+    options.limits.stream_chunk_bytes = 2000;  // many messages
+    StartServer(options);
+    off_ = GridOff(24, 18, true);
+    testing::UploadResult up = Upload(*stub_, off_, "hills");
+    ASSERT_TRUE(up.status.ok()) << up.status.error_message();
+    local_ = std::make_unique<TriangleMesh>(BuildLocal(off_));
+    faces_ = up.mesh.face_count();
+  }
+
+  // 4 km/h, a 5% bound, friction 1, 2 or 3 by face, cliffs over 40 degrees impassable.
+  GeodesicOptions Travel() const {
+    TravelCost travel;
+    travel.speed_kmh = 4;
+    travel.epsilon = 0.05;
+    travel.max_slope_deg = 40;
+    auto weights = std::make_shared<std::vector<double>>();
+    for (uint64_t f = 0; f < faces_; ++f) weights->push_back(1.0 + static_cast<double>(f % 3));
+    travel.face_weight = std::move(weights);
+    travel.max_steiner_points = ServiceLimits().max_steiner_points;  // the server's default
+    GeodesicOptions options;
+    options.travel = travel;
+    return options;
+  }
+  std::vector<SurfacePoint> Sites() const {
+    return {SurfacePoint::AtVertex(3), SurfacePoint::OnEdge(400, 401, 0.3),
+            SurfacePoint::InFace(700, 0.2, 0.3, 0.5)};
+  }
+
+  struct Field {
+    grpc::Status status;
+    std::vector<double> distances;
+    double travel_epsilon = -1;
+    bool cached = false;
+  };
+  Field ReadField(const v1::ComputeDistanceFieldRequest& request) {
+    std::vector<v1::ComputeDistanceFieldResponse> messages;
+    Field out;
+    out.status = ReadAll<v1::ComputeDistanceFieldResponse>(
+        [&](grpc::ClientContext* c, const auto& r) { return stub_->ComputeDistanceField(c, r); },
+        request, &messages);
+    for (const auto& m : messages) {
+      if (m.offset() == 0) out.travel_epsilon = m.travel_epsilon();
+      out.distances.insert(out.distances.end(), m.distances_f64().begin(), m.distances_f64().end());
+      if (m.has_stats()) out.cached = m.stats().cached();
+    }
+    return out;
+  }
+  v1::ComputeDistanceFieldRequest FieldRequestOf(const GeodesicOptions& options) const {
+    v1::ComputeDistanceFieldRequest request;
+    request.set_mesh("meshes/hills");
+    request.set_want_stats(true);
+    FieldQuery query;
+    query.sources = Sites();
+    query.options = options;
+    api::FieldQueryToProto(query, &request);
+    return request;
+  }
+
+  std::string off_;
+  std::unique_ptr<TriangleMesh> local_;
+  uint64_t faces_ = 0;
+};
+
+TEST_F(TravelServiceTest, SolverOptionsRoundTrip) {
+  v1::SolverOptions proto;
+  api::SolverOptionsToProto(Travel(), &proto);
+  ASSERT_TRUE(proto.has_travel());
+  EXPECT_EQ(proto.travel().face_weights_size(), static_cast<int>(faces_));
+  absl::StatusOr<GeodesicOptions> back = SolverOptionsFromProto(proto, 0, 77, "options");
+  ASSERT_TRUE(back.ok()) << back.status();
+  ASSERT_TRUE(back->travel.has_value());
+  EXPECT_EQ(back->travel->speed_kmh, 4);
+  EXPECT_EQ(back->travel->epsilon, 0.05);
+  EXPECT_EQ(back->travel->max_slope_deg, 40);
+  EXPECT_EQ(back->travel->max_steiner_points, 77u);
+  EXPECT_EQ(back->travel->face_weight, nullptr);  // the mesh's business (query_support Options)
+  // Without a travel cost none comes back; an unset epsilon is core's default.
+  v1::SolverOptions plain;
+  EXPECT_FALSE(SolverOptionsFromProto(plain, 0, 0, "options")->travel.has_value());
+  plain.mutable_travel()->set_speed_kmh(5);
+  EXPECT_EQ(SolverOptionsFromProto(plain, 0, 0, "options")->travel->epsilon, TravelCost().epsilon);
+  // A field's bound rides in its first message and comes back through the client's assembler.
+  DistanceField field;
+  field.distance = {0, 1.5};
+  field.source = {0, 0};
+  field.travel_epsilon = 0.05;
+  v1::ComputeDistanceFieldResponse first, second;
+  api::FieldChunkToProto(field, DistanceField(), 0, 1, {}, &first);
+  api::FieldChunkToProto(field, DistanceField(), 1, 2, {}, &second);
+  EXPECT_EQ(first.travel_epsilon(), 0.05);
+  EXPECT_EQ(second.travel_epsilon(), 0);  // only in the first message
+  api::FieldAssembler assembler;
+  assembler.Add(first);
+  assembler.Add(second);
+  EXPECT_EQ(assembler.result().travel_epsilon, 0.05);
+  EXPECT_EQ(assembler.result().distance, field.distance);
+  EXPECT_EQ(OptionFieldName("face_weight[7]"), "options.travel.face_weights[7]");
+  EXPECT_EQ(OptionFieldName("travel.speed_kmh"), "options.travel.speed_kmh");
+  EXPECT_EQ(OptionFieldName("lambda"), "options.lambda");
+}
+
+TEST_F(TravelServiceTest, FieldPathMatrixAndIsolinesEqualCore) {
+  const GeodesicOptions options = Travel();
+  // The field.
+  absl::StatusOr<DistanceField> want = ComputeDistanceField(*local_, Sites(), options);
+  ASSERT_TRUE(want.ok()) << want.status();
+  Field got = ReadField(FieldRequestOf(options));
+  ASSERT_TRUE(got.status.ok()) << got.status.error_message();
+  EXPECT_EQ(got.travel_epsilon, 0.05);
+  ASSERT_EQ(got.distances.size(), want->distance.size());
+  size_t finite = 0;
+  for (size_t v = 0; v < got.distances.size(); ++v) {
+    EXPECT_TRUE(BitEqual(got.distances[v], want->distance[v])) << v;
+    finite += std::isfinite(got.distances[v]);
+  }
+  EXPECT_GT(finite, got.distances.size() / 2);
+
+  // A path (from a point whose field is cached: a travel path is still its own solve).
+  PathQuery path_query{Sites()[0], SurfacePoint::AtVertex(420), {}};
+  path_query.options.solver = options;
+  absl::StatusOr<PathQueryResult> want_path =
+      ComputeShortestPath(*local_, path_query.from, path_query.to, path_query.options);
+  ASSERT_TRUE(want_path.ok()) << want_path.status();
+  for (int repeat = 0; repeat < 3; ++repeat) {
+    v1::FindShortestPathRequest request;
+    request.set_mesh("meshes/hills");
+    api::PathQueryToProto(path_query, &request);
+    v1::FindShortestPathResponse response;
+    grpc::ClientContext context;
+    grpc::Status status = stub_->FindShortestPath(&context, request, &response);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    EXPECT_TRUE(BitEqual(response.distance(), want_path->distance));
+    EXPECT_EQ(response.travel_epsilon(), 0.05);
+    ASSERT_EQ(response.points_size(), static_cast<int>(want_path->path.points.size()));
+    for (int i = 0; i < response.points_size(); ++i) {
+      EXPECT_TRUE(
+          BitEqual(response.points(i).position().x(), want_path->path.points[i].position[0]));
+      EXPECT_TRUE(
+          BitEqual(response.points(i).position().y(), want_path->path.points[i].position[1]));
+    }
+  }
+  // FindShortestPaths: the same time, the bound on the response and on each path.
+  {
+    v1::FindShortestPathsRequest request;
+    request.set_mesh("meshes/hills");
+    v1::ShortestPathPair* pair = request.add_pairs();
+    SurfacePointToProto(path_query.from, pair->mutable_from());
+    SurfacePointToProto(path_query.to, pair->mutable_to());
+    api::SolverOptionsToProto(options, request.mutable_options());
+    v1::FindShortestPathsResponse response;
+    grpc::ClientContext context;
+    grpc::Status status = stub_->FindShortestPaths(&context, request, &response);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    EXPECT_EQ(response.travel_epsilon(), 0.05);
+    ASSERT_EQ(response.paths_size(), 1);
+    EXPECT_EQ(response.paths(0).travel_epsilon(), 0.05);
+    EXPECT_TRUE(BitEqual(response.paths(0).distance(), want_path->distance));
+  }
+
+  // A matrix (not symmetric: sources and targets differ).
+  MatrixQuery matrix_query;
+  matrix_query.sources = Sites();
+  for (uint32_t v = 5; v < 475; v += 41) matrix_query.targets.push_back(SurfacePoint::AtVertex(v));
+  matrix_query.targets.push_back(SurfacePoint::InFace(100, 0.5, 0.25, 0.25));
+  matrix_query.options.solver = options;
+  matrix_query.options.threads = 1;
+  absl::StatusOr<DistanceMatrix> want_matrix = ComputeDistanceMatrix(
+      *local_, matrix_query.sources, matrix_query.targets, matrix_query.options);
+  ASSERT_TRUE(want_matrix.ok()) << want_matrix.status();
+  {
+    v1::ComputeDistanceMatrixRequest request;
+    request.set_mesh("meshes/hills");
+    api::MatrixQueryToProto(matrix_query, &request);
+    std::vector<v1::ComputeDistanceMatrixResponse> messages;
+    grpc::Status status = ReadAll<v1::ComputeDistanceMatrixResponse>(
+        [&](grpc::ClientContext* c, const auto& r) { return stub_->ComputeDistanceMatrix(c, r); },
+        request, &messages);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    ASSERT_FALSE(messages.empty());
+    EXPECT_EQ(messages.front().travel_epsilon(), 0.05);
+    std::vector<double> values;
+    for (const auto& m : messages) {
+      values.insert(values.end(), m.values_f64().begin(), m.values_f64().end());
+    }
+    ASSERT_EQ(values.size(), want_matrix->values.size());
+    for (size_t i = 0; i < values.size(); ++i) {
+      EXPECT_TRUE(BitEqual(values[i], want_matrix->values[i])) << i;
+    }
+  }
+
+  // Isolines of the (cached) travel field, levels in seconds.
+  IsolineQuery iso_query;
+  iso_query.sources = Sites();
+  iso_query.options = options;
+  iso_query.levels.count = 5;
+  absl::StatusOr<Isolines> want_iso = ExtractIsolines(*local_, *want, iso_query.levels);
+  ASSERT_TRUE(want_iso.ok()) << want_iso.status();
+  ASSERT_FALSE(want_iso->polylines.empty());
+  {
+    v1::ComputeIsolinesRequest request;
+    request.set_mesh("meshes/hills");
+    api::IsolineQueryToProto(iso_query, &request);
+    std::vector<v1::ComputeIsolinesResponse> messages;
+    grpc::Status status = ReadAll<v1::ComputeIsolinesResponse>(
+        [&](grpc::ClientContext* c, const auto& r) { return stub_->ComputeIsolines(c, r); },
+        request, &messages);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    EXPECT_EQ(messages.front().travel_epsilon(), 0.05);
+    std::vector<double> levels(messages.front().levels().begin(), messages.front().levels().end());
+    ASSERT_EQ(levels.size(), want_iso->levels.size());
+    for (size_t i = 0; i < levels.size(); ++i)
+      EXPECT_TRUE(BitEqual(levels[i], want_iso->levels[i]));
+    size_t points = 0, want_points = 0;
+    for (const auto& m : messages) {
+      for (const auto& line : m.isolines()) points += line.points_size();
+    }
+    for (const IsolinePolyline& line : want_iso->polylines) want_points += line.points.size();
+    EXPECT_EQ(points, want_points);
+  }
+
+  // Voronoi of the travel field says its bound too.
+  {
+    v1::ComputeVoronoiRequest request;
+    request.set_mesh("meshes/hills");
+    for (const SurfacePoint& p : Sites()) SurfacePointToProto(p, request.add_sources());
+    api::SolverOptionsToProto(options, request.mutable_options());
+    std::vector<v1::ComputeVoronoiResponse> messages;
+    grpc::Status status = ReadAll<v1::ComputeVoronoiResponse>(
+        [&](grpc::ClientContext* c, const auto& r) { return stub_->ComputeVoronoi(c, r); }, request,
+        &messages);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    EXPECT_EQ(messages.front().travel_epsilon(), 0.05);
+  }
+  // EstimateDistances, EXACT: core's point values in seconds.
+  {
+    v1::EstimateDistancesRequest request;
+    request.set_mesh("meshes/hills");
+    PointQuery query{Sites(), matrix_query.targets, options, false};
+    api::PointQueryToProto(query, &request);
+    request.set_mode(v1::POINT_DISTANCE_MODE_EXACT);
+    v1::EstimateDistancesResponse response;
+    grpc::ClientContext context;
+    grpc::Status status = stub_->EstimateDistances(&context, request, &response);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    EXPECT_EQ(response.travel_epsilon(), 0.05);
+    absl::StatusOr<PointValues> values = ComputePointValues(*local_, query);
+    ASSERT_TRUE(values.ok()) << values.status();
+    ASSERT_EQ(response.exact_size(), static_cast<int>(values->distance.size()));
+    for (int i = 0; i < response.exact_size(); ++i) {
+      EXPECT_TRUE(BitEqual(response.exact(i), values->distance[i])) << i;
+    }
+  }
+}
+
+TEST_F(TravelServiceTest, CacheNeverMixesTravelAndPlainFields) {
+  const GeodesicOptions travel = Travel();
+  const DistanceField plain_want = *ComputeDistanceField(*local_, Sites());
+  const DistanceField travel_want = *ComputeDistanceField(*local_, Sites(), travel);
+
+  Field first = ReadField(FieldRequestOf(travel));
+  ASSERT_TRUE(first.status.ok()) << first.status.error_message();
+  EXPECT_FALSE(first.cached);
+  // The same sources without a travel cost: solved, in metres, exact.
+  Field plain = ReadField(FieldRequestOf(GeodesicOptions()));
+  ASSERT_TRUE(plain.status.ok()) << plain.status.error_message();
+  EXPECT_FALSE(plain.cached);
+  EXPECT_EQ(plain.travel_epsilon, 0);
+  ASSERT_EQ(plain.distances.size(), plain_want.distance.size());
+  for (size_t v = 0; v < plain.distances.size(); ++v) {
+    ASSERT_TRUE(BitEqual(plain.distances[v], plain_want.distance[v])) << v;
+  }
+  // Each again: from the cache, each its own.
+  Field travel_again = ReadField(FieldRequestOf(travel));
+  EXPECT_TRUE(travel_again.cached);
+  EXPECT_EQ(travel_again.travel_epsilon, 0.05);
+  EXPECT_EQ(travel_again.distances, travel_want.distance);
+  Field plain_again = ReadField(FieldRequestOf(GeodesicOptions()));
+  EXPECT_TRUE(plain_again.cached);
+  EXPECT_EQ(plain_again.travel_epsilon, 0);
+  EXPECT_EQ(plain_again.distances, plain_want.distance);
+  // Another travel cost (other weights, speed, bound or slope) is another field.
+  GeodesicOptions other = travel;
+  auto weights = std::make_shared<std::vector<double>>(*travel.travel->face_weight);
+  (*weights)[5] = 7;
+  other.travel->face_weight = weights;
+  EXPECT_FALSE(ReadField(FieldRequestOf(other)).cached);
+  other = travel;
+  other.travel->speed_kmh = 5;
+  EXPECT_FALSE(ReadField(FieldRequestOf(other)).cached);
+  other = travel;
+  other.travel->max_slope_deg = 0;
+  EXPECT_FALSE(ReadField(FieldRequestOf(other)).cached);
+  other = travel;
+  other.travel->face_weight = nullptr;
+  EXPECT_FALSE(ReadField(FieldRequestOf(other)).cached);
+}
+
+TEST_F(TravelServiceTest, FrictionPolygonsWeighTheirFaces) {
+  // Friction 4 over x in [0, 10] in the mesh's own x y: the field equals core's with the weights
+  // terrain reads from the same text.
+  const std::string geojson =
+      R"({"type": "FeatureCollection", "features": [{"type": "Feature",
+          "properties": {"friction": 4},
+          "geometry": {"type": "Polygon",
+                       "coordinates": [[[-1, -1], [10, -1], [10, 20], [-1, 20], [-1, -1]]]}}]})";
+  absl::StatusOr<MeshData> data = ReadMeshFromBuffer(off_, MeshFormat::kOff, "local.off");
+  ASSERT_TRUE(data.ok());
+  absl::StatusOr<std::vector<double>> friction =
+      terrain::FrictionFromGeoJson(*data, geojson, nullptr, "friction");
+  ASSERT_TRUE(friction.ok()) << friction.status();
+  GeodesicOptions options = Travel();
+  options.travel->face_weight = std::make_shared<const std::vector<double>>(*friction);
+  const DistanceField want = *ComputeDistanceField(*local_, Sites(), options);
+
+  GeodesicOptions request_options = Travel();
+  request_options.travel->face_weight = nullptr;
+  v1::ComputeDistanceFieldRequest request = FieldRequestOf(request_options);
+  request.mutable_options()->mutable_travel()->set_friction_geojson(geojson);
+  Field got = ReadField(request);
+  ASSERT_TRUE(got.status.ok()) << got.status.error_message();
+  EXPECT_EQ(got.travel_epsilon, 0.05);
+  EXPECT_EQ(got.distances, want.distance);
+  // The same weights given as face_weights are the same field (from the cache), and so is the
+  // same text again (its friction cached too: answered without reading the polygons).
+  Field same = ReadField(FieldRequestOf(options));
+  EXPECT_TRUE(same.cached);
+  EXPECT_EQ(same.distances, want.distance);
+  Field again = ReadField(request);
+  ASSERT_TRUE(again.status.ok()) << again.status.error_message();
+  EXPECT_TRUE(again.cached);
+  EXPECT_EQ(again.distances, want.distance);
+
+  // Text that is not friction polygons names the field.
+  request.mutable_options()->mutable_travel()->set_friction_geojson("{not json");
+  Field bad = ReadField(request);
+  EXPECT_EQ(bad.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_EQ(BadField(bad.status), "options.travel.friction_geojson") << bad.status.error_message();
+}
+
+TEST_F(TravelServiceTest, ErrorsNameTheTravelField) {
+  auto field_error = [&](const v1::ComputeDistanceFieldRequest& request) {
+    Field got = ReadField(request);
+    EXPECT_EQ(got.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT)
+        << got.status.error_message();
+    return std::make_pair(BadField(got.status), got.status.error_message());
+  };
+  v1::ComputeDistanceFieldRequest request = FieldRequestOf(Travel());
+  v1::TravelCost* travel = request.mutable_options()->mutable_travel();
+
+  travel->set_speed_kmh(0);
+  EXPECT_EQ(field_error(request).first, "options.travel.speed_kmh");
+  travel->set_speed_kmh(4);
+  travel->set_epsilon(1.5);
+  EXPECT_EQ(field_error(request).first, "options.travel.epsilon");
+  travel->set_epsilon(0.05);
+  travel->set_max_slope_deg(91);
+  EXPECT_EQ(field_error(request).first, "options.travel.max_slope_deg");
+  travel->set_max_slope_deg(0);
+
+  // Weights: one per face, each > 0 (or +inf).
+  travel->mutable_face_weights()->RemoveLast();
+  auto [field, message] = field_error(request);
+  EXPECT_EQ(field, "options.travel.face_weights");
+  EXPECT_TRUE(Contains(message, std::to_string(faces_))) << message;
+  travel->add_face_weights(1);
+  travel->set_face_weights(7, -2);
+  EXPECT_EQ(field_error(request).first, "options.travel.face_weights[7]");
+  travel->set_face_weights(7, std::numeric_limits<double>::quiet_NaN());
+  EXPECT_EQ(field_error(request).first, "options.travel.face_weights[7]");
+  travel->set_face_weights(7, std::numeric_limits<double>::infinity());  // impassable: fine
+  EXPECT_TRUE(ReadField(request).status.ok());
+  // At most one of weights and friction polygons.
+  travel->set_friction_geojson(R"({"type": "FeatureCollection", "features": []})");
+  EXPECT_EQ(field_error(request).first, "options.travel.friction_geojson");
+  travel->clear_friction_geojson();
+  // lambda > 0 with a travel cost.
+  request.mutable_options()->set_lambda(0.5);
+  EXPECT_EQ(field_error(request).first, "options.travel");
+  request.mutable_options()->set_lambda(0);
+
+  // Directions have no travel-time version.
+  request.set_want_directions(true);
+  EXPECT_EQ(field_error(request).first, "options.travel");
+  request.set_want_directions(false);
+  {
+    v1::EstimateDistancesRequest estimate;
+    estimate.set_mesh("meshes/hills");
+    estimate.add_sources()->set_vertex(3);
+    estimate.add_points()->set_vertex(40);
+    *estimate.mutable_options() = request.options();
+    estimate.set_mode(v1::POINT_DISTANCE_MODE_EXACT);
+    estimate.set_want_directions(true);
+    v1::EstimateDistancesResponse response;
+    grpc::ClientContext context;
+    grpc::Status status = stub_->EstimateDistances(&context, estimate, &response);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_EQ(BadField(status), "options.travel") << status.error_message();
+    // The unfolding estimate reads metres.
+    estimate.set_want_directions(false);
+    estimate.set_mode(v1::POINT_DISTANCE_MODE_BOTH);
+    grpc::ClientContext context2;
+    status = stub_->EstimateDistances(&context2, estimate, &response);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_EQ(BadField(status), "options.travel") << status.error_message();
+  }
+  // Nor has the geodesic Delaunay triangulation.
+  {
+    v1::ComputeDelaunayRequest delaunay;
+    delaunay.set_mesh("meshes/hills");
+    for (const SurfacePoint& p : Sites()) SurfacePointToProto(p, delaunay.add_sources());
+    *delaunay.mutable_options() = request.options();
+    std::vector<v1::ComputeDelaunayResponse> messages;
+    grpc::Status status = ReadAll<v1::ComputeDelaunayResponse>(
+        [&](grpc::ClientContext* c, const auto& r) { return stub_->ComputeDelaunay(c, r); },
+        delaunay, &messages);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_EQ(BadField(status), "options.travel") << status.error_message();
+  }
+  // Paths name the weights too.
+  {
+    v1::FindShortestPathRequest path;
+    path.set_mesh("meshes/hills");
+    path.mutable_from()->set_vertex(3);
+    path.mutable_to()->set_vertex(40);
+    *path.mutable_options() = request.options();
+    path.mutable_options()->mutable_travel()->set_face_weights(11, 0);
+    v1::FindShortestPathResponse response;
+    grpc::ClientContext context;
+    grpc::Status status = stub_->FindShortestPath(&context, path, &response);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_EQ(BadField(status), "options.travel.face_weights[11]") << status.error_message();
+  }
+}
+
+TEST_F(TravelServiceTest, SteinerPointBudgetIsAFlag) {
+  server_->Shutdown(absl::Now() + absl::Seconds(10));
+  server_.reset();
+  ServerOptions options;
+  options.limits.max_steiner_points = 10;
+  StartServer(options);
+  ASSERT_TRUE(Upload(*stub_, off_, "hills").status.ok());
+  Field got = ReadField(FieldRequestOf(Travel()));
+  EXPECT_EQ(got.status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_TRUE(Contains(got.status.error_message(), "--max_steiner_points"))
+      << got.status.error_message();
+  EXPECT_EQ(Info(got.status).metadata().at("flag"), "max_steiner_points");
+  // A plain field is not the weighted engine's: no Steiner points.
+  EXPECT_TRUE(ReadField(FieldRequestOf(GeodesicOptions())).status.ok());
+}
+
+}  // namespace
+}  // namespace geodex::server
