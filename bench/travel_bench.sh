@@ -13,6 +13,7 @@
 # Relative differences are over the cells farther than 5% of the largest time from the source.
 # Prints markdown tables for docs/performance.md.
 # usage: bench/travel_bench.sh [GEODEX] [SHARED_MESHES] [STEP] [EPSILONS]
+#   DEMS="jacksboro:2 smooth:4" (environment) picks the DEMs and a step for each.
 set -euo pipefail
 geodex="${1:-build/client/geodex}"
 shared="${2:-../shared/meshes}"
@@ -105,7 +106,9 @@ for name, moves in (("8", eight), ("16", sixteen)):
           f"{r.max():.2e} (min {r.min():.2e}) | {r.mean():.2e} |")
 PY
 
-for dem in jacksboro smooth; do
+for spec in ${DEMS:-jacksboro:$step smooth:$step}; do
+  dem=${spec%%:*}
+  step=${spec##*:}
   D="$tmp/$dem.tif"
   src=$(centre "$D")
   echo

@@ -156,7 +156,10 @@ std::string FlagOfOption(const std::string& option) {
   if (option == "travel" || option == "travel.speed_kmh") return "--speed";
   if (option == "travel.epsilon") return "--cost-epsilon";
   if (option == "travel.max_slope_deg") return "--max-slope";
-  if (absl::StartsWith(option, "face_weight")) return "--face-weights";  // or --friction's values
+  if (absl::StartsWith(option, "face_weight") || absl::StartsWith(option, "travel.face_weights")) {
+    return "--face-weights";  // or --friction's values
+  }
+  if (option == "travel.friction_geojson") return "--friction";
   std::string flag = option;
   std::replace(flag.begin(), flag.end(), '_', '-');
   return "--" + flag;

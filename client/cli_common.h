@@ -66,7 +66,8 @@ inline const std::set<std::string> kMeshReadingFlags = {
 inline const std::set<std::string> kTravelFlags = {
     "speed", "cost-epsilon", "max-slope", "friction", "face-weights", "max-steiner-points"};
 // The flag a core option error is about (InvalidOptionOf: "lambda", "travel.epsilon",
-// "face_weight[3]"), as the user typed it: "--lambda", "--cost-epsilon", "--face-weights".
+// "face_weight[3]"; or geodexd's request field under "options.", "travel.face_weights[3]"), as the
+// user typed it: "--lambda", "--cost-epsilon", "--face-weights".
 std::string FlagOfOption(const std::string& option);
 // False with *error naming the first option neither in `known` nor in kMeshReadingFlags (nor, for
 // a command that takes --lambda, kTravelFlags).

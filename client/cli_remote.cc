@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
+#include <limits>
 #include <optional>
 
 #include "absl/strings/ascii.h"
@@ -71,6 +72,10 @@ absl::StatusOr<T> Flagged(
   if (!violation.has_value()) return result;
   const absl::string_view head =
       absl::string_view(violation->field).substr(0, violation->field.find_first_of("[."));
+  if (head == "options" && violation->field.size() > 8) {  // the solver options: every command's
+    return absl::InvalidArgumentError(
+        absl::StrCat(FlagOfOption(violation->field.substr(8)), ": ", violation->description));
+  }
   for (const auto& [field, flag] : flags) {
     if (head == field) {
       return absl::InvalidArgumentError(absl::StrCat("--", flag, ": ", violation->description));
@@ -261,12 +266,17 @@ class RemoteBackend final : public Backend {
   }
 
   absl::StatusOr<AtValues> DistancesAt(const PointQuery& query) override {
+    // A travel cost has times only (the unfolding estimate is geometry).
+    const bool travel = query.options.travel.has_value();
     absl::StatusOr<client::PointDistances> r =
-        Flagged(client_->DistancesAtPoints(mesh_, query, client::PointDistanceMode::kBoth),
+        Flagged(client_->DistancesAtPoints(
+                    mesh_, query,
+                    travel ? client::PointDistanceMode::kExact : client::PointDistanceMode::kBoth),
                 {{"sources", "sources"}, {"points", "at"}});
     if (!r.ok()) return r.status();
     AtValues out;
     for (const PointEstimate& e : r->estimates) out.estimate.push_back(e.distance);
+    if (travel) out.estimate.assign(query.points.size(), std::numeric_limits<double>::quiet_NaN());
     out.exact = std::move(r->exact);
     // What the command prints needs one value per point (a geodexd older than this client
     // answers without the directions it does not know).

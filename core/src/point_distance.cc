@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "absl/strings/str_format.h"
+#include "geodex/geodesic_solver.h"
 #include "mesh_lookup.h"
 
 namespace geodex {
@@ -56,6 +57,11 @@ absl::Status PlacePoint(const TriangleMesh& mesh, const SurfacePoint& p,
 absl::StatusOr<PointEstimate> EstimateDistanceAt(const TriangleMesh& mesh,
                                                  const DistanceField& field,
                                                  const SurfacePoint& point) {
+  if (field.travel_epsilon > 0) {  // seconds, not lengths: an unfolding means nothing there
+    return OptionError("travel",
+                       "the unfolding estimate is geometry; a travel cost's times have none (ask "
+                       "for the times at the points)");
+  }
   if (field.internal_distance.size() != mesh.vertex_count()) {
     return absl::InvalidArgumentError("the distance field was not computed on this mesh");
   }

@@ -254,6 +254,11 @@ absl::StatusOr<GeodesicPath> TracePathFromVertex(const TriangleMesh& mesh,
     return absl::InvalidArgumentError(absl::StrFormat(
         "vertex %d does not exist (the mesh has %d vertices)", vertex, mesh.file_vertex_count()));
   }
+  if (field.travel_epsilon > 0) {
+    return OptionError("travel",
+                       "a travel field has no geodesic origins to trace; ask for the least-time "
+                       "path (ComputeShortestPath with the travel cost)");
+  }
   if (field.internal_origin.size() != mesh.vertex_count()) {
     return absl::InvalidArgumentError("the distance field was not computed on this mesh");
   }

@@ -483,23 +483,31 @@ absl::StatusOr<std::string> FilePointSpec(const FilePoint& point) {
   return absl::StrCat("ll:", Shortest(x), ":", Shortest(y));
 }
 
-absl::StatusOr<MeshData> CutBarrierPolygons(const MeshData& mesh, const std::string& geojson,
-                                            const DemInfo* dem, double width,
-                                            const std::string& name, CutStats* stats,
-                                            uint64_t max_vertices) {
-  QuietGdal quiet;
+namespace {
+
+// The DEM's file CRS in x-y order into *crs (left empty without a DEM); InvalidArgument starting
+// with `name` when its text does not parse.
+absl::Status ParseFileCrs(const DemInfo* dem, const std::string& name, OGRSpatialReference* crs) {
+  if (dem == nullptr) return absl::OkStatus();
+  if (crs->importFromWkt(dem->file_crs_wkt.c_str()) != OGRERR_NONE) {
+    return absl::InvalidArgumentError(absl::StrCat(name, ": the DEM's CRS does not parse"));
+  }
+  crs->SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  return absl::OkStatus();
+}
+
+// GeoJSON text a client sent (a barrier, friction polygons), checked and opened for `use`: its
+// "crs" members name CRSs by identifier only (CheckGeoJsonCrs), and it goes into an in-memory file
+// of its own that GDAL's GeoJSON driver alone opens. (Given to GDAL as the "file name", text not
+// starting with '{' would be taken for a path or a URL: a client could make a server read its
+// files or fetch addresses.) Errors start with `name`.
+template <typename Result>
+absl::StatusOr<Result> WithGeoJsonText(
+    const std::string& geojson, const std::string& name,
+    const std::function<absl::StatusOr<Result>(GDALDataset&)>& use) {
   auto bad = [&](const std::string& why) {
     return absl::InvalidArgumentError(absl::StrCat(name, ": ", why));
   };
-  OGRSpatialReference file_crs;
-  if (dem != nullptr) {
-    if (file_crs.importFromWkt(dem->file_crs_wkt.c_str()) != OGRERR_NONE)
-      return bad("the DEM's CRS does not parse");
-    file_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  }
-  // The text goes into an in-memory file of its own that GDAL's GeoJSON driver alone opens. (Given
-  // to GDAL as the "file name", text not starting with '{' would be taken for a path or a URL: a
-  // client could make a server read its files or fetch addresses.)
   const size_t first = geojson.find_first_not_of(" \t\r\n");
   if (first == std::string::npos || geojson[first] != '{') {
     return bad("not GeoJSON (a JSON object, starting with '{')");
@@ -513,11 +521,25 @@ absl::StatusOr<MeshData> CutBarrierPolygons(const MeshData& mesh, const std::str
   const char* const drivers[] = {"GeoJSON", nullptr};
   GDALDatasetUniquePtr ds(GDALDataset::FromHandle(GDALOpenEx(
       text.path().c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, drivers, nullptr, nullptr)));
-  absl::StatusOr<std::unique_ptr<OGRGeometry>> polygons =
-      ds == nullptr ? bad(absl::StrCat("not GeoJSON polygons (", QuietGdal::LastMessage(), ")"))
-                    : BarrierPolygonsOf(ds.get(), name, dem != nullptr ? &file_crs : nullptr);
-  if (!polygons.ok()) return polygons.status();
-  return CutBarrier(mesh, **polygons, dem, &file_crs, width, max_vertices, name, stats);
+  if (ds == nullptr) return bad(absl::StrCat("not GeoJSON (", QuietGdal::LastMessage(), ")"));
+  return use(*ds);
+}
+
+}  // namespace
+
+absl::StatusOr<MeshData> CutBarrierPolygons(const MeshData& mesh, const std::string& geojson,
+                                            const DemInfo* dem, double width,
+                                            const std::string& name, CutStats* stats,
+                                            uint64_t max_vertices) {
+  QuietGdal quiet;
+  OGRSpatialReference file_crs;
+  if (absl::Status s = ParseFileCrs(dem, name, &file_crs); !s.ok()) return s;
+  return WithGeoJsonText<MeshData>(geojson, name, [&](GDALDataset& ds) -> absl::StatusOr<MeshData> {
+    absl::StatusOr<std::unique_ptr<OGRGeometry>> polygons =
+        BarrierPolygonsOf(&ds, name, dem != nullptr ? &file_crs : nullptr);
+    if (!polygons.ok()) return polygons.status();
+    return CutBarrier(mesh, **polygons, dem, &file_crs, width, max_vertices, name, stats);
+  });
 }
 
 bool IsGeoTiffPath(const std::string& path) {
@@ -1825,31 +1847,11 @@ absl::StatusOr<std::vector<double>> FrictionFromGeoJson(const MeshData& mesh,
                                                         const DemInfo* dem,
                                                         const std::string& name) {
   QuietGdal quiet;
-  auto bad = [&](const std::string& why) {
-    return absl::InvalidArgumentError(absl::StrCat(name, ": ", why));
-  };
   OGRSpatialReference file_crs;
-  if (dem != nullptr) {
-    if (file_crs.importFromWkt(dem->file_crs_wkt.c_str()) != OGRERR_NONE)
-      return bad("the DEM's CRS does not parse");
-    file_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  }
-  // As CutBarrierPolygons: the text in an in-memory file of its own, GeoJSON's driver alone.
-  const size_t first = geojson.find_first_not_of(" \t\r\n");
-  if (first == std::string::npos || geojson[first] != '{') {
-    return bad("not GeoJSON (a JSON object, starting with '{')");
-  }
-  CPLJSONDocument document;
-  if (!document.LoadMemory(geojson))
-    return bad(absl::StrCat("not GeoJSON (", QuietGdal::LastMessage(), ")"));
-  if (absl::Status crs = CheckGeoJsonCrs(document.GetRoot(), name); !crs.ok()) return crs;
-  MemFile text(".geojson", geojson);
-  if (!text.ok()) return absl::InternalError("GDAL cannot make an in-memory file");
-  const char* const drivers[] = {"GeoJSON", nullptr};
-  GDALDatasetUniquePtr ds(GDALDataset::FromHandle(GDALOpenEx(
-      text.path().c_str(), GDAL_OF_VECTOR | GDAL_OF_READONLY, drivers, nullptr, nullptr)));
-  if (ds == nullptr) return bad(absl::StrCat("not GeoJSON (", QuietGdal::LastMessage(), ")"));
-  return FrictionOfPolygons(*ds, mesh, dem, dem != nullptr ? &file_crs : nullptr, name);
+  if (absl::Status s = ParseFileCrs(dem, name, &file_crs); !s.ok()) return s;
+  return WithGeoJsonText<std::vector<double>>(geojson, name, [&](GDALDataset& ds) {
+    return FrictionOfPolygons(ds, mesh, dem, dem != nullptr ? &file_crs : nullptr, name);
+  });
 }
 
 absl::StatusOr<std::vector<double>> ReadFrictionFile(const MeshData& mesh, const std::string& path,
@@ -1859,9 +1861,7 @@ absl::StatusOr<std::vector<double>> ReadFrictionFile(const MeshData& mesh, const
     return absl::InvalidArgumentError(absl::StrCat(name, ": ", why));
   };
   OGRSpatialReference file_crs;
-  if (file_crs.importFromWkt(dem.file_crs_wkt.c_str()) != OGRERR_NONE)
-    return bad("the DEM's CRS does not parse");
-  file_crs.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  if (absl::Status s = ParseFileCrs(&dem, name, &file_crs); !s.ok()) return s;
   const GisFormat* format = GisFormatOf(path);
   if (format == nullptr || format->kind != GisFileKind::kRaster) {  // polygons
     absl::StatusOr<GDALDatasetUniquePtr> ds = OpenBarrierFile(path, name);

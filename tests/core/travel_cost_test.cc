@@ -13,6 +13,7 @@
 #include "geodex/distance_matrix.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/geometry_queries.h"
+#include "geodex/point_distance.h"
 #include "geodex/shortest_path.h"
 #include "gtest/gtest.h"
 #include "util/mesh_factory.h"
@@ -211,6 +212,9 @@ TEST(TravelCostTest, BadValuesAndWhatATravelCostCannotDoAreNamedErrors) {
   DistanceField products;
   EXPECT_EQ(InvalidOptionOf(ComputeFieldProducts(mesh, *field, with_directions, &products)),
             "travel");
+  EXPECT_EQ(InvalidOptionOf(EstimateDistanceAt(mesh, *field, SurfacePoint::AtVertex(3)).status()),
+            "travel");
+  EXPECT_EQ(InvalidOptionOf(TracePathFromVertex(mesh, *field, 3).status()), "travel");
   DelaunayQuery delaunay{sources, Travel(5)};
   EXPECT_EQ(InvalidOptionOf(ComputeDelaunay(mesh, delaunay).status()), "travel");
 }
