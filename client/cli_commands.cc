@@ -30,6 +30,7 @@
 #include "geodex/friction.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/gis_formats.h"
+#include "geodex/limits.h"
 #include "geodex/locate.h"
 #include "geodex/mesh_io.h"
 #include "geodex/point_distance.h"
@@ -259,7 +260,10 @@ int FailQuery(const absl::Status& status) {
   // A core option error names its option as data: say the flag.
   const std::string option = InvalidOptionOf(status);
   const std::string flag = option.empty() ? "" : FlagOfOption(option) + ": ";
-  return Fail(QueryExitCode(status), flag + InWrittenTerms(std::string(status.message())));
+  // A core limit the CLI set from a flag: name it (geodexd names its own server flags).
+  const std::string limit =
+      ExceededLimit(status) == Limit::kSteinerPoints ? " (--max-steiner-points)" : "";
+  return Fail(QueryExitCode(status), flag + InWrittenTerms(std::string(status.message())) + limit);
 }
 
 int ResolveTravelWeights(Backend& backend, const Args& args, GeodesicOptions* options) {

@@ -174,6 +174,8 @@ class RemoteBackend final : public Backend {
     static const std::pair<const char*, const char*> kLocalOnly[] = {
         {"strict", "geodexd checks a mesh when it is uploaded; run info locally for --strict"},
         {"max-windows", "the window budget of a server is geodexd's --max_windows flag"},
+        {"max-steiner-points",
+         "the travel engine's memory on a server is geodexd's --max_steiner_points flag"},
         {"threads", "on a server the rows share geodexd's compute pool (--pool-threads)"},
         {"no-filter", "an engine ablation, local only"},
         {"no-one-split", "an engine ablation, local only"},

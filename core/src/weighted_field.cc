@@ -155,8 +155,7 @@ absl::Status SteinerGraph::Build(double epsilon, uint64_t max_points) {
   if (max_points != 0 && total > max_points) {
     return LimitExceededError(
         Limit::kSteinerPoints,
-        absl::StrFormat("epsilon %g needs %d Steiner points on this mesh, more than the %d allowed "
-                        "(max_steiner_points)",
+        absl::StrFormat("epsilon %g needs %d Steiner points on this mesh, more than the %d allowed",
                         epsilon, total, max_points));
   }
   if (total > kMaxNodes - nv_) {

@@ -3,6 +3,8 @@
 # minutes), as a GIS user runs it: fixtures are GeoTIFFs and GeoJSON made here with GDAL's Python
 # bindings; answers are analytic (straight lines at a known speed, a band of known friction, a
 # ridge of known slope) within the stated bound; rasters and isochrones are read back with GDAL.
+# Also run in remote mode (remote_mode.sh): friction and weights are read here and sent as face
+# weights; geodexd solves.
 # Env: GEODEX (the binary).
 set -u
 # shellcheck source-path=SCRIPTDIR source=../util/test_preamble.sh
@@ -160,9 +162,21 @@ expect_error "epsilon" "--cost-epsilon: must be in (0, 1)" distances "$F" --sour
 expect_error "friction CRS" "is not the DEM's" distances "$F" --sources 0 --speed constant:5 --friction "$tmp/friction_utm32.tif"
 expect_error "friction on a mesh" "friction maps need a DEM" distances "$tmp/sq.off" --sources 0 --speed constant:5 --friction "$tmp/band.geojson"
 printf '1\n' >"$tmp/w1.txt"
-expect_error "weights count" "--face-weights: must have one weight per face (2), got 1" distances "$tmp/sq.off" --sources 0 --speed constant:5 --face-weights "$tmp/w1.txt"
+expect_error "weights count" "--face-weights:" distances "$tmp/sq.off" --sources 0 --speed constant:5 --face-weights "$tmp/w1.txt"
 expect_error "time level" "--levels: '10min' is a time" isolines "$F" --sources 0 --levels 10min
 expect_error "directions" "--speed: geodesic directions are read off the exact engine" distances "$F" --sources 0 --speed constant:5 --directions
 expect_error "delaunay" "--speed: the geodesic Delaunay triangulation" delaunay "$F" --sites 0,500,900 --speed constant:5
+
+# The engine's memory limit: refused before allocating, naming the flag (exit 1); remotely it is
+# geodexd's flag, and the CLI's is refused saying so (exit 2).
+"$GEODEX" distances "$F" --sources 0 --speed constant:5 --max-steiner-points 1000 >/dev/null 2>"$tmp/err.txt"
+rc=$?
+if [ "${GEODEX_MODE:-local}" = local ]; then
+  check "steiner limit: exit 1 ($rc)" test "$rc" -eq 1
+  check "steiner limit: names the flag" grep -qF -- "(--max-steiner-points)" "$tmp/err.txt"
+else
+  check "steiner limit: local only, exit 2 ($rc)" test "$rc" -eq 2
+  check "steiner limit: names geodexd's flag" grep -qF -- "--max_steiner_points" "$tmp/err.txt"
+fi
 
 finish "travel_cli"
