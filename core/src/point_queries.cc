@@ -300,7 +300,10 @@ absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
   std::vector<std::string> source_keys, target_keys;
   for (const SurfacePoint& p : sources) source_keys.push_back(SurfacePointToString(p));
   for (const SurfacePoint& p : targets) target_keys.push_back(SurfacePointToString(p));
-  const bool symmetric = options.k_nearest == 0 && source_keys == target_keys;
+  // A slope-dependent speed's times differ by direction: row to column, every pair solved.
+  const bool directional =
+      options.solver.travel.has_value() && IsDirectional(*options.solver.travel);
+  const bool symmetric = options.k_nearest == 0 && source_keys == target_keys && !directional;
   std::vector<size_t> source_row(sources.size());  // source -> its distinct row
   std::vector<size_t> distinct;                    // distinct row -> first source index
   {
@@ -402,7 +405,8 @@ absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
     absl::Status status = absl::OkStatus();
     SolveStats stats;
     if (!columns.empty() && options.solver.travel.has_value()) {
-      // Travel times (direction-independent: the symmetric sweep holds) from the weighted engine.
+      // Travel times from the weighted engine (row to column; the symmetric sweep only when they
+      // are direction-independent).
       std::vector<SurfacePoint> points;
       for (size_t c : columns) points.push_back(solved_targets[c]);
       PointQuery query{{sources[distinct[r]]}, std::move(points), options.solver};

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <string>
 
 #include "absl/strings/str_format.h"
 #include "geodex/geodesic_solver.h"
@@ -24,18 +26,98 @@ SolveStats StatsOf(const WeightedStats& w) {
   return s;
 }
 
-// Engine cost (weighted metres) to seconds; +inf stays.
+// Seconds per engine cost unit: a constant speed runs the engine in weighted metres; a
+// slope-dependent one in seconds already (its SlopeCost is seconds per metre).
+double SecondsPerUnit(const TravelCost& travel) {
+  return IsDirectional(travel) ? 1.0 : 3.6 / travel.speed_kmh;
+}
+
+// Engine cost to seconds; +inf stays.
 double Seconds(const TravelCost& travel, double cost) {
-  return cost == kInf ? kInf : cost * SecondsPerMetre(travel);
+  return cost == kInf ? kInf : cost * SecondsPerUnit(travel);
+}
+
+// The speed (km/h) of a table at a slope in degrees; 0 beyond its slopes (cannot be walked).
+double TableKmh(const std::vector<std::array<double, 2>>& table, double slope_deg) {
+  if (slope_deg < table.front()[0] || slope_deg > table.back()[0]) return 0;
+  auto hi = std::lower_bound(table.begin(), table.end(), slope_deg,
+                             [](const std::array<double, 2>& row, double s) { return row[0] < s; });
+  if (hi == table.begin()) return hi->at(1);
+  const auto lo = hi - 1;
+  const double t = (slope_deg - (*lo)[0]) / ((*hi)[0] - (*lo)[0]);
+  return (*lo)[1] + t * ((*hi)[1] - (*lo)[1]);
+}
+
+// The engine's slope cost for a slope-dependent speed: seconds per 3D metre, sampled on the slope
+// sine (weighted_field.h). 8193 samples: a step of 0.014 degrees at the level.
+std::shared_ptr<const SlopeCost> SlopeCostOf(const TravelCost& travel) {
+  constexpr int kSamples = 8193;
+  auto cost = std::make_shared<SlopeCost>();
+  cost->per_metre.resize(kSamples);
+  for (int i = 0; i < kSamples; ++i) {
+    const double sine = -1 + 2.0 * i / (kSamples - 1);
+    double kmh = 0;
+    if (travel.speed_model == SpeedModel::kTobler) {
+      const double cosine = std::sqrt(std::max(0.0, 1 - sine * sine));
+      kmh = cosine == 0 ? 0 : ToblerKmh(sine / cosine);
+    } else {
+      kmh = TableKmh(*travel.speed_table, std::asin(sine) * 180 / M_PI);
+    }
+    cost->per_metre[i] = kmh > 0 ? 3.6 / kmh : kInf;
+  }
+  return cost;
 }
 
 }  // namespace
 
+double ToblerKmh(double rise_over_run) {
+  return 6 * std::exp(-3.5 * std::abs(rise_over_run + 0.05));
+}
+
 absl::Status ValidateTravelCost(const TravelCost& travel) {
-  if (!(travel.speed_kmh > 0) || !std::isfinite(travel.speed_kmh)) {
+  if (travel.speed_model == SpeedModel::kConstant) {
+    if (!(travel.speed_kmh > 0) || !std::isfinite(travel.speed_kmh)) {
+      return OptionError(
+          "travel.speed_kmh",
+          absl::StrFormat("must be > 0 and finite (km/h), got %g", travel.speed_kmh));
+    }
+  } else if (travel.speed_kmh != 0) {
     return OptionError("travel.speed_kmh",
-                       absl::StrFormat("must be > 0 and finite (km/h), got %g", travel.speed_kmh));
+                       absl::StrFormat("must be 0 with a slope-dependent speed (it sets the "
+                                       "speed), got %g",
+                                       travel.speed_kmh));
   }
+  if (travel.speed_model == SpeedModel::kTable) {
+    const auto* table = travel.speed_table.get();
+    if (table == nullptr || table->size() < 2) {
+      return OptionError("travel.speed_table",
+                         absl::StrFormat("needs >= 2 rows (slope in degrees, km/h), got %d",
+                                         table == nullptr ? 0 : table->size()));
+    }
+    for (size_t i = 0; i < table->size(); ++i) {
+      const double slope = (*table)[i][0], kmh = (*table)[i][1];
+      std::string problem;
+      if (!(slope >= -90 && slope <= 90)) {
+        problem = absl::StrFormat("slope %g is not in [-90, 90] degrees", slope);
+      } else if (i > 0 && !(slope > (*table)[i - 1][0])) {
+        problem =
+            absl::StrFormat("slope %g does not increase (after %g)", slope, (*table)[i - 1][0]);
+      } else if (!(kmh > 0) || !std::isfinite(kmh)) {
+        problem = absl::StrFormat("speed %g km/h is not > 0 and finite", kmh);
+      }
+      if (!problem.empty())
+        return OptionError(absl::StrFormat("travel.speed_table[%d]", i), problem);
+    }
+    if (!(table->front()[0] <= 0 && table->back()[0] >= 0)) {
+      return OptionError(
+          "travel.speed_table",
+          absl::StrFormat("must cover slope 0 (the level; it covers %g to %g degrees)",
+                          table->front()[0], table->back()[0]));
+    }
+  } else if (travel.speed_table != nullptr) {
+    return OptionError("travel.speed_table", "is only read with the table speed model");
+  }
+
   if (!(travel.epsilon > 0 && travel.epsilon < 1)) {
     return OptionError("travel.epsilon",
                        absl::StrFormat("must be in (0, 1), got %g", travel.epsilon));
@@ -76,7 +158,11 @@ absl::StatusOr<WeightedOptions> WeightedOptionsFor(const TriangleMesh& mesh,
   out.epsilon = travel.epsilon;
   out.max_steiner_points = travel.max_steiner_points;
   out.cancel = options.cancel;
-  out.max_distance = options.max_distance / SecondsPerMetre(travel);
+  out.max_distance = options.max_distance / SecondsPerUnit(travel);
+  if (IsDirectional(travel)) {
+    out.slope_cost = SlopeCostOf(travel);
+    out.inbound = travel.inbound;
+  }
   if (travel.face_weight != nullptr) out.face_weight = *travel.face_weight;
   if (travel.max_slope_deg > 0 && travel.max_slope_deg < 90) {
     if (out.face_weight.empty()) out.face_weight.assign(mesh.face_count(), 1.0);

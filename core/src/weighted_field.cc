@@ -45,6 +45,7 @@ class SteinerGraph {
   uint32_t nv() const { return nv_; }
   uint64_t steiner_points() const { return param_.size(); }
   uint64_t graph_edges() const { return graph_edges_; }
+  uint32_t edge_count() const { return static_cast<uint32_t>(edge_half_.size()); }
   uint32_t node_count() const { return nv_ + static_cast<uint32_t>(param_.size()); }
   double FaceWeight(uint32_t f) const { return weights_.empty() ? 1.0 : weights_[f]; }
   uint32_t EdgeOfHalf(uint32_t h) const { return edge_of_half_[h]; }
@@ -246,44 +247,236 @@ absl::StatusOr<Located> Locate(const TriangleMesh& mesh, const SurfacePoint& p) 
   return out;
 }
 
-// Calls fn(node, weight) for every node a point links to straight (the weight of the face or
-// edge the segment runs in; a node may come more than once). A vertex point links to its copies
-// with weight 0.
+// What a straight link runs in: nothing (a vertex point and its internal copies), a face or an
+// edge (along it).
+struct Medium {
+  enum Kind : uint8_t { kSame, kFace, kEdge } kind;
+  uint32_t id;
+};
+
+// The cost of a straight piece, by what it runs in: weight x 3D length. (x, y, z) is the piece in
+// the search's direction.
+class IsotropicCost {
+ public:
+  explicit IsotropicCost(const SteinerGraph& g) : g_(g) {}
+  double Face(uint32_t f, double x, double y, double z) const {
+    return g_.FaceWeight(f) * std::sqrt(x * x + y * y + z * z);
+  }
+  double Edge(uint32_t e, double x, double y, double z) const {
+    return g_.EdgeWeight(e) * std::sqrt(x * x + y * y + z * z);
+  }
+
+ private:
+  const SteinerGraph& g_;
+};
+
+// The cost of a straight piece under a slope cost (weighted_field.h's SlopeCost): weight x 3D
+// length x the cost per metre of its slope, or inside a face's switchback range the zigzag's cost
+// (the face's convex envelope). The search runs from the sources; with `inbound` the walker goes
+// the other way, so a piece's rise changes sign.
+class DirectionalCost {
+ public:
+  DirectionalCost(const SteinerGraph& g, const SlopeCost& slope, bool inbound)
+      : g_(g), table_(slope.per_metre), sign_(inbound ? -1 : 1) {
+    const TriangleMesh& mesh = g.mesh();
+    const uint32_t nf = mesh.face_count();
+    inv_sin_.assign(nf, 0);
+    chord_first_.assign(nf + 1, 0);
+    for (uint32_t f = 0; f < nf; ++f) {
+      chord_first_[f] = static_cast<uint32_t>(chords_.size());
+      if (!std::isfinite(g.FaceWeight(f)) || mesh.FaceDegenerate(f)) continue;
+      const Vec a = mesh.Position(mesh.FaceVertex(f, 0)), b = mesh.Position(mesh.FaceVertex(f, 1)),
+                c = mesh.Position(mesh.FaceVertex(f, 2));
+      const double ux = b[0] - a[0], uy = b[1] - a[1], uz = b[2] - a[2];
+      const double vx = c[0] - a[0], vy = c[1] - a[1], vz = c[2] - a[2];
+      const double nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;
+      const double sin_slope = std::hypot(nx, ny) / std::sqrt(nx * nx + ny * ny + nz * nz);
+      if (!(sin_slope > 1e-12)) continue;  // level: the same cost every way, nothing to envelope
+      inv_sin_[f] = 1 / sin_slope;
+      AddSwitchbacks(sin_slope);
+    }
+    chord_first_[nf] = static_cast<uint32_t>(chords_.size());
+    // Along an edge: the cheaper of its passable faces, per direction (walker's).
+    const uint32_t ne = g.edge_count();
+    edge_dir_.assign(3 * size_t{ne}, 0);
+    edge_fwd_.assign(ne, kInf);
+    edge_bwd_.assign(ne, kInf);
+    for (uint32_t e = 0; e < ne; ++e) {
+      const uint32_t h0 = g.EdgeHalf(e);
+      const Vec p = mesh.Position(mesh.From(h0)), q = mesh.Position(mesh.To(h0));
+      const double len = Dist(p, q);
+      if (!(len > 0)) continue;
+      const double dx = (q[0] - p[0]) / len, dy = (q[1] - p[1]) / len, dz = (q[2] - p[2]) / len;
+      edge_dir_[3 * e] = dx;
+      edge_dir_[3 * e + 1] = dy;
+      edge_dir_[3 * e + 2] = dz;
+      for (const uint32_t h : {h0, mesh.Twin(h0)}) {
+        if (h == kNoIndex) continue;
+        const uint32_t f = TriangleMesh::FaceOf(h);
+        if (!std::isfinite(g.FaceWeight(f))) continue;
+        edge_fwd_[e] = std::min(edge_fwd_[e], Walk(f, dx, dy, dz));
+        edge_bwd_[e] = std::min(edge_bwd_[e], Walk(f, -dx, -dy, -dz));
+      }
+    }
+  }
+
+  double Face(uint32_t f, double x, double y, double z) const {
+    return Walk(f, sign_ * x, sign_ * y, sign_ * z);
+  }
+  double Edge(uint32_t e, double x, double y, double z) const {
+    const double len = std::sqrt(x * x + y * y + z * z);
+    if (len == 0) return 0;
+    const double along =
+        sign_ * (x * edge_dir_[3 * e] + y * edge_dir_[3 * e + 1] + z * edge_dir_[3 * e + 2]);
+    return len * (along >= 0 ? edge_fwd_[e] : edge_bwd_[e]);
+  }
+
+ private:
+  // A switchback range of a face: for slope sines in [lo, hi] the cost of a piece is
+  // weight x (up_cost x its uphill component + across_cost x its across-slope component).
+  struct Chord {
+    double lo, hi, up_cost, across_cost;
+  };
+
+  // Cost per metre at slope sine `sine` (linear between samples).
+  double PerMetre(double sine) const {
+    const double at = (std::clamp(sine, -1.0, 1.0) + 1) * 0.5 * (table_.size() - 1);
+    const size_t i = std::min(static_cast<size_t>(at), table_.size() - 2);
+    const double t = at - i;
+    if (t == 0) return table_[i];
+    if (t == 1) return table_[i + 1];
+    return table_[i] + t * (table_[i + 1] - table_[i]);  // +inf stays +inf
+  }
+
+  // The walker's cost of the piece (x, y, z) inside face f.
+  double Walk(uint32_t f, double x, double y, double z) const {
+    const double len2 = x * x + y * y + z * z;
+    if (len2 == 0) return 0;
+    const double len = std::sqrt(len2);
+    const double sine = z / len;
+    const double w = g_.FaceWeight(f);
+    for (uint32_t i = chord_first_[f]; i < chord_first_[f + 1]; ++i) {
+      const Chord& c = chords_[i];
+      if (sine < c.lo || sine > c.hi) continue;
+      if (!std::isfinite(c.up_cost)) return kInf;  // a range no zigzag can walk
+      const double up = z * inv_sin_[f];
+      const double across = std::sqrt(std::max(0.0, len2 - up * up));
+      return w * (c.up_cost * up + c.across_cost * across);
+    }
+    return w * len * PerMetre(sine);
+  }
+
+  // The convex envelope of a face of slope sine `sin_slope`. In the face's frame (x uphill, y
+  // across), the set a walker reaches at cost 1 going straight is bounded by the points
+  // (cos phi, sin phi) / cost(phi), cost(phi) = PerMetre(sin_slope cos phi); zigzags reach its
+  // convex hull. The cost is symmetric in y, so the upper half (phi in [0, pi]) is built: a Graham
+  // scan over the samples in angular order, with the two axis points of the hull (x = the largest
+  // and the smallest sample x, where a symmetric convex set crosses its axis). Hull edges that
+  // skip samples are switchback ranges.
+  void AddSwitchbacks(double sin_slope) {
+    constexpr int kSteps = 360;  // half-degree samples
+    std::array<double, kSteps + 1> px, py;
+    double xmax = -kInf, xmin = kInf;
+    for (int j = 0; j <= kSteps; ++j) {
+      const double phi = M_PI * j / kSteps;
+      const double cost = PerMetre(sin_slope * std::cos(phi));
+      const double r = std::isfinite(cost) ? 1 / cost : 0;
+      px[j] = r * std::cos(phi);
+      py[j] = j == 0 || j == kSteps ? 0 : r * std::sin(phi);
+      xmax = std::max(xmax, px[j]);
+      xmin = std::min(xmin, px[j]);
+    }
+    const bool axis0 = xmax > px[0], axis_pi = xmin < px[kSteps];  // hull points off the samples
+    px[0] = xmax;
+    px[kSteps] = xmin;
+    std::array<int, kSteps + 1> hull;
+    int top = 0;
+    for (int j = 0; j <= kSteps; ++j) {
+      while (top >= 2) {
+        const int a = hull[top - 2], b = hull[top - 1];
+        const double cross = (px[b] - px[a]) * (py[j] - py[a]) - (py[b] - py[a]) * (px[j] - px[a]);
+        if (cross > 0) break;
+        --top;
+      }
+      hull[top++] = j;
+    }
+    for (int i = 0; i + 1 < top; ++i) {
+      const int a = hull[i], b = hull[i + 1];
+      if (b == a + 1 && !(a == 0 && axis0) && !(b == kSteps && axis_pi)) continue;  // the curve
+      // The hull edge's line n . p = h, n outward: the gauge of d is n . d / h.
+      const double nx = py[b] - py[a], ny = px[a] - px[b];
+      const double h = nx * px[a] + ny * py[a];
+      Chord c;
+      c.lo = sin_slope * std::cos(M_PI * b / kSteps);
+      c.hi = sin_slope * std::cos(M_PI * a / kSteps);
+      c.up_cost = h > 0 ? nx / h : kInf;
+      c.across_cost = h > 0 ? ny / h : kInf;
+      chords_.push_back(c);
+    }
+  }
+
+  const SteinerGraph& g_;
+  const std::vector<double>& table_;
+  double sign_;
+  std::vector<double> inv_sin_;
+  std::vector<uint32_t> chord_first_;
+  std::vector<Chord> chords_;
+  std::vector<double> edge_dir_, edge_fwd_, edge_bwd_;
+};
+
+template <typename Cost>
+double LinkCost(const Cost& cost, Medium m, const Vec& from, const Vec& to) {
+  const double x = to[0] - from[0], y = to[1] - from[1], z = to[2] - from[2];
+  switch (m.kind) {
+    case Medium::kSame:
+      return 0;
+    case Medium::kFace:
+      return cost.Face(m.id, x, y, z);
+    case Medium::kEdge:
+      return cost.Edge(m.id, x, y, z);
+  }
+  return kInf;
+}
+
+// Calls fn(node, medium) for every node a point links to straight (what the segment runs in; a
+// node may come more than once). A vertex point links to its copies through kSame.
 template <typename Fn>
 void ForEachLink(const SteinerGraph& g, const Located& p, Fn&& fn) {
   const TriangleMesh& mesh = g.mesh();
-  auto edge_nodes = [&](uint32_t h, double w) {
+  auto edge_nodes = [&](uint32_t h, Medium m) {
     const uint32_t e = g.EdgeOfHalf(h);
-    for (uint32_t n = g.First(e); n < g.End(e); ++n) fn(n, w);
+    for (uint32_t n = g.First(e); n < g.End(e); ++n) fn(n, m);
   };
   auto face_nodes = [&](uint32_t h) {  // the face of h, except the open edge h
-    const double w = g.FaceWeight(TriangleMesh::FaceOf(h));
-    if (!std::isfinite(w)) return;
-    edge_nodes(TriangleMesh::Next(h), w);
-    edge_nodes(TriangleMesh::Prev(h), w);
-    fn(mesh.Opposite(h), w);
+    const uint32_t f = TriangleMesh::FaceOf(h);
+    if (!std::isfinite(g.FaceWeight(f))) return;
+    const Medium m{Medium::kFace, f};
+    edge_nodes(TriangleMesh::Next(h), m);
+    edge_nodes(TriangleMesh::Prev(h), m);
+    fn(mesh.Opposite(h), m);
   };
   switch (p.canonical.kind) {
     case SurfacePoint::Kind::kVertex:
-      for (const uint32_t v : p.vertices) fn(v, 0.0);
+      for (const uint32_t v : p.vertices) fn(v, Medium{Medium::kSame, 0});
       break;
     case SurfacePoint::Kind::kEdge:
       for (const uint32_t h : p.half_edges) {
-        const double we = g.EdgeWeight(g.EdgeOfHalf(h));
-        if (std::isfinite(we)) {
-          edge_nodes(h, we);
-          fn(mesh.From(h), we);
-          fn(mesh.To(h), we);
+        const uint32_t e = g.EdgeOfHalf(h);
+        if (std::isfinite(g.EdgeWeight(e))) {
+          const Medium m{Medium::kEdge, e};
+          edge_nodes(h, m);
+          fn(mesh.From(h), m);
+          fn(mesh.To(h), m);
         }
         face_nodes(h);
       }
       break;
     case SurfacePoint::Kind::kFace: {
-      const double w = g.FaceWeight(p.face);
-      if (!std::isfinite(w)) break;
+      if (!std::isfinite(g.FaceWeight(p.face))) break;
+      const Medium m{Medium::kFace, p.face};
       for (int k = 0; k < 3; ++k) {
-        edge_nodes(3 * p.face + k, w);
-        fn(mesh.FaceVertex(p.face, k), w);
+        edge_nodes(3 * p.face + k, m);
+        fn(mesh.FaceVertex(p.face, k), m);
       }
       break;
     }
@@ -292,9 +485,10 @@ void ForEachLink(const SteinerGraph& g, const Located& p, Fn&& fn) {
   }
 }
 
-// The cost of the straight segment between two points when they share a face or an edge (+inf
+// The cost of the straight segment from a to b when they share a face or an edge (+inf
 // otherwise).
-double DirectCost(const SteinerGraph& g, const Located& a, const Located& b) {
+template <typename Cost>
+double DirectCost(const SteinerGraph& g, const Cost& cost, const Located& a, const Located& b) {
   const TriangleMesh& mesh = g.mesh();
   // Faces and edges holding each point.
   auto supports = [&](const Located& p, std::vector<uint32_t>* faces,
@@ -325,22 +519,29 @@ double DirectCost(const SteinerGraph& g, const Located& a, const Located& b) {
   std::vector<uint32_t> fa, ea, fb, eb;
   supports(a, &fa, &ea);
   supports(b, &fb, &eb);
-  double w = kInf;
+  double best = kInf;
   for (const uint32_t f : fa) {
-    if (std::find(fb.begin(), fb.end(), f) != fb.end()) w = std::min(w, g.FaceWeight(f));
+    if (std::isfinite(g.FaceWeight(f)) && std::find(fb.begin(), fb.end(), f) != fb.end()) {
+      best = std::min(best, LinkCost(cost, Medium{Medium::kFace, f}, a.pos, b.pos));
+    }
   }
   for (const uint32_t e : ea) {
-    if (std::find(eb.begin(), eb.end(), e) != eb.end()) w = std::min(w, g.EdgeWeight(e));
+    if (std::isfinite(g.EdgeWeight(e)) && std::find(eb.begin(), eb.end(), e) != eb.end()) {
+      best = std::min(best, LinkCost(cost, Medium{Medium::kEdge, e}, a.pos, b.pos));
+    }
   }
-  return std::isfinite(w) ? w * Dist(a.pos, b.pos) : kInf;
+  return best;
 }
 
 // Dijkstra over the implicit graph: an indexed binary heap (decrease-key) keyed by cost, ties by
-// node id.
+// node id. Cost: IsotropicCost or DirectionalCost (a template, so the inner loop has no virtual
+// call).
+template <typename Cost>
 class Search {
  public:
-  explicit Search(const SteinerGraph& g)
+  Search(const SteinerGraph& g, const Cost& cost)
       : g_(g),
+        costs_(cost),
         mesh_(g.mesh()),
         cost_(g.node_count(), kInf),
         label_(g.node_count(), kNoIndex),
@@ -363,8 +564,8 @@ class Search {
   void Seed(const Located& p, uint32_t label) {
     const uint32_t parent =
         p.canonical.kind == SurfacePoint::Kind::kVertex ? kFromSourceVertex : kFromSourcePoint;
-    ForEachLink(g_, p, [&](uint32_t n, double w) {
-      Offer(n, w == 0 ? 0.0 : w * Dist(p.pos, g_.Pos(n)), label, parent);
+    ForEachLink(g_, p, [&](uint32_t n, Medium m) {
+      Offer(n, LinkCost(costs_, m, p.pos, g_.Pos(n)), label, parent);
     });
   }
 
@@ -453,8 +654,8 @@ class Search {
     slot_[last] = i;
   }
 
-  // Relaxes the Steiner nodes of edge e from point p at weight w.
-  void RelaxEdge(uint32_t e, const Vec& p, double base, double w, uint32_t label, uint32_t from) {
+  // Relaxes the Steiner nodes of edge e from point p across face f.
+  void RelaxEdge(uint32_t e, const Vec& p, double base, uint32_t f, uint32_t label, uint32_t from) {
     const uint32_t begin = g_.First(e), end = g_.End(e);
     if (begin == end) return;
     const uint32_t h = g_.EdgeHalf(e);
@@ -465,12 +666,12 @@ class Search {
       if (slot_[n] == kNoIndex - 1) continue;  // settled
       const double s = g_.Param(n);
       const double x = ax + s * dx, y = ay + s * dy, z = az + s * dz;
-      Offer(n, base + w * std::sqrt(x * x + y * y + z * z), label, from);
+      Offer(n, base + costs_.Face(f, x, y, z), label, from);
     }
   }
-  void RelaxNode(uint32_t n, const Vec& p, double base, double w, uint32_t label, uint32_t from) {
+  void RelaxNode(uint32_t n, const Vec& p, double base, Medium m, uint32_t label, uint32_t from) {
     if (slot_[n] == kNoIndex - 1) return;
-    Offer(n, base + w * Dist(p, g_.Pos(n)), label, from);
+    Offer(n, base + LinkCost(costs_, m, p, g_.Pos(n)), label, from);
   }
 
   void Settle(uint32_t u, double d) {
@@ -481,40 +682,42 @@ class Search {
         // Along the two edges at u: the nearest node.
         for (const uint32_t h : {*c, TriangleMesh::Prev(*c)}) {
           const uint32_t e = g_.EdgeOfHalf(h);
-          const double we = g_.EdgeWeight(e);
-          if (!std::isfinite(we)) continue;
+          if (!std::isfinite(g_.EdgeWeight(e))) continue;
           uint32_t next;
           if (g_.First(e) == g_.End(e)) {
             next = mesh_.From(h) == u ? mesh_.To(h) : mesh_.From(h);
           } else {
             next = mesh_.From(g_.EdgeHalf(e)) == u ? g_.First(e) : g_.End(e) - 1;
           }
-          RelaxNode(next, p, d, we, lab, u);
+          RelaxNode(next, p, d, Medium{Medium::kEdge, e}, lab, u);
         }
         // Across the face: the opposite edge's Steiner points.
-        const double wf = g_.FaceWeight(TriangleMesh::FaceOf(*c));
-        if (std::isfinite(wf)) {
-          RelaxEdge(g_.EdgeOfHalf(TriangleMesh::Next(*c)), p, d, wf, lab, u);
+        const uint32_t f = TriangleMesh::FaceOf(*c);
+        if (std::isfinite(g_.FaceWeight(f))) {
+          RelaxEdge(g_.EdgeOfHalf(TriangleMesh::Next(*c)), p, d, f, lab, u);
         }
       }
       return;
     }
     const uint32_t e = g_.EdgeOfNode(u);
     const uint32_t h0 = g_.EdgeHalf(e);
-    const double we = g_.EdgeWeight(e);
-    RelaxNode(u == g_.First(e) ? mesh_.From(h0) : u - 1, p, d, we, lab, u);
-    RelaxNode(u + 1 == g_.End(e) ? mesh_.To(h0) : u + 1, p, d, we, lab, u);
+    if (std::isfinite(g_.EdgeWeight(e))) {  // (a Steiner node's edge has a passable face)
+      const Medium along{Medium::kEdge, e};
+      RelaxNode(u == g_.First(e) ? mesh_.From(h0) : u - 1, p, d, along, lab, u);
+      RelaxNode(u + 1 == g_.End(e) ? mesh_.To(h0) : u + 1, p, d, along, lab, u);
+    }
     for (const uint32_t h : {h0, mesh_.Twin(h0)}) {
       if (h == kNoIndex) continue;
-      const double wf = g_.FaceWeight(TriangleMesh::FaceOf(h));
-      if (!std::isfinite(wf)) continue;
-      RelaxEdge(g_.EdgeOfHalf(TriangleMesh::Next(h)), p, d, wf, lab, u);
-      RelaxEdge(g_.EdgeOfHalf(TriangleMesh::Prev(h)), p, d, wf, lab, u);
-      RelaxNode(mesh_.Opposite(h), p, d, wf, lab, u);
+      const uint32_t f = TriangleMesh::FaceOf(h);
+      if (!std::isfinite(g_.FaceWeight(f))) continue;
+      RelaxEdge(g_.EdgeOfHalf(TriangleMesh::Next(h)), p, d, f, lab, u);
+      RelaxEdge(g_.EdgeOfHalf(TriangleMesh::Prev(h)), p, d, f, lab, u);
+      RelaxNode(mesh_.Opposite(h), p, d, Medium{Medium::kFace, f}, lab, u);
     }
   }
 
   const SteinerGraph& g_;
+  const Cost& costs_;
   const TriangleMesh& mesh_;
   std::vector<double> cost_;
   std::vector<uint32_t> label_, parent_, slot_;
@@ -539,14 +742,15 @@ absl::Status Prepare(const TriangleMesh& mesh, const std::vector<SurfacePoint>& 
 }
 
 // The best (cost, node) over the links of point t; node kNoIndex when the best is none.
-std::pair<double, uint32_t> BestLink(const SteinerGraph& g, const Search& search,
-                                     const Located& t) {
+template <typename Cost>
+std::pair<double, uint32_t> BestLink(const SteinerGraph& g, const Cost& cost,
+                                     const Search<Cost>& search, const Located& t) {
   double best = kInf;
   uint32_t node = kNoIndex;
-  ForEachLink(g, t, [&](uint32_t n, double w) {
+  ForEachLink(g, t, [&](uint32_t n, Medium m) {
     const double c = search.cost(n);
     if (!std::isfinite(c)) return;
-    const double total = w == 0 ? c : c + w * Dist(t.pos, g.Pos(n));
+    const double total = c + LinkCost(cost, m, g.Pos(n), t.pos);
     if (total < best || (total == best && n < node)) {
       best = total;
       node = n;
@@ -577,6 +781,13 @@ PathPoint LocatedPoint(const TriangleMesh& mesh, const Located& l) {
   return pp;
 }
 
+// Calls fn(cost) with the cost model of `options` (the one place the two are chosen).
+template <typename Fn>
+auto WithCost(const SteinerGraph& g, const WeightedOptions& options, bool inbound, Fn&& fn) {
+  if (options.slope_cost == nullptr) return fn(IsotropicCost(g));
+  return fn(DirectionalCost(g, *options.slope_cost, inbound));
+}
+
 }  // namespace
 
 absl::Status ValidateWeightedOptions(const TriangleMesh& mesh, const WeightedOptions& options) {
@@ -586,6 +797,17 @@ absl::Status ValidateWeightedOptions(const TriangleMesh& mesh, const WeightedOpt
   if (!(options.max_distance > 0)) {
     return OptionError("max_distance",
                        absl::StrFormat("must be > 0, got %g", options.max_distance));
+  }
+  if (options.slope_cost != nullptr) {
+    const std::vector<double>& c = options.slope_cost->per_metre;
+    bool ok = c.size() >= 2;
+    for (size_t i = 0; ok && i < c.size(); ++i) ok = c[i] > 0;  // also NaN
+    // The level direction (sine 0) must be walkable: a face always has one.
+    if (ok && c.size() % 2 == 1) ok = std::isfinite(c[c.size() / 2]);
+    if (ok && c.size() % 2 == 0) ok = std::isfinite(c[c.size() / 2 - 1] + c[c.size() / 2]);
+    if (!ok) {
+      return OptionError("slope_cost", "needs >= 2 samples, each > 0 (or +inf), finite at slope 0");
+    }
   }
   const std::vector<double>& w = options.face_weight;
   if (!w.empty() && w.size() != mesh.face_count()) {
@@ -611,29 +833,32 @@ absl::StatusOr<WeightedField> ComputeWeightedField(const TriangleMesh& mesh,
   if (absl::Status s = Prepare(mesh, sources, &located); !s.ok()) return s;
   SteinerGraph g(mesh, options);
   if (absl::Status s = g.Build(options.epsilon, options.max_steiner_points); !s.ok()) return s;
-  Search search(g);
-  for (uint32_t i = 0; i < located.size(); ++i) search.Seed(located[i], i);
-  if (absl::Status s = search.Run(
-          options, [](double) { return false; }, [](uint32_t) {});
-      !s.ok()) {
-    return s;
-  }
-  search.ClampTo(options.max_distance);
-  WeightedField field;
-  field.cost.assign(mesh.file_vertex_count(), kInf);
-  field.source.assign(mesh.file_vertex_count(), kNoIndex);
-  for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
-    const uint32_t fv = mesh.FileVertex(v);
-    if (search.cost(v) < field.cost[fv]) {
-      field.cost[fv] = search.cost(v);
-      field.source[fv] = search.label(v);
-    }
-  }
-  field.steiner_points = g.steiner_points();
-  field.graph_edges = g.graph_edges();
-  field.epsilon = options.epsilon;
-  field.stats = search.Stats(Elapsed(start));
-  return field;
+  return WithCost(g, options, options.inbound,
+                  [&](const auto& cost) -> absl::StatusOr<WeightedField> {
+                    Search search(g, cost);
+                    for (uint32_t i = 0; i < located.size(); ++i) search.Seed(located[i], i);
+                    if (absl::Status s = search.Run(
+                            options, [](double) { return false; }, [](uint32_t) {});
+                        !s.ok()) {
+                      return s;
+                    }
+                    search.ClampTo(options.max_distance);
+                    WeightedField field;
+                    field.cost.assign(mesh.file_vertex_count(), kInf);
+                    field.source.assign(mesh.file_vertex_count(), kNoIndex);
+                    for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+                      const uint32_t fv = mesh.FileVertex(v);
+                      if (search.cost(v) < field.cost[fv]) {
+                        field.cost[fv] = search.cost(v);
+                        field.source[fv] = search.label(v);
+                      }
+                    }
+                    field.steiner_points = g.steiner_points();
+                    field.graph_edges = g.graph_edges();
+                    field.epsilon = options.epsilon;
+                    field.stats = search.Stats(Elapsed(start));
+                    return field;
+                  });
 }
 
 absl::StatusOr<WeightedCosts> ComputeWeightedCostsAt(const TriangleMesh& mesh,
@@ -648,38 +873,41 @@ absl::StatusOr<WeightedCosts> ComputeWeightedCostsAt(const TriangleMesh& mesh,
   if (absl::Status s = Prepare(mesh, targets, &to); !s.ok()) return s;
   SteinerGraph g(mesh, options);
   if (absl::Status s = g.Build(options.epsilon, options.max_steiner_points); !s.ok()) return s;
-  Search search(g);
-  for (uint32_t i = 0; i < from.size(); ++i) search.Seed(from[i], i);
-  if (absl::Status s = search.Run(
-          options, [](double) { return false; }, [](uint32_t) {});
-      !s.ok()) {
-    return s;
-  }
-  search.ClampTo(options.max_distance);
-  WeightedCosts out;
-  out.cost.assign(to.size(), kInf);
-  out.source.assign(to.size(), kNoIndex);
-  for (size_t t = 0; t < to.size(); ++t) {
-    const auto [c, n] = BestLink(g, search, to[t]);
-    if (n != kNoIndex) {
-      out.cost[t] = c;
-      out.source[t] = search.label(n);
-    }
-    for (uint32_t s = 0; s < from.size(); ++s) {
-      const double direct = DirectCost(g, from[s], to[t]);
-      if (direct < out.cost[t]) {
-        out.cost[t] = direct;
-        out.source[t] = s;
-      }
-    }
-    if (out.cost[t] > options.max_distance) {
-      out.cost[t] = kInf;
-      out.source[t] = kNoIndex;
-    }
-  }
-  out.steiner_points = g.steiner_points();
-  out.stats = search.Stats(Elapsed(start));
-  return out;
+  return WithCost(g, options, options.inbound,
+                  [&](const auto& cost) -> absl::StatusOr<WeightedCosts> {
+                    Search search(g, cost);
+                    for (uint32_t i = 0; i < from.size(); ++i) search.Seed(from[i], i);
+                    if (absl::Status s = search.Run(
+                            options, [](double) { return false; }, [](uint32_t) {});
+                        !s.ok()) {
+                      return s;
+                    }
+                    search.ClampTo(options.max_distance);
+                    WeightedCosts out;
+                    out.cost.assign(to.size(), kInf);
+                    out.source.assign(to.size(), kNoIndex);
+                    for (size_t t = 0; t < to.size(); ++t) {
+                      const auto [c, n] = BestLink(g, cost, search, to[t]);
+                      if (n != kNoIndex) {
+                        out.cost[t] = c;
+                        out.source[t] = search.label(n);
+                      }
+                      for (uint32_t s = 0; s < from.size(); ++s) {
+                        const double direct = DirectCost(g, cost, from[s], to[t]);
+                        if (direct < out.cost[t]) {
+                          out.cost[t] = direct;
+                          out.source[t] = s;
+                        }
+                      }
+                      if (out.cost[t] > options.max_distance) {
+                        out.cost[t] = kInf;
+                        out.source[t] = kNoIndex;
+                      }
+                    }
+                    out.steiner_points = g.steiner_points();
+                    out.stats = search.Stats(Elapsed(start));
+                    return out;
+                  });
 }
 
 absl::StatusOr<WeightedPath> ComputeWeightedPath(const TriangleMesh& mesh, const SurfacePoint& from,
@@ -693,56 +921,62 @@ absl::StatusOr<WeightedPath> ComputeWeightedPath(const TriangleMesh& mesh, const
   const Located& dst = pts[1];
   SteinerGraph g(mesh, options);
   if (absl::Status s = g.Build(options.epsilon, options.max_steiner_points); !s.ok()) return s;
-  Search search(g);
-  search.Seed(src, 0);
-  // The weight of the straight link from each node to the target (the cheapest of its links).
-  std::vector<std::pair<uint32_t, double>> links;
-  ForEachLink(g, dst, [&](uint32_t n, double w) { links.emplace_back(n, w); });
-  std::sort(links.begin(), links.end());
-  const double direct = DirectCost(g, src, dst);
-  double best = direct;
-  if (absl::Status s = search.Run(
-          options, [&](double key) { return key >= best; },
-          [&](uint32_t u) {
-            auto it =
-                std::lower_bound(links.begin(), links.end(), std::pair<uint32_t, double>(u, -kInf));
-            for (; it != links.end() && it->first == u; ++it) {
-              const double w = it->second;
-              best = std::min(best, search.cost(u) + (w == 0 ? 0 : w * Dist(dst.pos, g.Pos(u))));
-            }
-          });
-      !s.ok()) {
-    return s;
-  }
-  auto [cost, node] = BestLink(g, search, dst);
-  WeightedPath path;
-  if (direct <= cost) {
-    cost = direct;
-    node = kNoIndex;
-  }
-  if (!std::isfinite(cost) || cost > options.max_distance) {
-    return absl::NotFoundError(absl::StrFormat("point %s cannot be reached from %s%s",
-                                               SurfacePointToString(to), SurfacePointToString(from),
-                                               std::isfinite(cost) ? " within max_distance" : ""));
-  }
-  path.cost = cost;
-  // Backwards from the target, then reversed.
-  path.points.push_back(LocatedPoint(mesh, dst));
-  uint32_t parent = kFromSourcePoint;
-  while (node != kNoIndex) {
-    if (!(dst.canonical.kind == SurfacePoint::Kind::kVertex && search.cost(node) == cost &&
-          path.points.size() == 1 && node < g.nv() &&
-          mesh.FileVertex(node) == dst.canonical.vertex)) {
-      path.points.push_back(NodePoint(g, node));
-    }
-    parent = search.parent(node);
-    node = parent >= kFromSourcePoint ? kNoIndex : parent;
-  }
-  if (parent == kFromSourcePoint) path.points.push_back(LocatedPoint(mesh, src));
-  std::reverse(path.points.begin(), path.points.end());
-  path.steiner_points = g.steiner_points();
-  path.stats = search.Stats(Elapsed(start));
-  return path;
+  // A path is walked from `from`: the search runs outward whatever options.inbound says.
+  return WithCost(
+      g, options, /*inbound=*/false, [&](const auto& cost) -> absl::StatusOr<WeightedPath> {
+        Search search(g, cost);
+        search.Seed(src, 0);
+        // What the straight link from each node to the target runs in.
+        std::vector<std::pair<uint32_t, Medium>> links;
+        ForEachLink(g, dst, [&](uint32_t n, Medium m) { links.emplace_back(n, m); });
+        std::sort(links.begin(), links.end(),
+                  [](const auto& a, const auto& b) { return a.first < b.first; });
+        const double direct = DirectCost(g, cost, src, dst);
+        double best = direct;
+        if (absl::Status s = search.Run(
+                options, [&](double key) { return key >= best; },
+                [&](uint32_t u) {
+                  auto it = std::lower_bound(
+                      links.begin(), links.end(), u,
+                      [](const std::pair<uint32_t, Medium>& l, uint32_t n) { return l.first < n; });
+                  for (; it != links.end() && it->first == u; ++it) {
+                    best = std::min(best,
+                                    search.cost(u) + LinkCost(cost, it->second, g.Pos(u), dst.pos));
+                  }
+                });
+            !s.ok()) {
+          return s;
+        }
+        auto [total, node] = BestLink(g, cost, search, dst);
+        WeightedPath path;
+        if (direct <= total) {
+          total = direct;
+          node = kNoIndex;
+        }
+        if (!std::isfinite(total) || total > options.max_distance) {
+          return absl::NotFoundError(absl::StrFormat(
+              "point %s cannot be reached from %s%s", SurfacePointToString(to),
+              SurfacePointToString(from), std::isfinite(total) ? " within max_distance" : ""));
+        }
+        path.cost = total;
+        // Backwards from the target, then reversed.
+        path.points.push_back(LocatedPoint(mesh, dst));
+        uint32_t parent = kFromSourcePoint;
+        while (node != kNoIndex) {
+          if (!(dst.canonical.kind == SurfacePoint::Kind::kVertex && search.cost(node) == total &&
+                path.points.size() == 1 && node < g.nv() &&
+                mesh.FileVertex(node) == dst.canonical.vertex)) {
+            path.points.push_back(NodePoint(g, node));
+          }
+          parent = search.parent(node);
+          node = parent >= kFromSourcePoint ? kNoIndex : parent;
+        }
+        if (parent == kFromSourcePoint) path.points.push_back(LocatedPoint(mesh, src));
+        std::reverse(path.points.begin(), path.points.end());
+        path.steiner_points = g.steiner_points();
+        path.stats = search.Stats(Elapsed(start));
+        return path;
+      });
 }
 
 }  // namespace geodex

@@ -5,13 +5,19 @@
 // takes its 3D length x w(f) / v. Every product built on a distance field (values at vertices and
 // points, paths, matrices, isolines, Voronoi regions) then speaks seconds, and max_distance is a
 // time too. Approximate with a stated bound: every time is at least the true least time and at
-// most (1 + epsilon) times it. Direction-independent (part 1 of the travel-cost work): times from
-// the sources outward equal times towards them.
+// most (1 + epsilon) times it.
+//
+// The speed is constant (times are direction-independent: from the sources equals towards them)
+// or depends on the slope along the direction of travel (Tobler's hiking function or a table): a
+// walker zigzags up and down steep faces where that is quicker (switchbacks), times from the
+// sources differ from times towards them (`inbound`), and no bound is proved: epsilon then only
+// sets the density of the engine's Steiner points (docs/travel.md states the measured error).
 //
 // Not available with a travel cost (InvalidArgument naming "travel"): the exact-only products
 // read off the exact engine's per-vertex origins (geodesic directions, the geodesic Delaunay
 // triangulation), lambda > 0 and the Dijkstra method.
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -22,9 +28,22 @@ namespace geodex {
 
 class TriangleMesh;
 
+enum class SpeedModel {
+  kConstant,  // speed_kmh everywhere
+  kTobler,    // Tobler (1993): 6 exp(-3.5 |s + 0.05|) km/h, s = rise / run along the travel
+  kTable,     // speed_table, linear between its slopes; steeper slopes cannot be walked
+};
+
 struct TravelCost {
-  // v, the speed on a face of weight 1 (km/h). > 0 and finite.
+  SpeedModel speed_model = SpeedModel::kConstant;
+  // kConstant: v, the speed on a face of weight 1 (km/h), > 0 and finite. Otherwise 0.
   double speed_kmh = 0;
+  // kTable: rows (slope in degrees, speed in km/h on weight 1): >= 2 rows, slopes in [-90, 90],
+  // strictly increasing, the first <= 0 <= the last; speeds > 0 and finite. Shared.
+  std::shared_ptr<const std::vector<std::array<double, 2>>> speed_table;
+  // With a slope-dependent speed: times to REACH the sources (a walker ends there) instead of
+  // times from them. Paths are always walked from their start.
+  bool inbound = false;
   // The stated bound, in (0, 1): the answer is within (1 + epsilon) of the least time.
   double epsilon = 0.01;
   // Faces steeper than this (degrees from the horizontal x-y plane, z up) are impassable: a cliff
@@ -38,13 +57,19 @@ struct TravelCost {
   uint64_t max_steiner_points = 0;
 };
 
-// The one check of a travel cost's own values (speed, epsilon, slope); the weights are checked
-// against the mesh by the engine. Errors name "travel.speed_kmh", "travel.epsilon",
-// "travel.max_slope_deg" (InvalidOptionOf).
+// The one check of a travel cost's own values (speed model, speed, table, epsilon, slope); the
+// weights are checked against the mesh by the engine. Errors name "travel.speed_kmh",
+// "travel.speed_table", "travel.speed_table[3]", "travel.epsilon", "travel.max_slope_deg"
+// (InvalidOptionOf).
 absl::Status ValidateTravelCost(const TravelCost& travel);
 
-// Seconds per metre on a face of weight 1.
-inline double SecondsPerMetre(const TravelCost& travel) { return 3.6 / travel.speed_kmh; }
+// True when times depend on the direction of travel (a slope-dependent speed).
+inline bool IsDirectional(const TravelCost& travel) {
+  return travel.speed_model != SpeedModel::kConstant;
+}
+
+// Tobler's hiking function: km/h at s = rise / run along the direction of travel.
+double ToblerKmh(double rise_over_run);
 
 // The slope of each face in degrees from the x-y plane (0 flat, 90 vertical; 0 for a degenerate
 // face): what max_slope_deg compares.

@@ -55,6 +55,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <vector>
 
 #include "absl/status/status.h"
@@ -66,6 +67,22 @@
 #include "geodex/triangle_mesh.h"
 
 namespace geodex {
+
+// A direction-dependent cost (slope-dependent speed, docs/travel.md): the cost per 3D metre of a
+// straight piece as a function of the sine of its slope angle along the direction of travel
+// (rise / 3D length, -1 straight down to +1 straight up), sampled uniformly on [-1, 1] and
+// linearly interpolated; +inf where a direction cannot be walked. A face's weight multiplies it.
+//
+// Switchbacks: inside each face the cost of a direction is the lower convex envelope of that
+// polar cost (Rowe and Ross 1990): where zigzagging between two directions is cheaper than going
+// straight, the straight piece costs the zigzag. The engine builds the envelope per face (the
+// convex hull of the unit-cost set, sampled every half degree), so a face's cost does not depend
+// on how it is cut. Costs then differ by direction: fields are costs from the sources outward
+// unless WeightedOptions::inbound. No (1 + epsilon) bound is proved for such costs: epsilon only
+// sets the Steiner points' density.
+struct SlopeCost {
+  std::vector<double> per_metre;  // >= 2 samples; > 0 or +inf; finite at sine 0 (the level)
+};
 
 struct WeightedOptions {
   // The stated bound: every cost is at most (1 + epsilon) x the true least cost and never below
@@ -79,11 +96,17 @@ struct WeightedOptions {
   // LimitExceededError(Limit::kSteinerPoints) before allocating them.
   uint64_t max_steiner_points = 0;
   const CancelToken* cancel = nullptr;  // polled every few thousand settled nodes
+  // Null: direction-independent (cost = length x weight, the bound above holds). Shared, so
+  // copying options does not copy the samples.
+  std::shared_ptr<const SlopeCost> slope_cost;
+  // With a slope cost: costs of reaching the sources (a walker ends there) rather than of leaving
+  // them. A path from `from` to `to` is always walked from `from`.
+  bool inbound = false;
 };
 
-// Checks epsilon, max_distance and the weights (their count against the mesh's faces). Errors
-// are InvalidArgument naming the option (InvalidOptionOf: "epsilon", "max_distance",
-// "face_weight", "face_weight[7]").
+// Checks epsilon, max_distance, the weights (their count against the mesh's faces) and the slope
+// cost's samples. Errors are InvalidArgument naming the option (InvalidOptionOf: "epsilon",
+// "max_distance", "face_weight", "face_weight[7]", "slope_cost").
 absl::Status ValidateWeightedOptions(const TriangleMesh& mesh, const WeightedOptions& options);
 
 struct WeightedStats {
@@ -139,8 +162,9 @@ absl::StatusOr<WeightedPath> ComputeWeightedPath(const TriangleMesh& mesh, const
 
 // The weighted engine's options for `options` (which carry a travel cost): the weights with every
 // face steeper than max_slope_deg made +inf, epsilon, max_distance in engine units (seconds /
-// SecondsPerMetre), the Steiner-point limit and the cancel token. Errors: InvalidArgument naming
-// "travel" for what the weighted engine does not do (lambda > 0, Dijkstra).
+// seconds per unit), the slope cost of a slope-dependent speed, inbound, the Steiner-point limit
+// and the cancel token. Errors: InvalidArgument naming "travel" for what the weighted engine does
+// not do (lambda > 0, Dijkstra).
 absl::StatusOr<WeightedOptions> WeightedOptionsFor(const TriangleMesh& mesh,
                                                    const GeodesicOptions& options);
 
