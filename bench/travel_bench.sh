@@ -10,6 +10,10 @@
 #     the finest one, and an 8- and a 16-neighbour grid Dijkstra with the same model (r.cost's
 #     moves: a move's cost is its 3D length x the mean friction of its two end cells) against the
 #     finest run.
+# With SPEED=tobler (environment), per DEM instead: the exact geodesic field and the Tobler field
+# (--speed tobler) at each epsilon against the finest one, with wall times and their ratio to the
+# exact field's, and an 8- and a 16-neighbour grid Dijkstra under Tobler (r.walk's moves: a move
+# takes its 3D length / Tobler(rise / run)) against the finest run.
 # Relative differences are over the cells farther than 5% of the largest time from the source.
 # Prints markdown tables for docs/performance.md.
 # usage: bench/travel_bench.sh [GEODEX] [SHARED_MESHES] [STEP] [EPSILONS]
@@ -73,8 +77,10 @@ cat >"$tmp/grid.py" <<'PY'
 import heapq, math, sys, time
 import numpy as np
 from osgeo import gdal
-# argv: DEM, friction raster or "1" (every cell 1), the reference time raster, STEP.
+# argv: DEM, friction raster or "1" (every cell 1), the reference time raster, STEP, and
+# optionally "tobler" (a move takes its 3D length / Tobler(rise / run), friction ignored).
 dem, finest, s = gdal.Open(sys.argv[1]), sys.argv[3], int(sys.argv[4])
+tobler = len(sys.argv) > 5 and sys.argv[5] == "tobler"
 z = dem.ReadAsArray().astype(float)[::s, ::s]
 f = np.ones(z.shape) if sys.argv[2] == "1" else gdal.Open(sys.argv[2]).ReadAsArray().astype(float)[::s, ::s]
 gt = dem.GetGeoTransform(); cx, cy = abs(gt[1]) * s, abs(gt[5]) * s
@@ -93,7 +99,11 @@ def grid(moves):
             rr, qq = r + b, q + a
             if 0 <= rr < H and 0 <= qq < W:
                 m = rr * W + qq
-                w = c + math.sqrt(L * L + (zf[m] - zf[n]) ** 2) * (ff[m] + ff[n]) / 2  # 1 m/s
+                rise = zf[m] - zf[n]
+                if tobler:
+                    w = c + math.sqrt(L * L + rise * rise) * 3.6 / (6 * math.exp(-3.5 * abs(rise / L + 0.05)))
+                else:
+                    w = c + math.sqrt(L * L + rise * rise) * (ff[m] + ff[n]) / 2  # 1 m/s
                 if w < d[m]: d[m] = w; heapq.heappush(heap, (w, m))
     return d.reshape(H, W), time.time() - t0
 eight = [(a, b) for a in (-1, 0, 1) for b in (-1, 0, 1) if (a, b) != (0, 0)]
@@ -102,7 +112,8 @@ for name, moves in (("8", eight), ("16", sixteen)):
     d, secs = grid(moves)
     ok = (best >= 0) & (best > 0.05 * best.max())
     r = d[ok] / best[ok] - 1
-    print(f"| grid Dijkstra, {name} neighbours (r.cost's moves; Python, {secs:.0f} s) | | "
+    what = "r.walk's" if tobler else "r.cost's"
+    print(f"| grid Dijkstra, {name} neighbours ({what} moves; Python, {secs:.0f} s) | | "
           f"{r.max():.2e} (min {r.min():.2e}) | {r.mean():.2e} |")
 PY
 
@@ -115,6 +126,35 @@ for spec in ${DEMS:-jacksboro:$step smooth:$step}; do
   echo "### $dem at --dem-step $step, source $src"
   timed "$geodex" distances "$D" --dem-step "$step" --sources "$src" --output "$tmp/exact.tif"
   read -r exact_s exact_kib <"$tmp/last.time"
+  if [ "${SPEED:-constant}" = tobler ]; then
+    echo
+    echo "| run | wall s | x exact | peak MiB | max rel diff | mean rel diff |"
+    echo "|---|---|---|---|---|---|"
+    echo "| exact geodesic field (metres) | $exact_s | 1 | $((exact_kib / 1024)) | | |"
+    finest=""
+    for e in $epsilons; do
+      finest="$e"
+      timed "$geodex" distances "$D" --dem-step "$step" --sources "$src" --speed tobler \
+        --cost-epsilon "$e" --output "$tmp/tob_$e.tif"
+      read -r s kib <"$tmp/last.time"
+      echo "$e $s $kib" >>"$tmp/tobler_times"
+    done
+    while read -r e s kib; do
+      /usr/bin/python3 - "$tmp/tob_$e.tif" "$tmp/tob_$finest.tif" "$s" "$exact_s" "$kib" "$e" <<'PY'
+import sys
+import numpy as np
+from osgeo import gdal
+t = gdal.Open(sys.argv[1]).ReadAsArray().astype(float); f = gdal.Open(sys.argv[2]).ReadAsArray().astype(float)
+ok = (f >= 0) & (t >= 0) & (f > 0.05 * f.max())
+r = t[ok] / f[ok] - 1
+print(f"| Tobler, epsilon {sys.argv[6]} | {sys.argv[3]} | {float(sys.argv[3]) / float(sys.argv[4]):.1f} | "
+      f"{int(sys.argv[5]) // 1024} | {r.max():.2e} | {r.mean():.2e} |")
+PY
+    done <"$tmp/tobler_times"
+    rm -f "$tmp/tobler_times"
+    /usr/bin/python3 "$tmp/grid.py" "$D" 1 "$tmp/tob_$finest.tif" "$step" tobler | sed 's/| | /| | | | /'
+    continue
+  fi
   echo
   echo "| run | wall s | x exact | peak MiB | max rel diff | mean rel diff |"
   echo "|---|---|---|---|---|---|"

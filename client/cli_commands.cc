@@ -551,17 +551,32 @@ std::string FormatDistances(const std::vector<double>& distances,
 // How a travel-cost answer says what it is (seconds, approximate, its bound), as the geometry
 // commands say they are approximate: a first comment line of text output, leading members of a
 // JSON object. Both "" without a travel cost.
+// A slope-dependent speed has no proven bound: the header says so and JSON's "bound" is false.
 std::string TravelTextHeader(const GeodesicOptions& options) {
   if (!options.travel.has_value()) return "";
+  const TravelCost& t = *options.travel;
+  if (!IsDirectional(t)) {
+    return absl::StrFormat(
+        "# travel time in seconds at %g km/h on friction 1; approximate: at most (1 + %g) x the "
+        "least time\n",
+        t.speed_kmh, t.epsilon);
+  }
   return absl::StrFormat(
-      "# travel time in seconds at %g km/h on friction 1; approximate: at most (1 + %g) x the "
-      "least time\n",
-      options.travel->speed_kmh, options.travel->epsilon);
+      "# travel time in seconds %s, %s; approximate (epsilon %g, no proven bound)\n",
+      t.inbound ? "to reach the sources" : "from the sources",
+      t.speed_model == SpeedModel::kTobler ? "Tobler's hiking function" : "speed table", t.epsilon);
 }
 std::string TravelJsonMembers(const GeodesicOptions& options) {
   if (!options.travel.has_value()) return "";
-  return absl::StrFormat("\"unit\": \"s\", \"approximate\": true, \"epsilon\": %s, ",
-                         JsonNumber(options.travel->epsilon));
+  const TravelCost& t = *options.travel;
+  const char* speed = t.speed_model == SpeedModel::kConstant ? "constant"
+                      : t.speed_model == SpeedModel::kTobler ? "tobler"
+                                                             : "table";
+  return absl::StrFormat(
+      "\"unit\": \"s\", \"approximate\": true, \"epsilon\": %s, \"bound\": %s, \"speed\": "
+      "\"%s\", \"inbound\": %s, ",
+      JsonNumber(t.epsilon), IsDirectional(t) ? "false" : "true", speed,
+      t.inbound ? "true" : "false");
 }
 
 // `distances --at`: one line per point, "POINT<TAB>estimate D<TAB>exact D<TAB>source I" (I = -1
@@ -1104,10 +1119,10 @@ const std::vector<Command>& QueryCommands() {
       {"info", kInfoHelp, {"strict"}, RunInfo},
       {"distances",
        kDistancesHelp,
-       {"stats", "no-filter", "no-one-split", "directions"},
+       {"stats", "no-filter", "no-one-split", "directions", "inbound"},
        RunDistances},
-      {"path", kPathHelp, {"stats"}, RunPath},
-      {"matrix", kMatrixHelp, {"stats"}, RunMatrix},
+      {"path", kPathHelp, {"stats", "inbound"}, RunPath},
+      {"matrix", kMatrixHelp, {"stats", "inbound"}, RunMatrix},
       {"locate", kLocateHelp, {}, RunLocate},
       IsolinesCommand(),
       VoronoiCommand(),

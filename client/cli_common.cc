@@ -3,15 +3,18 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <memory>
 #include <mutex>
 #include <thread>
 
+#include "absl/strings/ascii.h"
 #include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
@@ -153,8 +156,12 @@ bool GetUint(const Args& args, const std::string& key, uint64_t* out, std::strin
 }
 
 std::string FlagOfOption(const std::string& option) {
-  if (option == "travel" || option == "travel.speed_kmh") return "--speed";
+  if (option == "travel" || option == "travel.speed_kmh" ||
+      absl::StartsWith(option, "travel.speed_table")) {
+    return "--speed";
+  }
   if (option == "travel.epsilon") return "--cost-epsilon";
+  if (option == "travel.inbound") return "--inbound";
   if (option == "travel.max_slope_deg") return "--max-slope";
   if (absl::StartsWith(option, "face_weight") || absl::StartsWith(option, "travel.face_weights")) {
     return "--face-weights";  // or --friction's values
@@ -167,13 +174,44 @@ std::string FlagOfOption(const std::string& option) {
 
 namespace {
 
-// --speed constant:KMH and the cost flags that need it (the weights, read once the mesh is open,
-// come later: ResolveTravelWeights).
+// A speed table file: "slope_deg,speed_kmh" rows (a header line, blank lines and # comments are
+// skipped); the rows' rules are core's (ValidateTravelCost).
+bool ReadSpeedTable(const std::string& path, TravelCost* travel, std::string* error) {
+  std::ifstream in(path);
+  if (!in) {
+    *error = absl::StrCat("--speed table:", path, ": cannot open: ", std::strerror(errno));
+    return false;
+  }
+  auto table = std::make_shared<std::vector<std::array<double, 2>>>();
+  std::string line;
+  for (size_t n = 1; std::getline(in, line); ++n) {
+    const absl::string_view text = absl::StripAsciiWhitespace(line);
+    if (text.empty() || text[0] == '#') continue;
+    const std::vector<absl::string_view> cells = absl::StrSplit(text, ',');
+    std::array<double, 2> row{};
+    if (cells.size() != 2 || !absl::SimpleAtod(cells[0], &row[0]) ||
+        !absl::SimpleAtod(cells[1], &row[1])) {
+      if (table->empty() && n == 1 && cells.size() == 2) continue;  // a header
+      *error = absl::StrFormat(
+          "--speed table:%s: line %d: '%s' is not 'slope_deg,speed_kmh' (two numbers)", path, n,
+          text);
+      return false;
+    }
+    table->push_back(row);
+  }
+  travel->speed_model = SpeedModel::kTable;
+  travel->speed_table = std::move(table);
+  return true;
+}
+
+// --speed constant:KMH | tobler | table:FILE.csv, --inbound and the cost flags that need a
+// speed (the weights, read once the mesh is open, come later: ResolveTravelWeights).
 bool GetTravelFlags(const Args& args, GeodesicOptions* options, std::string* error) {
   if (!args.options.count("speed")) {
     for (const std::string& flag : kTravelFlags) {
       if (args.options.count(flag)) {
-        *error = absl::StrFormat("--%s: a travel cost needs --speed constant:KMH", flag);
+        *error = absl::StrFormat(
+            "--%s: a travel cost needs --speed constant:KMH, tobler or table:FILE.csv", flag);
         return false;
       }
     }
@@ -181,12 +219,19 @@ bool GetTravelFlags(const Args& args, GeodesicOptions* options, std::string* err
   }
   const std::string& speed = args.options.at("speed");
   TravelCost travel;
-  if (!absl::StartsWith(speed, "constant:") ||
-      !absl::SimpleAtod(speed.substr(9), &travel.speed_kmh)) {
+  if (speed == "tobler") {
+    travel.speed_model = SpeedModel::kTobler;
+  } else if (absl::StartsWith(speed, "table:")) {
+    if (!ReadSpeedTable(speed.substr(6), &travel, error)) return false;
+  } else if (!absl::StartsWith(speed, "constant:") ||
+             !absl::SimpleAtod(speed.substr(9), &travel.speed_kmh)) {
     *error = absl::StrFormat(
-        "--speed: '%s' is not constant:KMH (a speed in km/h on a face of friction 1)", speed);
+        "--speed: '%s' is not constant:KMH (a speed in km/h on a face of friction 1), tobler "
+        "(Tobler's hiking function of the slope) or table:FILE.csv (slope_deg,speed_kmh rows)",
+        speed);
     return false;
   }
+  travel.inbound = args.options.count("inbound") > 0;
   if (!GetDouble(args, "cost-epsilon", &travel.epsilon, error) ||
       !GetDouble(args, "max-slope", &travel.max_slope_deg, error) ||
       !GetUint(args, "max-steiner-points", &travel.max_steiner_points, error)) {

@@ -455,15 +455,15 @@ int RunDelaunay(Backend& backend, const Args& args) {
 }  // namespace
 
 const Command& IsolinesCommand() {
-  static const Command command{"isolines", kIsolinesHelp, {}, RunIsolines};
+  static const Command command{"isolines", kIsolinesHelp, {"inbound"}, RunIsolines};
   return command;
 }
 const Command& VoronoiCommand() {
-  static const Command command{"voronoi", kVoronoiHelp, {}, RunVoronoi};
+  static const Command command{"voronoi", kVoronoiHelp, {"inbound"}, RunVoronoi};
   return command;
 }
 const Command& DelaunayCommand() {
-  static const Command command{"delaunay", kDelaunayHelp, {}, RunDelaunay};
+  static const Command command{"delaunay", kDelaunayHelp, {"inbound"}, RunDelaunay};
   return command;
 }
 

@@ -22,11 +22,17 @@ std::string Key(const std::vector<SurfacePoint>& sources, const GeodesicOptions&
   std::string key = absl::StrFormat("%d|%.17g|%d|%.17g|%d|%d|%d|", static_cast<int>(o.method),
                                     o.lambda, static_cast<int>(o.lambda_scale), o.max_distance,
                                     o.max_windows, o.use_filter, o.use_one_angle_one_split);
-  if (o.travel.has_value()) {  // a travel field is another field; its weights by address
-    absl::StrAppend(&key, absl::StrFormat("travel %.17g|%.17g|%.17g|%d|%p|", o.travel->speed_kmh,
-                                          o.travel->epsilon, o.travel->max_slope_deg,
-                                          o.travel->max_steiner_points,
-                                          static_cast<const void*>(o.travel->face_weight.get())));
+  if (o.travel.has_value()) {  // a travel field is another field; weights and table by content
+    const TravelCost& t = *o.travel;
+    absl::StrAppend(&key, absl::StrFormat("travel %d|%.17g|%.17g|%.17g|%d|%d|",
+                                          static_cast<int>(t.speed_model), t.speed_kmh, t.epsilon,
+                                          t.max_slope_deg, t.max_steiner_points, t.inbound));
+    auto bytes = [](const auto* v) {
+      return v == nullptr ? std::string("-")
+                          : std::string(reinterpret_cast<const char*>(v->data()),
+                                        v->size() * sizeof((*v)[0]));
+    };
+    absl::StrAppend(&key, bytes(t.face_weight.get()), "|", bytes(t.speed_table.get()), "|");
   }
   for (const SurfacePoint& p : sources) absl::StrAppend(&key, SurfacePointToString(p), ",");
   return key;

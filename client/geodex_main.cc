@@ -77,6 +77,11 @@ Travel time (distances, path, matrix, isolines, voronoi; docs/travel.md): --spee
       line, or JSON "unit": "s", "approximate": true, "epsilon", and "time_s" for values.
       Isoline levels may carry a unit: --levels 10min,20min (s, min, h). Not with --lambda,
       --directions or delaunay.
+      --speed tobler (Tobler's hiking function of the slope along the way) or --speed
+      table:FILE.csv (slope_deg,speed_kmh rows, linear between them; steeper slopes cannot be
+      walked): the speed depends on the direction, walkers zigzag up and down steep faces
+      (switchbacks), matrices are row to column, --inbound gives times to reach the sources;
+      approximate with no proven bound (--cost-epsilon sets the density; "bound": false).
 
 --format json (distances, path, matrix, locate, info) prints one JSON object instead of text:
       distances {"distances": [...]} (or {"points": [...]} with --at), path {"length", "points"

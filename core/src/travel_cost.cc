@@ -225,6 +225,10 @@ absl::StatusOr<PathsQueryResult> ComputeTravelPaths(const TriangleMesh& mesh,
                                                     const SurfacePoint& from,
                                                     const std::vector<SurfacePoint>& tos,
                                                     const GeodesicOptions& options) {
+  if (options.travel.has_value() && options.travel->inbound) {
+    return OptionError("travel.inbound",
+                       "a path is walked from its start to its end (swap them for the way back)");
+  }
   absl::StatusOr<WeightedOptions> weighted = WeightedOptionsFor(mesh, options);
   if (!weighted.ok()) return weighted.status();
   PathsQueryResult out;
