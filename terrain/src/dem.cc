@@ -318,6 +318,17 @@ CPLStringList SideCarsOf(const std::string& path) {
   return siblings;
 }
 
+// A user's own raster file (a DEM or a friction raster), through the drivers of the formats
+// IsDemPath names, with its side-cars given by name. Not VRT: its sources name files and URLs of
+// their own, opened by any driver. Null when none of the drivers reads it (QuietGdal's message).
+GDALDatasetUniquePtr OpenUserRaster(const std::string& path) {
+  const char* const drivers[] = {"GTiff",   "AAIGrid", "HFA",    "SRTMHGT",
+                                 "USGSDEM", "EHdr",    "netCDF", nullptr};
+  CPLStringList siblings = SideCarsOf(path);
+  return GDALDatasetUniquePtr(GDALDataset::FromHandle(GDALOpenEx(
+      path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, drivers, nullptr, siblings.List())));
+}
+
 // A barrier file the CLI's user names: GeoJSON (its "crs" checked as for text), a Shapefile,
 // GeoPackage or FlatGeobuf, each through its own driver only (no KML network links, GML schemas
 // or VRT sources).
@@ -561,21 +572,14 @@ absl::StatusOr<Dem> Dem::Read(const std::string& path, const DemOptions& options
     return absl::NotFoundError(absl::StrCat(path, ": cannot open: No such file or directory"));
   }
   QuietGdal quiet;
-  // The user's own file, through the drivers of the formats IsDemPath names, with its own side-cars
-  // (.prj, .hdr, .aux.xml: the files beside it whose names start with its stem) given by name,
-  // since PrepareGdal stops GDAL listing directories. Not VRT: its sources name files and URLs of
-  // their own, opened by any driver.
-  const char* const drivers[] = {"GTiff",   "AAIGrid", "HFA",    "SRTMHGT",
-                                 "USGSDEM", "EHdr",    "netCDF", nullptr};
+  // The user's own file (OpenUserRaster); a VRT is refused by name.
   if (absl::EndsWithIgnoreCase(path, ".vrt")) {
     return absl::InvalidArgumentError(absl::StrCat(
         path,
         ": a VRT is not read (its sources may name other files or URLs); make it a GeoTIFF "
         "(gdal_translate in.vrt out.tif)"));
   }
-  CPLStringList siblings = SideCarsOf(path);
-  GDALDatasetUniquePtr ds(GDALDataset::FromHandle(GDALOpenEx(
-      path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, drivers, nullptr, siblings.List())));
+  GDALDatasetUniquePtr ds = OpenUserRaster(path);
   if (ds == nullptr) {
     return absl::InvalidArgumentError(
         absl::StrCat(path, ": not a raster GDAL reads (", QuietGdal::LastMessage(), ")"));
@@ -1873,11 +1877,7 @@ absl::StatusOr<std::vector<double>> ReadFrictionFile(const MeshData& mesh, const
     return absl::NotFoundError(absl::StrCat(name, ": cannot open: No such file or directory"));
   }
   // A raster: the drivers and side-car rules of Dem::Read.
-  const char* const drivers[] = {"GTiff",   "AAIGrid", "HFA",    "SRTMHGT",
-                                 "USGSDEM", "EHdr",    "netCDF", nullptr};
-  CPLStringList siblings = SideCarsOf(path);
-  GDALDatasetUniquePtr ds(GDALDataset::FromHandle(GDALOpenEx(
-      path.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY, drivers, nullptr, siblings.List())));
+  GDALDatasetUniquePtr ds = OpenUserRaster(path);
   if (ds == nullptr) {
     return bad(absl::StrCat("not a raster GDAL reads (", QuietGdal::LastMessage(), ")"));
   }
