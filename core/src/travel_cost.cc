@@ -231,27 +231,29 @@ absl::StatusOr<PathsQueryResult> ComputeTravelPaths(const TriangleMesh& mesh,
   }
   absl::StatusOr<WeightedOptions> weighted = WeightedOptionsFor(mesh, options);
   if (!weighted.ok()) return weighted.status();
+  absl::StatusOr<std::vector<WeightedPath>> paths =
+      ComputeWeightedPaths(mesh, from, tos, *weighted);
+  if (!paths.ok()) return paths.status();
   PathsQueryResult out;
   out.distance.assign(tos.size(), kUnreachable);
   out.paths.resize(tos.size());
   for (size_t i = 0; i < tos.size(); ++i) {
-    absl::StatusOr<WeightedPath> path = ComputeWeightedPath(mesh, from, tos[i], *weighted);
-    if (absl::IsNotFound(path.status())) continue;  // unreachable: inf, no points
-    if (!path.ok()) return path.status();
-    out.distance[i] = Seconds(*options.travel, path->cost);
+    WeightedPath& path = (*paths)[i];
+    if (!std::isfinite(path.cost)) continue;  // unreachable: inf, no points
+    out.distance[i] = Seconds(*options.travel, path.cost);
     // The path's length stays a length (metres along the polyline); its time is the distance.
     double length = 0;
-    for (size_t k = 1; k < path->points.size(); ++k) {
-      const auto& a = path->points[k - 1].position;
-      const auto& b = path->points[k].position;
+    for (size_t k = 1; k < path.points.size(); ++k) {
+      const auto& a = path.points[k - 1].position;
+      const auto& b = path.points[k].position;
       length += std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
                           (a[2] - b[2]) * (a[2] - b[2]));
     }
     out.paths[i].length = length;
     out.paths[i].source = 0;
-    out.paths[i].points = std::move(path->points);
-    AddSolveStats(StatsOf(path->stats), &out.stats);
+    out.paths[i].points = std::move(path.points);
   }
+  if (!paths->empty()) out.stats = StatsOf((*paths)[0].stats);  // one search for every target
   return out;
 }
 

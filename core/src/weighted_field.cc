@@ -910,73 +910,108 @@ absl::StatusOr<WeightedCosts> ComputeWeightedCostsAt(const TriangleMesh& mesh,
                   });
 }
 
-absl::StatusOr<WeightedPath> ComputeWeightedPath(const TriangleMesh& mesh, const SurfacePoint& from,
-                                                 const SurfacePoint& to,
-                                                 const WeightedOptions& options) {
+absl::StatusOr<std::vector<WeightedPath>> ComputeWeightedPaths(const TriangleMesh& mesh,
+                                                               const SurfacePoint& from,
+                                                               const std::vector<SurfacePoint>& tos,
+                                                               const WeightedOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   if (absl::Status s = ValidateWeightedOptions(mesh, options); !s.ok()) return s;
-  std::vector<Located> pts;
-  if (absl::Status s = Prepare(mesh, {from, to}, &pts); !s.ok()) return s;
-  const Located& src = pts[0];
-  const Located& dst = pts[1];
+  std::vector<Located> src_list, dsts;
+  if (absl::Status s = Prepare(mesh, {from}, &src_list); !s.ok()) return s;
+  if (absl::Status s = Prepare(mesh, tos, &dsts); !s.ok()) return s;
+  const Located& src = src_list[0];
   SteinerGraph g(mesh, options);
   if (absl::Status s = g.Build(options.epsilon, options.max_steiner_points); !s.ok()) return s;
-  // A path is walked from `from`: the search runs outward whatever options.inbound says.
+  // A path is walked from `from`: the search runs outward whatever options.inbound says. One graph
+  // and one search serve every target; it stops once every target's best is final.
   return WithCost(
-      g, options, /*inbound=*/false, [&](const auto& cost) -> absl::StatusOr<WeightedPath> {
+      g, options, /*inbound=*/false,
+      [&](const auto& cost) -> absl::StatusOr<std::vector<WeightedPath>> {
         Search search(g, cost);
         search.Seed(src, 0);
-        // What the straight link from each node to the target runs in.
-        std::vector<std::pair<uint32_t, Medium>> links;
-        ForEachLink(g, dst, [&](uint32_t n, Medium m) { links.emplace_back(n, m); });
-        std::sort(links.begin(), links.end(),
-                  [](const auto& a, const auto& b) { return a.first < b.first; });
-        const double direct = DirectCost(g, cost, src, dst);
-        double best = direct;
+        struct Link {
+          uint32_t node, target;
+          Medium medium;
+        };
+        // What the straight link from each node to each target runs in, by node.
+        std::vector<Link> links;
+        std::vector<double> best(dsts.size());
+        for (uint32_t t = 0; t < dsts.size(); ++t) {
+          ForEachLink(g, dsts[t], [&](uint32_t n, Medium m) { links.push_back({n, t, m}); });
+          best[t] = DirectCost(g, cost, src, dsts[t]);
+        }
+        std::stable_sort(links.begin(), links.end(),
+                         [](const Link& a, const Link& b) { return a.node < b.node; });
+        double worst = best.empty() ? 0 : *std::max_element(best.begin(), best.end());
         if (absl::Status s = search.Run(
-                options, [&](double key) { return key >= best; },
+                options, [&](double key) { return key >= worst; },
                 [&](uint32_t u) {
-                  auto it = std::lower_bound(
-                      links.begin(), links.end(), u,
-                      [](const std::pair<uint32_t, Medium>& l, uint32_t n) { return l.first < n; });
-                  for (; it != links.end() && it->first == u; ++it) {
-                    best = std::min(best,
-                                    search.cost(u) + LinkCost(cost, it->second, g.Pos(u), dst.pos));
+                  auto it = std::lower_bound(links.begin(), links.end(), u,
+                                             [](const Link& l, uint32_t n) { return l.node < n; });
+                  bool improved = false;
+                  for (; it != links.end() && it->node == u; ++it) {
+                    const double c =
+                        search.cost(u) + LinkCost(cost, it->medium, g.Pos(u), dsts[it->target].pos);
+                    if (c < best[it->target]) {
+                      best[it->target] = c;
+                      improved = true;
+                    }
                   }
+                  if (improved) worst = *std::max_element(best.begin(), best.end());
                 });
             !s.ok()) {
           return s;
         }
-        auto [total, node] = BestLink(g, cost, search, dst);
-        WeightedPath path;
-        if (direct <= total) {
-          total = direct;
-          node = kNoIndex;
-        }
-        if (!std::isfinite(total) || total > options.max_distance) {
-          return absl::NotFoundError(absl::StrFormat(
-              "point %s cannot be reached from %s%s", SurfacePointToString(to),
-              SurfacePointToString(from), std::isfinite(total) ? " within max_distance" : ""));
-        }
-        path.cost = total;
-        // Backwards from the target, then reversed.
-        path.points.push_back(LocatedPoint(mesh, dst));
-        uint32_t parent = kFromSourcePoint;
-        while (node != kNoIndex) {
-          if (!(dst.canonical.kind == SurfacePoint::Kind::kVertex && search.cost(node) == total &&
-                path.points.size() == 1 && node < g.nv() &&
-                mesh.FileVertex(node) == dst.canonical.vertex)) {
-            path.points.push_back(NodePoint(g, node));
+        std::vector<WeightedPath> paths(dsts.size());
+        for (size_t t = 0; t < dsts.size(); ++t) {
+          const Located& dst = dsts[t];
+          WeightedPath& path = paths[t];
+          path.steiner_points = g.steiner_points();
+          auto [total, node] = BestLink(g, cost, search, dst);
+          const double direct = DirectCost(g, cost, src, dst);
+          if (direct <= total) {
+            total = direct;
+            node = kNoIndex;
           }
-          parent = search.parent(node);
-          node = parent >= kFromSourcePoint ? kNoIndex : parent;
+          if (!std::isfinite(total) || total > options.max_distance) {
+            path.cost = kInf;  // unreachable: no points
+            continue;
+          }
+          path.cost = total;
+          // Backwards from the target, then reversed.
+          path.points.push_back(LocatedPoint(mesh, dst));
+          uint32_t parent = kFromSourcePoint;
+          while (node != kNoIndex) {
+            if (!(dst.canonical.kind == SurfacePoint::Kind::kVertex && search.cost(node) == total &&
+                  path.points.size() == 1 && node < g.nv() &&
+                  mesh.FileVertex(node) == dst.canonical.vertex)) {
+              path.points.push_back(NodePoint(g, node));
+            }
+            parent = search.parent(node);
+            node = parent >= kFromSourcePoint ? kNoIndex : parent;
+          }
+          if (parent == kFromSourcePoint) path.points.push_back(LocatedPoint(mesh, src));
+          std::reverse(path.points.begin(), path.points.end());
         }
-        if (parent == kFromSourcePoint) path.points.push_back(LocatedPoint(mesh, src));
-        std::reverse(path.points.begin(), path.points.end());
-        path.steiner_points = g.steiner_points();
-        path.stats = search.Stats(Elapsed(start));
-        return path;
+        const WeightedStats stats = search.Stats(Elapsed(start));
+        for (WeightedPath& path : paths) path.stats = stats;
+        return paths;
       });
+}
+
+absl::StatusOr<WeightedPath> ComputeWeightedPath(const TriangleMesh& mesh, const SurfacePoint& from,
+                                                 const SurfacePoint& to,
+                                                 const WeightedOptions& options) {
+  absl::StatusOr<std::vector<WeightedPath>> paths = ComputeWeightedPaths(mesh, from, {to}, options);
+  if (!paths.ok()) return paths.status();
+  WeightedPath& path = (*paths)[0];
+  if (!std::isfinite(path.cost)) {
+    return absl::NotFoundError(
+        absl::StrFormat("point %s cannot be reached from %s%s", SurfacePointToString(to),
+                        SurfacePointToString(from),
+                        std::isfinite(options.max_distance) ? " within max_distance" : ""));
+  }
+  return std::move(path);
 }
 
 }  // namespace geodex

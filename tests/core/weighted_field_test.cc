@@ -280,6 +280,48 @@ TEST(WeightedFieldTest, EnclosedRegionIsUnreachable) {
   EXPECT_EQ(path.status().code(), absl::StatusCode::kNotFound);
 }
 
+// Many targets share one graph and one search: each path equals the one-target path bit for bit,
+// an enclosed target is +inf with no points, and the search stops once every target is final.
+TEST(WeightedFieldTest, PathsToManyTargetsShareOneSearch) {
+  GridSpec spec;
+  spec.cells_x = spec.cells_y = 20;
+  spec.jitter = 0.2;
+  const MeshData data = MakeGrid(spec);
+  const TriangleMesh mesh = BuildMesh(data);
+  WeightedOptions options;
+  options.epsilon = 0.1;
+  for (uint32_t f = 0; f < data.face_count(); ++f) {
+    const Vec3 c = Centroid(data, f);
+    const int i = static_cast<int>(c[0] * 20), j = static_cast<int>(c[1] * 20);
+    const bool ring =
+        i >= 14 && i <= 18 && j >= 14 && j <= 18 && (i == 14 || i == 18 || j == 14 || j == 18);
+    options.face_weight.push_back(ring ? kInf : (c[0] > 0.5 ? 3.0 : 1.0));
+  }
+  const SurfacePoint from = SurfacePoint::InFace(7, 0.2, 0.3, 0.5);
+  const std::vector<SurfacePoint> tos = {SurfacePoint::AtVertex(3 * 21 + 15),
+                                         SurfacePoint::InFace(300, 0.6, 0.2, 0.2),
+                                         SurfacePoint::AtVertex(16 * 21 + 16),  // enclosed
+                                         SurfacePoint::AtVertex(12 * 21 + 2)};
+  absl::StatusOr<std::vector<WeightedPath>> paths = ComputeWeightedPaths(mesh, from, tos, options);
+  ASSERT_TRUE(paths.ok()) << paths.status();
+  ASSERT_EQ(paths->size(), tos.size());
+  for (size_t t = 0; t < tos.size(); ++t) {
+    absl::StatusOr<WeightedPath> one = ComputeWeightedPath(mesh, from, tos[t], options);
+    if (t == 2) {
+      EXPECT_EQ(one.status().code(), absl::StatusCode::kNotFound);
+      EXPECT_EQ((*paths)[t].cost, kInf);
+      EXPECT_TRUE((*paths)[t].points.empty());
+      continue;
+    }
+    ASSERT_TRUE(one.ok()) << one.status();
+    EXPECT_EQ((*paths)[t].cost, one->cost) << t;
+    ASSERT_EQ((*paths)[t].points.size(), one->points.size()) << t;
+    for (size_t k = 0; k < one->points.size(); ++k) {
+      EXPECT_EQ((*paths)[t].points[k].position, one->points[k].position) << t << " " << k;
+    }
+  }
+}
+
 TEST(WeightedFieldTest, BadOptionsAreNamed) {
   const TriangleMesh mesh = BuildMesh(MakeGrid(GridSpec{}));
   const std::vector<SurfacePoint> sources{SurfacePoint::AtVertex(0)};

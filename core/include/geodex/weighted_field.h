@@ -160,6 +160,14 @@ absl::StatusOr<WeightedPath> ComputeWeightedPath(const TriangleMesh& mesh, const
                                                  const SurfacePoint& to,
                                                  const WeightedOptions& options);
 
+// One least-cost path per target from `from`, on one graph with one search (it stops once every
+// target is final); an unreachable target (or one beyond max_distance) has cost +inf and no
+// points. Each path's stats are the whole call's.
+absl::StatusOr<std::vector<WeightedPath>> ComputeWeightedPaths(const TriangleMesh& mesh,
+                                                               const SurfacePoint& from,
+                                                               const std::vector<SurfacePoint>& tos,
+                                                               const WeightedOptions& options);
+
 // The weighted engine's options for `options` (which carry a travel cost): the weights with every
 // face steeper than max_slope_deg made +inf, epsilon, max_distance in engine units (seconds /
 // seconds per unit), the slope cost of a slope-dependent speed, inbound, the Steiner-point limit
