@@ -781,6 +781,18 @@ PathPoint LocatedPoint(const TriangleMesh& mesh, const Located& l) {
   return pp;
 }
 
+// Seeds every source (its label: its index) and searches to the end, or to max_distance (costs
+// beyond it become unreachable): what a field and point costs need.
+template <typename Cost>
+absl::Status SearchWhole(const std::vector<Located>& sources, const WeightedOptions& options,
+                         Search<Cost>* search) {
+  for (uint32_t i = 0; i < sources.size(); ++i) search->Seed(sources[i], i);
+  absl::Status status = search->Run(
+      options, [](double) { return false; }, [](uint32_t) {});
+  if (status.ok()) search->ClampTo(options.max_distance);
+  return status;
+}
+
 // Calls fn(cost) with the cost model of `options` (the one place the two are chosen).
 template <typename Fn>
 auto WithCost(const SteinerGraph& g, const WeightedOptions& options, bool inbound, Fn&& fn) {
@@ -836,13 +848,7 @@ absl::StatusOr<WeightedField> ComputeWeightedField(const TriangleMesh& mesh,
   return WithCost(g, options, options.inbound,
                   [&](const auto& cost) -> absl::StatusOr<WeightedField> {
                     Search search(g, cost);
-                    for (uint32_t i = 0; i < located.size(); ++i) search.Seed(located[i], i);
-                    if (absl::Status s = search.Run(
-                            options, [](double) { return false; }, [](uint32_t) {});
-                        !s.ok()) {
-                      return s;
-                    }
-                    search.ClampTo(options.max_distance);
+                    if (absl::Status s = SearchWhole(located, options, &search); !s.ok()) return s;
                     WeightedField field;
                     field.cost.assign(mesh.file_vertex_count(), kInf);
                     field.source.assign(mesh.file_vertex_count(), kNoIndex);
@@ -876,13 +882,7 @@ absl::StatusOr<WeightedCosts> ComputeWeightedCostsAt(const TriangleMesh& mesh,
   return WithCost(g, options, options.inbound,
                   [&](const auto& cost) -> absl::StatusOr<WeightedCosts> {
                     Search search(g, cost);
-                    for (uint32_t i = 0; i < from.size(); ++i) search.Seed(from[i], i);
-                    if (absl::Status s = search.Run(
-                            options, [](double) { return false; }, [](uint32_t) {});
-                        !s.ok()) {
-                      return s;
-                    }
-                    search.ClampTo(options.max_distance);
+                    if (absl::Status s = SearchWhole(from, options, &search); !s.ok()) return s;
                     WeightedCosts out;
                     out.cost.assign(to.size(), kInf);
                     out.source.assign(to.size(), kNoIndex);

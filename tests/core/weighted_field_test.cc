@@ -255,6 +255,20 @@ TEST(WeightedFieldTest, ImpassableWallIsGoneAroundThroughItsGap) {
   }
 }
 
+// On a 20 x 20 grid of the unit square: weight +inf on the faces of the border cells of the
+// square of cells [lo, hi]^2, 1 elsewhere.
+std::vector<double> RingWeights(const MeshData& data, int lo, int hi) {
+  std::vector<double> w;
+  for (uint32_t f = 0; f < data.face_count(); ++f) {
+    const Vec3 c = Centroid(data, f);
+    const int i = static_cast<int>(c[0] * 20), j = static_cast<int>(c[1] * 20);
+    const bool ring =
+        i >= lo && i <= hi && j >= lo && j <= hi && (i == lo || i == hi || j == lo || j == hi);
+    w.push_back(ring ? kInf : 1.0);
+  }
+  return w;
+}
+
 TEST(WeightedFieldTest, EnclosedRegionIsUnreachable) {
   GridSpec spec;
   spec.cells_x = spec.cells_y = 20;
@@ -262,13 +276,7 @@ TEST(WeightedFieldTest, EnclosedRegionIsUnreachable) {
   const TriangleMesh mesh = BuildMesh(data);
   WeightedOptions options;
   options.epsilon = 0.1;
-  for (uint32_t f = 0; f < data.face_count(); ++f) {
-    const Vec3 c = Centroid(data, f);
-    const int i = static_cast<int>(c[0] * 20), j = static_cast<int>(c[1] * 20);
-    const bool ring =
-        i >= 5 && i <= 14 && j >= 5 && j <= 14 && (i == 5 || i == 14 || j == 5 || j == 14);
-    options.face_weight.push_back(ring ? kInf : 1.0);
-  }
+  options.face_weight = RingWeights(data, 5, 14);
   absl::StatusOr<WeightedField> field =
       ComputeWeightedField(mesh, {SurfacePoint::AtVertex(10 * 21 + 10)}, options);
   ASSERT_TRUE(field.ok()) << field.status();
@@ -290,12 +298,9 @@ TEST(WeightedFieldTest, PathsToManyTargetsShareOneSearch) {
   const TriangleMesh mesh = BuildMesh(data);
   WeightedOptions options;
   options.epsilon = 0.1;
-  for (uint32_t f = 0; f < data.face_count(); ++f) {
-    const Vec3 c = Centroid(data, f);
-    const int i = static_cast<int>(c[0] * 20), j = static_cast<int>(c[1] * 20);
-    const bool ring =
-        i >= 14 && i <= 18 && j >= 14 && j <= 18 && (i == 14 || i == 18 || j == 14 || j == 18);
-    options.face_weight.push_back(ring ? kInf : (c[0] > 0.5 ? 3.0 : 1.0));
+  options.face_weight = RingWeights(data, 14, 18);
+  for (uint32_t f = 0; f < data.face_count(); ++f) {  // friction 3 on the right half
+    if (Centroid(data, f)[0] > 0.5) options.face_weight[f] *= 3;
   }
   const SurfacePoint from = SurfacePoint::InFace(7, 0.2, 0.3, 0.5);
   const std::vector<SurfacePoint> tos = {SurfacePoint::AtVertex(3 * 21 + 15),
