@@ -45,12 +45,18 @@ std::string FieldCacheKey(const std::string& mesh_id, const std::vector<SurfaceP
   Append(&key, options.lambda);
   Append(&key, static_cast<int>(options.lambda_scale));
   Append(&key, options.max_distance);
-  // A travel field is never another field: a marker byte, then its speed, bound, slope limit and
-  // weights (by their SHA-256; the friction polygons count by the weights they made).
+  // A travel field is never another field: a marker byte, then its speed model, speed, table
+  // (row count, then the rows), direction (inbound), bound, slope limit and weights (by their
+  // SHA-256; the friction polygons count by the weights they made).
   Append(&key, static_cast<uint8_t>(options.travel.has_value()));
   if (options.travel) {
     const TravelCost& travel = *options.travel;
+    Append(&key, static_cast<uint8_t>(travel.speed_model));
     Append(&key, travel.speed_kmh);
+    const size_t rows = travel.speed_table == nullptr ? 0 : travel.speed_table->size();
+    Append(&key, rows);
+    for (size_t i = 0; i < rows; ++i) Append(&key, (*travel.speed_table)[i]);
+    Append(&key, static_cast<uint8_t>(travel.inbound));
     Append(&key, travel.epsilon);
     Append(&key, travel.max_slope_deg);
     const bool weighted = travel.face_weight != nullptr;

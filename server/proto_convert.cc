@@ -1,6 +1,9 @@
 #include "proto_convert.h"
 
+#include <array>
 #include <cmath>
+#include <memory>
+#include <vector>
 
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
@@ -170,6 +173,8 @@ std::string OptionFieldName(const std::string& option, const std::string& field)
     return absl::StrCat(field, ".travel.face_weights", option.substr(kWeight.size()));
   }
   if (option == "epsilon") return absl::StrCat(field, ".travel.epsilon");
+  // The slope cost is made from the speed model's table (core's travel_cost.cc).
+  if (option == "slope_cost") return absl::StrCat(field, ".travel.speed_table");
   return absl::StrCat(field, ".", option);
 }
 
@@ -198,6 +203,30 @@ absl::StatusOr<GeodesicOptions> SolverOptionsFromProto(const v1::SolverOptions& 
     travel.speed_kmh = t.speed_kmh();
     if (t.has_epsilon()) travel.epsilon = t.epsilon();
     travel.max_slope_deg = t.max_slope_deg();
+    switch (t.speed_model()) {
+      case v1::SPEED_MODEL_UNSPECIFIED:
+      case v1::SPEED_MODEL_CONSTANT:
+        travel.speed_model = SpeedModel::kConstant;
+        break;
+      case v1::SPEED_MODEL_TOBLER:
+        travel.speed_model = SpeedModel::kTobler;
+        break;
+      case v1::SPEED_MODEL_TABLE:
+        travel.speed_model = SpeedModel::kTable;
+        break;
+      default:
+        return FieldError(absl::StrCat(field, ".travel.speed_model"),
+                          absl::StrCat("unknown value ", t.speed_model()));
+    }
+    if (!t.speed_table().empty()) {  // core checks the rows (and that the model reads them)
+      auto table = std::make_shared<std::vector<std::array<double, 2>>>();
+      table->reserve(t.speed_table_size());
+      for (const v1::SpeedTableRow& row : t.speed_table()) {
+        table->push_back({row.slope_deg(), row.speed_kmh()});
+      }
+      travel.speed_table = std::move(table);
+    }
+    travel.inbound = t.inbound();
     travel.max_steiner_points = max_steiner_points;
     out.travel = std::move(travel);
     if (!t.face_weights().empty() && !t.friction_geojson().empty()) {

@@ -1,6 +1,7 @@
 #include "api_convert.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace geodex::api {
@@ -167,6 +168,25 @@ void SolverOptionsToProto(const GeodesicOptions& options, v1::SolverOptions* out
     if (travel.face_weight != nullptr) {
       t->mutable_face_weights()->Add(travel.face_weight->begin(), travel.face_weight->end());
     }
+    switch (travel.speed_model) {
+      case SpeedModel::kConstant:
+        t->set_speed_model(v1::SPEED_MODEL_CONSTANT);
+        break;
+      case SpeedModel::kTobler:
+        t->set_speed_model(v1::SPEED_MODEL_TOBLER);
+        break;
+      case SpeedModel::kTable:
+        t->set_speed_model(v1::SPEED_MODEL_TABLE);
+        break;
+    }
+    if (travel.speed_table != nullptr) {
+      for (const std::array<double, 2>& row : *travel.speed_table) {
+        v1::SpeedTableRow* r = t->add_speed_table();
+        r->set_slope_deg(row[0]);
+        r->set_speed_kmh(row[1]);
+      }
+    }
+    t->set_inbound(travel.inbound);
     // max_steiner_points is the server's (--max_steiner_points), not the request's.
   }
 }
