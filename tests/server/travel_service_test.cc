@@ -1,13 +1,16 @@
 // Travel cost through geodexd (SolverOptions.travel): fields, paths, matrices and isolines equal
 // core's answers bit for bit and say their bound (travel_epsilon); the result cache never serves a
 // travel field for a plain request or another travel cost; errors name the option's field; the
-// Steiner-point budget is a server flag.
+// Steiner-point budget is a server flag. A slope-dependent speed (Tobler, a table, inbound) rides
+// through too, equals core bit for bit and keys its own cache entries; paths refuse inbound.
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "geodex/distance_matrix.h"
@@ -80,6 +83,26 @@ class TravelServiceTest : public testing::ServerFixture {
     GeodesicOptions options;
     options.travel = travel;
     return options;
+  }
+  // Tobler's hiking function (or a speed table when given), a 5% Steiner density, no weights.
+  GeodesicOptions SlopeTravel(bool inbound = false,
+                              std::vector<std::array<double, 2>> table = {}) const {
+    TravelCost travel;
+    travel.speed_model = table.empty() ? SpeedModel::kTobler : SpeedModel::kTable;
+    if (!table.empty()) {
+      travel.speed_table =
+          std::make_shared<const std::vector<std::array<double, 2>>>(std::move(table));
+    }
+    travel.inbound = inbound;
+    travel.epsilon = 0.05;
+    travel.max_steiner_points = ServiceLimits().max_steiner_points;
+    GeodesicOptions options;
+    options.travel = travel;
+    return options;
+  }
+  // A walker's table: 5 km/h on the level, slower uphill than down, nothing beyond 35 degrees.
+  static std::vector<std::array<double, 2>> WalkerTable() {
+    return {{-35, 1}, {-10, 5.5}, {0, 5}, {10, 3.5}, {35, 0.5}};
   }
   std::vector<SurfacePoint> Sites() const {
     return {SurfacePoint::AtVertex(3), SurfacePoint::OnEdge(400, 401, 0.3),
@@ -154,6 +177,41 @@ TEST_F(TravelServiceTest, SolverOptionsRoundTrip) {
   assembler.Add(second);
   EXPECT_EQ(assembler.result().travel_epsilon, 0.05);
   EXPECT_EQ(assembler.result().distance, field.distance);
+  // The slope-dependent speed round-trips: model, table rows, inbound.
+  GeodesicOptions table = SlopeTravel(/*inbound=*/true, WalkerTable());
+  v1::SolverOptions table_proto;
+  api::SolverOptionsToProto(table, &table_proto);
+  EXPECT_EQ(table_proto.travel().speed_model(), v1::SPEED_MODEL_TABLE);
+  ASSERT_EQ(table_proto.travel().speed_table_size(), 5);
+  EXPECT_EQ(table_proto.travel().speed_table(1).slope_deg(), -10);
+  EXPECT_EQ(table_proto.travel().speed_table(1).speed_kmh(), 5.5);
+  EXPECT_TRUE(table_proto.travel().inbound());
+  absl::StatusOr<GeodesicOptions> table_back =
+      SolverOptionsFromProto(table_proto, 0, 77, "options");
+  ASSERT_TRUE(table_back.ok()) << table_back.status();
+  EXPECT_EQ(table_back->travel->speed_model, SpeedModel::kTable);
+  ASSERT_NE(table_back->travel->speed_table, nullptr);
+  EXPECT_EQ(*table_back->travel->speed_table, WalkerTable());
+  EXPECT_TRUE(table_back->travel->inbound);
+  EXPECT_EQ(table_back->travel->speed_kmh, 0);
+  v1::SolverOptions tobler_proto;
+  api::SolverOptionsToProto(SlopeTravel(), &tobler_proto);
+  EXPECT_EQ(tobler_proto.travel().speed_model(), v1::SPEED_MODEL_TOBLER);
+  EXPECT_EQ(tobler_proto.travel().speed_table_size(), 0);
+  EXPECT_FALSE(tobler_proto.travel().inbound());
+  absl::StatusOr<GeodesicOptions> tobler_back =
+      SolverOptionsFromProto(tobler_proto, 0, 77, "options");
+  ASSERT_TRUE(tobler_back.ok()) << tobler_back.status();
+  EXPECT_EQ(tobler_back->travel->speed_model, SpeedModel::kTobler);
+  EXPECT_EQ(tobler_back->travel->speed_table, nullptr);
+  EXPECT_FALSE(tobler_back->travel->inbound);
+  // An unset model is the constant speed (an old client's request).
+  EXPECT_EQ(SolverOptionsFromProto(plain, 0, 0, "options")->travel->speed_model,
+            SpeedModel::kConstant);
+  EXPECT_EQ(proto.travel().speed_model(), v1::SPEED_MODEL_CONSTANT);
+  EXPECT_EQ(OptionFieldName("travel.speed_table[3]"), "options.travel.speed_table[3]");
+  EXPECT_EQ(OptionFieldName("travel.speed_table", "pairs[2].options"),
+            "pairs[2].options.travel.speed_table");
   EXPECT_EQ(OptionFieldName("face_weight[7]"), "options.travel.face_weights[7]");
   EXPECT_EQ(OptionFieldName("travel.speed_kmh"), "options.travel.speed_kmh");
   EXPECT_EQ(OptionFieldName("lambda"), "options.lambda");
@@ -395,6 +453,227 @@ TEST_F(TravelServiceTest, FrictionPolygonsWeighTheirFaces) {
   Field bad = ReadField(request);
   EXPECT_EQ(bad.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_EQ(BadField(bad.status), "options.travel.friction_geojson") << bad.status.error_message();
+}
+
+TEST_F(TravelServiceTest, SlopeSpeedFieldsPathsAndMatricesEqualCore) {
+  // Tobler's speed, from the sources and towards them: each equals core's bit for bit and says
+  // its epsilon (the Steiner density; no bound is proved with a slope-dependent speed).
+  std::vector<double> outbound;
+  for (bool inbound : {false, true}) {
+    const GeodesicOptions options = SlopeTravel(inbound);
+    absl::StatusOr<DistanceField> want = ComputeDistanceField(*local_, Sites(), options);
+    ASSERT_TRUE(want.ok()) << want.status();
+    Field got = ReadField(FieldRequestOf(options));
+    ASSERT_TRUE(got.status.ok()) << got.status.error_message();
+    EXPECT_FALSE(got.cached);
+    EXPECT_EQ(got.travel_epsilon, 0.05);
+    ASSERT_EQ(got.distances.size(), want->distance.size());
+    size_t finite = 0;
+    for (size_t v = 0; v < got.distances.size(); ++v) {
+      ASSERT_TRUE(BitEqual(got.distances[v], want->distance[v])) << inbound << " " << v;
+      finite += std::isfinite(got.distances[v]);
+    }
+    EXPECT_EQ(finite, got.distances.size());  // Tobler walks every slope of the hills
+    if (!inbound) {
+      outbound = got.distances;
+      continue;
+    }
+    // On the hills times towards the sources are not times from them: uphill is slower.
+    size_t differ = 0;
+    for (size_t v = 0; v < got.distances.size(); ++v) {
+      differ += std::abs(got.distances[v] - outbound[v]) > 1e-6 * outbound[v];
+    }
+    EXPECT_GT(differ, got.distances.size() / 2);
+  }
+  // A speed table through the service equals core's too.
+  {
+    const GeodesicOptions options = SlopeTravel(false, WalkerTable());
+    absl::StatusOr<DistanceField> want = ComputeDistanceField(*local_, Sites(), options);
+    ASSERT_TRUE(want.ok()) << want.status();
+    Field got = ReadField(FieldRequestOf(options));
+    ASSERT_TRUE(got.status.ok()) << got.status.error_message();
+    ASSERT_EQ(got.distances.size(), want->distance.size());
+    for (size_t v = 0; v < got.distances.size(); ++v) {
+      ASSERT_TRUE(BitEqual(got.distances[v], want->distance[v])) << v;
+    }
+  }
+  // A path is walked from its start and equals core's; the way back (the ends swapped) takes
+  // another time.
+  std::vector<double> times;
+  for (bool back : {false, true}) {
+    PathQuery path_query{Sites()[0], SurfacePoint::AtVertex(420), {}};
+    if (back) std::swap(path_query.from, path_query.to);
+    path_query.options.solver = SlopeTravel();
+    absl::StatusOr<PathQueryResult> want =
+        ComputeShortestPath(*local_, path_query.from, path_query.to, path_query.options);
+    ASSERT_TRUE(want.ok()) << want.status();
+    v1::FindShortestPathRequest request;
+    request.set_mesh("meshes/hills");
+    api::PathQueryToProto(path_query, &request);
+    v1::FindShortestPathResponse response;
+    grpc::ClientContext context;
+    grpc::Status status = stub_->FindShortestPath(&context, request, &response);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    EXPECT_TRUE(BitEqual(response.distance(), want->distance));
+    EXPECT_EQ(response.travel_epsilon(), 0.05);
+    EXPECT_EQ(response.points_size(), static_cast<int>(want->path.points.size()));
+    times.push_back(response.distance());
+  }
+  EXPECT_NE(times[0], times[1]);
+  // A path refuses inbound (core's rule), naming the field.
+  {
+    PathQuery path_query{Sites()[0], SurfacePoint::AtVertex(420), {}};
+    path_query.options.solver = SlopeTravel(/*inbound=*/true);
+    v1::FindShortestPathRequest request;
+    request.set_mesh("meshes/hills");
+    api::PathQueryToProto(path_query, &request);
+    EXPECT_TRUE(request.options().travel().inbound());
+    v1::FindShortestPathResponse response;
+    grpc::ClientContext context;
+    grpc::Status status = stub_->FindShortestPath(&context, request, &response);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_EQ(BadField(status), "options.travel.inbound") << status.error_message();
+  }
+  // A matrix of the same points both ways is not symmetric (row to column) and equals core's.
+  MatrixQuery matrix_query;
+  matrix_query.sources = {SurfacePoint::AtVertex(3), SurfacePoint::AtVertex(212),
+                          SurfacePoint::AtVertex(420)};
+  matrix_query.targets = matrix_query.sources;
+  matrix_query.options.solver = SlopeTravel();
+  matrix_query.options.threads = 1;
+  absl::StatusOr<DistanceMatrix> want_matrix = ComputeDistanceMatrix(
+      *local_, matrix_query.sources, matrix_query.targets, matrix_query.options);
+  ASSERT_TRUE(want_matrix.ok()) << want_matrix.status();
+  v1::ComputeDistanceMatrixRequest request;
+  request.set_mesh("meshes/hills");
+  api::MatrixQueryToProto(matrix_query, &request);
+  std::vector<v1::ComputeDistanceMatrixResponse> messages;
+  grpc::Status status = ReadAll<v1::ComputeDistanceMatrixResponse>(
+      [&](grpc::ClientContext* c, const auto& r) { return stub_->ComputeDistanceMatrix(c, r); },
+      request, &messages);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  std::vector<double> values;
+  for (const auto& m : messages) {
+    values.insert(values.end(), m.values_f64().begin(), m.values_f64().end());
+  }
+  ASSERT_EQ(values.size(), 9u);
+  ASSERT_EQ(values.size(), want_matrix->values.size());
+  for (size_t i = 0; i < values.size(); ++i) {
+    EXPECT_TRUE(BitEqual(values[i], want_matrix->values[i])) << i;
+  }
+  EXPECT_NE(values[0 * 3 + 2], values[2 * 3 + 0]);
+  // Inbound, entry [i][j] is the time from target j to source i: the outbound [j][i].
+  matrix_query.options.solver = SlopeTravel(/*inbound=*/true);
+  request.Clear();
+  request.set_mesh("meshes/hills");
+  api::MatrixQueryToProto(matrix_query, &request);
+  messages.clear();
+  status = ReadAll<v1::ComputeDistanceMatrixResponse>(
+      [&](grpc::ClientContext* c, const auto& r) { return stub_->ComputeDistanceMatrix(c, r); },
+      request, &messages);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  std::vector<double> inbound;
+  for (const auto& m : messages) {
+    inbound.insert(inbound.end(), m.values_f64().begin(), m.values_f64().end());
+  }
+  ASSERT_EQ(inbound.size(), 9u);
+  for (size_t i = 0; i < 3; ++i) {
+    for (size_t j = 0; j < 3; ++j) {
+      EXPECT_NEAR(inbound[i * 3 + j], values[j * 3 + i], 1e-9 * values[j * 3 + i]) << i << j;
+    }
+  }
+}
+
+TEST_F(TravelServiceTest, CacheKeepsSpeedModelsTablesAndDirectionsApart) {
+  // A constant speed, Tobler outbound and inbound, a table, another table, the constant speed
+  // inbound: each its own solve, then each again from the cache with its own values.
+  GeodesicOptions constant = Travel();
+  constant.travel->face_weight = nullptr;
+  constant.travel->max_slope_deg = 0;
+  GeodesicOptions constant_inbound = constant;
+  constant_inbound.travel->inbound = true;
+  std::vector<std::array<double, 2>> other_table = WalkerTable();
+  other_table[2][1] = 4.5;  // one speed differs
+  const std::vector<GeodesicOptions> all = {constant,
+                                            SlopeTravel(false),
+                                            SlopeTravel(true),
+                                            SlopeTravel(false, WalkerTable()),
+                                            SlopeTravel(false, other_table),
+                                            SlopeTravel(true, WalkerTable()),
+                                            constant_inbound};
+  std::vector<std::vector<double>> first;
+  for (size_t i = 0; i < all.size(); ++i) {
+    Field got = ReadField(FieldRequestOf(all[i]));
+    ASSERT_TRUE(got.status.ok()) << i << ": " << got.status.error_message();
+    EXPECT_FALSE(got.cached) << i;
+    first.push_back(got.distances);
+  }
+  for (size_t i = 0; i < all.size(); ++i) {
+    Field again = ReadField(FieldRequestOf(all[i]));
+    ASSERT_TRUE(again.status.ok()) << i << ": " << again.status.error_message();
+    EXPECT_TRUE(again.cached) << i;
+    EXPECT_EQ(again.distances, first[i]) << i;
+  }
+  // A constant speed is the same both ways (inbound only keys its own entry), and the
+  // slope-dependent ones differ from each other (the cache would have hidden a mix-up).
+  EXPECT_EQ(first.front(), first.back());
+  for (size_t i = 1; i + 1 < all.size(); ++i) {
+    for (size_t j = i + 1; j + 1 < all.size(); ++j) EXPECT_NE(first[i], first[j]) << i << " " << j;
+  }
+}
+
+TEST_F(TravelServiceTest, SlopeSpeedErrorsNameTheirField) {
+  auto field_error = [&](const v1::ComputeDistanceFieldRequest& request) {
+    Field got = ReadField(request);
+    EXPECT_EQ(got.status.error_code(), grpc::StatusCode::INVALID_ARGUMENT)
+        << got.status.error_message();
+    return std::make_pair(BadField(got.status), got.status.error_message());
+  };
+  v1::ComputeDistanceFieldRequest request = FieldRequestOf(SlopeTravel(false, WalkerTable()));
+  v1::TravelCost* travel = request.mutable_options()->mutable_travel();
+  ASSERT_TRUE(ReadField(request).status.ok());
+
+  // A bad row: its index.
+  travel->mutable_speed_table(1)->set_speed_kmh(-1);
+  auto [field, message] = field_error(request);
+  EXPECT_EQ(field, "options.travel.speed_table[1]");
+  EXPECT_TRUE(Contains(message, "-1")) << message;
+  travel->mutable_speed_table(1)->set_speed_kmh(5.5);
+  travel->mutable_speed_table(1)->set_slope_deg(-40);  // does not increase
+  EXPECT_EQ(field_error(request).first, "options.travel.speed_table[1]");
+  travel->mutable_speed_table(1)->set_slope_deg(-10);
+  // Too few rows, or not covering the level.
+  v1::TravelCost saved = *travel;
+  while (travel->speed_table_size() > 1) travel->mutable_speed_table()->RemoveLast();
+  EXPECT_EQ(field_error(request).first, "options.travel.speed_table");
+  *travel = saved;
+  travel->mutable_speed_table()->DeleteSubrange(0, 3);  // 10 and 35 degrees only
+  EXPECT_EQ(field_error(request).first, "options.travel.speed_table");
+  *travel = saved;
+  // A table without the table model; a speed with a slope-dependent one.
+  travel->set_speed_model(v1::SPEED_MODEL_TOBLER);
+  EXPECT_EQ(field_error(request).first, "options.travel.speed_table");
+  travel->clear_speed_table();
+  ASSERT_TRUE(ReadField(request).status.ok());
+  travel->set_speed_kmh(4);
+  EXPECT_EQ(field_error(request).first, "options.travel.speed_kmh");
+  travel->set_speed_kmh(0);
+  // An unknown model.
+  travel->set_speed_model(static_cast<v1::SpeedModel>(9));
+  EXPECT_EQ(field_error(request).first, "options.travel.speed_model");
+  // Paths name the row under their own options too.
+  *travel = saved;
+  travel->mutable_speed_table(1)->set_speed_kmh(0);
+  v1::FindShortestPathRequest path;
+  path.set_mesh("meshes/hills");
+  path.mutable_from()->set_vertex(3);
+  path.mutable_to()->set_vertex(40);
+  *path.mutable_options() = request.options();
+  v1::FindShortestPathResponse response;
+  grpc::ClientContext context;
+  grpc::Status status = stub_->FindShortestPath(&context, path, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_EQ(BadField(status), "options.travel.speed_table[1]") << status.error_message();
 }
 
 TEST_F(TravelServiceTest, ErrorsNameTheTravelField) {
