@@ -654,6 +654,80 @@ class ControlLoopTest(unittest.TestCase):
         self.assertEqual(a_matrix.tobytes(), matrix.tobytes())
         self.assertEqual(a_matrix.travel_epsilon, 0.05)
 
+    def test_slope_dependent_speed_from_both_clients(self):
+        from geodex.aio import AsyncGeodexClient
+        sync = self.client(timeout=120)
+        mesh = sync.upload(bumpy_grid(21))  # slopes up to about 24 degrees
+        sources = [vertex(0), vertex(220)]
+        plain = sync.distance_field(mesh.name, sources)
+        # Tobler's speed: in seconds, never faster than its 6 km/h (0.6 s per metre of the
+        # shortest path), and a dict of Travel's fields is the same request.
+        tobler = geodex.Travel(speed="tobler", epsilon=0.05)
+        field = sync.distance_field(mesh.name, sources, travel=tobler)
+        self.assertEqual(field.travel_epsilon, 0.05)
+        self.assertTrue(numpy.all(numpy.isfinite(field.distances)))
+        self.assertTrue(numpy.all(field.distances >= plain.distances * 0.6 * (1 - 1e-9)))
+        self.assertGreater(field.distances.max(), 0)
+        same = sync.distance_field(mesh.name, sources, travel={"speed": "tobler", "epsilon": 0.05})
+        self.assertEqual(same.distances.tobytes(), field.distances.tobytes())
+        # Towards the sources is not from them on the bumps (its own field, not the cached one).
+        inbound = geodex.Travel(speed="tobler", epsilon=0.05, inbound=True)
+        towards = sync.distance_field(mesh.name, sources, travel=inbound, want_stats=True)
+        self.assertFalse(towards.stats.cached)
+        self.assertEqual(towards.travel_epsilon, 0.05)
+        differ = numpy.abs(towards.distances - field.distances) > 1e-6 * field.distances
+        self.assertGreater(differ.sum(), len(field.distances) // 2)
+        # A matrix is row to column (not symmetric); inbound, column to row.
+        points = [vertex(0), vertex(220), vertex(440)]
+        matrix = sync.distance_matrix(mesh.name, points, points, travel=tobler)
+        self.assertFalse(numpy.allclose(matrix, matrix.T, rtol=1e-6))
+        back = sync.distance_matrix(mesh.name, points, points, travel=inbound)
+        numpy.testing.assert_allclose(back, matrix.T, rtol=1e-9)
+        # A path is walked from its start (the way back takes another time) and refuses inbound.
+        there = sync.shortest_path(mesh.name, vertex(0), vertex(440), travel=tobler)
+        back_path = sync.shortest_path(mesh.name, vertex(440), vertex(0), travel=tobler)
+        self.assertEqual(there.travel_epsilon, 0.05)
+        self.assertGreater(len(there.points), 1)
+        self.assertNotEqual(there.length, back_path.length)
+        with self.assertRaises(geodex.InvalidArgumentError) as error:
+            sync.shortest_path(mesh.name, vertex(0), vertex(440), travel=inbound)
+        self.assertEqual(error.exception.field, "options.travel.inbound")
+        # A speed table (the model follows from the rows); speed_kmh=5 still means constant.
+        table = geodex.Travel(speed_table=[(-30, 2), (-5, 5.5), (0, 5), (30, 1.5)], epsilon=0.05)
+        tabled = sync.distance_field(mesh.name, sources, travel=table)
+        self.assertEqual(tabled.travel_epsilon, 0.05)
+        self.assertNotEqual(tabled.distances.tobytes(), field.distances.tobytes())
+        constant = sync.distance_field(mesh.name, sources,
+                                       travel=geodex.Travel(speed_kmh=5, epsilon=0.05))
+        self.assertNotEqual(constant.distances.tobytes(), field.distances.tobytes())
+        # Bad values name their field: the server's checks, and the client's own.
+        cases = [
+            (geodex.Travel(speed_table=[(-30, 2), (0, -5), (30, 2)]),
+             "options.travel.speed_table[1]"),
+            (geodex.Travel(speed_table=[(0, 5)]), "options.travel.speed_table"),
+            (geodex.Travel(speed="tobler", speed_table=[(-30, 2), (30, 2)]),
+             "options.travel.speed_table"),
+            (geodex.Travel(5, speed="tobler"), "options.travel.speed_kmh"),
+            (geodex.Travel(speed="table"), "options.travel.speed_table"),
+            (geodex.Travel(speed="walk"), "options.travel.speed_model"),
+            (geodex.Travel(speed_table=[(0, 5, 1), (10, 2, 1)]), "options.travel.speed_table"),
+        ]
+        for travel, field_name in cases:
+            with self.assertRaises(geodex.InvalidArgumentError, msg=str(travel)) as error:
+                sync.distance_field(mesh.name, sources, travel=travel)
+            self.assertEqual(error.exception.field, field_name, str(error.exception))
+        with self.assertRaises(geodex.InvalidArgumentError) as error:
+            sync.distance_field(mesh.name, sources, travel=geodex.Travel(speed="walk"))
+        self.assertIn("tobler", str(error.exception))  # lists the valid ones
+
+        async def run():
+            async with AsyncGeodexClient("127.0.0.1:" + self.port, timeout=120) as client:
+                return (await client.distance_field(mesh.name, sources, travel=inbound),
+                        await client.distance_matrix(mesh.name, points, points, travel=tobler))
+        a_field, a_matrix = asyncio.run(run())
+        self.assertEqual(a_field.distances.tobytes(), towards.distances.tobytes())
+        self.assertEqual(a_matrix.tobytes(), matrix.tobytes())
+
     def test_bad_names_are_typed_errors(self):
         client = self.client(timeout=60)
         mesh = client.upload(os.path.join(DATA, "knight.off"))

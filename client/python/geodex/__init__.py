@@ -25,7 +25,7 @@ from ._plans import SnapWarning  # noqa: E402
 from .results import (Delaunay, DistanceMatrix, Field, GisFile, Isolines, Located,  # noqa: E402
                       Mesh, Path, PathPoint, PointDistances, RetryPolicy, Travel, Voronoi)
 
-__version__ = "0.3.0"
+__version__ = "0.4.0"
 __all__ = [
     "GeodexClient", "RetryPolicy", "Travel", "Mesh", "vertex", "edge_point", "face_point",
     "position", "map_point", "lon_lat", "Field", "Path", "PathPoint", "Located", "PointDistances",

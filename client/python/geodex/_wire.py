@@ -85,9 +85,25 @@ def travel_cost(travel) -> "pb.TravelCost":
         travel = Travel(**travel)
     if not isinstance(travel, Travel):
         raise invalid("travel: expected a geodex.Travel, got %r" % (travel,), "options.travel")
-    out = pb.TravelCost(speed_kmh=travel.speed_kmh, max_slope_deg=travel.max_slope_deg)
+    out = pb.TravelCost(speed_kmh=travel.speed_kmh, max_slope_deg=travel.max_slope_deg,
+                        inbound=bool(travel.inbound))
     if travel.epsilon is not None:
         out.epsilon = travel.epsilon
+    speed = travel.speed
+    if speed is None:
+        speed = "constant" if travel.speed_table is None else "table"
+    out.speed_model = enum_value(pb.SpeedModel, "SPEED_MODEL_", speed,
+                                 "options.travel.speed_model")
+    if travel.speed_table is not None:
+        try:
+            rows = np.asarray(travel.speed_table, dtype=np.float64)
+        except (TypeError, ValueError):
+            rows = None
+        if rows is None or (rows.size and (rows.ndim != 2 or rows.shape[1] != 2)):
+            raise invalid("travel.speed_table: expected rows of (slope_deg, speed_kmh), got %r"
+                          % (travel.speed_table,), "options.travel.speed_table")
+        for slope_deg, speed_kmh in rows.reshape(-1, 2).tolist():
+            out.speed_table.add(slope_deg=slope_deg, speed_kmh=speed_kmh)
     if travel.face_weights is not None:
         out.face_weights.extend(np.asarray(travel.face_weights, dtype=np.float64).tolist())
     if travel.friction_geojson is not None:

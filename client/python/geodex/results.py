@@ -32,22 +32,36 @@ def _exact():
 @dataclasses.dataclass
 class Travel:
     """Travel time instead of length (geodex.v1.TravelCost, docs/travel.md), the `travel=` of
-    every query that takes solver options: its answers are then in SECONDS, each at least the
-    least travel time and at most (1 + epsilon) times it (the answer's `travel_epsilon`).
+    every query that takes solver options: its answers are then in SECONDS (the answer's
+    `travel_epsilon` > 0). With a constant speed each is at least the least travel time and at
+    most (1 + epsilon) times it; with a slope-dependent speed no bound is proved (epsilon only
+    sets the density of the server's Steiner points).
 
-    `speed_kmh`: the speed on a face of weight 1 (km/h, > 0). `epsilon`: the bound, in (0, 1)
-    (None: the server's 0.01). `max_slope_deg`: faces steeper than this (degrees from the x-y
-    plane) are impassable (0: no limit). `face_weights`: one friction per face of the mesh, in
-    order (> 0, inf impassable; None: 1). `friction_geojson`: GeoJSON polygons (text or a dict)
-    with a numeric "friction" property; each face takes the friction of the polygon holding its
+    `speed_kmh`: the constant speed on a face of weight 1 (km/h, > 0; leave it 0 with a
+    slope-dependent speed). `speed`: "constant", "tobler" (Tobler's hiking function: 6 km/h
+    slightly downhill, slower up and steeply down; a walker zigzags where that is quicker) or
+    "table" (None: "table" when speed_table is given, else "constant"). `speed_table`: rows
+    (slope in degrees, > 0 uphill, speed in km/h), at least 2, slopes strictly increasing in
+    [-90, 90] with the first <= 0 <= the last, speeds > 0; linear between rows, steeper slopes
+    cannot be walked. `inbound`: with a slope-dependent speed, times to REACH the sources instead
+    of from them (paths are walked from their start and refuse it). `epsilon`: in (0, 1) (None: the
+    server's 0.01). `max_slope_deg`: faces steeper than this (degrees from the x-y plane) are
+    impassable (0: no limit). `face_weights`: one friction per face of the mesh, in order (> 0,
+    inf impassable; None: 1). `friction_geojson`: GeoJSON polygons (text or a dict) with a
+    numeric "friction" property; each face takes the friction of the polygon holding its
     centroid (WGS 84 on a DEM's mesh unless the GeoJSON names its CRS, else the mesh's x y). At
     most one of face_weights and friction_geojson. Not with want_directions, delaunay() or the
-    unfolding estimates (point_distances() then returns exact values only)."""
-    speed_kmh: float
+    unfolding estimates (point_distances() then returns exact values only). The server checks
+    the values: a bad one is an InvalidArgumentError naming its field
+    (`"options.travel.speed_table[1]"`)."""
+    speed_kmh: float = 0.0
     epsilon: Optional[float] = None
     max_slope_deg: float = 0.0
     face_weights: Optional[Sequence[float]] = None
     friction_geojson: Union[None, str, Dict[str, Any]] = None
+    speed: Optional[str] = None
+    speed_table: Optional[Sequence[Tuple[float, float]]] = None
+    inbound: bool = False
 
 
 class _Unpacks:
