@@ -57,14 +57,17 @@ using api::StatsToProto;
 using api::SurfacePointToProto;
 
 // The request field of a core option error (InvalidOptionOf) under the options field `field`:
-// "lambda" -> "options.lambda", "travel.speed_kmh" -> "options.travel.speed_kmh", "travel" ->
-// "options.travel", and the weighted engine's "epsilon", "face_weight", "face_weight[7]" ->
-// "options.travel.epsilon", "options.travel.face_weights", "options.travel.face_weights[7]".
+// "lambda" -> "options.lambda", "travel.speed_kmh" -> "options.travel.speed_kmh",
+// "travel.speed_table[3]" -> "options.travel.speed_table[3]", "travel" -> "options.travel", and
+// the weighted engine's "epsilon", "face_weight", "face_weight[7]", "slope_cost" ->
+// "options.travel.epsilon", "options.travel.face_weights", "options.travel.face_weights[7]",
+// "options.travel.speed_table".
 std::string OptionFieldName(const std::string& option, const std::string& field = "options");
 
-// Solver options (lambda, lambda_scale, max_distance, and the travel cost's own values: speed,
-// epsilon, slope limit), checked by core's ValidateGeodesicOptions, errors naming the field
-// ("options.travel.speed_kmh"). `max_windows` and `max_steiner_points` come from the server's
+// Solver options (lambda, lambda_scale, max_distance, and the travel cost's own values: speed
+// model, speed, table, inbound, epsilon, slope limit), checked by core's ValidateGeodesicOptions,
+// errors naming the field ("options.travel.speed_kmh"; an unknown speed model is
+// "options.travel.speed_model" here). `max_windows` and `max_steiner_points` come from the server's
 // limits. The travel cost's face weights need the mesh: query_support.h's Options resolves them
 // (face_weights, friction_geojson); here only "at most one of them" is checked.
 absl::StatusOr<GeodesicOptions> SolverOptionsFromProto(const v1::SolverOptions& options,

@@ -562,6 +562,46 @@ TEST_F(TravelServiceTest, SlopeSpeedFieldsPathsAndMatricesEqualCore) {
     EXPECT_TRUE(BitEqual(values[i], want_matrix->values[i])) << i;
   }
   EXPECT_NE(values[0 * 3 + 2], values[2 * 3 + 0]);
+  // A row read from a cached one-source field (vertex targets, not the same points) is the row
+  // core solves, from the source or (inbound) towards it.
+  for (bool inbound : {false, true}) {
+    const GeodesicOptions options = SlopeTravel(inbound);
+    v1::ComputeDistanceFieldRequest field_request;
+    field_request.set_mesh("meshes/hills");
+    FieldQuery field_query;
+    field_query.sources = {SurfacePoint::AtVertex(212)};
+    field_query.options = options;
+    api::FieldQueryToProto(field_query, &field_request);
+    ASSERT_TRUE(ReadField(field_request).status.ok());
+    MatrixQuery row_query;
+    row_query.sources = field_query.sources;
+    for (uint32_t v = 7; v < 475; v += 53) row_query.targets.push_back(SurfacePoint::AtVertex(v));
+    row_query.options.solver = options;
+    row_query.options.threads = 1;
+    absl::StatusOr<DistanceMatrix> want_row =
+        ComputeDistanceMatrix(*local_, row_query.sources, row_query.targets, row_query.options);
+    ASSERT_TRUE(want_row.ok()) << want_row.status();
+    v1::ComputeDistanceMatrixRequest row_request;
+    row_request.set_mesh("meshes/hills");
+    row_request.set_want_stats(true);
+    api::MatrixQueryToProto(row_query, &row_request);
+    std::vector<v1::ComputeDistanceMatrixResponse> row_messages;
+    grpc::Status row_status = ReadAll<v1::ComputeDistanceMatrixResponse>(
+        [&](grpc::ClientContext* c, const auto& r) { return stub_->ComputeDistanceMatrix(c, r); },
+        row_request, &row_messages);
+    ASSERT_TRUE(row_status.ok()) << row_status.error_message();
+    std::vector<double> row;
+    bool row_cached = false;
+    for (const auto& m : row_messages) {
+      row.insert(row.end(), m.values_f64().begin(), m.values_f64().end());
+      if (m.has_stats()) row_cached = m.stats().cached();
+    }
+    EXPECT_TRUE(row_cached) << inbound;
+    ASSERT_EQ(row.size(), want_row->values.size());
+    for (size_t i = 0; i < row.size(); ++i) {
+      EXPECT_TRUE(BitEqual(row[i], want_row->values[i])) << inbound << " " << i;
+    }
+  }
   // Inbound, entry [i][j] is the time from target j to source i: the outbound [j][i].
   matrix_query.options.solver = SlopeTravel(/*inbound=*/true);
   request.Clear();
