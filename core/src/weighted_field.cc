@@ -8,6 +8,10 @@
 #include <utility>
 #include <vector>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "absl/strings/str_format.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/limits.h"
@@ -61,9 +65,14 @@ class SteinerGraph {
            1;
   }
   double Param(uint32_t node) const { return param_[node - nv_]; }
+  const double* Params(uint32_t node) const { return param_.data() + (node - nv_); }
   Vec Pos(uint32_t node) const {
     if (node < nv_) return mesh_.Position(node);
-    const uint32_t h = edge_half_[EdgeOfNode(node)];
+    return PosOn(node, EdgeOfNode(node));
+  }
+  // The position of Steiner node `node` of edge e.
+  Vec PosOn(uint32_t node, uint32_t e) const {
+    const uint32_t h = edge_half_[e];
     return Lerp(mesh_.Position(mesh_.From(h)), mesh_.Position(mesh_.To(h)), Param(node));
   }
   static Vec Lerp(const Vec& a, const Vec& b, double s) {
@@ -265,6 +274,8 @@ class IsotropicCost {
   double Edge(uint32_t e, double x, double y, double z) const {
     return g_.EdgeWeight(e) * std::sqrt(x * x + y * y + z * z);
   }
+  // A lower bound on Face(f, ...) per metre of 3D length (here the cost itself).
+  double FaceFloor(uint32_t f) const { return g_.FaceWeight(f); }
 
  private:
   const SteinerGraph& g_;
@@ -277,7 +288,10 @@ class IsotropicCost {
 class DirectionalCost {
  public:
   DirectionalCost(const SteinerGraph& g, const SlopeCost& slope, bool inbound)
-      : g_(g), table_(slope.per_metre), sign_(inbound ? -1 : 1) {
+      : g_(g),
+        table_(slope.per_metre),
+        sign_(inbound ? -1 : 1),
+        cheapest_(*std::min_element(table_.begin(), table_.end())) {
     const TriangleMesh& mesh = g.mesh();
     const uint32_t nf = mesh.face_count();
     inv_sin_.assign(nf, 0);
@@ -330,6 +344,9 @@ class DirectionalCost {
         sign_ * (x * edge_dir_[3 * e] + y * edge_dir_[3 * e + 1] + z * edge_dir_[3 * e + 2]);
     return len * (along >= 0 ? edge_fwd_[e] : edge_bwd_[e]);
   }
+  // A lower bound on Face(f, ...) per metre: the weight x the cheapest sample. The envelope's
+  // unit-cost set is the hull of samples no farther than 1 / cheapest, so it holds for zigzags too.
+  double FaceFloor(uint32_t f) const { return g_.FaceWeight(f) * cheapest_; }
 
  private:
   // A switchback range of a face: for slope sines in [lo, hi] the cost of a piece is
@@ -418,6 +435,7 @@ class DirectionalCost {
   const SteinerGraph& g_;
   const std::vector<double>& table_;
   double sign_;
+  double cheapest_;  // the table's least cost per metre
   std::vector<double> inv_sin_;
   std::vector<uint32_t> chord_first_;
   std::vector<Chord> chords_;
@@ -533,9 +551,50 @@ double DirectCost(const SteinerGraph& g, const Cost& cost, const Located& a, con
   return best;
 }
 
-// Dijkstra over the implicit graph: an indexed binary heap (decrease-key) keyed by cost, ties by
-// node id. Cost: IsotropicCost or DirectionalCost (a template, so the inner loop has no virtual
-// call).
+// Bit j of the result: node j of a chain (cost c[j], at a + t[j] d relative to the settled point)
+// might be improved by a link from the settled point, of cost `base` + length x at least
+// 1 / per_metre: the link's squared length is below the node's room squared, loosened by 1e-9 so
+// rounding never drops an improvement. Settled nodes (c[j] <= base) and nodes already cheaper
+// than any link could make them are not marked. count <= 64.
+inline uint64_t MarkCandidates(const double* c, const double* t, uint32_t count, double base,
+                               double per_metre, const Vec& a, const Vec& d) {
+  constexpr double kSlack = 1 + 1e-9;
+  uint64_t hits = 0;
+  uint32_t j = 0;
+#if defined(__SSE2__)
+  const __m128d vbase = _mm_set1_pd(base), vper = _mm_set1_pd(per_metre);
+  const __m128d vslack = _mm_set1_pd(kSlack), zero = _mm_setzero_pd();
+  const __m128d ax = _mm_set1_pd(a[0]), ay = _mm_set1_pd(a[1]), az = _mm_set1_pd(a[2]);
+  const __m128d dx = _mm_set1_pd(d[0]), dy = _mm_set1_pd(d[1]), dz = _mm_set1_pd(d[2]);
+  for (; j + 2 <= count; j += 2) {
+    const __m128d room = _mm_mul_pd(_mm_sub_pd(_mm_loadu_pd(c + j), vbase), vper);
+    const __m128d s = _mm_loadu_pd(t + j);
+    const __m128d x = _mm_add_pd(ax, _mm_mul_pd(s, dx));
+    const __m128d y = _mm_add_pd(ay, _mm_mul_pd(s, dy));
+    const __m128d z = _mm_add_pd(az, _mm_mul_pd(s, dz));
+    const __m128d len2 =
+        _mm_add_pd(_mm_add_pd(_mm_mul_pd(x, x), _mm_mul_pd(y, y)), _mm_mul_pd(z, z));
+    const __m128d hit = _mm_and_pd(_mm_cmpgt_pd(room, zero),
+                                   _mm_cmplt_pd(len2, _mm_mul_pd(_mm_mul_pd(room, room), vslack)));
+    hits |= uint64_t(_mm_movemask_pd(hit)) << j;
+  }
+#endif
+  for (; j < count; ++j) {
+    const double room = (c[j] - base) * per_metre;
+    const double x = a[0] + t[j] * d[0], y = a[1] + t[j] * d[1], z = a[2] + t[j] * d[2];
+    const bool hit = (room > 0) & (x * x + y * y + z * z < room * room * kSlack);
+    hits |= uint64_t{hit} << j;
+  }
+  return hits;
+}
+
+// Dijkstra over the implicit graph, nodes settled in order of (cost, node id). The queue is an
+// indexed binary heap of buckets, not of nodes: a bucket is a vertex or one edge's chain of
+// Steiner points, keyed by its least unsettled node. A node's cost drops about a hundred times
+// before it settles (each settled neighbour across a face offers a better link); in a bucket most
+// drops leave its least node alone and cost no heap work, and the heap is an edge count, not a
+// node count, deep. Settling a chain's least node rescans the chain. Cost: IsotropicCost or
+// DirectionalCost (a template, so the inner loop has no virtual call).
 template <typename Cost>
 class Search {
  public:
@@ -546,26 +605,44 @@ class Search {
         cost_(g.node_count(), kInf),
         label_(g.node_count(), kNoIndex),
         parent_(g.node_count(), kNoIndex),
-        slot_(g.node_count(), kNoIndex) {}
+        done_(g.node_count(), 0),
+        least_(g.nv() + g.edge_count(), kNoIndex),
+        slot_(g.nv() + g.edge_count(), kNoIndex),
+        run_lo_(g.edge_count(), kNoIndex),
+        run_hi_(g.edge_count(), kNoIndex) {}
 
-  void Offer(uint32_t node, double cost, uint32_t label, uint32_t parent) {
+  // The bucket of a node: the vertex itself, or nv + its edge.
+  uint32_t BucketOf(uint32_t node) const {
+    return node < g_.nv() ? node : g_.nv() + g_.EdgeOfNode(node);
+  }
+
+  void Offer(uint32_t node, uint32_t bucket, double cost, uint32_t label, uint32_t parent) {
     ++relaxations_;
+    Improve(node, bucket, cost, label, parent);
+  }
+  // Offer without the count (RelaxEdge counts its links in bulk).
+  void Improve(uint32_t node, uint32_t bucket, double cost, uint32_t label, uint32_t parent) {
     if (!(cost < cost_[node])) return;
     cost_[node] = cost;
     label_[node] = label;
     parent_[node] = parent;
-    if (slot_[node] == kNoIndex) {
-      slot_[node] = static_cast<uint32_t>(heap_.size());
-      heap_.push_back(node);
+    const uint32_t least = least_[bucket];
+    if (least == kNoIndex) {
+      least_[bucket] = node;
+      slot_[bucket] = static_cast<uint32_t>(heap_.size());
+      heap_.push_back(bucket);
+      SiftUp(slot_[bucket]);
+    } else if (node == least || Less(node, least)) {  // the bucket's key dropped
+      least_[bucket] = node;
+      SiftUp(slot_[bucket]);
     }
-    SiftUp(slot_[node]);
   }
 
   void Seed(const Located& p, uint32_t label) {
     const uint32_t parent =
         p.canonical.kind == SurfacePoint::Kind::kVertex ? kFromSourceVertex : kFromSourcePoint;
     ForEachLink(g_, p, [&](uint32_t n, Medium m) {
-      Offer(n, LinkCost(costs_, m, p.pos, g_.Pos(n)), label, parent);
+      Offer(n, BucketOf(n), LinkCost(costs_, m, p.pos, g_.Pos(n)), label, parent);
     });
   }
 
@@ -575,10 +652,12 @@ class Search {
   absl::Status Run(const WeightedOptions& options, Stop&& stop, Settled&& settled) {
     uint32_t polls = 0;
     while (!heap_.empty()) {
-      const uint32_t u = heap_[0];
+      const uint32_t bucket = heap_[0];
+      const uint32_t u = least_[bucket];
       const double d = cost_[u];
       if (d > options.max_distance || stop(d)) break;
-      PopTop();
+      done_[u] = 1;
+      Refill(bucket);
       ++settled_;
       if (++polls == 4096) {
         polls = 0;
@@ -586,10 +665,33 @@ class Search {
           return absl::CancelledError("weighted solve cancelled");
         }
       }
-      Settle(u, d);
+      Settle(u, bucket, d);
       settled(u);
     }
     peak_heap_ = std::max<uint64_t>(peak_heap_, heap_.capacity());
+    return absl::OkStatus();
+  }
+
+  // Checks the search's result: no link from a settled node lowers any node's cost. Run after
+  // the search (it relaxes every settled node's links again, as if unsettled, and compares).
+  absl::Status CheckOptimality() {
+    const std::vector<double> settled_cost = cost_;
+    std::vector<uint32_t> settled;
+    for (uint32_t n = 0; n < done_.size(); ++n) {
+      if (done_[n]) settled.push_back(n);
+    }
+    std::fill(done_.begin(), done_.end(), 0);
+    std::fill(run_lo_.begin(), run_lo_.end(), kNoIndex);
+    checking_ = true;  // every link is evaluated, the lower-bound skip too is under test
+    for (const uint32_t u : settled) Settle(u, BucketOf(u), settled_cost[u]);
+    checking_ = false;
+    for (uint32_t n = 0; n < cost_.size(); ++n) {
+      if (cost_[n] < settled_cost[n]) {
+        return absl::InternalError(
+            absl::StrFormat("weighted search: node %d costs %.17g, a link offers %.17g", n,
+                            settled_cost[n], cost_[n]));
+      }
+    }
     return absl::OkStatus();
   }
 
@@ -611,7 +713,8 @@ class Search {
     WeightedStats s;
     s.nodes_settled = settled_;
     s.edge_relaxations = relaxations_;
-    s.peak_bytes = g_.bytes() + cost_.size() * (sizeof(double) + 3 * sizeof(uint32_t)) +
+    s.peak_bytes = g_.bytes() + cost_.size() * (sizeof(double) + 2 * sizeof(uint32_t) + 1) +
+                   (least_.size() + run_lo_.size()) * 2 * sizeof(uint32_t) +
                    peak_heap_ * sizeof(uint32_t);
     s.solve_ms = ms;
     return s;
@@ -621,61 +724,130 @@ class Search {
   bool Less(uint32_t a, uint32_t b) const {
     return cost_[a] < cost_[b] || (cost_[a] == cost_[b] && a < b);
   }
+  bool Before(uint32_t bucket_a, uint32_t bucket_b) const {
+    return Less(least_[bucket_a], least_[bucket_b]);
+  }
   void SiftUp(uint32_t i) {
-    const uint32_t n = heap_[i];
+    const uint32_t b = heap_[i];
     while (i > 0) {
       const uint32_t p = (i - 1) / 2;
-      if (!Less(n, heap_[p])) break;
+      if (!Before(b, heap_[p])) break;
       heap_[i] = heap_[p];
       slot_[heap_[i]] = i;
       i = p;
     }
-    heap_[i] = n;
-    slot_[n] = i;
+    heap_[i] = b;
+    slot_[b] = i;
   }
-  void PopTop() {
-    peak_heap_ = std::max<uint64_t>(peak_heap_, heap_.size());
-    slot_[heap_[0]] = kNoIndex - 1;  // settled: never re-entered (costs only decrease before)
-    const uint32_t last = heap_.back();
-    heap_.pop_back();
-    if (heap_.empty()) return;
+  void SiftDown(uint32_t i) {
+    const uint32_t b = heap_[i];
     const uint32_t size = static_cast<uint32_t>(heap_.size());
-    uint32_t i = 0;
     while (true) {
       uint32_t c = 2 * i + 1;
       if (c >= size) break;
-      if (c + 1 < size && Less(heap_[c + 1], heap_[c])) ++c;
-      if (!Less(heap_[c], last)) break;
+      if (c + 1 < size && Before(heap_[c + 1], heap_[c])) ++c;
+      if (!Before(heap_[c], b)) break;
       heap_[i] = heap_[c];
       slot_[heap_[i]] = i;
       i = c;
     }
-    heap_[i] = last;
-    slot_[last] = i;
+    heap_[i] = b;
+    slot_[b] = i;
+  }
+  // The top bucket's least node was just settled: its next least unsettled node (with a cost)
+  // becomes its key, or the bucket leaves the heap.
+  void Refill(uint32_t bucket) {
+    uint32_t least = kNoIndex;
+    if (bucket >= g_.nv()) {
+      const uint32_t e = bucket - g_.nv();
+      const uint32_t first = g_.First(e), end = g_.End(e);
+      const uint32_t settled = least_[bucket];
+      // Grow the edge's settled run by the node just settled (and any settled nodes it joins).
+      if (run_lo_[e] == kNoIndex) {
+        run_lo_[e] = settled;
+        run_hi_[e] = settled + 1;
+      } else if (settled == run_hi_[e]) {
+        ++run_hi_[e];
+      } else if (settled + 1 == run_lo_[e]) {
+        --run_lo_[e];
+      }
+      while (run_hi_[e] < end && done_[run_hi_[e]]) ++run_hi_[e];
+      while (run_lo_[e] > first && done_[run_lo_[e] - 1]) --run_lo_[e];
+      double best = kInf;
+      auto scan = [&](uint32_t from, uint32_t to) {
+        for (uint32_t n = from; n < to; ++n) {
+          if (!done_[n] && cost_[n] < best) {  // (cost, id): the first of equal costs wins
+            best = cost_[n];
+            least = n;
+          }
+        }
+      };
+      scan(first, run_lo_[e]);
+      scan(run_hi_[e], end);
+    }
+    least_[bucket] = least;
+    if (least != kNoIndex) {
+      SiftDown(0);
+      return;
+    }
+    peak_heap_ = std::max<uint64_t>(peak_heap_, heap_.size());
+    slot_[bucket] = kNoIndex;
+    const uint32_t last = heap_.back();
+    heap_.pop_back();
+    if (heap_.empty()) return;
+    heap_[0] = last;
+    SiftDown(0);
   }
 
   // Relaxes the Steiner nodes of edge e from point p across face f.
   void RelaxEdge(uint32_t e, const Vec& p, double base, uint32_t f, uint32_t label, uint32_t from) {
     const uint32_t begin = g_.First(e), end = g_.End(e);
     if (begin == end) return;
+    const uint32_t bucket = g_.nv() + e;
     const uint32_t h = g_.EdgeHalf(e);
     const Vec a = mesh_.Position(mesh_.From(h)), b = mesh_.Position(mesh_.To(h));
     const double ax = a[0] - p[0], ay = a[1] - p[1], az = a[2] - p[2];
     const double dx = b[0] - a[0], dy = b[1] - a[1], dz = b[2] - a[2];
-    for (uint32_t n = begin; n < end; ++n) {
-      if (slot_[n] == kNoIndex - 1) continue;  // settled
-      const double s = g_.Param(n);
-      const double x = ax + s * dx, y = ay + s * dy, z = az + s * dz;
-      Offer(n, base + costs_.Face(f, x, y, z), label, from);
+    // Most links cannot improve their node: skip them on a square-root-free lower bound, length
+    // x the face's least cost per metre (slightly loosened, so rounding never skips an
+    // improvement; the cost that is offered is computed in full). Settled nodes cost at most
+    // `base`, so they fail it too.
+    const double per_metre = checking_ ? kInf : 1 / costs_.FaceFloor(f);  // (check: no skips)
+    const double* param = g_.Params(begin);
+    const double* cost = cost_.data();
+    // The settled run is skipped whole; the nodes on either side are tested.
+    const uint32_t run_lo = run_lo_[e] == kNoIndex ? end : run_lo_[e];
+    const uint32_t run_hi = run_lo_[e] == kNoIndex ? end : run_hi_[e];
+    relaxations_ += (run_lo - begin) + (end - run_hi);
+    // In blocks of 64: a branch-free pass marks the candidates, then only they are offered.
+    uint32_t count = 0;
+    for (uint32_t block = begin; block < end; block += count) {
+      if (block == run_lo) block = run_hi;
+      if (block >= end) break;
+      count = std::min<uint32_t>(64, (block < run_lo ? run_lo : end) - block);
+      const double* c = cost + block;
+      const double* t = param + (block - begin);
+      uint64_t hits = MarkCandidates(c, t, count, base, per_metre, {ax, ay, az}, {dx, dy, dz});
+      while (hits != 0) {
+        const uint32_t j = static_cast<uint32_t>(__builtin_ctzll(hits));
+        hits &= hits - 1;
+        const uint32_t n = block + j;
+        if (done_[n]) continue;  // settled (a zero-length link)
+        const double x = ax + t[j] * dx, y = ay + t[j] * dy, z = az + t[j] * dz;
+        Improve(n, bucket, base + costs_.Face(f, x, y, z), label, from);
+      }
     }
   }
-  void RelaxNode(uint32_t n, const Vec& p, double base, Medium m, uint32_t label, uint32_t from) {
-    if (slot_[n] == kNoIndex - 1) return;
-    Offer(n, base + LinkCost(costs_, m, p, g_.Pos(n)), label, from);
+  // Relaxes node n (of `bucket`) from p through medium m.
+  void RelaxNode(uint32_t n, uint32_t bucket, const Vec& p, double base, Medium m, uint32_t label,
+                 uint32_t from) {
+    if (done_[n]) return;
+    Offer(n, bucket, base + LinkCost(costs_, m, p, g_.Pos(n)), label, from);
   }
 
-  void Settle(uint32_t u, double d) {
-    const Vec p = g_.Pos(u);
+  void Settle(uint32_t u, uint32_t bucket, double d) {
+    const uint32_t nv = g_.nv();
+    const Vec p = u < nv ? mesh_.Position(u) : g_.PosOn(u, bucket - nv);
     const uint32_t lab = label_[u];
     if (u < g_.nv()) {
       for (const uint32_t* c = mesh_.CornersBegin(u); c != mesh_.CornersEnd(u); ++c) {
@@ -689,7 +861,7 @@ class Search {
           } else {
             next = mesh_.From(g_.EdgeHalf(e)) == u ? g_.First(e) : g_.End(e) - 1;
           }
-          RelaxNode(next, p, d, Medium{Medium::kEdge, e}, lab, u);
+          RelaxNode(next, next < nv ? next : nv + e, p, d, Medium{Medium::kEdge, e}, lab, u);
         }
         // Across the face: the opposite edge's Steiner points.
         const uint32_t f = TriangleMesh::FaceOf(*c);
@@ -699,12 +871,20 @@ class Search {
       }
       return;
     }
-    const uint32_t e = g_.EdgeOfNode(u);
+    const uint32_t e = bucket - nv;
     const uint32_t h0 = g_.EdgeHalf(e);
     if (std::isfinite(g_.EdgeWeight(e))) {  // (a Steiner node's edge has a passable face)
       const Medium along{Medium::kEdge, e};
-      RelaxNode(u == g_.First(e) ? mesh_.From(h0) : u - 1, p, d, along, lab, u);
-      RelaxNode(u + 1 == g_.End(e) ? mesh_.To(h0) : u + 1, p, d, along, lab, u);
+      if (u == g_.First(e)) {
+        RelaxNode(mesh_.From(h0), mesh_.From(h0), p, d, along, lab, u);
+      } else {
+        RelaxNode(u - 1, bucket, p, d, along, lab, u);
+      }
+      if (u + 1 == g_.End(e)) {
+        RelaxNode(mesh_.To(h0), mesh_.To(h0), p, d, along, lab, u);
+      } else {
+        RelaxNode(u + 1, bucket, p, d, along, lab, u);
+      }
     }
     for (const uint32_t h : {h0, mesh_.Twin(h0)}) {
       if (h == kNoIndex) continue;
@@ -712,7 +892,8 @@ class Search {
       if (!std::isfinite(g_.FaceWeight(f))) continue;
       RelaxEdge(g_.EdgeOfHalf(TriangleMesh::Next(h)), p, d, f, lab, u);
       RelaxEdge(g_.EdgeOfHalf(TriangleMesh::Prev(h)), p, d, f, lab, u);
-      RelaxNode(mesh_.Opposite(h), p, d, Medium{Medium::kFace, f}, lab, u);
+      const uint32_t o = mesh_.Opposite(h);
+      RelaxNode(o, o, p, d, Medium{Medium::kFace, f}, lab, u);
     }
   }
 
@@ -720,8 +901,15 @@ class Search {
   const Cost& costs_;
   const TriangleMesh& mesh_;
   std::vector<double> cost_;
-  std::vector<uint32_t> label_, parent_, slot_;
-  std::vector<uint32_t> heap_;
+  std::vector<uint32_t> label_, parent_;
+  std::vector<uint8_t> done_;           // per node: settled
+  std::vector<uint32_t> least_, slot_;  // per bucket: least unsettled node, heap position
+  // Per edge: a run [lo, hi) of its settled Steiner nodes, the first one settled and those that
+  // joined it (on an edge the wave mostly settles outward from where it arrived); relaxations and
+  // rescans skip it.
+  std::vector<uint32_t> run_lo_, run_hi_;
+  bool checking_ = false;       // CheckOptimality is running
+  std::vector<uint32_t> heap_;  // buckets
   uint64_t settled_ = 0, relaxations_ = 0, peak_heap_ = 0;
 };
 
@@ -789,6 +977,7 @@ absl::Status SearchWhole(const std::vector<Located>& sources, const WeightedOpti
   for (uint32_t i = 0; i < sources.size(); ++i) search->Seed(sources[i], i);
   absl::Status status = search->Run(
       options, [](double) { return false; }, [](uint32_t) {});
+  if (status.ok() && options.check_optimality) status = search->CheckOptimality();
   if (status.ok()) search->ClampTo(options.max_distance);
   return status;
 }

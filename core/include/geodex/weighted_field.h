@@ -102,6 +102,10 @@ struct WeightedOptions {
   // With a slope cost: costs of reaching the sources (a walker ends there) rather than of leaving
   // them. A path from `from` to `to` is always walked from `from`.
   bool inbound = false;
+  // A self-check for tests (it costs a second pass over every graph edge): after a whole search,
+  // every edge's far node must cost no more than its near node plus the link (the search settled
+  // the graph's least costs); otherwise the solve fails with an Internal error.
+  bool check_optimality = false;
 };
 
 // Checks epsilon, max_distance, the weights (their count against the mesh's faces) and the slope
