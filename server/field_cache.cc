@@ -46,8 +46,8 @@ std::string FieldCacheKey(const std::string& mesh_id, const std::vector<SurfaceP
   Append(&key, static_cast<int>(options.lambda_scale));
   Append(&key, options.max_distance);
   // A travel field is never another field: a marker byte, then its speed model, speed, table
-  // (row count, then the rows), direction (inbound), bound, slope limit and weights (by their
-  // SHA-256; the friction polygons count by the weights they made).
+  // (row count, then the rows), direction (inbound, for a slope speed), bound, slope limit and
+  // weights (by their SHA-256; the friction polygons count by the weights they made).
   Append(&key, static_cast<uint8_t>(options.travel.has_value()));
   if (options.travel) {
     const TravelCost& travel = *options.travel;
@@ -56,7 +56,8 @@ std::string FieldCacheKey(const std::string& mesh_id, const std::vector<SurfaceP
     const size_t rows = travel.speed_table == nullptr ? 0 : travel.speed_table->size();
     Append(&key, rows);
     for (size_t i = 0; i < rows; ++i) Append(&key, (*travel.speed_table)[i]);
-    Append(&key, static_cast<uint8_t>(travel.inbound));
+    // (a constant speed takes the same time both ways: one entry for both directions)
+    Append(&key, static_cast<uint8_t>(travel.inbound && IsDirectional(travel)));
     Append(&key, travel.epsilon);
     Append(&key, travel.max_slope_deg);
     const bool weighted = travel.face_weight != nullptr;
