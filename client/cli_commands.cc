@@ -569,13 +569,10 @@ std::string TravelTextHeader(const GeodesicOptions& options) {
 std::string TravelJsonMembers(const GeodesicOptions& options) {
   if (!options.travel.has_value()) return "";
   const TravelCost& t = *options.travel;
-  const char* speed = t.speed_model == SpeedModel::kConstant ? "constant"
-                      : t.speed_model == SpeedModel::kTobler ? "tobler"
-                                                             : "table";
   return absl::StrFormat(
       "\"unit\": \"s\", \"approximate\": true, \"epsilon\": %s, \"bound\": %s, \"speed\": "
       "\"%s\", \"inbound\": %s, ",
-      JsonNumber(t.epsilon), IsDirectional(t) ? "false" : "true", speed,
+      JsonNumber(t.epsilon), IsDirectional(t) ? "false" : "true", SpeedModelName(t.speed_model),
       t.inbound ? "true" : "false");
 }
 

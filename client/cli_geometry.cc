@@ -284,9 +284,11 @@ int RunIsolines(Backend& backend, const Args& args) {
     // Isochrones: per level, the area within that distance (union of each face's part below it).
     absl::StatusOr<const DistanceField*> field = backend.Field({s.points, query.options, false});
     if (!field.ok()) return FailQuery(field.status());
-    return WriteVectorOutput(backend, args,
-                             terrain::IsochroneFeatures(*s.data, (*field)->distance, iso->levels,
-                                                        (*field)->travel_epsilon));
+    return WriteVectorOutput(
+        backend, args,
+        terrain::IsochroneFeatures(
+            *s.data, (*field)->distance, iso->levels,
+            query.options.travel.has_value() ? &*query.options.travel : nullptr));
   }
   if (format == Format::kObj) return WriteOutput(args, Obj("isolines", lines));
   if (format == Format::kSvg)

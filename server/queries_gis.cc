@@ -175,8 +175,10 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
     case v1::GIS_PRODUCT_ISOCHRONES: {
       absl::StatusOr<Isolines> iso = ExtractIsolines(mesh, field, *levels);  // its levels
       if (!iso.ok()) return iso.status();
-      return geojson_of(grid, terrain::IsochroneFeatures(grid.mesh(), field.distance, iso->levels,
-                                                         field.travel_epsilon));
+      const GeodesicOptions& options = solved->options;
+      return geojson_of(grid, terrain::IsochroneFeatures(
+                                  grid.mesh(), field.distance, iso->levels,
+                                  options.travel.has_value() ? &*options.travel : nullptr));
     }
     case v1::GIS_PRODUCT_VORONOI: {
       absl::StatusOr<VoronoiDiagram> diagram = BuildVoronoi(mesh, field);

@@ -212,11 +212,13 @@ absl::Status WriteVectorFile(const DemInfo& dem, const std::vector<GeoFeature>& 
         continue;
       fields[at->second].second = std::holds_alternative<double>(value)    ? OFTReal
                                   : std::holds_alternative<int64_t>(value) ? OFTInteger64
+                                  : std::holds_alternative<bool>(value)    ? OFTInteger
                                                                            : OFTString;
     }
   }
   for (const auto& [name, type] : fields) {
     OGRFieldDefn field(name.c_str(), type);
+    if (type == OFTInteger) field.SetSubType(OFSTBoolean);  // (bool is the only OFTInteger)
     if (layer->CreateField(&field) != OGRERR_NONE) return failed(QuietGdal::LastMessage());
   }
   for (const GeoFeature& f : features) {
@@ -254,6 +256,8 @@ absl::Status WriteVectorFile(const DemInfo& dem, const std::vector<GeoFeature>& 
         feature->SetField(name.c_str(), *d);
       } else if (const int64_t* i = std::get_if<int64_t>(&value)) {
         feature->SetField(name.c_str(), static_cast<GIntBig>(*i));
+      } else if (const bool* b = std::get_if<bool>(&value)) {
+        feature->SetField(name.c_str(), *b ? 1 : 0);
       } else {
         feature->SetField(name.c_str(), std::get<std::string>(value).c_str());
       }
@@ -278,15 +282,20 @@ absl::StatusOr<std::string> GeoJsonText(const DemInfo& dem, const std::vector<Ge
 
 std::vector<GeoFeature> IsochroneFeatures(const MeshData& mesh, const std::vector<double>& distance,
                                           const std::vector<double>& levels,
-                                          double travel_epsilon) {
+                                          const TravelCost* travel) {
   std::vector<GeoFeature> features;
   for (double level : levels) {
     GeoFeature f;
     f.kind = GeoFeature::Kind::kArea;
     f.pieces = SublevelPieces(mesh, distance, level);
     f.exact_tiling = true;
-    f.properties = {{"level", level}, {"units", std::string(travel_epsilon > 0 ? "s" : "m")}};
-    if (travel_epsilon > 0) f.properties.push_back({"epsilon", travel_epsilon});
+    f.properties = {{"level", level}, {"units", std::string(travel != nullptr ? "s" : "m")}};
+    if (travel != nullptr) {
+      f.properties.push_back({"epsilon", travel->epsilon});
+      f.properties.push_back({"bound", !IsDirectional(*travel)});
+      f.properties.push_back({"speed", std::string(SpeedModelName(travel->speed_model))});
+      f.properties.push_back({"inbound", travel->inbound && IsDirectional(*travel)});
+    }
     features.push_back(std::move(f));
   }
   return features;

@@ -112,7 +112,9 @@ from osgeo import ogr
 areas = {}
 for x in json.load(open('$tmp/iso.geojson'))['features']:
     g = ogr.CreateGeometryFromJson(json.dumps(x['geometry']))
-    assert g.IsValid() and x['properties']['units'] == 's', x['properties']
+    p = x['properties']
+    assert g.IsValid() and p['units'] == 's', p
+    assert p['bound'] is False and p['speed'] == 'tobler' and p['inbound'] is False, p
     areas[x['properties']['level']] = areas.get(x['properties']['level'], 0) + g.GetArea()
 assert sorted(areas) == [60, 120, 180], areas
 assert 0 < areas[60] < areas[120] < areas[180], areas"

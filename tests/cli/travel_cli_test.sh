@@ -112,6 +112,7 @@ for x in f:
     g = ogr.CreateGeometryFromJson(json.dumps(x['geometry']))
     assert g.IsValid(), x['properties']
     assert x['properties']['units'] == 's' and x['properties']['epsilon'] == 0.01, x['properties']
+    assert x['properties']['bound'] is True and x['properties']['speed'] == 'constant', x['properties']
     areas[x['properties']['level']] = areas.get(x['properties']['level'], 0) + g.GetArea()
 assert sorted(areas) == [60, 120], areas
 for r in (60, 120):

@@ -731,11 +731,19 @@ TEST_F(TerrainServiceTest, TravelWithFrictionInTheDemsMap) {
     auto reader = stub_->ExportGis(&context, gis);
     v1::ExportGisResponse message;
     std::vector<double> bounds;
-    while (reader->Read(&message)) bounds.push_back(message.travel_epsilon());
+    std::string file;
+    while (reader->Read(&message)) {
+      bounds.push_back(message.travel_epsilon());
+      file += message.data();
+    }
     grpc::Status status = reader->Finish();
     ASSERT_TRUE(status.ok()) << status.error_message();
     ASSERT_FALSE(bounds.empty());
     EXPECT_EQ(bounds.front(), 0.1);
+    // Each feature says how its times were made, as the CLI's files do.
+    EXPECT_NE(file.find(R"("units": "s", "epsilon": 0.1, "bound": true, "speed": "constant")"),
+              std::string::npos)
+        << file.substr(0, 400);
   }
   gis.set_product(v1::GIS_PRODUCT_DELAUNAY);
   {

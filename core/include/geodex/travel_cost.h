@@ -68,6 +68,19 @@ inline bool IsDirectional(const TravelCost& travel) {
   return travel.speed_model != SpeedModel::kConstant;
 }
 
+// The model's name in answers: "constant", "tobler" or "table".
+inline const char* SpeedModelName(SpeedModel model) {
+  switch (model) {
+    case SpeedModel::kConstant:
+      return "constant";
+    case SpeedModel::kTobler:
+      return "tobler";
+    case SpeedModel::kTable:
+      return "table";
+  }
+  return "constant";
+}
+
 // Tobler's hiking function: km/h at s = rise / run along the direction of travel.
 double ToblerKmh(double rise_over_run);
 

@@ -18,13 +18,15 @@
 #include "geodex/mesh_data.h"
 #include "geodex/shortest_path.h"
 #include "geodex/terrain.h"
+#include "geodex/travel_cost.h"
 #include "geodex/voronoi.h"
 
 namespace geodex::terrain {
 
 using Polygon2 = std::vector<std::array<double, 2>>;  // one ring, mesh x y (not closed)
 // A property's value; std::monostate is JSON null (written as null, not left out).
-using Property = std::pair<std::string, std::variant<std::monostate, double, int64_t, std::string>>;
+using Property =
+    std::pair<std::string, std::variant<std::monostate, double, int64_t, std::string, bool>>;
 
 struct GeoFeature {
   enum class Kind { kArea, kLine, kPoint };
@@ -51,11 +53,13 @@ absl::StatusOr<std::string> GeoJsonText(const DemInfo& dem, const std::vector<Ge
 
 // The features of each product, as the CLI and geodexd write them; x y z in the DEM's mesh.
 // Isochrones: per level, the area within that distance (`level`, `units` "m"), from the field's
-// vertex values on `mesh`. A travel-cost field (travel_epsilon > 0, geodex/travel_cost.h): levels
-// are times (`units` "s") and each feature says its bound (`epsilon`).
+// vertex values on `mesh`. A travel-cost field (`travel` non-null, geodex/travel_cost.h): levels
+// are times (`units` "s") and each feature says how they were made, as JSON answers do:
+// `epsilon`, `bound` (true: within (1 + epsilon) of the least time; false for a slope speed, which
+// has no proven bound), `speed` ("constant", "tobler", "table") and `inbound`.
 std::vector<GeoFeature> IsochroneFeatures(const MeshData& mesh, const std::vector<double>& distance,
                                           const std::vector<double>& levels,
-                                          double travel_epsilon = 0);
+                                          const TravelCost* travel = nullptr);
 // Voronoi cells: one (Multi)Polygon per site (`site`, `area`), its whole faces and fragments.
 std::vector<GeoFeature> VoronoiFeatures(const MeshData& mesh, const VoronoiDiagram& diagram);
 // Delaunay edges: one 3D LineString per edge (`site_a`, `site_b`, `length`).
