@@ -609,7 +609,8 @@ class Search {
         least_(g.nv() + g.edge_count(), kNoIndex),
         slot_(g.nv() + g.edge_count(), kNoIndex),
         run_lo_(g.edge_count(), kNoIndex),
-        run_hi_(g.edge_count(), kNoIndex) {}
+        run_hi_(g.edge_count(), kNoIndex),
+        chain_max_(g.edge_count(), kInf) {}
 
   // The bucket of a node: the vertex itself, or nv + its edge.
   uint32_t BucketOf(uint32_t node) const {
@@ -715,7 +716,7 @@ class Search {
     s.edge_relaxations = relaxations_;
     s.peak_bytes = g_.bytes() + cost_.size() * (sizeof(double) + 2 * sizeof(uint32_t) + 1) +
                    (least_.size() + run_lo_.size()) * 2 * sizeof(uint32_t) +
-                   peak_heap_ * sizeof(uint32_t);
+                   chain_max_.size() * sizeof(double) + peak_heap_ * sizeof(uint32_t);
     s.solve_ms = ms;
     return s;
   }
@@ -773,10 +774,12 @@ class Search {
       }
       while (run_hi_[e] < end && done_[run_hi_[e]]) ++run_hi_[e];
       while (run_lo_[e] > first && done_[run_lo_[e] - 1]) --run_lo_[e];
-      double best = kInf;
+      double best = kInf, most = 0;
       auto scan = [&](uint32_t from, uint32_t to) {
         for (uint32_t n = from; n < to; ++n) {
-          if (!done_[n] && cost_[n] < best) {  // (cost, id): the first of equal costs wins
+          if (done_[n]) continue;
+          most = std::max(most, cost_[n]);
+          if (cost_[n] < best) {  // (cost, id): the first of equal costs wins
             best = cost_[n];
             least = n;
           }
@@ -784,6 +787,7 @@ class Search {
       };
       scan(first, run_lo_[e]);
       scan(run_hi_[e], end);
+      chain_max_[e] = most;  // costs only drop: it stays an upper bound until the next rescan
     }
     least_[bucket] = least;
     if (least != kNoIndex) {
@@ -812,7 +816,19 @@ class Search {
     // x the face's least cost per metre (slightly loosened, so rounding never skips an
     // improvement; the cost that is offered is computed in full). Settled nodes cost at most
     // `base`, so they fail it too.
-    const double per_metre = checking_ ? kInf : 1 / costs_.FaceFloor(f);  // (check: no skips)
+    const double floor = costs_.FaceFloor(f);
+    if (!checking_ && std::isfinite(chain_max_[e])) {
+      // The whole chain: no link is shorter than the distance from p to the edge, so when that
+      // costs more than the chain's costliest unsettled node, nothing can improve.
+      const double sx = -ax, sy = -ay, sz = -az;  // p - a
+      const double along =
+          std::clamp((sx * dx + sy * dy + sz * dz) / (dx * dx + dy * dy + dz * dz), 0.0, 1.0);
+      const double qx = sx - along * dx, qy = sy - along * dy, qz = sz - along * dz;
+      if (base + floor * std::sqrt(qx * qx + qy * qy + qz * qz) * (1 - 1e-9) >= chain_max_[e]) {
+        return;
+      }
+    }
+    const double per_metre = checking_ ? kInf : 1 / floor;  // (check: no skips)
     const double* param = g_.Params(begin);
     const double* cost = cost_.data();
     // The settled run is skipped whole; the nodes on either side are tested.
@@ -908,6 +924,9 @@ class Search {
   // joined it (on an edge the wave mostly settles outward from where it arrived); relaxations and
   // rescans skip it.
   std::vector<uint32_t> run_lo_, run_hi_;
+  // Per edge: at least the cost of its costliest unsettled node (+inf until the edge's first
+  // rescan, or while one is unreached); a relaxation that cannot beat it skips the chain.
+  std::vector<double> chain_max_;
   bool checking_ = false;       // CheckOptimality is running
   std::vector<uint32_t> heap_;  // buckets
   uint64_t settled_ = 0, relaxations_ = 0, peak_heap_ = 0;
