@@ -276,6 +276,14 @@ class IsotropicCost {
   }
   // A lower bound on Face(f, ...) per metre of 3D length (here the cost itself).
   double FaceFloor(uint32_t f) const { return g_.FaceWeight(f); }
+  // Face(f, ...) with f's values read once (a relaxation evaluates many pieces in one face).
+  struct FaceWalk {
+    double w;
+    double operator()(double x, double y, double z) const {
+      return w * std::sqrt(x * x + y * y + z * z);
+    }
+  };
+  FaceWalk ForFace(uint32_t f) const { return {g_.FaceWeight(f)}; }
 
  private:
   const SteinerGraph& g_;
@@ -334,9 +342,7 @@ class DirectionalCost {
     }
   }
 
-  double Face(uint32_t f, double x, double y, double z) const {
-    return Walk(f, sign_ * x, sign_ * y, sign_ * z);
-  }
+  double Face(uint32_t f, double x, double y, double z) const { return ForFace(f)(x, y, z); }
   double Edge(uint32_t e, double x, double y, double z) const {
     const double len = std::sqrt(x * x + y * y + z * z);
     if (len == 0) return 0;
@@ -356,32 +362,54 @@ class DirectionalCost {
   };
 
   // Cost per metre at slope sine `sine` (linear between samples).
-  double PerMetre(double sine) const {
-    const double at = (std::clamp(sine, -1.0, 1.0) + 1) * 0.5 * (table_.size() - 1);
-    const size_t i = std::min(static_cast<size_t>(at), table_.size() - 2);
+  static double Interpolate(const std::vector<double>& table, double sine) {
+    const double at = (std::clamp(sine, -1.0, 1.0) + 1) * 0.5 * (table.size() - 1);
+    const size_t i = std::min(static_cast<size_t>(at), table.size() - 2);
     const double t = at - i;
-    if (t == 0) return table_[i];
-    if (t == 1) return table_[i + 1];
-    return table_[i] + t * (table_[i + 1] - table_[i]);  // +inf stays +inf
+    if (t == 0) return table[i];
+    if (t == 1) return table[i + 1];
+    return table[i] + t * (table[i + 1] - table[i]);  // +inf stays +inf
   }
+  double PerMetre(double sine) const { return Interpolate(table_, sine); }
 
-  // The walker's cost of the piece (x, y, z) inside face f.
-  double Walk(uint32_t f, double x, double y, double z) const {
-    const double len2 = x * x + y * y + z * z;
-    if (len2 == 0) return 0;
-    const double len = std::sqrt(len2);
-    const double sine = z / len;
-    const double w = g_.FaceWeight(f);
-    for (uint32_t i = chord_first_[f]; i < chord_first_[f + 1]; ++i) {
-      const Chord& c = chords_[i];
-      if (sine < c.lo || sine > c.hi) continue;
-      if (!std::isfinite(c.up_cost)) return kInf;  // a range no zigzag can walk
-      const double up = z * inv_sin_[f];
-      const double across = std::sqrt(std::max(0.0, len2 - up * up));
-      return w * (c.up_cost * up + c.across_cost * across);
+ public:
+  // The walker's cost of pieces inside one face, what a face's values read once (a relaxation
+  // evaluates many pieces in one face).
+  struct FaceWalk {
+    const std::vector<double>* table;
+    const Chord* chord;
+    const Chord* chord_end;
+    double w, inv_sin, sign;
+    // The cost of the piece (x, y, z) in the search's direction.
+    double operator()(double x, double y, double z) const {
+      const double len2 = x * x + y * y + z * z;
+      if (len2 == 0) return 0;
+      const double len = std::sqrt(len2);
+      const double rise = sign * z;
+      const double sine = rise / len;
+      for (const Chord* c = chord; c != chord_end; ++c) {
+        if (sine < c->lo || sine > c->hi) continue;
+        if (!std::isfinite(c->up_cost)) return kInf;  // a range no zigzag can walk
+        const double up = rise * inv_sin;
+        const double across = std::sqrt(std::max(0.0, len2 - up * up));
+        return w * (c->up_cost * up + c->across_cost * across);
+      }
+      return w * len * Interpolate(*table, sine);
     }
-    return w * len * PerMetre(sine);
+  };
+  FaceWalk ForFace(uint32_t f) const { return WalkOf(f, sign_); }
+
+ private:
+  FaceWalk WalkOf(uint32_t f, double sign) const {
+    return {&table_,
+            chords_.data() + chord_first_[f],
+            chords_.data() + chord_first_[f + 1],
+            g_.FaceWeight(f),
+            inv_sin_[f],
+            sign};
   }
+  // The walker's cost of the piece (x, y, z) inside face f.
+  double Walk(uint32_t f, double x, double y, double z) const { return WalkOf(f, 1)(x, y, z); }
 
   // The convex envelope of a face of slope sine `sin_slope`. In the face's frame (x uphill, y
   // across), the set a walker reaches at cost 1 going straight is bounded by the points
@@ -829,6 +857,7 @@ class Search {
       }
     }
     const double per_metre = checking_ ? kInf : 1 / floor;  // (check: no skips)
+    const auto walk = costs_.ForFace(f);
     const double* param = g_.Params(begin);
     const double* cost = cost_.data();
     // The settled run is skipped whole; the nodes on either side are tested.
@@ -850,7 +879,7 @@ class Search {
         const uint32_t n = block + j;
         if (done_[n]) continue;  // settled (a zero-length link)
         const double x = ax + t[j] * dx, y = ay + t[j] * dy, z = az + t[j] * dz;
-        Improve(n, bucket, base + costs_.Face(f, x, y, z), label, from);
+        Improve(n, bucket, base + walk(x, y, z), label, from);
       }
     }
   }
