@@ -1758,6 +1758,61 @@ absl::StatusOr<std::vector<std::array<double, 2>>> FaceCentresInMap(const MeshDa
   return out;
 }
 
+// Points bucketed on a uniform grid over their bounding box (counting sort: flat arrays).
+class CentreGrid {
+ public:
+  explicit CentreGrid(const std::vector<std::array<double, 2>>& points) : points_(points) {
+    if (points.empty()) return;
+    min_x_ = max_x_ = points[0][0];
+    min_y_ = max_y_ = points[0][1];
+    for (const auto& [x, y] : points) {
+      min_x_ = std::min(min_x_, x);
+      max_x_ = std::max(max_x_, x);
+      min_y_ = std::min(min_y_, y);
+      max_y_ = std::max(max_y_, y);
+    }
+    side_ = std::max<size_t>(1, static_cast<size_t>(std::sqrt(points.size() / 4.0)));
+    start_.assign(side_ * side_ + 1, 0);
+    for (const auto& [x, y] : points) ++start_[Cell(x, y) + 1];
+    for (size_t c = 0; c < side_ * side_; ++c) start_[c + 1] += start_[c];
+    order_.resize(points.size());
+    std::vector<uint32_t> at(start_.begin(), start_.end() - 1);
+    for (uint32_t i = 0; i < points.size(); ++i) {
+      order_[at[Cell(points[i][0], points[i][1])]++] = i;
+    }
+  }
+
+  // The points of every cell the box [x0, x1] x [y0, y1] touches (a superset of those inside).
+  std::vector<uint32_t> Near(double x0, double y0, double x1, double y1) const {
+    std::vector<uint32_t> out;
+    if (points_.empty() || x1 < min_x_ || x0 > max_x_ || y1 < min_y_ || y0 > max_y_) return out;
+    const size_t i0 = Index(x0, min_x_, max_x_), i1 = Index(x1, min_x_, max_x_);
+    const size_t j0 = Index(y0, min_y_, max_y_), j1 = Index(y1, min_y_, max_y_);
+    for (size_t j = j0; j <= j1; ++j) {
+      for (size_t i = i0; i <= i1; ++i) {
+        const size_t c = j * side_ + i;
+        out.insert(out.end(), order_.begin() + start_[c], order_.begin() + start_[c + 1]);
+      }
+    }
+    return out;
+  }
+
+ private:
+  size_t Index(double v, double lo, double hi) const {
+    if (!(hi > lo)) return 0;
+    const double at = (v - lo) / (hi - lo) * side_;
+    return at <= 0 ? 0 : std::min(side_ - 1, static_cast<size_t>(at));
+  }
+  size_t Cell(double x, double y) const {
+    return Index(y, min_y_, max_y_) * side_ + Index(x, min_x_, max_x_);
+  }
+
+  const std::vector<std::array<double, 2>>& points_;
+  double min_x_ = 0, max_x_ = 0, min_y_ = 0, max_y_ = 0;
+  size_t side_ = 1;
+  std::vector<uint32_t> start_, order_;
+};
+
 // The friction polygons of a vector dataset, in `crs` (null: as they are), each face taking the
 // largest friction of the polygons containing its centroid, 1 elsewhere.
 absl::StatusOr<std::vector<double>> FrictionOfPolygons(GDALDataset& ds, const MeshData& mesh,
@@ -1823,9 +1878,13 @@ absl::StatusOr<std::vector<double>> FrictionOfPolygons(GDALDataset& ds, const Me
   if (!centres.ok()) return centres.status();
   std::vector<double> weight(centres->size(), 1.0);
   std::vector<char> inside_any(centres->size(), 0);
+  // The centres bucketed on a grid of about 4 per cell, so a polygon visits only the faces near
+  // its box: the cost grows with faces + polygons + the faces inside boxes, not faces x polygons
+  // (a land-cover layer has thousands of polygons, a DEM a million faces).
+  const CentreGrid grid(*centres);
   OGRPoint point;
   for (const Region& r : regions) {
-    for (size_t f = 0; f < centres->size(); ++f) {
+    for (const uint32_t f : grid.Near(r.box.MinX, r.box.MinY, r.box.MaxX, r.box.MaxY)) {
       const auto& [x, y] = (*centres)[f];
       if (x < r.box.MinX || x > r.box.MaxX || y < r.box.MinY || y > r.box.MaxY) continue;
       point.setX(x);
