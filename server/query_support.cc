@@ -67,11 +67,8 @@ namespace {
 absl::StatusOr<std::shared_ptr<const std::vector<double>>> TravelWeights(
     const QueryEnv& env, const StoredMesh& mesh, const v1::TravelCost& travel) {
   if (!travel.face_weights().empty()) {
-    if (static_cast<uint64_t>(travel.face_weights_size()) != mesh.face_count) {
-      return FieldError("options.travel.face_weights",
-                        absl::StrCat(travel.face_weights_size(), " weights, but the mesh has ",
-                                     mesh.face_count, " faces: give one per face, in order"));
-    }
+    // (their count and values are the engine's to check: its errors name face_weight[i], which
+    // OptionFieldName maps to options.travel.face_weights[i])
     return std::make_shared<const std::vector<double>>(travel.face_weights().begin(),
                                                        travel.face_weights().end());
   }
