@@ -56,8 +56,7 @@ std::string FieldCacheKey(const std::string& mesh_id, const std::vector<SurfaceP
     const size_t rows = travel.speed_table == nullptr ? 0 : travel.speed_table->size();
     Append(&key, rows);
     for (size_t i = 0; i < rows; ++i) Append(&key, (*travel.speed_table)[i]);
-    // (a constant speed takes the same time both ways: one entry for both directions)
-    Append(&key, static_cast<uint8_t>(travel.inbound && IsDirectional(travel)));
+    Append(&key, static_cast<uint8_t>(TimesInbound(travel)));  // (one entry at a constant speed)
     Append(&key, travel.epsilon);
     Append(&key, travel.max_slope_deg);
     const bool weighted = travel.face_weight != nullptr;

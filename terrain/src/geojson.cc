@@ -294,7 +294,7 @@ std::vector<GeoFeature> IsochroneFeatures(const MeshData& mesh, const std::vecto
       f.properties.push_back({"epsilon", travel->epsilon});
       f.properties.push_back({"bound", !IsDirectional(*travel)});
       f.properties.push_back({"speed", std::string(SpeedModelName(travel->speed_model))});
-      f.properties.push_back({"inbound", travel->inbound && IsDirectional(*travel)});
+      f.properties.push_back({"inbound", TimesInbound(*travel)});
     }
     features.push_back(std::move(f));
   }

@@ -68,6 +68,12 @@ inline bool IsDirectional(const TravelCost& travel) {
   return travel.speed_model != SpeedModel::kConstant;
 }
 
+// Whether times are to reach the sources: inbound, and only for a direction-dependent speed (a
+// constant speed takes the same time both ways, so its inbound field is the outbound one).
+inline bool TimesInbound(const TravelCost& travel) {
+  return travel.inbound && IsDirectional(travel);
+}
+
 // The model's name in answers: "constant", "tobler" or "table".
 inline const char* SpeedModelName(SpeedModel model) {
   switch (model) {
