@@ -12,6 +12,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -385,6 +386,13 @@ absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
     }
   };
   const uint32_t k = options.k_nearest;
+  // A travel cost: one weighted graph for every row.
+  std::optional<TravelPointSolver> travel;
+  if (options.solver.travel.has_value()) {
+    absl::StatusOr<TravelPointSolver> solver = TravelPointSolver::Create(mesh, options.solver);
+    if (!solver.ok()) return solver.status();
+    travel.emplace(*std::move(solver));
+  }
   auto solve_row = [&](size_t r) {
     if (failed.load(std::memory_order_relaxed)) return;
     // Symmetric: row r needs only the columns after it in the sweep; d(r, r) = 0.
@@ -409,8 +417,7 @@ absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
       // are direction-independent).
       std::vector<SurfacePoint> points;
       for (size_t c : columns) points.push_back(solved_targets[c]);
-      PointQuery query{{sources[distinct[r]]}, std::move(points), options.solver};
-      absl::StatusOr<PointValues> values = ComputeTravelPointValues(mesh, query);
+      absl::StatusOr<PointValues> values = travel->Solve({sources[distinct[r]]}, points);
       status = values.status();
       if (values.ok()) {
         double* row = &solved[r * cols];

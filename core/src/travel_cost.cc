@@ -203,22 +203,36 @@ absl::StatusOr<DistanceField> ComputeTravelField(const TriangleMesh& mesh,
   return field;
 }
 
+absl::StatusOr<TravelPointSolver> TravelPointSolver::Create(const TriangleMesh& mesh,
+                                                            const GeodesicOptions& options) {
+  absl::StatusOr<WeightedOptions> weighted = WeightedOptionsFor(mesh, options);
+  if (!weighted.ok()) return weighted.status();
+  absl::StatusOr<WeightedSurface> surface = WeightedSurface::Build(mesh, *weighted);
+  if (!surface.ok()) return surface.status();
+  return TravelPointSolver(*options.travel, *std::move(surface));
+}
+
+absl::StatusOr<PointValues> TravelPointSolver::Solve(const std::vector<SurfacePoint>& sources,
+                                                     const std::vector<SurfacePoint>& points,
+                                                     bool covers_surface) const {
+  absl::StatusOr<WeightedCosts> w = surface_.CostsAt(sources, points, covers_surface);
+  if (!w.ok()) return w.status();
+  PointValues out;
+  for (double c : w->cost) out.distance.push_back(Seconds(travel_, c));
+  out.source = std::move(w->source);
+  out.stats = StatsOf(w->stats);
+  return out;
+}
+
 absl::StatusOr<PointValues> ComputeTravelPointValues(const TriangleMesh& mesh,
                                                      const PointQuery& query) {
   if (query.directions) {
     return OptionError("travel",
                        "geodesic directions are read off the exact engine; a travel cost has none");
   }
-  absl::StatusOr<WeightedOptions> weighted = WeightedOptionsFor(mesh, query.options);
-  if (!weighted.ok()) return weighted.status();
-  absl::StatusOr<WeightedCosts> w =
-      ComputeWeightedCostsAt(mesh, query.sources, query.points, *weighted);
-  if (!w.ok()) return w.status();
-  PointValues out;
-  for (double c : w->cost) out.distance.push_back(Seconds(*query.options.travel, c));
-  out.source = std::move(w->source);
-  out.stats = StatsOf(w->stats);
-  return out;
+  absl::StatusOr<TravelPointSolver> solver = TravelPointSolver::Create(mesh, query.options);
+  if (!solver.ok()) return solver.status();
+  return solver->Solve(query.sources, query.points, query.covers_surface);
 }
 
 absl::StatusOr<PathsQueryResult> ComputeTravelPaths(const TriangleMesh& mesh,

@@ -5,6 +5,7 @@
 // options carry a travel cost, so every product built on them speaks seconds. Each converts the
 // weighted engine's costs to seconds; none adds a rule of its own.
 
+#include <utility>
 #include <vector>
 
 #include "absl/status/statusor.h"
@@ -13,7 +14,9 @@
 #include "geodex/geodesic_solver.h"
 #include "geodex/shortest_path.h"
 #include "geodex/surface_point.h"
+#include "geodex/travel_cost.h"
 #include "geodex/triangle_mesh.h"
+#include "geodex/weighted_field.h"
 
 namespace geodex {
 
@@ -24,6 +27,25 @@ absl::StatusOr<DistanceField> ComputeTravelField(const TriangleMesh& mesh,
 // InvalidArgument naming "travel" when the query asks for directions.
 absl::StatusOr<PointValues> ComputeTravelPointValues(const TriangleMesh& mesh,
                                                      const PointQuery& query);
+
+// Travel times at points for many queries with one mesh and one travel cost (a matrix's rows):
+// the weighted graph is built once and shared, read-only, by every query (thread-safe).
+class TravelPointSolver {
+ public:
+  // `options` carry the travel cost. Errors: as ComputeTravelPointValues.
+  static absl::StatusOr<TravelPointSolver> Create(const TriangleMesh& mesh,
+                                                  const GeodesicOptions& options);
+  // Times from `sources` at `points`, in seconds (ComputeTravelPointValues without directions).
+  absl::StatusOr<PointValues> Solve(const std::vector<SurfacePoint>& sources,
+                                    const std::vector<SurfacePoint>& points,
+                                    bool covers_surface = false) const;
+
+ private:
+  TravelPointSolver(TravelCost travel, WeightedSurface surface)
+      : travel_(std::move(travel)), surface_(std::move(surface)) {}
+  TravelCost travel_;
+  WeightedSurface surface_;
+};
 
 // One least-time path per target (each path's `length` is its length in metres; `distance` its
 // time in seconds); an unreachable target has +inf and no points.

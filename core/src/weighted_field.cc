@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -995,6 +996,66 @@ std::pair<double, uint32_t> BestLink(const SteinerGraph& g, const Cost& cost,
   return {best, node};
 }
 
+// Targets watched during a search, so that it can stop once each is final: per target its best
+// cost so far, straight from a source or through a settled node linked to it. Once the next
+// cost to settle exceeds every best, no link can lower one (an unsettled node costs at least
+// that). The stop is strict, so every node a best could come through is settled, as in a whole
+// search: the answers are the whole search's bit for bit.
+template <typename Cost>
+class TargetWatch {
+ public:
+  TargetWatch(const SteinerGraph& g, const Cost& cost, const std::vector<Located>& from,
+              const std::vector<Located>& to)
+      : g_(g), cost_(cost), to_(to), best_(to.size(), kInf) {
+    for (uint32_t t = 0; t < to.size(); ++t) {
+      ForEachLink(g, to[t], [&](uint32_t n, Medium m) { links_.push_back({n, t, m}); });
+      for (const Located& s : from) best_[t] = std::min(best_[t], DirectCost(g, cost, s, to[t]));
+    }
+    std::stable_sort(links_.begin(), links_.end(),
+                     [](const Link& a, const Link& b) { return a.node < b.node; });
+    Rebound();
+  }
+  // True once a node settling at `key` can improve no target.
+  bool Done(double key) {
+    if (!(key > worst_)) return false;
+    Rebound();  // worst_ was an upper bound (bests only drop): make it exact
+    return key > worst_;
+  }
+  void Settled(uint32_t u, double cost_u) {
+    auto it = std::lower_bound(links_.begin(), links_.end(), u,
+                               [](const Link& l, uint32_t n) { return l.node < n; });
+    for (; it != links_.end() && it->node == u; ++it) {
+      const double c = cost_u + LinkCost(cost_, it->medium, g_.Pos(u), to_[it->target].pos);
+      double& best = best_[it->target];
+      if (!(c < best)) continue;
+      const bool last = best == kInf && --unreached_ == 0;
+      best = c;
+      if (last) Rebound();  // every target has a best: worst_ becomes finite
+    }
+  }
+ private:
+  struct Link {
+    uint32_t node, target;
+    Medium medium;
+  };
+  void Rebound() {
+    worst_ = -kInf;
+    unreached_ = 0;
+    for (const double b : best_) {
+      worst_ = std::max(worst_, b);
+      unreached_ += b == kInf;
+    }
+  }
+
+  const SteinerGraph& g_;
+  const Cost& cost_;
+  const std::vector<Located>& to_;
+  std::vector<Link> links_;  // what the straight link from each node to each target runs in
+  std::vector<double> best_;
+  double worst_ = kInf;     // at least the largest best
+  uint32_t unreached_ = 0;  // targets with no best yet (worst_ is +inf while there are)
+};
+
 PathPoint NodePoint(const SteinerGraph& g, uint32_t n) {
   const TriangleMesh& mesh = g.mesh();
   PathPoint pp;
@@ -1104,47 +1165,100 @@ absl::StatusOr<WeightedField> ComputeWeightedField(const TriangleMesh& mesh,
                   });
 }
 
+// The graph and its cost model, built once; the cost model refers to the graph and the graph to
+// the options' weights, so all three live here, at fixed addresses.
+struct WeightedSurface::Impl {
+  Impl(const TriangleMesh& mesh, WeightedOptions opts)
+      : options(std::move(opts)), graph(mesh, options) {}
+  WeightedOptions options;
+  SteinerGraph graph;
+  std::optional<IsotropicCost> isotropic;
+  std::optional<DirectionalCost> directional;
+
+  template <typename Fn>
+  auto WithCost(Fn&& fn) const {
+    return isotropic.has_value() ? fn(*isotropic) : fn(*directional);
+  }
+};
+
+WeightedSurface::WeightedSurface(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+WeightedSurface::WeightedSurface(WeightedSurface&&) noexcept = default;
+WeightedSurface& WeightedSurface::operator=(WeightedSurface&&) noexcept = default;
+WeightedSurface::~WeightedSurface() = default;
+
+absl::StatusOr<WeightedSurface> WeightedSurface::Build(const TriangleMesh& mesh,
+                                                       const WeightedOptions& options) {
+  if (absl::Status s = ValidateWeightedOptions(mesh, options); !s.ok()) return s;
+  auto impl = std::make_unique<Impl>(mesh, options);
+  if (absl::Status s = impl->graph.Build(options.epsilon, options.max_steiner_points); !s.ok()) {
+    return s;
+  }
+  if (options.slope_cost == nullptr) {
+    impl->isotropic.emplace(impl->graph);
+  } else {
+    impl->directional.emplace(impl->graph, *impl->options.slope_cost, options.inbound);
+  }
+  return WeightedSurface(std::move(impl));
+}
+
+uint64_t WeightedSurface::steiner_points() const { return impl_->graph.steiner_points(); }
+
+absl::StatusOr<WeightedCosts> WeightedSurface::CostsAt(const std::vector<SurfacePoint>& sources,
+                                                       const std::vector<SurfacePoint>& targets,
+                                                       bool whole) const {
+  const auto start = std::chrono::steady_clock::now();
+  if (sources.empty()) return absl::InvalidArgumentError("no sources given");
+  const SteinerGraph& g = impl_->graph;
+  const WeightedOptions& options = impl_->options;
+  std::vector<Located> from, to;
+  if (absl::Status s = Prepare(g.mesh(), sources, &from); !s.ok()) return s;
+  if (absl::Status s = Prepare(g.mesh(), targets, &to); !s.ok()) return s;
+  return impl_->WithCost([&](const auto& cost) -> absl::StatusOr<WeightedCosts> {
+    Search search(g, cost);
+    TargetWatch watch(g, cost, from, to);
+    if (whole || options.check_optimality) {
+      if (absl::Status s = SearchWhole(from, options, &search); !s.ok()) return s;
+    } else {
+      for (uint32_t i = 0; i < from.size(); ++i) search.Seed(from[i], i);
+      absl::Status s = search.Run(
+          options, [&](double key) { return watch.Done(key); },
+          [&](uint32_t u) { watch.Settled(u, search.cost(u)); });
+      if (!s.ok()) return s;
+    }
+    WeightedCosts out;
+    out.cost.assign(to.size(), kInf);
+    out.source.assign(to.size(), kNoIndex);
+    for (size_t t = 0; t < to.size(); ++t) {
+      const auto [c, n] = BestLink(g, cost, search, to[t]);
+      if (n != kNoIndex) {
+        out.cost[t] = c;
+        out.source[t] = search.label(n);
+      }
+      for (uint32_t s = 0; s < from.size(); ++s) {
+        const double direct = DirectCost(g, cost, from[s], to[t]);
+        if (direct < out.cost[t]) {
+          out.cost[t] = direct;
+          out.source[t] = s;
+        }
+      }
+      if (out.cost[t] > options.max_distance) {
+        out.cost[t] = kInf;
+        out.source[t] = kNoIndex;
+      }
+    }
+    out.steiner_points = g.steiner_points();
+    out.stats = search.Stats(Elapsed(start));
+    return out;
+  });
+}
+
 absl::StatusOr<WeightedCosts> ComputeWeightedCostsAt(const TriangleMesh& mesh,
                                                      const std::vector<SurfacePoint>& sources,
                                                      const std::vector<SurfacePoint>& targets,
                                                      const WeightedOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
-  if (absl::Status s = ValidateWeightedOptions(mesh, options); !s.ok()) return s;
-  if (sources.empty()) return absl::InvalidArgumentError("no sources given");
-  std::vector<Located> from, to;
-  if (absl::Status s = Prepare(mesh, sources, &from); !s.ok()) return s;
-  if (absl::Status s = Prepare(mesh, targets, &to); !s.ok()) return s;
-  SteinerGraph g(mesh, options);
-  if (absl::Status s = g.Build(options.epsilon, options.max_steiner_points); !s.ok()) return s;
-  return WithCost(g, options, options.inbound,
-                  [&](const auto& cost) -> absl::StatusOr<WeightedCosts> {
-                    Search search(g, cost);
-                    if (absl::Status s = SearchWhole(from, options, &search); !s.ok()) return s;
-                    WeightedCosts out;
-                    out.cost.assign(to.size(), kInf);
-                    out.source.assign(to.size(), kNoIndex);
-                    for (size_t t = 0; t < to.size(); ++t) {
-                      const auto [c, n] = BestLink(g, cost, search, to[t]);
-                      if (n != kNoIndex) {
-                        out.cost[t] = c;
-                        out.source[t] = search.label(n);
-                      }
-                      for (uint32_t s = 0; s < from.size(); ++s) {
-                        const double direct = DirectCost(g, cost, from[s], to[t]);
-                        if (direct < out.cost[t]) {
-                          out.cost[t] = direct;
-                          out.source[t] = s;
-                        }
-                      }
-                      if (out.cost[t] > options.max_distance) {
-                        out.cost[t] = kInf;
-                        out.source[t] = kNoIndex;
-                      }
-                    }
-                    out.steiner_points = g.steiner_points();
-                    out.stats = search.Stats(Elapsed(start));
-                    return out;
-                  });
+  absl::StatusOr<WeightedSurface> surface = WeightedSurface::Build(mesh, options);
+  if (!surface.ok()) return surface.status();
+  return surface->CostsAt(sources, targets);
 }
 
 absl::StatusOr<std::vector<WeightedPath>> ComputeWeightedPaths(const TriangleMesh& mesh,
@@ -1161,79 +1275,53 @@ absl::StatusOr<std::vector<WeightedPath>> ComputeWeightedPaths(const TriangleMes
   if (absl::Status s = g.Build(options.epsilon, options.max_steiner_points); !s.ok()) return s;
   // A path is walked from `from`: the search runs outward whatever options.inbound says. One graph
   // and one search serve every target; it stops once every target's best is final.
-  return WithCost(
-      g, options, /*inbound=*/false,
-      [&](const auto& cost) -> absl::StatusOr<std::vector<WeightedPath>> {
-        Search search(g, cost);
-        search.Seed(src, 0);
-        struct Link {
-          uint32_t node, target;
-          Medium medium;
-        };
-        // What the straight link from each node to each target runs in, by node.
-        std::vector<Link> links;
-        std::vector<double> best(dsts.size());
-        for (uint32_t t = 0; t < dsts.size(); ++t) {
-          ForEachLink(g, dsts[t], [&](uint32_t n, Medium m) { links.push_back({n, t, m}); });
-          best[t] = DirectCost(g, cost, src, dsts[t]);
-        }
-        std::stable_sort(links.begin(), links.end(),
-                         [](const Link& a, const Link& b) { return a.node < b.node; });
-        double worst = best.empty() ? 0 : *std::max_element(best.begin(), best.end());
-        if (absl::Status s = search.Run(
-                options, [&](double key) { return key >= worst; },
-                [&](uint32_t u) {
-                  auto it = std::lower_bound(links.begin(), links.end(), u,
-                                             [](const Link& l, uint32_t n) { return l.node < n; });
-                  bool improved = false;
-                  for (; it != links.end() && it->node == u; ++it) {
-                    const double c =
-                        search.cost(u) + LinkCost(cost, it->medium, g.Pos(u), dsts[it->target].pos);
-                    if (c < best[it->target]) {
-                      best[it->target] = c;
-                      improved = true;
+  return WithCost(g, options, /*inbound=*/false,
+                  [&](const auto& cost) -> absl::StatusOr<std::vector<WeightedPath>> {
+                    Search search(g, cost);
+                    search.Seed(src, 0);
+                    TargetWatch watch(g, cost, src_list, dsts);
+                    if (absl::Status s = search.Run(
+                            options, [&](double key) { return watch.Done(key); },
+                            [&](uint32_t u) { watch.Settled(u, search.cost(u)); });
+                        !s.ok()) {
+                      return s;
                     }
-                  }
-                  if (improved) worst = *std::max_element(best.begin(), best.end());
-                });
-            !s.ok()) {
-          return s;
-        }
-        std::vector<WeightedPath> paths(dsts.size());
-        for (size_t t = 0; t < dsts.size(); ++t) {
-          const Located& dst = dsts[t];
-          WeightedPath& path = paths[t];
-          path.steiner_points = g.steiner_points();
-          auto [total, node] = BestLink(g, cost, search, dst);
-          const double direct = DirectCost(g, cost, src, dst);
-          if (direct <= total) {
-            total = direct;
-            node = kNoIndex;
-          }
-          if (!std::isfinite(total) || total > options.max_distance) {
-            path.cost = kInf;  // unreachable: no points
-            continue;
-          }
-          path.cost = total;
-          // Backwards from the target, then reversed.
-          path.points.push_back(LocatedPoint(mesh, dst));
-          uint32_t parent = kFromSourcePoint;
-          while (node != kNoIndex) {
-            if (!(dst.canonical.kind == SurfacePoint::Kind::kVertex && search.cost(node) == total &&
-                  path.points.size() == 1 && node < g.nv() &&
-                  mesh.FileVertex(node) == dst.canonical.vertex)) {
-              path.points.push_back(NodePoint(g, node));
-            }
-            parent = search.parent(node);
-            node = parent >= kFromSourcePoint ? kNoIndex : parent;
-          }
-          if (parent == kFromSourcePoint) path.points.push_back(LocatedPoint(mesh, src));
-          std::reverse(path.points.begin(), path.points.end());
-        }
-        const WeightedStats stats = search.Stats(Elapsed(start));
-        for (WeightedPath& path : paths) path.stats = stats;
-        return paths;
-      });
+                    std::vector<WeightedPath> paths(dsts.size());
+                    for (size_t t = 0; t < dsts.size(); ++t) {
+                      const Located& dst = dsts[t];
+                      WeightedPath& path = paths[t];
+                      path.steiner_points = g.steiner_points();
+                      auto [total, node] = BestLink(g, cost, search, dst);
+                      const double direct = DirectCost(g, cost, src, dst);
+                      if (direct <= total) {
+                        total = direct;
+                        node = kNoIndex;
+                      }
+                      if (!std::isfinite(total) || total > options.max_distance) {
+                        path.cost = kInf;  // unreachable: no points
+                        continue;
+                      }
+                      path.cost = total;
+                      // Backwards from the target, then reversed.
+                      path.points.push_back(LocatedPoint(mesh, dst));
+                      uint32_t parent = kFromSourcePoint;
+                      while (node != kNoIndex) {
+                        if (!(dst.canonical.kind == SurfacePoint::Kind::kVertex &&
+                              search.cost(node) == total && path.points.size() == 1 &&
+                              node < g.nv() && mesh.FileVertex(node) == dst.canonical.vertex)) {
+                          path.points.push_back(NodePoint(g, node));
+                        }
+                        parent = search.parent(node);
+                        node = parent >= kFromSourcePoint ? kNoIndex : parent;
+                      }
+                      if (parent == kFromSourcePoint)
+                        path.points.push_back(LocatedPoint(mesh, src));
+                      std::reverse(path.points.begin(), path.points.end());
+                    }
+                    const WeightedStats stats = search.Stats(Elapsed(start));
+                    for (WeightedPath& path : paths) path.stats = stats;
+                    return paths;
+                  });
 }
 
 absl::StatusOr<WeightedPath> ComputeWeightedPath(const TriangleMesh& mesh, const SurfacePoint& from,

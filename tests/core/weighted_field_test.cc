@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <thread>
 #include <vector>
 
 #include "geodex/geodesic_solver.h"
@@ -457,6 +458,56 @@ TEST(WeightedFieldTest, DeterministicBitForBit) {
   ASSERT_TRUE(a.ok() && b.ok());
   EXPECT_EQ(a->cost, b->cost);
   EXPECT_EQ(a->source, b->source);
+}
+
+// Costs at points stop the search once every point is final, with the whole search's answers bit
+// for bit; one WeightedSurface serves many queries, from several threads at once, with each one's
+// own answers. Friction and a slope cost (asymmetric), two sources.
+TEST(WeightedFieldTest, CostsAtPointsStopEarlyOnASharedSurface) {
+  GridSpec spec;
+  spec.cells_x = spec.cells_y = 30;
+  spec.jitter = 0.2;
+  const MeshData data = MakeGrid(spec);
+  const TriangleMesh mesh = BuildMesh(data);
+  auto slope = std::make_shared<SlopeCost>();
+  for (int i = 0; i <= 32; ++i) slope->per_metre.push_back(1 + 2 * std::abs(-1 + i / 16.0));
+  for (int variant = 0; variant < 2; ++variant) {
+    WeightedOptions options;
+    options.epsilon = 0.1;
+    for (uint32_t f = 0; f < data.face_count(); ++f) {
+      options.face_weight.push_back(Centroid(data, f)[0] > 0.3 ? 2 : 1);
+    }
+    if (variant == 1) options.slope_cost = slope;
+    absl::StatusOr<WeightedSurface> surface = WeightedSurface::Build(mesh, options);
+    ASSERT_TRUE(surface.ok()) << surface.status();
+    const std::vector<SurfacePoint> sources = {SurfacePoint::AtVertex(31 * 5 + 5),
+                                               SurfacePoint::InFace(40, 0.2, 0.3, 0.5)};
+    // Near the sources, and one across the grid.
+    const std::vector<std::vector<SurfacePoint>> queries = {
+        {SurfacePoint::AtVertex(31 * 7 + 6), SurfacePoint::InFace(100, 0.6, 0.2, 0.2)},
+        {SurfacePoint::AtVertex(31 * 29 + 29), SurfacePoint::AtVertex(31 * 6 + 4)}};
+    std::vector<absl::StatusOr<WeightedCosts>> early(queries.size(), absl::UnknownError("not run"));
+    {
+      std::vector<std::thread> threads;
+      for (size_t q = 0; q < queries.size(); ++q) {
+        threads.emplace_back([&, q] { early[q] = surface->CostsAt(sources, queries[q]); });
+      }
+      for (std::thread& t : threads) t.join();
+    }
+    for (size_t q = 0; q < queries.size(); ++q) {
+      absl::StatusOr<WeightedCosts> whole = surface->CostsAt(sources, queries[q], /*whole=*/true);
+      absl::StatusOr<WeightedCosts> fresh =
+          ComputeWeightedCostsAt(mesh, sources, queries[q], options);
+      ASSERT_TRUE(early[q].ok() && whole.ok() && fresh.ok()) << early[q].status();
+      EXPECT_EQ(early[q]->cost, whole->cost) << variant << " " << q;
+      EXPECT_EQ(early[q]->source, whole->source) << variant << " " << q;
+      EXPECT_EQ(fresh->cost, whole->cost) << variant << " " << q;
+      for (const double c : whole->cost) EXPECT_TRUE(std::isfinite(c) && c > 0);
+      if (q == 0) {  // near points: a small part of the graph
+        EXPECT_LT(early[q]->stats.nodes_settled, whole->stats.nodes_settled / 4) << variant;
+      }
+    }
+  }
 }
 
 }  // namespace

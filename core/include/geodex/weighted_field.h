@@ -143,11 +143,38 @@ struct WeightedCosts {
   WeightedStats stats;
 };
 
-// Least costs at arbitrary surface points (vertex, edge or face points).
+// Least costs at arbitrary surface points (vertex, edge or face points). The search stops once
+// every target is final. Errors: as ComputeWeightedField.
 absl::StatusOr<WeightedCosts> ComputeWeightedCostsAt(const TriangleMesh& mesh,
                                                      const std::vector<SurfacePoint>& sources,
                                                      const std::vector<SurfacePoint>& targets,
                                                      const WeightedOptions& options);
+
+// The weighted engine's graph (Steiner points) and cost model (the per-face switchback ranges of
+// a slope cost) for one mesh and one set of options, built once for many queries: a matrix's
+// rows. Immutable once built; CostsAt may run on many threads at once. `mesh` must outlive it.
+class WeightedSurface {
+ public:
+  // Errors: as ComputeWeightedField (options, the Steiner-point limit).
+  static absl::StatusOr<WeightedSurface> Build(const TriangleMesh& mesh,
+                                               const WeightedOptions& options);
+  WeightedSurface(WeightedSurface&&) noexcept;
+  WeightedSurface& operator=(WeightedSurface&&) noexcept;
+  ~WeightedSurface();
+
+  // ComputeWeightedCostsAt on this surface, with the options it was built with. The search stops
+  // once every target is final, unless `whole` (targets covering the surface: the early stop's
+  // bookkeeping would cost more than it saves); the answers are the same either way.
+  absl::StatusOr<WeightedCosts> CostsAt(const std::vector<SurfacePoint>& sources,
+                                        const std::vector<SurfacePoint>& targets,
+                                        bool whole = false) const;
+  uint64_t steiner_points() const;
+
+ private:
+  struct Impl;
+  explicit WeightedSurface(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
 
 struct WeightedPath {
   double cost = 0;
