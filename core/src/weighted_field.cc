@@ -1033,6 +1033,7 @@ class TargetWatch {
       if (last) Rebound();  // every target has a best: worst_ becomes finite
     }
   }
+
  private:
   struct Link {
     uint32_t node, target;
