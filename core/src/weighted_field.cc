@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -580,6 +581,16 @@ double DirectCost(const SteinerGraph& g, const Cost& cost, const Located& a, con
   return best;
 }
 
+// Where a search is headed (A*): a ball around its targets and a least cost per metre of any
+// link, so that per_metre x (the distance to the ball) is a lower bound of the cost left: a
+// consistent heuristic (a link costs at least per_metre x its length, which is at least the
+// change in that distance).
+struct Goal {
+  Vec centre{};
+  double radius = 0;
+  double per_metre = 0;
+};
+
 // Bit j of the result: node j of a chain (cost c[j], at a + t[j] d relative to the settled point)
 // might be improved by a link from the settled point, of cost `base` + length x at least
 // 1 / per_metre: the link's squared length is below the node's room squared, loosened by 1e-9 so
@@ -623,8 +634,10 @@ inline uint64_t MarkCandidates(const double* c, const double* t, uint32_t count,
 // before it settles (each settled neighbour across a face offers a better link); in a bucket most
 // drops leave its least node alone and cost no heap work, and the heap is an edge count, not a
 // node count, deep. Settling a chain's least node rescans the chain. Cost: IsotropicCost or
-// DirectionalCost (a template, so the inner loop has no virtual call).
-template <typename Cost>
+// DirectionalCost (a template, so the inner loop has no virtual call). kHeaded: A* (HeadFor),
+// ordered by (cost + a lower bound of the cost left, node id); a template too, so a whole field's
+// search pays nothing for it.
+template <typename Cost, bool kHeaded = false>
 class Search {
  public:
   Search(const SteinerGraph& g, const Cost& cost)
@@ -641,6 +654,16 @@ class Search {
         run_hi_(g.edge_count(), kNoIndex),
         chain_max_(g.edge_count(), kInf) {}
 
+  // Orders the search by cost + a lower bound of the cost left to `goal` (A*) instead of by cost.
+  // Every node it settles has its least cost, as with Dijkstra, and those costs are Dijkstra's
+  // bit for bit (a node's cost is the least of its settled neighbours' offers, whatever their
+  // order); it settles fewer. For a search with targets only: costs away from them stay high.
+  void HeadFor(const Goal& goal) {
+    static_assert(kHeaded, "a Search<Cost, true> heads for a goal");
+    goal_ = goal;
+    ahead_.assign(cost_.size(), 0);
+  }
+
   // The bucket of a node: the vertex itself, or nv + its edge.
   uint32_t BucketOf(uint32_t node) const {
     return node < g_.nv() ? node : g_.nv() + g_.EdgeOfNode(node);
@@ -653,6 +676,9 @@ class Search {
   // Offer without the count (RelaxEdge counts its links in bulk).
   void Improve(uint32_t node, uint32_t bucket, double cost, uint32_t label, uint32_t parent) {
     if (!(cost < cost_[node])) return;
+    if constexpr (kHeaded) {
+      if (cost_[node] == kInf) ahead_[node] = Ahead(node, bucket);
+    }
     cost_[node] = cost;
     label_[node] = label;
     parent_[node] = parent;
@@ -685,7 +711,9 @@ class Search {
       const uint32_t bucket = heap_[0];
       const uint32_t u = least_[bucket];
       const double d = cost_[u];
-      if (d > options.max_distance || stop(d)) break;
+      // Headed: the key is at most the cost of any target reached through u.
+      const double key = Key(u);
+      if (key > options.max_distance || stop(key)) break;
       done_[u] = 1;
       Refill(bucket);
       ++settled_;
@@ -745,14 +773,27 @@ class Search {
     s.edge_relaxations = relaxations_;
     s.peak_bytes = g_.bytes() + cost_.size() * (sizeof(double) + 2 * sizeof(uint32_t) + 1) +
                    (least_.size() + run_lo_.size()) * 2 * sizeof(uint32_t) +
-                   chain_max_.size() * sizeof(double) + peak_heap_ * sizeof(uint32_t);
+                   (chain_max_.size() + ahead_.size()) * sizeof(double) +
+                   peak_heap_ * sizeof(uint32_t);
     s.solve_ms = ms;
     return s;
   }
 
  private:
+  // The queue's order: (key, node id).
+  double Key(uint32_t n) const {
+    if constexpr (kHeaded) return cost_[n] + ahead_[n];
+    return cost_[n];
+  }
   bool Less(uint32_t a, uint32_t b) const {
-    return cost_[a] < cost_[b] || (cost_[a] == cost_[b] && a < b);
+    const double ka = Key(a), kb = Key(b);
+    return ka < kb || (ka == kb && a < b);
+  }
+  // The lower bound of the cost left from node n (of `bucket`) to the goal.
+  double Ahead(uint32_t n, uint32_t bucket) const {
+    const Vec p = n < g_.nv() ? mesh_.Position(n) : g_.PosOn(n, bucket - g_.nv());
+    const double away = Dist(p, goal_.centre) - goal_.radius;
+    return away > 0 ? away * goal_.per_metre : 0;
   }
   bool Before(uint32_t bucket_a, uint32_t bucket_b) const {
     return Less(least_[bucket_a], least_[bucket_b]);
@@ -808,8 +849,9 @@ class Search {
         for (uint32_t n = from; n < to; ++n) {
           if (done_[n]) continue;
           most = std::max(most, cost_[n]);
-          if (cost_[n] < best) {  // (cost, id): the first of equal costs wins
-            best = cost_[n];
+          const double key = Key(n);
+          if (key < best) {  // (key, id): the first of equal keys wins
+            best = key;
             least = n;
           }
         }
@@ -957,7 +999,9 @@ class Search {
   // Per edge: at least the cost of its costliest unsettled node (+inf until the edge's first
   // rescan, or while one is unreached); a relaxation that cannot beat it skips the chain.
   std::vector<double> chain_max_;
-  bool checking_ = false;       // CheckOptimality is running
+  bool checking_ = false;  // CheckOptimality is running
+  Goal goal_;
+  std::vector<double> ahead_;   // headed: per node reached, Ahead(node)
   std::vector<uint32_t> heap_;  // buckets
   uint64_t settled_ = 0, relaxations_ = 0, peak_heap_ = 0;
 };
@@ -979,9 +1023,9 @@ absl::Status Prepare(const TriangleMesh& mesh, const std::vector<SurfacePoint>& 
 }
 
 // The best (cost, node) over the links of point t; node kNoIndex when the best is none.
-template <typename Cost>
+template <typename Cost, bool kHeaded>
 std::pair<double, uint32_t> BestLink(const SteinerGraph& g, const Cost& cost,
-                                     const Search<Cost>& search, const Located& t) {
+                                     const Search<Cost, kHeaded>& search, const Located& t) {
   double best = kInf;
   uint32_t node = kNoIndex;
   ForEachLink(g, t, [&](uint32_t n, Medium m) {
@@ -994,6 +1038,30 @@ std::pair<double, uint32_t> BestLink(const SteinerGraph& g, const Cost& cost,
     }
   });
   return {best, node};
+}
+
+// The goal of a search towards `to`: the ball around the targets' bounding box and the least
+// cost per metre of any link (every passable face's floor; an edge link costs what one of its
+// faces would), shaved so that rounding never makes the bound exceed a true cost.
+template <typename Cost>
+Goal GoalOf(const SteinerGraph& g, const Cost& cost, const std::vector<Located>& to) {
+  Goal goal;
+  if (to.empty()) return goal;
+  Vec lo = to[0].pos, hi = to[0].pos;
+  for (const Located& t : to) {
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], t.pos[k]);
+      hi[k] = std::max(hi[k], t.pos[k]);
+    }
+  }
+  for (int k = 0; k < 3; ++k) goal.centre[k] = (lo[k] + hi[k]) / 2;
+  for (const Located& t : to) goal.radius = std::max(goal.radius, Dist(t.pos, goal.centre));
+  double floor = kInf;
+  for (uint32_t f = 0; f < g.mesh().face_count(); ++f) {
+    if (std::isfinite(g.FaceWeight(f))) floor = std::min(floor, cost.FaceFloor(f));
+  }
+  goal.per_metre = std::isfinite(floor) ? floor * (1 - 1e-9) : 0;
+  return goal;
 }
 
 // Targets watched during a search, so that it can stop once each is final: per target its best
@@ -1215,41 +1283,49 @@ absl::StatusOr<WeightedCosts> WeightedSurface::CostsAt(const std::vector<Surface
   if (absl::Status s = Prepare(g.mesh(), sources, &from); !s.ok()) return s;
   if (absl::Status s = Prepare(g.mesh(), targets, &to); !s.ok()) return s;
   return impl_->WithCost([&](const auto& cost) -> absl::StatusOr<WeightedCosts> {
-    Search search(g, cost);
-    TargetWatch watch(g, cost, from, to);
-    if (whole || options.check_optimality) {
-      if (absl::Status s = SearchWhole(from, options, &search); !s.ok()) return s;
-    } else {
-      for (uint32_t i = 0; i < from.size(); ++i) search.Seed(from[i], i);
-      absl::Status s = search.Run(
-          options, [&](double key) { return watch.Done(key); },
-          [&](uint32_t u) { watch.Settled(u, search.cost(u)); });
-      if (!s.ok()) return s;
-    }
-    WeightedCosts out;
-    out.cost.assign(to.size(), kInf);
-    out.source.assign(to.size(), kNoIndex);
-    for (size_t t = 0; t < to.size(); ++t) {
-      const auto [c, n] = BestLink(g, cost, search, to[t]);
-      if (n != kNoIndex) {
-        out.cost[t] = c;
-        out.source[t] = search.label(n);
-      }
-      for (uint32_t s = 0; s < from.size(); ++s) {
-        const double direct = DirectCost(g, cost, from[s], to[t]);
-        if (direct < out.cost[t]) {
-          out.cost[t] = direct;
-          out.source[t] = s;
+    // The answers off a finished search.
+    auto answer = [&](const auto& search) {
+      WeightedCosts out;
+      out.cost.assign(to.size(), kInf);
+      out.source.assign(to.size(), kNoIndex);
+      for (size_t t = 0; t < to.size(); ++t) {
+        const auto [c, n] = BestLink(g, cost, search, to[t]);
+        if (n != kNoIndex) {
+          out.cost[t] = c;
+          out.source[t] = search.label(n);
+        }
+        for (uint32_t s = 0; s < from.size(); ++s) {
+          const double direct = DirectCost(g, cost, from[s], to[t]);
+          if (direct < out.cost[t]) {
+            out.cost[t] = direct;
+            out.source[t] = s;
+          }
+        }
+        if (out.cost[t] > options.max_distance) {
+          out.cost[t] = kInf;
+          out.source[t] = kNoIndex;
         }
       }
-      if (out.cost[t] > options.max_distance) {
-        out.cost[t] = kInf;
-        out.source[t] = kNoIndex;
-      }
+      out.steiner_points = g.steiner_points();
+      out.stats = search.Stats(Elapsed(start));
+      return out;
+    };
+    using CostModel = std::decay_t<decltype(cost)>;
+    if (whole || options.check_optimality) {
+      Search<CostModel> search(g, cost);
+      if (absl::Status s = SearchWhole(from, options, &search); !s.ok()) return s;
+      return answer(search);
     }
-    out.steiner_points = g.steiner_points();
-    out.stats = search.Stats(Elapsed(start));
-    return out;
+    // Headed for the targets (A*), stopping once each is final.
+    Search<CostModel, true> search(g, cost);
+    search.HeadFor(GoalOf(g, cost, to));
+    TargetWatch watch(g, cost, from, to);
+    for (uint32_t i = 0; i < from.size(); ++i) search.Seed(from[i], i);
+    absl::Status s = search.Run(
+        options, [&](double key) { return watch.Done(key); },
+        [&](uint32_t u) { watch.Settled(u, search.cost(u)); });
+    if (!s.ok()) return s;
+    return answer(search);
   });
 }
 
@@ -1278,7 +1354,8 @@ absl::StatusOr<std::vector<WeightedPath>> ComputeWeightedPaths(const TriangleMes
   // and one search serve every target; it stops once every target's best is final.
   return WithCost(g, options, /*inbound=*/false,
                   [&](const auto& cost) -> absl::StatusOr<std::vector<WeightedPath>> {
-                    Search search(g, cost);
+                    Search<std::decay_t<decltype(cost)>, true> search(g, cost);
+                    search.HeadFor(GoalOf(g, cost, dsts));
                     search.Seed(src, 0);
                     TargetWatch watch(g, cost, src_list, dsts);
                     if (absl::Status s = search.Run(

@@ -510,5 +510,34 @@ TEST(WeightedFieldTest, CostsAtPointsStopEarlyOnASharedSurface) {
   }
 }
 
+// A path heads for its target (A*, cost + a lower bound of the cost left): it settles a part of
+// the surface, and its cost is the whole field's at the target, bit for bit. Friction 1-3 with a
+// slope cost too; the target a vertex half-way across.
+TEST(WeightedFieldTest, PathsHeadForTheirTargets) {
+  GridSpec spec;
+  spec.cells_x = spec.cells_y = 30;
+  spec.jitter = 0.2;
+  const MeshData data = MakeGrid(spec);
+  const TriangleMesh mesh = BuildMesh(data);
+  auto slope = std::make_shared<SlopeCost>();
+  for (int i = 0; i <= 32; ++i) slope->per_metre.push_back(1 + 2 * std::abs(-1 + i / 16.0));
+  for (int variant = 0; variant < 2; ++variant) {
+    WeightedOptions options;
+    options.epsilon = 0.1;
+    for (uint32_t f = 0; f < data.face_count(); ++f) {
+      options.face_weight.push_back(1 + (Centroid(data, f)[1] > 0.6) + (f * 7919 % 5 == 0));
+    }
+    if (variant == 1) options.slope_cost = slope;
+    const SurfacePoint from = SurfacePoint::AtVertex(31 * 15 + 2);
+    const uint32_t to = 31 * 15 + 17;
+    absl::StatusOr<WeightedPath> path =
+        ComputeWeightedPath(mesh, from, SurfacePoint::AtVertex(to), options);
+    absl::StatusOr<WeightedField> field = ComputeWeightedField(mesh, {from}, options);
+    ASSERT_TRUE(path.ok() && field.ok()) << path.status();
+    EXPECT_EQ(path->cost, field->cost[to]) << variant;
+    EXPECT_LT(path->stats.nodes_settled, field->stats.nodes_settled / 2) << variant;
+  }
+}
+
 }  // namespace
 }  // namespace geodex
