@@ -460,24 +460,39 @@ TEST(WeightedFieldTest, DeterministicBitForBit) {
   EXPECT_EQ(a->source, b->source);
 }
 
+// A jittered grid of cells x cells squares on the unit square.
+MeshData JitteredGrid(uint32_t cells) {
+  GridSpec spec;
+  spec.cells_x = spec.cells_y = cells;
+  spec.jitter = 0.2;
+  return MakeGrid(spec);
+}
+
+// Epsilon 0.1 with these weights, constant speed, then with a slope cost 1 on the level rising to
+// 3 straight up or down.
+std::vector<WeightedOptions> WithAndWithoutSlope(const std::vector<double>& weights) {
+  WeightedOptions flat;
+  flat.epsilon = 0.1;
+  flat.face_weight = weights;
+  WeightedOptions sloped = flat;
+  auto slope = std::make_shared<SlopeCost>();
+  for (int i = 0; i <= 32; ++i) slope->per_metre.push_back(1 + 2 * std::abs(-1 + i / 16.0));
+  sloped.slope_cost = slope;
+  return {flat, sloped};
+}
+
 // Costs at points stop the search once every point is final, with the whole search's answers bit
 // for bit; one WeightedSurface serves many queries, from several threads at once, with each one's
 // own answers. Friction and a slope cost (asymmetric), two sources.
 TEST(WeightedFieldTest, CostsAtPointsStopEarlyOnASharedSurface) {
-  GridSpec spec;
-  spec.cells_x = spec.cells_y = 30;
-  spec.jitter = 0.2;
-  const MeshData data = MakeGrid(spec);
+  const MeshData data = JitteredGrid(30);
   const TriangleMesh mesh = BuildMesh(data);
-  auto slope = std::make_shared<SlopeCost>();
-  for (int i = 0; i <= 32; ++i) slope->per_metre.push_back(1 + 2 * std::abs(-1 + i / 16.0));
-  for (int variant = 0; variant < 2; ++variant) {
-    WeightedOptions options;
-    options.epsilon = 0.1;
-    for (uint32_t f = 0; f < data.face_count(); ++f) {
-      options.face_weight.push_back(Centroid(data, f)[0] > 0.3 ? 2 : 1);
-    }
-    if (variant == 1) options.slope_cost = slope;
+  std::vector<double> weights;
+  for (uint32_t f = 0; f < data.face_count(); ++f) {
+    weights.push_back(Centroid(data, f)[0] > 0.3 ? 2 : 1);
+  }
+  for (const WeightedOptions& options : WithAndWithoutSlope(weights)) {
+    const int variant = options.slope_cost != nullptr;
     absl::StatusOr<WeightedSurface> surface = WeightedSurface::Build(mesh, options);
     ASSERT_TRUE(surface.ok()) << surface.status();
     const std::vector<SurfacePoint> sources = {SurfacePoint::AtVertex(31 * 5 + 5),
@@ -514,20 +529,14 @@ TEST(WeightedFieldTest, CostsAtPointsStopEarlyOnASharedSurface) {
 // the surface, and its cost is the whole field's at the target, bit for bit. Friction 1-3 with a
 // slope cost too; the target a vertex half-way across.
 TEST(WeightedFieldTest, PathsHeadForTheirTargets) {
-  GridSpec spec;
-  spec.cells_x = spec.cells_y = 30;
-  spec.jitter = 0.2;
-  const MeshData data = MakeGrid(spec);
+  const MeshData data = JitteredGrid(30);
   const TriangleMesh mesh = BuildMesh(data);
-  auto slope = std::make_shared<SlopeCost>();
-  for (int i = 0; i <= 32; ++i) slope->per_metre.push_back(1 + 2 * std::abs(-1 + i / 16.0));
-  for (int variant = 0; variant < 2; ++variant) {
-    WeightedOptions options;
-    options.epsilon = 0.1;
-    for (uint32_t f = 0; f < data.face_count(); ++f) {
-      options.face_weight.push_back(1 + (Centroid(data, f)[1] > 0.6) + (f * 7919 % 5 == 0));
-    }
-    if (variant == 1) options.slope_cost = slope;
+  std::vector<double> weights;
+  for (uint32_t f = 0; f < data.face_count(); ++f) {
+    weights.push_back(1 + (Centroid(data, f)[1] > 0.6) + (f * 7919 % 5 == 0));
+  }
+  for (const WeightedOptions& options : WithAndWithoutSlope(weights)) {
+    const int variant = options.slope_cost != nullptr;
     const SurfacePoint from = SurfacePoint::AtVertex(31 * 15 + 2);
     const uint32_t to = 31 * 15 + 17;
     absl::StatusOr<WeightedPath> path =
