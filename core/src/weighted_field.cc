@@ -13,6 +13,10 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#define GEODEX_AVX2_FILTER 1  // MarkCandidatesAvx2, chosen at run time
+#endif
 
 #include "absl/strings/str_format.h"
 #include "geodex/geodesic_solver.h"
@@ -596,9 +600,23 @@ struct Goal {
 // 1 / per_metre: the link's squared length is below the node's room squared, loosened by 1e-9 so
 // rounding never drops an improvement. Settled nodes (c[j] <= base) and nodes already cheaper
 // than any link could make them are not marked. count <= 64.
+constexpr double kSlack = 1 + 1e-9;
+
+// MarkCandidates' test for nodes j.. count-1, one at a time.
+inline uint64_t MarkRest(const double* c, const double* t, uint32_t j, uint32_t count, double base,
+                         double per_metre, const Vec& a, const Vec& d) {
+  uint64_t hits = 0;
+  for (; j < count; ++j) {
+    const double room = (c[j] - base) * per_metre;
+    const double x = a[0] + t[j] * d[0], y = a[1] + t[j] * d[1], z = a[2] + t[j] * d[2];
+    const bool hit = (room > 0) & (x * x + y * y + z * z < room * room * kSlack);
+    hits |= uint64_t{hit} << j;
+  }
+  return hits;
+}
+
 inline uint64_t MarkCandidates(const double* c, const double* t, uint32_t count, double base,
                                double per_metre, const Vec& a, const Vec& d) {
-  constexpr double kSlack = 1 + 1e-9;
   uint64_t hits = 0;
   uint32_t j = 0;
 #if defined(__SSE2__)
@@ -619,14 +637,39 @@ inline uint64_t MarkCandidates(const double* c, const double* t, uint32_t count,
     hits |= uint64_t(_mm_movemask_pd(hit)) << j;
   }
 #endif
-  for (; j < count; ++j) {
-    const double room = (c[j] - base) * per_metre;
-    const double x = a[0] + t[j] * d[0], y = a[1] + t[j] * d[1], z = a[2] + t[j] * d[2];
-    const bool hit = (room > 0) & (x * x + y * y + z * z < room * room * kSlack);
-    hits |= uint64_t{hit} << j;
-  }
-  return hits;
+  return hits | MarkRest(c, t, j, count, base, per_metre, a, d);
 }
+
+#if defined(GEODEX_AVX2_FILTER)
+// MarkCandidates four nodes per instruction, the same operations per lane (AVX2 without FMA: no
+// contraction), so the same marks. Called only where the CPU has AVX2 (kHasAvx2).
+__attribute__((target("avx2"))) uint64_t MarkCandidatesAvx2(const double* c, const double* t,
+                                                            uint32_t count, double base,
+                                                            double per_metre, const Vec& a,
+                                                            const Vec& d) {
+  uint64_t hits = 0;
+  uint32_t j = 0;
+  const __m256d vbase = _mm256_set1_pd(base), vper = _mm256_set1_pd(per_metre);
+  const __m256d vslack = _mm256_set1_pd(kSlack), zero = _mm256_setzero_pd();
+  const __m256d ax = _mm256_set1_pd(a[0]), ay = _mm256_set1_pd(a[1]), az = _mm256_set1_pd(a[2]);
+  const __m256d dx = _mm256_set1_pd(d[0]), dy = _mm256_set1_pd(d[1]), dz = _mm256_set1_pd(d[2]);
+  for (; j + 4 <= count; j += 4) {
+    const __m256d room = _mm256_mul_pd(_mm256_sub_pd(_mm256_loadu_pd(c + j), vbase), vper);
+    const __m256d s = _mm256_loadu_pd(t + j);
+    const __m256d x = _mm256_add_pd(ax, _mm256_mul_pd(s, dx));
+    const __m256d y = _mm256_add_pd(ay, _mm256_mul_pd(s, dy));
+    const __m256d z = _mm256_add_pd(az, _mm256_mul_pd(s, dz));
+    const __m256d len2 =
+        _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(x, x), _mm256_mul_pd(y, y)), _mm256_mul_pd(z, z));
+    const __m256d hit = _mm256_and_pd(
+        _mm256_cmp_pd(room, zero, _CMP_GT_OQ),
+        _mm256_cmp_pd(len2, _mm256_mul_pd(_mm256_mul_pd(room, room), vslack), _CMP_LT_OQ));
+    hits |= uint64_t(_mm256_movemask_pd(hit)) << j;
+  }
+  return hits | MarkRest(c, t, j, count, base, per_metre, a, d);
+}
+const bool kHasAvx2 = __builtin_cpu_supports("avx2");
+#endif
 
 // Dijkstra over the implicit graph, nodes settled in order of (cost, node id). The queue is an
 // indexed binary heap of buckets, not of nodes: a bucket is a vertex or one edge's chain of
@@ -915,7 +958,13 @@ class Search {
       count = std::min<uint32_t>(64, (block < run_lo ? run_lo : end) - block);
       const double* c = cost + block;
       const double* t = param + (block - begin);
+#if defined(GEODEX_AVX2_FILTER)
+      uint64_t hits =
+          kHasAvx2 ? MarkCandidatesAvx2(c, t, count, base, per_metre, {ax, ay, az}, {dx, dy, dz})
+                   : MarkCandidates(c, t, count, base, per_metre, {ax, ay, az}, {dx, dy, dz});
+#else
       uint64_t hits = MarkCandidates(c, t, count, base, per_metre, {ax, ay, az}, {dx, dy, dz});
+#endif
       while (hits != 0) {
         const uint32_t j = static_cast<uint32_t>(__builtin_ctzll(hits));
         hits &= hits - 1;
