@@ -1209,11 +1209,41 @@ absl::Status SearchWhole(const std::vector<Located>& sources, const WeightedOpti
   return status;
 }
 
-// Calls fn(cost) with the cost model of `options` (the one place the two are chosen).
-template <typename Fn>
-auto WithCost(const SteinerGraph& g, const WeightedOptions& options, bool inbound, Fn&& fn) {
-  if (options.slope_cost == nullptr) return fn(IsotropicCost(g));
-  return fn(DirectionalCost(g, *options.slope_cost, inbound));
+}  // namespace
+
+// The graph and its cost model, built once; the cost model refers to the graph and the graph to
+// the options' weights, so all three live here, at fixed addresses.
+struct WeightedSurface::Impl {
+  Impl(const TriangleMesh& mesh, WeightedOptions opts)
+      : options(std::move(opts)), graph(mesh, options) {}
+  WeightedOptions options;
+  SteinerGraph graph;
+  std::optional<IsotropicCost> isotropic;
+  std::optional<DirectionalCost> directional;
+
+  // Calls fn(cost model).
+  template <typename Fn>
+  auto WithCost(Fn&& fn) const {
+    return isotropic.has_value() ? fn(*isotropic) : fn(*directional);
+  }
+};
+
+namespace {
+
+// The graph and the cost model of `options` (already validated): the one place the model is
+// chosen. Every solve builds its surface here.
+absl::StatusOr<std::unique_ptr<WeightedSurface::Impl>> BuildSurface(
+    const TriangleMesh& mesh, const WeightedOptions& options) {
+  auto impl = std::make_unique<WeightedSurface::Impl>(mesh, options);
+  if (absl::Status s = impl->graph.Build(options.epsilon, options.max_steiner_points); !s.ok()) {
+    return s;
+  }
+  if (options.slope_cost == nullptr) {
+    impl->isotropic.emplace(impl->graph);
+  } else {
+    impl->directional.emplace(impl->graph, *impl->options.slope_cost, options.inbound);
+  }
+  return impl;
 }
 
 }  // namespace
@@ -1259,45 +1289,29 @@ absl::StatusOr<WeightedField> ComputeWeightedField(const TriangleMesh& mesh,
   if (sources.empty()) return absl::InvalidArgumentError("no sources given");
   std::vector<Located> located;
   if (absl::Status s = Prepare(mesh, sources, &located); !s.ok()) return s;
-  SteinerGraph g(mesh, options);
-  if (absl::Status s = g.Build(options.epsilon, options.max_steiner_points); !s.ok()) return s;
-  return WithCost(g, options, options.inbound,
-                  [&](const auto& cost) -> absl::StatusOr<WeightedField> {
-                    Search search(g, cost);
-                    if (absl::Status s = SearchWhole(located, options, &search); !s.ok()) return s;
-                    WeightedField field;
-                    field.cost.assign(mesh.file_vertex_count(), kInf);
-                    field.source.assign(mesh.file_vertex_count(), kNoIndex);
-                    for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
-                      const uint32_t fv = mesh.FileVertex(v);
-                      if (search.cost(v) < field.cost[fv]) {
-                        field.cost[fv] = search.cost(v);
-                        field.source[fv] = search.label(v);
-                      }
-                    }
-                    field.steiner_points = g.steiner_points();
-                    field.graph_edges = g.graph_edges();
-                    field.epsilon = options.epsilon;
-                    field.stats = search.Stats(Elapsed(start));
-                    return field;
-                  });
+  absl::StatusOr<std::unique_ptr<WeightedSurface::Impl>> surface = BuildSurface(mesh, options);
+  if (!surface.ok()) return surface.status();
+  const SteinerGraph& g = (*surface)->graph;
+  return (*surface)->WithCost([&](const auto& cost) -> absl::StatusOr<WeightedField> {
+    Search search(g, cost);
+    if (absl::Status s = SearchWhole(located, options, &search); !s.ok()) return s;
+    WeightedField field;
+    field.cost.assign(mesh.file_vertex_count(), kInf);
+    field.source.assign(mesh.file_vertex_count(), kNoIndex);
+    for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+      const uint32_t fv = mesh.FileVertex(v);
+      if (search.cost(v) < field.cost[fv]) {
+        field.cost[fv] = search.cost(v);
+        field.source[fv] = search.label(v);
+      }
+    }
+    field.steiner_points = g.steiner_points();
+    field.graph_edges = g.graph_edges();
+    field.epsilon = options.epsilon;
+    field.stats = search.Stats(Elapsed(start));
+    return field;
+  });
 }
-
-// The graph and its cost model, built once; the cost model refers to the graph and the graph to
-// the options' weights, so all three live here, at fixed addresses.
-struct WeightedSurface::Impl {
-  Impl(const TriangleMesh& mesh, WeightedOptions opts)
-      : options(std::move(opts)), graph(mesh, options) {}
-  WeightedOptions options;
-  SteinerGraph graph;
-  std::optional<IsotropicCost> isotropic;
-  std::optional<DirectionalCost> directional;
-
-  template <typename Fn>
-  auto WithCost(Fn&& fn) const {
-    return isotropic.has_value() ? fn(*isotropic) : fn(*directional);
-  }
-};
 
 WeightedSurface::WeightedSurface(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 WeightedSurface::WeightedSurface(WeightedSurface&&) noexcept = default;
@@ -1307,16 +1321,9 @@ WeightedSurface::~WeightedSurface() = default;
 absl::StatusOr<WeightedSurface> WeightedSurface::Build(const TriangleMesh& mesh,
                                                        const WeightedOptions& options) {
   if (absl::Status s = ValidateWeightedOptions(mesh, options); !s.ok()) return s;
-  auto impl = std::make_unique<Impl>(mesh, options);
-  if (absl::Status s = impl->graph.Build(options.epsilon, options.max_steiner_points); !s.ok()) {
-    return s;
-  }
-  if (options.slope_cost == nullptr) {
-    impl->isotropic.emplace(impl->graph);
-  } else {
-    impl->directional.emplace(impl->graph, *impl->options.slope_cost, options.inbound);
-  }
-  return WeightedSurface(std::move(impl));
+  absl::StatusOr<std::unique_ptr<Impl>> impl = BuildSurface(mesh, options);
+  if (!impl.ok()) return impl.status();
+  return WeightedSurface(*std::move(impl));
 }
 
 uint64_t WeightedSurface::steiner_points() const { return impl_->graph.steiner_points(); }
@@ -1397,58 +1404,59 @@ absl::StatusOr<std::vector<WeightedPath>> ComputeWeightedPaths(const TriangleMes
   if (absl::Status s = Prepare(mesh, {from}, &src_list); !s.ok()) return s;
   if (absl::Status s = Prepare(mesh, tos, &dsts); !s.ok()) return s;
   const Located& src = src_list[0];
-  SteinerGraph g(mesh, options);
-  if (absl::Status s = g.Build(options.epsilon, options.max_steiner_points); !s.ok()) return s;
   // A path is walked from `from`: the search runs outward whatever options.inbound says. One graph
   // and one search serve every target; it stops once every target's best is final.
-  return WithCost(g, options, /*inbound=*/false,
-                  [&](const auto& cost) -> absl::StatusOr<std::vector<WeightedPath>> {
-                    Search<std::decay_t<decltype(cost)>, true> search(g, cost);
-                    search.HeadFor(GoalOf(g, cost, dsts));
-                    search.Seed(src, 0);
-                    TargetWatch watch(g, cost, src_list, dsts);
-                    if (absl::Status s = search.Run(
-                            options, [&](double key) { return watch.Done(key); },
-                            [&](uint32_t u) { watch.Settled(u, search.cost(u)); });
-                        !s.ok()) {
-                      return s;
-                    }
-                    std::vector<WeightedPath> paths(dsts.size());
-                    for (size_t t = 0; t < dsts.size(); ++t) {
-                      const Located& dst = dsts[t];
-                      WeightedPath& path = paths[t];
-                      path.steiner_points = g.steiner_points();
-                      auto [total, node] = BestLink(g, cost, search, dst);
-                      const double direct = DirectCost(g, cost, src, dst);
-                      if (direct <= total) {
-                        total = direct;
-                        node = kNoIndex;
-                      }
-                      if (!std::isfinite(total) || total > options.max_distance) {
-                        path.cost = kInf;  // unreachable: no points
-                        continue;
-                      }
-                      path.cost = total;
-                      // Backwards from the target, then reversed.
-                      path.points.push_back(LocatedPoint(mesh, dst));
-                      uint32_t parent = kFromSourcePoint;
-                      while (node != kNoIndex) {
-                        if (!(dst.canonical.kind == SurfacePoint::Kind::kVertex &&
-                              search.cost(node) == total && path.points.size() == 1 &&
-                              node < g.nv() && mesh.FileVertex(node) == dst.canonical.vertex)) {
-                          path.points.push_back(NodePoint(g, node));
-                        }
-                        parent = search.parent(node);
-                        node = parent >= kFromSourcePoint ? kNoIndex : parent;
-                      }
-                      if (parent == kFromSourcePoint)
-                        path.points.push_back(LocatedPoint(mesh, src));
-                      std::reverse(path.points.begin(), path.points.end());
-                    }
-                    const WeightedStats stats = search.Stats(Elapsed(start));
-                    for (WeightedPath& path : paths) path.stats = stats;
-                    return paths;
-                  });
+  WeightedOptions outward = options;
+  outward.inbound = false;
+  absl::StatusOr<std::unique_ptr<WeightedSurface::Impl>> surface = BuildSurface(mesh, outward);
+  if (!surface.ok()) return surface.status();
+  const SteinerGraph& g = (*surface)->graph;
+  return (*surface)->WithCost([&](const auto& cost) -> absl::StatusOr<std::vector<WeightedPath>> {
+    Search<std::decay_t<decltype(cost)>, true> search(g, cost);
+    search.HeadFor(GoalOf(g, cost, dsts));
+    search.Seed(src, 0);
+    TargetWatch watch(g, cost, src_list, dsts);
+    if (absl::Status s = search.Run(
+            options, [&](double key) { return watch.Done(key); },
+            [&](uint32_t u) { watch.Settled(u, search.cost(u)); });
+        !s.ok()) {
+      return s;
+    }
+    std::vector<WeightedPath> paths(dsts.size());
+    for (size_t t = 0; t < dsts.size(); ++t) {
+      const Located& dst = dsts[t];
+      WeightedPath& path = paths[t];
+      path.steiner_points = g.steiner_points();
+      auto [total, node] = BestLink(g, cost, search, dst);
+      const double direct = DirectCost(g, cost, src, dst);
+      if (direct <= total) {
+        total = direct;
+        node = kNoIndex;
+      }
+      if (!std::isfinite(total) || total > options.max_distance) {
+        path.cost = kInf;  // unreachable: no points
+        continue;
+      }
+      path.cost = total;
+      // Backwards from the target, then reversed.
+      path.points.push_back(LocatedPoint(mesh, dst));
+      uint32_t parent = kFromSourcePoint;
+      while (node != kNoIndex) {
+        if (!(dst.canonical.kind == SurfacePoint::Kind::kVertex && search.cost(node) == total &&
+              path.points.size() == 1 && node < g.nv() &&
+              mesh.FileVertex(node) == dst.canonical.vertex)) {
+          path.points.push_back(NodePoint(g, node));
+        }
+        parent = search.parent(node);
+        node = parent >= kFromSourcePoint ? kNoIndex : parent;
+      }
+      if (parent == kFromSourcePoint) path.points.push_back(LocatedPoint(mesh, src));
+      std::reverse(path.points.begin(), path.points.end());
+    }
+    const WeightedStats stats = search.Stats(Elapsed(start));
+    for (WeightedPath& path : paths) path.stats = stats;
+    return paths;
+  });
 }
 
 absl::StatusOr<WeightedPath> ComputeWeightedPath(const TriangleMesh& mesh, const SurfacePoint& from,

@@ -170,8 +170,9 @@ class WeightedSurface {
                                         bool whole = false) const;
   uint64_t steiner_points() const;
 
+  struct Impl;  // the graph and cost model (weighted_field.cc); every solve builds one
+
  private:
-  struct Impl;
   explicit WeightedSurface(std::unique_ptr<Impl> impl);
   std::unique_ptr<Impl> impl_;
 };
