@@ -50,6 +50,9 @@ struct World {
   ServiceCounters counters;
   World() {
     limits.max_windows = 100000;
+    // Travel-cost solves grow as k^2 links per face: a fuzzed tiny epsilon on the grid must stay
+    // well inside the per-input timeout under the sanitizers, as max_windows bounds the exact one.
+    limits.max_steiner_points = 20000;
     limits.max_sources = 64;
     limits.max_targets = 64;
     limits.max_levels = 16;
