@@ -52,7 +52,7 @@ class SteinerGraph {
   // Bounded: the geometric placement of Aleksandrov, Maheshwari and Sack (dense near vertices),
   // for a (1 + epsilon) bound on link paths. Uniform: ceil(1 / epsilon) - 1 points evenly spaced
   // on every edge (spacing epsilon x its length), for a search that crosses between nodes
-  // (Search::CrossSegment) and claims no bound: the error then falls about as the spacing
+  // (Search::CrossSegments) and claims no bound: the error then falls about as the spacing
   // squared, so far fewer points reach a given accuracy.
   enum class Placement { kBounded, kUniform };
   absl::Status Build(double epsilon, uint64_t max_points, Placement placement);
@@ -291,7 +291,7 @@ struct Medium {
 class IsotropicCost {
  public:
   explicit IsotropicCost(const SteinerGraph& g) : g_(g) {}
-  // Links only: every cost is a real path's, so the bound holds (see Search::CrossSegment).
+  // Links only: every cost is a real path's, so the bound holds (see Search::CrossSegments).
   static constexpr bool kInterpolates = false;
   double Face(uint32_t f, double x, double y, double z) const {
     return g_.FaceWeight(f) * std::sqrt(x * x + y * y + z * z);
@@ -320,7 +320,7 @@ class IsotropicCost {
 // the other way, so a piece's rise changes sign.
 class DirectionalCost {
  public:
-  // No bound to keep: the wave also crosses between settled nodes (Search::CrossSegment).
+  // No bound to keep: the wave also crosses between settled nodes (Search::CrossSegments).
   static constexpr bool kInterpolates = true;
   DirectionalCost(const SteinerGraph& g, const SlopeCost& slope, bool inbound)
       : g_(g),
@@ -1009,7 +1009,8 @@ class Search {
   void RelaxNode(uint32_t n, uint32_t bucket, const Vec& p, double base, Medium m, uint32_t label,
                  uint32_t from) {
     if (done_[n]) return;
-    Offer(n, bucket, base + LinkCost(costs_, m, p, g_.Pos(n)), label, from);
+    const Vec q = n < g_.nv() ? mesh_.Position(n) : g_.PosOn(n, bucket - g_.nv());
+    Offer(n, bucket, base + LinkCost(costs_, m, p, q), label, from);
   }
 
   // The wave between two settled neighbours u and v on one edge crosses the segment [u, v]
@@ -1022,34 +1023,45 @@ class Search {
   // slope cost); it is clamped to at least T(u) so that costs still settle in order, and A* (whose
   // bound covers links) is off for such costs (GoalOf). The cost is convex in s (a convex face
   // cost along a line, plus a linear term), so a golden-section search finds the minimum.
-  void CrossSegment(uint32_t f, uint32_t h, uint32_t u, const Vec& p, double dp, uint32_t v,
-                    uint32_t lab) {
-    if (checking_ || !done_[v] || v == u) return;
-    const double dq = cost_[v];
-    const Vec q = v < g_.nv() ? mesh_.Position(v) : g_.PosOn(v, g_.EdgeOfHalf(h));
+  void CrossSegments(uint32_t f, uint32_t h, uint32_t u, const Vec& p, double dp,
+                     std::array<uint32_t, 2> ends, uint32_t lab) {
+    if (checking_) return;
+    struct Segment {
+      uint32_t v = kNoIndex;
+      double dq, rx, ry, rz, r2;
+    };
+    std::array<Segment, 2> segs;
+    int count = 0;
+    for (const uint32_t v : ends) {
+      if (v == kNoIndex || v == u || !done_[v]) continue;
+      const Vec q = v < g_.nv() ? mesh_.Position(v) : g_.PosOn(v, g_.EdgeOfHalf(h));
+      Segment& sg = segs[count];
+      sg.rx = q[0] - p[0], sg.ry = q[1] - p[1], sg.rz = q[2] - p[2];
+      sg.r2 = sg.rx * sg.rx + sg.ry * sg.ry + sg.rz * sg.rz;
+      if (!(sg.r2 > 0)) continue;
+      sg.v = v;
+      sg.dq = cost_[v];
+      ++count;
+    }
+    if (count == 0) return;
     const auto walk = costs_.ForFace(f);
     const double floor = costs_.FaceFloor(f) * (1 - 1e-9);
-    const double rx = q[0] - p[0], ry = q[1] - p[1], rz = q[2] - p[2];
-    const double r2 = rx * rx + ry * ry + rz * rz;
-    if (!(r2 > 0)) return;
-    const double low = std::min(dp, dq);
-    auto offer = [&](uint32_t n, uint32_t bucket, const Vec& x) {
-      if (done_[n] || cost_[n] <= dp) return;  // the clamped offer is at least dp
-      // Only a node whose best link is from u or v: the wave reaches it across [u, v].
-      if (parent_[n] != u && parent_[n] != v) return;
-      const double xx = x[0] - p[0], xy = x[1] - p[1], xz = x[2] - p[2];
-      // Square-root-free skip: low + floor x the distance to the segment cannot beat the node.
-      const double t = std::clamp((xx * rx + xy * ry + xz * rz) / r2, 0.0, 1.0);
-      const double ox = xx - t * rx, oy = xy - t * ry, oz = xz - t * rz;
-      const double gap = cost_[n] - low;
+    auto cross = [&](const Segment& sg, uint32_t n, uint32_t bucket, double xx, double xy,
+                     double xz) {
+      // Square-root-free skip: the lower end + floor x the distance to the segment cannot beat
+      // the node.
+      const double t = std::clamp((xx * sg.rx + xy * sg.ry + xz * sg.rz) / sg.r2, 0.0, 1.0);
+      const double ox = xx - t * sg.rx, oy = xy - t * sg.ry, oz = xz - t * sg.rz;
+      const double gap = cost_[n] - std::min(dp, sg.dq);
       if (gap * gap <= floor * floor * (ox * ox + oy * oy + oz * oz)) return;
       auto at = [&](double s) {
-        return (1 - s) * dp + s * dq + walk(xx - s * rx, xy - s * ry, xz - s * rz);
+        return (1 - s) * dp + s * sg.dq + walk(xx - s * sg.rx, xy - s * sg.ry, xz - s * sg.rz);
       };
       // An interior minimum needs the cost falling at s = 0 and rising at s = 1 (convexity);
       // otherwise an end is best, and its link was offered already.
       constexpr double kNudge = 1e-3;
       if (!(at(kNudge) < at(0)) || !(at(1 - kNudge) < at(1))) return;
+      // Golden section (the face's cost has kinks: Tobler's peak, the switchback ranges).
       constexpr double kGolden = 0.6180339887498949;
       double a = kNudge, b = 1 - kNudge;
       double c = b - kGolden * (b - a), e = a + kGolden * (b - a);
@@ -1066,7 +1078,16 @@ class Search {
       const double s = fc < fe ? c : e;
       const double cost = std::max(std::min(fc, fe), dp);
       ++relaxations_;
-      Improve(n, bucket, cost, s < 0.5 ? lab : label_[v], s < 0.5 ? u : v);
+      Improve(n, bucket, cost, s < 0.5 ? lab : label_[sg.v], s < 0.5 ? u : sg.v);
+    };
+    auto offer = [&](uint32_t n, uint32_t bucket, const Vec& x) {
+      if (done_[n] || cost_[n] <= dp) return;  // the clamped offer is at least dp
+      // Only a node whose best link is from a segment's end: the wave reaches it across it.
+      const uint32_t parent = parent_[n];
+      const double xx = x[0] - p[0], xy = x[1] - p[1], xz = x[2] - p[2];
+      for (int i = 0; i < count; ++i) {
+        if (parent == u || parent == segs[i].v) cross(segs[i], n, bucket, xx, xy, xz);
+      }
     };
     const uint32_t nv = g_.nv();
     for (const uint32_t t : {TriangleMesh::Next(h), TriangleMesh::Prev(h)}) {
@@ -1114,7 +1135,7 @@ class Search {
               const uint32_t next = g_.First(e) == g_.End(e)
                                         ? (mesh_.From(h) == u ? mesh_.To(h) : mesh_.From(h))
                                         : (from_u ? g_.First(e) : g_.End(e) - 1);
-              CrossSegment(f, h, u, p, d, next, lab);
+              CrossSegments(f, h, u, p, d, {next, kNoIndex}, lab);
             }
           }
         }
@@ -1143,8 +1164,10 @@ class Search {
       RelaxEdge(g_.EdgeOfHalf(TriangleMesh::Next(h)), p, d, f, lab, u);
       RelaxEdge(g_.EdgeOfHalf(TriangleMesh::Prev(h)), p, d, f, lab, u);
       if constexpr (Cost::kInterpolates) {
-        CrossSegment(f, h, u, p, d, u == g_.First(e) ? mesh_.From(h0) : u - 1, lab);
-        CrossSegment(f, h, u, p, d, u + 1 == g_.End(e) ? mesh_.To(h0) : u + 1, lab);
+        CrossSegments(
+            f, h, u, p, d,
+            {u == g_.First(e) ? mesh_.From(h0) : u - 1, u + 1 == g_.End(e) ? mesh_.To(h0) : u + 1},
+            lab);
       }
       const uint32_t o = mesh_.Opposite(h);
       RelaxNode(o, o, p, d, Medium{Medium::kFace, f}, lab, u);
@@ -1227,7 +1250,7 @@ Goal GoalOf(const SteinerGraph& g, const Cost& cost, const std::vector<Located>&
     if (std::isfinite(g.FaceWeight(f))) floor = std::min(floor, cost.FaceFloor(f));
   }
   goal.per_metre = std::isfinite(floor) ? floor * (1 - 1e-9) : 0;
-  // A segment's offer (Search::CrossSegment) is below its ends' links, outside what the bound
+  // A segment's offer (Search::CrossSegments) is below its ends' links, outside what the bound
   // covers: such a search runs as Dijkstra (a zero bound) and still stops once its targets are
   // final, so its answers stay the whole search's bit for bit.
   if constexpr (Cost::kInterpolates) goal.per_metre = 0;
