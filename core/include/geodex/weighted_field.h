@@ -78,15 +78,18 @@ namespace geodex {
 // straight, the straight piece costs the zigzag. The engine builds the envelope per face (the
 // convex hull of the unit-cost set, sampled every half degree), so a face's cost does not depend
 // on how it is cut. Costs then differ by direction: fields are costs from the sources outward
-// unless WeightedOptions::inbound. No (1 + epsilon) bound is proved for such costs: epsilon only
-// sets the Steiner points' density.
+// unless WeightedOptions::inbound. No (1 + epsilon) bound is proved for such costs, so their
+// search trades the graph's "a real path" for accuracy: ceil(1 / epsilon) - 1 evenly spaced
+// points per edge, and the wave also crosses an edge between two settled neighbouring points
+// (its cost linear along the segment: an ordered-upwind step), which makes the error fall about
+// as the spacing squared; a cost may then fall slightly below the least cost.
 struct SlopeCost {
   std::vector<double> per_metre;  // >= 2 samples; > 0 or +inf; finite at sine 0 (the level)
 };
 
 struct WeightedOptions {
   // The stated bound: every cost is at most (1 + epsilon) x the true least cost and never below
-  // it. Must be in (0, 1).
+  // it. Must be in (0, 1). With a slope cost, the Steiner points' spacing instead (SlopeCost).
   double epsilon = 0.01;
   // One weight per FILE face: > 0 and finite, or +inf (impassable). Empty: every face weighs 1.
   std::vector<double> face_weight;
