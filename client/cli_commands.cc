@@ -559,12 +559,13 @@ std::string TravelTextHeader(const GeodesicOptions& options) {
     return absl::StrFormat(
         "# travel time in seconds at %g km/h on friction 1; approximate: at most (1 + %g) x the "
         "least time\n",
-        t.speed_kmh, t.epsilon);
+        t.speed_kmh, TravelEpsilon(t));
   }
   return absl::StrFormat(
       "# travel time in seconds %s, %s; approximate (epsilon %g, no proven bound)\n",
       t.inbound ? "to reach the sources" : "from the sources",
-      t.speed_model == SpeedModel::kTobler ? "Tobler's hiking function" : "speed table", t.epsilon);
+      t.speed_model == SpeedModel::kTobler ? "Tobler's hiking function" : "speed table",
+      TravelEpsilon(t));
 }
 std::string TravelJsonMembers(const GeodesicOptions& options) {
   if (!options.travel.has_value()) return "";
@@ -572,8 +573,8 @@ std::string TravelJsonMembers(const GeodesicOptions& options) {
   return absl::StrFormat(
       "\"unit\": \"s\", \"approximate\": true, \"epsilon\": %s, \"bound\": %s, \"speed\": "
       "\"%s\", \"inbound\": %s, ",
-      JsonNumber(t.epsilon), IsDirectional(t) ? "false" : "true", SpeedModelName(t.speed_model),
-      t.inbound ? "true" : "false");
+      JsonNumber(TravelEpsilon(t)), IsDirectional(t) ? "false" : "true",
+      SpeedModelName(t.speed_model), t.inbound ? "true" : "false");
 }
 
 // `distances --at`: one line per point, "POINT<TAB>estimate D<TAB>exact D<TAB>source I" (I = -1

@@ -232,8 +232,12 @@ bool GetTravelFlags(const Args& args, GeodesicOptions* options, std::string* err
     return false;
   }
   travel.inbound = args.options.count("inbound") > 0;
-  if (!GetDouble(args, "cost-epsilon", &travel.epsilon, error) ||
-      !GetDouble(args, "max-slope", &travel.max_slope_deg, error) ||
+  if (args.options.count("cost-epsilon")) {  // unset: the speed model's default (TravelEpsilon)
+    double epsilon = 0;
+    if (!GetDouble(args, "cost-epsilon", &epsilon, error)) return false;
+    travel.epsilon = epsilon;
+  }
+  if (!GetDouble(args, "max-slope", &travel.max_slope_deg, error) ||
       !GetUint(args, "max-steiner-points", &travel.max_steiner_points, error)) {
     return false;
   }

@@ -24,9 +24,10 @@ std::string Key(const std::vector<SurfacePoint>& sources, const GeodesicOptions&
                                     o.max_windows, o.use_filter, o.use_one_angle_one_split);
   if (o.travel.has_value()) {  // a travel field is another field; weights and table by content
     const TravelCost& t = *o.travel;
-    absl::StrAppend(&key, absl::StrFormat("travel %d|%.17g|%.17g|%.17g|%d|%d|",
-                                          static_cast<int>(t.speed_model), t.speed_kmh, t.epsilon,
-                                          t.max_slope_deg, t.max_steiner_points, t.inbound));
+    absl::StrAppend(
+        &key, absl::StrFormat("travel %d|%.17g|%.17g|%.17g|%d|%d|", static_cast<int>(t.speed_model),
+                              t.speed_kmh, TravelEpsilon(t), t.max_slope_deg, t.max_steiner_points,
+                              t.inbound));
     auto bytes = [](const auto* v) {
       return v == nullptr ? std::string("-")
                           : std::string(reinterpret_cast<const char*>(v->data()),

@@ -57,7 +57,7 @@ std::string FieldCacheKey(const std::string& mesh_id, const std::vector<SurfaceP
     Append(&key, rows);
     for (size_t i = 0; i < rows; ++i) Append(&key, (*travel.speed_table)[i]);
     Append(&key, static_cast<uint8_t>(TimesInbound(travel)));  // (one entry at a constant speed)
-    Append(&key, travel.epsilon);
+    Append(&key, TravelEpsilon(travel));  // (unset and its default are one entry)
     Append(&key, travel.max_slope_deg);
     const bool weighted = travel.face_weight != nullptr;
     Append(&key, static_cast<uint8_t>(weighted));

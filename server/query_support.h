@@ -44,9 +44,10 @@ void SnapsToProto(const PointSnaps& snaps, Response* out) {
 // (terrain's FrictionFromGeoJson: in the DEM's map on a DEM's mesh, else in the mesh's x y).
 absl::StatusOr<GeodesicOptions> Options(const QueryEnv& env, const StoredMesh& mesh,
                                         const v1::SolverOptions& options);
-// What an answer's travel_epsilon says: 0 for exact metres, else the travel cost's bound.
+// What an answer's travel_epsilon says: 0 for exact metres, else the epsilon the solve uses
+// (set, or the speed model's default).
 inline double TravelEpsilon(const GeodesicOptions& options) {
-  return options.travel ? options.travel->epsilon : 0;
+  return options.travel ? TravelEpsilon(*options.travel) : 0;
 }
 // INVALID_ARGUMENT naming options.travel for a product a travel cost cannot give, before any
 // solve (`why`: what the product needs, "the geodesic Delaunay triangulation is traced through the

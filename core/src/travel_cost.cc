@@ -118,9 +118,9 @@ absl::Status ValidateTravelCost(const TravelCost& travel) {
     return OptionError("travel.speed_table", "is only read with the table speed model");
   }
 
-  if (!(travel.epsilon > 0 && travel.epsilon < 1)) {
+  if (travel.epsilon.has_value() && !(*travel.epsilon > 0 && *travel.epsilon < 1)) {
     return OptionError("travel.epsilon",
-                       absl::StrFormat("must be in (0, 1), got %g", travel.epsilon));
+                       absl::StrFormat("must be in (0, 1), got %g", *travel.epsilon));
   }
   if (!(travel.max_slope_deg >= 0 && travel.max_slope_deg <= 90)) {
     return OptionError(
@@ -155,7 +155,7 @@ absl::StatusOr<WeightedOptions> WeightedOptionsFor(const TriangleMesh& mesh,
   }
   const TravelCost& travel = *options.travel;
   WeightedOptions out;
-  out.epsilon = travel.epsilon;
+  out.epsilon = TravelEpsilon(travel);
   out.max_steiner_points = travel.max_steiner_points;
   out.cancel = options.cancel;
   out.max_distance = options.max_distance / SecondsPerUnit(travel);
@@ -199,7 +199,7 @@ absl::StatusOr<DistanceField> ComputeTravelField(const TriangleMesh& mesh,
     field.internal_source[v] = field.source[mesh.FileVertex(v)];
   }
   field.stats = StatsOf(w->stats);
-  field.travel_epsilon = options.travel->epsilon;
+  field.travel_epsilon = TravelEpsilon(*options.travel);
   return field;
 }
 

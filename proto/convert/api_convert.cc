@@ -163,7 +163,7 @@ void SolverOptionsToProto(const GeodesicOptions& options, v1::SolverOptions* out
     const TravelCost& travel = *options.travel;
     v1::TravelCost* t = out->mutable_travel();
     t->set_speed_kmh(travel.speed_kmh);
-    t->set_epsilon(travel.epsilon);
+    if (travel.epsilon.has_value()) t->set_epsilon(*travel.epsilon);  // unset: the model's default
     t->set_max_slope_deg(travel.max_slope_deg);
     if (travel.face_weight != nullptr) {
       t->mutable_face_weights()->Add(travel.face_weight->begin(), travel.face_weight->end());

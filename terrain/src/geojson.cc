@@ -291,7 +291,7 @@ std::vector<GeoFeature> IsochroneFeatures(const MeshData& mesh, const std::vecto
     f.exact_tiling = true;
     f.properties = {{"level", level}, {"units", std::string(travel != nullptr ? "s" : "m")}};
     if (travel != nullptr) {
-      f.properties.push_back({"epsilon", travel->epsilon});
+      f.properties.push_back({"epsilon", TravelEpsilon(*travel)});
       f.properties.push_back({"bound", !IsDirectional(*travel)});
       f.properties.push_back({"speed", std::string(SpeedModelName(travel->speed_model))});
       f.properties.push_back({"inbound", TimesInbound(*travel)});

@@ -214,6 +214,29 @@ TEST(SlopeSpeedTest, MatricesAreAsymmetric) {
   EXPECT_GT(m->values[1], 1.3 * m->values[2]);
 }
 
+// Unset, epsilon is the speed model's default: 0.1 for a slope speed (its points' spacing), 0.01
+// for a constant speed (its bound); a set one is used as set, and 0 is refused by name.
+TEST(SlopeSpeedTest, EpsilonDefaultsToTheSpeedModels) {
+  TravelCost constant;
+  constant.speed_kmh = 3.6;
+  EXPECT_EQ(TravelEpsilon(constant), 0.01);
+  TravelCost tobler;
+  tobler.speed_model = SpeedModel::kTobler;
+  EXPECT_EQ(TravelEpsilon(tobler), 0.1);
+  tobler.epsilon = 0.05;
+  EXPECT_EQ(TravelEpsilon(tobler), 0.05);
+  const TriangleMesh mesh = Incline(0.05);
+  GeodesicOptions options = Tobler();
+  options.travel->epsilon.reset();
+  absl::StatusOr<DistanceField> field = ComputeDistanceField(mesh, {GridVertex(0, 0)}, options);
+  ASSERT_TRUE(field.ok()) << field.status();
+  EXPECT_EQ(field->travel_epsilon, 0.1);
+  options.travel->epsilon = 0;
+  field = ComputeDistanceField(mesh, {GridVertex(0, 0)}, options);
+  ASSERT_FALSE(field.ok());
+  EXPECT_EQ(InvalidOptionOf(field.status()), "travel.epsilon") << field.status();
+}
+
 TEST(SlopeSpeedTest, BadSpeedModelsAreNamedErrors) {
   const TriangleMesh mesh = Incline(0.05, 2, 0);
   auto error_of = [&](const GeodesicOptions& options) {

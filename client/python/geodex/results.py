@@ -34,8 +34,8 @@ class Travel:
     """Travel time instead of length (geodex.v1.TravelCost, docs/travel.md), the `travel=` of
     every query that takes solver options: its answers are then in SECONDS (the answer's
     `travel_epsilon` > 0). With a constant speed each is at least the least travel time and at
-    most (1 + epsilon) times it; with a slope-dependent speed no bound is proved (epsilon only
-    sets the density of the server's Steiner points).
+    most (1 + epsilon) times it; with a slope-dependent speed no bound is proved (epsilon is the
+    spacing of the server's Steiner points along each edge).
 
     `speed_kmh`: the constant speed on a face of weight 1 (km/h, > 0; leave it 0 with a
     slope-dependent speed). `speed`: "constant", "tobler" (Tobler's hiking function: 6 km/h
@@ -45,7 +45,7 @@ class Travel:
     [-90, 90] with the first <= 0 <= the last, speeds > 0; linear between rows, steeper slopes
     cannot be walked. `inbound`: with a slope-dependent speed, times to REACH the sources instead
     of from them (paths are walked from their start and refuse it). `epsilon`: in (0, 1) (None: the
-    server's 0.01). `max_slope_deg`: faces steeper than this (degrees from the x-y plane) are
+    server's default for the speed model, 0.01 constant, 0.1 slope-dependent). `max_slope_deg`: faces steeper than this (degrees from the x-y plane) are
     impassable (0: no limit). `face_weights`: one friction per face of the mesh, in order (> 0,
     inf impassable; None: 1). `friction_geojson`: GeoJSON polygons (text or a dict) with a
     numeric "friction" property; each face takes the friction of the polygon holding its
