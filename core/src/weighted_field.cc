@@ -741,6 +741,10 @@ class Search {
   uint32_t BucketOf(uint32_t node) const {
     return node < g_.nv() ? node : g_.nv() + g_.EdgeOfNode(node);
   }
+  // The position of a node of `bucket` (no search for its edge, as SteinerGraph::Pos needs).
+  Vec PosOf(uint32_t node, uint32_t bucket) const {
+    return node < g_.nv() ? mesh_.Position(node) : g_.PosOn(node, bucket - g_.nv());
+  }
 
   void Offer(uint32_t node, uint32_t bucket, double cost, uint32_t label, uint32_t parent) {
     ++relaxations_;
@@ -864,7 +868,7 @@ class Search {
   }
   // The lower bound of the cost left from node n (of `bucket`) to the goal.
   double Ahead(uint32_t n, uint32_t bucket) const {
-    const Vec p = n < g_.nv() ? mesh_.Position(n) : g_.PosOn(n, bucket - g_.nv());
+    const Vec p = PosOf(n, bucket);
     const double away = Dist(p, goal_.centre) - goal_.radius;
     return away > 0 ? away * goal_.per_metre : 0;
   }
@@ -1009,8 +1013,7 @@ class Search {
   void RelaxNode(uint32_t n, uint32_t bucket, const Vec& p, double base, Medium m, uint32_t label,
                  uint32_t from) {
     if (done_[n]) return;
-    const Vec q = n < g_.nv() ? mesh_.Position(n) : g_.PosOn(n, bucket - g_.nv());
-    Offer(n, bucket, base + LinkCost(costs_, m, p, q), label, from);
+    Offer(n, bucket, base + LinkCost(costs_, m, p, PosOf(n, bucket)), label, from);
   }
 
   // The wave between two settled neighbours u and v on one edge crosses the segment [u, v]
@@ -1034,7 +1037,7 @@ class Search {
     int count = 0;
     for (const uint32_t v : ends) {
       if (v == kNoIndex || v == u || !done_[v]) continue;
-      const Vec q = v < g_.nv() ? mesh_.Position(v) : g_.PosOn(v, g_.EdgeOfHalf(h));
+      const Vec q = PosOf(v, v < g_.nv() ? v : g_.nv() + g_.EdgeOfHalf(h));
       Segment& sg = segs[count];
       sg.rx = q[0] - p[0], sg.ry = q[1] - p[1], sg.rz = q[2] - p[2];
       sg.r2 = sg.rx * sg.rx + sg.ry * sg.ry + sg.rz * sg.rz;
@@ -1107,36 +1110,32 @@ class Search {
 
   void Settle(uint32_t u, uint32_t bucket, double d) {
     const uint32_t nv = g_.nv();
-    const Vec p = u < nv ? mesh_.Position(u) : g_.PosOn(u, bucket - nv);
+    const Vec p = PosOf(u, bucket);
     const uint32_t lab = label_[u];
     if (u < g_.nv()) {
       for (const uint32_t* c = mesh_.CornersBegin(u); c != mesh_.CornersEnd(u); ++c) {
         // Along the two edges at u: the nearest node.
-        for (const uint32_t h : {*c, TriangleMesh::Prev(*c)}) {
-          const uint32_t e = g_.EdgeOfHalf(h);
+        const std::array<uint32_t, 2> at_u = {*c, TriangleMesh::Prev(*c)};
+        std::array<uint32_t, 2> next = {kNoIndex, kNoIndex};
+        for (int i = 0; i < 2; ++i) {
+          const uint32_t h = at_u[i], e = g_.EdgeOfHalf(h);
           if (!std::isfinite(g_.EdgeWeight(e))) continue;
-          uint32_t next;
           if (g_.First(e) == g_.End(e)) {
-            next = mesh_.From(h) == u ? mesh_.To(h) : mesh_.From(h);
+            next[i] = mesh_.From(h) == u ? mesh_.To(h) : mesh_.From(h);
           } else {
-            next = mesh_.From(g_.EdgeHalf(e)) == u ? g_.First(e) : g_.End(e) - 1;
+            next[i] = mesh_.From(g_.EdgeHalf(e)) == u ? g_.First(e) : g_.End(e) - 1;
           }
-          RelaxNode(next, next < nv ? next : nv + e, p, d, Medium{Medium::kEdge, e}, lab, u);
+          RelaxNode(next[i], next[i] < nv ? next[i] : nv + e, p, d, Medium{Medium::kEdge, e}, lab,
+                    u);
         }
         // Across the face: the opposite edge's Steiner points.
         const uint32_t f = TriangleMesh::FaceOf(*c);
         if (std::isfinite(g_.FaceWeight(f))) {
           RelaxEdge(g_.EdgeOfHalf(TriangleMesh::Next(*c)), p, d, f, lab, u);
           if constexpr (Cost::kInterpolates) {
-            // The segments from u to its nearest node on the face's two edges at u.
-            for (const uint32_t h : {*c, TriangleMesh::Prev(*c)}) {
-              const uint32_t e = g_.EdgeOfHalf(h);
-              const bool from_u = mesh_.From(g_.EdgeHalf(e)) == u;
-              const uint32_t next = g_.First(e) == g_.End(e)
-                                        ? (mesh_.From(h) == u ? mesh_.To(h) : mesh_.From(h))
-                                        : (from_u ? g_.First(e) : g_.End(e) - 1);
-              CrossSegments(f, h, u, p, d, {next, kNoIndex}, lab);
-            }
+            // The segments from u to those nearest nodes (the face is passable, so both edges are).
+            for (int i = 0; i < 2; ++i)
+              CrossSegments(f, at_u[i], u, p, d, {next[i], kNoIndex}, lab);
           }
         }
       }
@@ -1144,18 +1143,13 @@ class Search {
     }
     const uint32_t e = bucket - nv;
     const uint32_t h0 = g_.EdgeHalf(e);
+    // u's neighbours along its edge: the previous and next Steiner nodes, or the edge's ends.
+    const uint32_t before = u == g_.First(e) ? mesh_.From(h0) : u - 1;
+    const uint32_t after = u + 1 == g_.End(e) ? mesh_.To(h0) : u + 1;
     if (std::isfinite(g_.EdgeWeight(e))) {  // (a Steiner node's edge has a passable face)
       const Medium along{Medium::kEdge, e};
-      if (u == g_.First(e)) {
-        RelaxNode(mesh_.From(h0), mesh_.From(h0), p, d, along, lab, u);
-      } else {
-        RelaxNode(u - 1, bucket, p, d, along, lab, u);
-      }
-      if (u + 1 == g_.End(e)) {
-        RelaxNode(mesh_.To(h0), mesh_.To(h0), p, d, along, lab, u);
-      } else {
-        RelaxNode(u + 1, bucket, p, d, along, lab, u);
-      }
+      RelaxNode(before, before < nv ? before : bucket, p, d, along, lab, u);
+      RelaxNode(after, after < nv ? after : bucket, p, d, along, lab, u);
     }
     for (const uint32_t h : {h0, mesh_.Twin(h0)}) {
       if (h == kNoIndex) continue;
@@ -1163,12 +1157,7 @@ class Search {
       if (!std::isfinite(g_.FaceWeight(f))) continue;
       RelaxEdge(g_.EdgeOfHalf(TriangleMesh::Next(h)), p, d, f, lab, u);
       RelaxEdge(g_.EdgeOfHalf(TriangleMesh::Prev(h)), p, d, f, lab, u);
-      if constexpr (Cost::kInterpolates) {
-        CrossSegments(
-            f, h, u, p, d,
-            {u == g_.First(e) ? mesh_.From(h0) : u - 1, u + 1 == g_.End(e) ? mesh_.To(h0) : u + 1},
-            lab);
-      }
+      if constexpr (Cost::kInterpolates) CrossSegments(f, h, u, p, d, {before, after}, lab);
       const uint32_t o = mesh_.Opposite(h);
       RelaxNode(o, o, p, d, Medium{Medium::kFace, f}, lab, u);
     }
@@ -1235,6 +1224,10 @@ std::pair<double, uint32_t> BestLink(const SteinerGraph& g, const Cost& cost,
 template <typename Cost>
 Goal GoalOf(const SteinerGraph& g, const Cost& cost, const std::vector<Located>& to) {
   Goal goal;
+  // A segment's offer (Search::CrossSegments) is below its ends' links, outside what the bound
+  // covers: such a search runs as Dijkstra (a zero bound) and still stops once its targets are
+  // final, so its answers stay the whole search's bit for bit.
+  if constexpr (Cost::kInterpolates) return goal;
   if (to.empty()) return goal;
   Vec lo = to[0].pos, hi = to[0].pos;
   for (const Located& t : to) {
@@ -1250,10 +1243,6 @@ Goal GoalOf(const SteinerGraph& g, const Cost& cost, const std::vector<Located>&
     if (std::isfinite(g.FaceWeight(f))) floor = std::min(floor, cost.FaceFloor(f));
   }
   goal.per_metre = std::isfinite(floor) ? floor * (1 - 1e-9) : 0;
-  // A segment's offer (Search::CrossSegments) is below its ends' links, outside what the bound
-  // covers: such a search runs as Dijkstra (a zero bound) and still stops once its targets are
-  // final, so its answers stay the whole search's bit for bit.
-  if constexpr (Cost::kInterpolates) goal.per_metre = 0;
   return goal;
 }
 
@@ -1379,10 +1368,14 @@ namespace {
 absl::StatusOr<std::unique_ptr<WeightedSurface::Impl>> BuildSurface(
     const TriangleMesh& mesh, const WeightedOptions& options) {
   auto impl = std::make_unique<WeightedSurface::Impl>(mesh, options);
-  // A slope cost has no bound to keep: uniform points and crossings between them (the placement
-  // goes with the cost's kInterpolates).
-  const auto placement = options.slope_cost == nullptr ? SteinerGraph::Placement::kBounded
-                                                       : SteinerGraph::Placement::kUniform;
+  // The placement goes with the cost model: a model that crosses between points (no bound to
+  // keep, kInterpolates) takes them evenly spaced.
+  auto placement_of = [](auto interpolates) {
+    return interpolates ? SteinerGraph::Placement::kUniform : SteinerGraph::Placement::kBounded;
+  };
+  const SteinerGraph::Placement placement = options.slope_cost == nullptr
+                                                ? placement_of(IsotropicCost::kInterpolates)
+                                                : placement_of(DirectionalCost::kInterpolates);
   if (absl::Status s = impl->graph.Build(options.epsilon, options.max_steiner_points, placement);
       !s.ok()) {
     return s;
