@@ -389,7 +389,8 @@ absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
   // A travel cost: one weighted graph for every row.
   std::optional<TravelPointSolver> travel;
   if (options.solver.travel.has_value()) {
-    absl::StatusOr<TravelPointSolver> solver = TravelPointSolver::Create(mesh, options.solver);
+    absl::StatusOr<TravelPointSolver> solver =
+        TravelPointSolver::Create(mesh, options.solver, sources);
     if (!solver.ok()) return solver.status();
     travel.emplace(*std::move(solver));
   }

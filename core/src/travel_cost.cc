@@ -203,11 +203,12 @@ absl::StatusOr<DistanceField> ComputeTravelField(const TriangleMesh& mesh,
   return field;
 }
 
-absl::StatusOr<TravelPointSolver> TravelPointSolver::Create(const TriangleMesh& mesh,
-                                                            const GeodesicOptions& options) {
+absl::StatusOr<TravelPointSolver> TravelPointSolver::Create(
+    const TriangleMesh& mesh, const GeodesicOptions& options,
+    const std::vector<SurfacePoint>& sources) {
   absl::StatusOr<WeightedOptions> weighted = WeightedOptionsFor(mesh, options);
   if (!weighted.ok()) return weighted.status();
-  absl::StatusOr<WeightedSurface> surface = WeightedSurface::Build(mesh, *weighted);
+  absl::StatusOr<WeightedSurface> surface = WeightedSurface::Build(mesh, *weighted, sources);
   if (!surface.ok()) return surface.status();
   return TravelPointSolver(*options.travel, *std::move(surface));
 }
@@ -230,7 +231,8 @@ absl::StatusOr<PointValues> ComputeTravelPointValues(const TriangleMesh& mesh,
     return OptionError("travel",
                        "geodesic directions are read off the exact engine; a travel cost has none");
   }
-  absl::StatusOr<TravelPointSolver> solver = TravelPointSolver::Create(mesh, query.options);
+  absl::StatusOr<TravelPointSolver> solver =
+      TravelPointSolver::Create(mesh, query.options, query.sources);
   if (!solver.ok()) return solver.status();
   return solver->Solve(query.sources, query.points, query.covers_surface);
 }

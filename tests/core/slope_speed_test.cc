@@ -77,24 +77,55 @@ TEST(SlopeSpeedTest, AlongAContourTakesLengthOverToblerAtZero) {
 }
 
 // Obliquely across the 5% plane (about 22 degrees off the grid's rows, through jittered faces),
-// with 3 Steiner points per edge: the least time is the straight line's (the plane's cost is a
-// norm). The search crosses edges between Steiner points, so it stays within 0.5%; a path bent
-// at the points alone is several percent slower at this spacing.
+// with 3 Steiner points per edge (beyond the denser ones near the source, for 20 edge lengths):
+// the least time is the straight line's (the plane's cost is a norm). The search crosses edges
+// between Steiner points, so it stays within 0.1% (measured 0.013%); a path bent at the points
+// alone is 0.2% slower at this spacing.
 TEST(SlopeSpeedTest, ObliqueTimeIsCloseWithFewPointsPerEdge) {
-  const TriangleMesh mesh = Incline(0.05);
-  for (const auto& [i, j] : {std::pair{10, 4}, std::pair{3, 10}}) {
-    const SurfacePoint from = GridVertex(0, 0), to = GridVertex(i, j);
+  constexpr int kGrid = 60;
+  const TriangleMesh mesh = Incline(0.05, kGrid);
+  for (const auto& [i, j] : {std::pair{60, 24}, std::pair{18, 60}}) {
+    const SurfacePoint from = GridVertex(0, 0, kGrid), to = GridVertex(i, j, kGrid);
     const Vec3 a = mesh.Position(from.vertex), b = mesh.Position(to.vertex);
     const double dx = b[0] - a[0], dy = b[1] - a[1], dz = b[2] - a[2];
     const double expected =
         std::sqrt(dx * dx + dy * dy + dz * dz) * PerMetre(dz / std::hypot(dx, dy));
     const double t = TimeAt(mesh, from, to, Tobler(/*epsilon=*/0.25));
-    EXPECT_NEAR(t, expected, 0.005 * expected) << i << " " << j;
+    EXPECT_NEAR(t, expected, 0.001 * expected) << i << " " << j;
     const double back = TimeAt(mesh, to, from, Tobler(/*epsilon=*/0.25));
     const double back_expected =
         std::sqrt(dx * dx + dy * dy + dz * dz) * PerMetre(-dz / std::hypot(dx, dy));
-    EXPECT_NEAR(back, back_expected, 0.005 * back_expected) << i << " " << j;
+    EXPECT_NEAR(back, back_expected, 0.001 * back_expected) << i << " " << j;
   }
+}
+
+// Near a point source the times are small and bend most (a cone), so an error that is small
+// farther out is a large share of them there: the points are graded, denser near the source
+// (up to 4x within a few edge lengths). Across a 40 x 40 jittered 5% plane from its centre, with 3
+// points per edge far away: every vertex 2-8 cells from the source within 0.2% of the straight
+// line's time (the plane's cost is a norm; measured 0.09%). With even points it is 1.3%, and
+// with graded points but no crossings between them 0.25%.
+TEST(SlopeSpeedTest, TimesNearTheSourceAreCloseToo) {
+  constexpr int kGrid = 40;
+  const TriangleMesh mesh = Incline(0.05, kGrid);
+  const SurfacePoint from = GridVertex(kGrid / 2, kGrid / 2, kGrid);
+  absl::StatusOr<DistanceField> field = ComputeDistanceField(mesh, {from}, Tobler(0.25));
+  ASSERT_TRUE(field.ok()) << field.status();
+  const Vec3 a = mesh.Position(from.vertex);
+  double worst = 0;
+  for (int j = 0; j <= kGrid; ++j) {
+    for (int i = 0; i <= kGrid; ++i) {
+      const int rings = std::max(std::abs(i - kGrid / 2), std::abs(j - kGrid / 2));
+      if (rings < 2 || rings > 8) continue;
+      const uint32_t v = GridVertex(i, j, kGrid).vertex;
+      const Vec3 b = mesh.Position(v);
+      const double dx = b[0] - a[0], dy = b[1] - a[1], dz = b[2] - a[2];
+      const double expected =
+          std::sqrt(dx * dx + dy * dy + dz * dz) * PerMetre(dz / std::hypot(dx, dy));
+      worst = std::max(worst, std::abs(field->distance[v] / expected - 1));
+    }
+  }
+  EXPECT_LT(worst, 0.002);
 }
 
 // Up and down the gradient of the same plane: each within 1% of its analytic time, and their
@@ -200,6 +231,9 @@ TEST(SlopeSpeedTest, AFineToblerTableGivesToblersTimes) {
 }
 
 // Matrices are row to column: up and down the 5% plane differ; each entry is the field's time.
+// A one-row matrix is the field from its source bit for bit (one graph, graded near that
+// source); a matrix's shared graph is graded near all its sources, so its entries differ from
+// the fields' in the last digits the points' spacing governs.
 TEST(SlopeSpeedTest, MatricesAreAsymmetric) {
   const TriangleMesh mesh = Incline(0.05);
   const std::vector<SurfacePoint> points = {GridVertex(5, 0), GridVertex(5, kCells)};
@@ -209,9 +243,15 @@ TEST(SlopeSpeedTest, MatricesAreAsymmetric) {
   EXPECT_EQ(m->values[3], 0);
   const double up = TimeAt(mesh, points[0], points[1], Tobler());
   const double down = TimeAt(mesh, points[1], points[0], Tobler());
-  EXPECT_NEAR(m->values[1], up, 1e-9 * up);
-  EXPECT_NEAR(m->values[2], down, 1e-9 * down);
+  EXPECT_NEAR(m->values[1], up, 1e-4 * up);
+  EXPECT_NEAR(m->values[2], down, 1e-4 * down);
   EXPECT_GT(m->values[1], 1.3 * m->values[2]);
+  for (int row = 0; row < 2; ++row) {
+    absl::StatusOr<DistanceMatrix> one =
+        ComputeDistanceMatrix(mesh, {points[row]}, points, Tobler());
+    ASSERT_TRUE(one.ok()) << one.status();
+    EXPECT_EQ(one->values[1 - row], row == 0 ? up : down) << row;
+  }
 }
 
 // Unset, epsilon is the speed model's default: 0.1 for a slope speed (its points' spacing), 0.01

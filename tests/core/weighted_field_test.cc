@@ -483,7 +483,8 @@ std::vector<WeightedOptions> WithAndWithoutSlope(const std::vector<double>& weig
 
 // Costs at points stop the search once every point is final, with the whole search's answers bit
 // for bit; one WeightedSurface serves many queries, from several threads at once, with each one's
-// own answers. Friction and a slope cost (asymmetric), two sources.
+// own answers, and built for the queries' sources it is the one-shot call's graph (bit for bit).
+// Friction and a slope cost (asymmetric), two sources.
 TEST(WeightedFieldTest, CostsAtPointsStopEarlyOnASharedSurface) {
   const MeshData data = JitteredGrid(30);
   const TriangleMesh mesh = BuildMesh(data);
@@ -493,10 +494,10 @@ TEST(WeightedFieldTest, CostsAtPointsStopEarlyOnASharedSurface) {
   }
   for (const WeightedOptions& options : WithAndWithoutSlope(weights)) {
     const int variant = options.slope_cost != nullptr;
-    absl::StatusOr<WeightedSurface> surface = WeightedSurface::Build(mesh, options);
-    ASSERT_TRUE(surface.ok()) << surface.status();
     const std::vector<SurfacePoint> sources = {SurfacePoint::AtVertex(31 * 5 + 5),
                                                SurfacePoint::InFace(40, 0.2, 0.3, 0.5)};
+    absl::StatusOr<WeightedSurface> surface = WeightedSurface::Build(mesh, options, sources);
+    ASSERT_TRUE(surface.ok()) << surface.status();
     // Near the sources, and one across the grid.
     const std::vector<std::vector<SurfacePoint>> queries = {
         {SurfacePoint::AtVertex(31 * 7 + 6), SurfacePoint::InFace(100, 0.6, 0.2, 0.2)},
@@ -527,7 +528,8 @@ TEST(WeightedFieldTest, CostsAtPointsStopEarlyOnASharedSurface) {
 
 // A path heads for its target (A*, cost + a lower bound of the cost left): it settles a part of
 // the surface, and its cost is the whole field's at the target, bit for bit. Friction 1-3 with a
-// slope cost too; the target a vertex half-way across.
+// slope cost too (no A*: the search stops once the target is final; its points are denser near
+// the source, so that is more than half of them); the target a vertex half-way across.
 TEST(WeightedFieldTest, PathsHeadForTheirTargets) {
   const MeshData data = JitteredGrid(30);
   const TriangleMesh mesh = BuildMesh(data);
@@ -544,7 +546,8 @@ TEST(WeightedFieldTest, PathsHeadForTheirTargets) {
     absl::StatusOr<WeightedField> field = ComputeWeightedField(mesh, {from}, options);
     ASSERT_TRUE(path.ok() && field.ok()) << path.status();
     EXPECT_EQ(path->cost, field->cost[to]) << variant;
-    EXPECT_LT(path->stats.nodes_settled, field->stats.nodes_settled / 2) << variant;
+    EXPECT_LT(path->stats.nodes_settled, field->stats.nodes_settled / (variant ? 1.5 : 2))
+        << variant;
   }
 }
 

@@ -158,9 +158,13 @@ absl::StatusOr<WeightedCosts> ComputeWeightedCostsAt(const TriangleMesh& mesh,
 // rows. Immutable once built; CostsAt may run on many threads at once. `mesh` must outlive it.
 class WeightedSurface {
  public:
-  // Errors: as ComputeWeightedField (options, the Steiner-point limit).
+  // `seeds`: the sources the surface will be searched from, when known (a slope cost's points are
+  // then denser near them, for the small times there; docs/engine.md). Any sources may still be
+  // given to CostsAt. Errors: as ComputeWeightedField (options, a bad seed, the Steiner-point
+  // limit).
   static absl::StatusOr<WeightedSurface> Build(const TriangleMesh& mesh,
-                                               const WeightedOptions& options);
+                                               const WeightedOptions& options,
+                                               const std::vector<SurfacePoint>& seeds = {});
   WeightedSurface(WeightedSurface&&) noexcept;
   WeightedSurface& operator=(WeightedSurface&&) noexcept;
   ~WeightedSurface();
