@@ -7,6 +7,7 @@
 #include <limits>
 #include <optional>
 #include <type_traits>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -358,9 +359,12 @@ class DirectionalCost {
     const TriangleMesh& mesh = g.mesh();
     const uint32_t nf = mesh.face_count();
     inv_sin_.assign(nf, 0);
-    chord_first_.assign(nf + 1, 0);
+    // A face's switchback ranges depend on its slope alone, and a DEM's faces share few slopes
+    // (Jacksboro: 8,171 among 276k faces): each distinct slope's envelope is built once.
+    shape_of_.assign(nf, 0);
+    shape_first_ = {0, 0};  // shape 0: no ranges (level or impassable faces)
+    std::unordered_map<double, uint32_t> shape_of_slope;
     for (uint32_t f = 0; f < nf; ++f) {
-      chord_first_[f] = static_cast<uint32_t>(chords_.size());
       if (!std::isfinite(g.FaceWeight(f)) || mesh.FaceDegenerate(f)) continue;
       const Vec a = mesh.Position(mesh.FaceVertex(f, 0)), b = mesh.Position(mesh.FaceVertex(f, 1)),
                 c = mesh.Position(mesh.FaceVertex(f, 2));
@@ -370,9 +374,14 @@ class DirectionalCost {
       const double sin_slope = std::hypot(nx, ny) / std::sqrt(nx * nx + ny * ny + nz * nz);
       if (!(sin_slope > 1e-12)) continue;  // level: the same cost every way, nothing to envelope
       inv_sin_[f] = 1 / sin_slope;
-      AddSwitchbacks(sin_slope);
+      const auto [at, added] =
+          shape_of_slope.try_emplace(sin_slope, static_cast<uint32_t>(shape_first_.size() - 1));
+      if (added) {
+        AddSwitchbacks(sin_slope);
+        shape_first_.push_back(static_cast<uint32_t>(chords_.size()));
+      }
+      shape_of_[f] = at->second;
     }
-    chord_first_[nf] = static_cast<uint32_t>(chords_.size());
     // Along an edge: the cheaper of its passable faces, per direction (walker's).
     const uint32_t ne = g.edge_count();
     edge_dir_.assign(3 * size_t{ne}, 0);
@@ -457,8 +466,8 @@ class DirectionalCost {
  private:
   FaceWalk WalkOf(uint32_t f, double sign) const {
     return {&table_,
-            chords_.data() + chord_first_[f],
-            chords_.data() + chord_first_[f + 1],
+            chords_.data() + shape_first_[shape_of_[f]],
+            chords_.data() + shape_first_[shape_of_[f] + 1],
             g_.FaceWeight(f),
             inv_sin_[f],
             sign};
@@ -529,7 +538,8 @@ class DirectionalCost {
   double sign_;
   double cheapest_;  // the table's least cost per metre
   std::vector<double> inv_sin_;
-  std::vector<uint32_t> chord_first_;
+  std::vector<uint32_t> shape_of_;     // per face: its slope's shape
+  std::vector<uint32_t> shape_first_;  // per shape: its first chord (and a sentinel)
   std::vector<Chord> chords_;
   std::vector<double> edge_dir_, edge_fwd_, edge_bwd_;
 };
@@ -791,10 +801,11 @@ class Search {
     if (least == kNoIndex) {
       least_[bucket] = node;
       slot_[bucket] = static_cast<uint32_t>(heap_.size());
-      heap_.push_back(bucket);
+      heap_.push_back({Key(node), node, bucket});
       SiftUp(slot_[bucket]);
     } else if (node == least || Less(node, least)) {  // the bucket's key dropped
       least_[bucket] = node;
+      heap_[slot_[bucket]] = {Key(node), node, bucket};
       SiftUp(slot_[bucket]);
     }
   }
@@ -813,8 +824,8 @@ class Search {
   absl::Status Run(const WeightedOptions& options, Stop&& stop, Settled&& settled) {
     uint32_t polls = 0;
     while (!heap_.empty()) {
-      const uint32_t bucket = heap_[0];
-      const uint32_t u = least_[bucket];
+      const uint32_t bucket = heap_[0].bucket;
+      const uint32_t u = heap_[0].node;
       const double d = cost_[u];
       // Headed: the key is at most the cost of any target reached through u.
       const double key = Key(u);
@@ -879,7 +890,7 @@ class Search {
     s.peak_bytes = g_.bytes() + cost_.size() * (sizeof(double) + 2 * sizeof(uint32_t) + 1) +
                    (least_.size() + run_lo_.size()) * 2 * sizeof(uint32_t) +
                    (chain_max_.size() + ahead_.size()) * sizeof(double) +
-                   peak_heap_ * sizeof(uint32_t);
+                   peak_heap_ * sizeof(Entry);
     s.solve_ms = ms;
     return s;
   }
@@ -900,35 +911,41 @@ class Search {
     const double away = Dist(p, goal_.centre) - goal_.radius;
     return away > 0 ? away * goal_.per_metre : 0;
   }
-  bool Before(uint32_t bucket_a, uint32_t bucket_b) const {
-    return Less(least_[bucket_a], least_[bucket_b]);
+  // A heap entry: a bucket with its least node and that node's key, kept in the entry so that
+  // sifting reads the heap alone (no lookups per comparison).
+  struct Entry {
+    double key;
+    uint32_t node, bucket;
+  };
+  static bool Before(const Entry& a, const Entry& b) {
+    return a.key < b.key || (a.key == b.key && a.node < b.node);  // as Less
   }
   void SiftUp(uint32_t i) {
-    const uint32_t b = heap_[i];
+    const Entry x = heap_[i];
     while (i > 0) {
       const uint32_t p = (i - 1) / 2;
-      if (!Before(b, heap_[p])) break;
+      if (!Before(x, heap_[p])) break;
       heap_[i] = heap_[p];
-      slot_[heap_[i]] = i;
+      slot_[heap_[i].bucket] = i;
       i = p;
     }
-    heap_[i] = b;
-    slot_[b] = i;
+    heap_[i] = x;
+    slot_[x.bucket] = i;
   }
   void SiftDown(uint32_t i) {
-    const uint32_t b = heap_[i];
+    const Entry x = heap_[i];
     const uint32_t size = static_cast<uint32_t>(heap_.size());
     while (true) {
       uint32_t c = 2 * i + 1;
       if (c >= size) break;
       if (c + 1 < size && Before(heap_[c + 1], heap_[c])) ++c;
-      if (!Before(heap_[c], b)) break;
+      if (!Before(heap_[c], x)) break;
       heap_[i] = heap_[c];
-      slot_[heap_[i]] = i;
+      slot_[heap_[i].bucket] = i;
       i = c;
     }
-    heap_[i] = b;
-    slot_[b] = i;
+    heap_[i] = x;
+    slot_[x.bucket] = i;
   }
   // The top bucket's least node was just settled: its next least unsettled node (with a cost)
   // becomes its key, or the bucket leaves the heap.
@@ -967,12 +984,13 @@ class Search {
     }
     least_[bucket] = least;
     if (least != kNoIndex) {
+      heap_[0] = {Key(least), least, bucket};  // (the bucket is the heap's top)
       SiftDown(0);
       return;
     }
     peak_heap_ = std::max<uint64_t>(peak_heap_, heap_.size());
     slot_[bucket] = kNoIndex;
-    const uint32_t last = heap_.back();
+    const Entry last = heap_.back();
     heap_.pop_back();
     if (heap_.empty()) return;
     heap_[0] = last;
@@ -1207,8 +1225,8 @@ class Search {
   std::vector<double> chain_max_;
   bool checking_ = false;  // CheckOptimality is running
   Goal goal_;
-  std::vector<double> ahead_;   // headed: per node reached, Ahead(node)
-  std::vector<uint32_t> heap_;  // buckets
+  std::vector<double> ahead_;  // headed: per node reached, Ahead(node)
+  std::vector<Entry> heap_;    // buckets
   uint64_t settled_ = 0, relaxations_ = 0, peak_heap_ = 0;
 };
 
