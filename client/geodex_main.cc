@@ -82,7 +82,7 @@ Travel time (distances, path, matrix, isolines, voronoi; docs/travel.md): --spee
       walked): the speed depends on the direction, walkers zigzag up and down steep faces
       (switchbacks), matrices are row to column, --inbound gives times to reach the sources;
       approximate with no proven bound (--cost-epsilon is the Steiner points' spacing along
-      each edge, default 0.1: within about 1% of the finest run; "bound": false).
+      each edge, default 0.125: within about 1% of the finest run; "bound": false).
 
 --format json (distances, path, matrix, locate, info) prints one JSON object instead of text:
       distances {"distances": [...]} (or {"points": [...]} with --at), path {"length", "points"

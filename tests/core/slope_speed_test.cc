@@ -254,7 +254,7 @@ TEST(SlopeSpeedTest, MatricesAreAsymmetric) {
   }
 }
 
-// Unset, epsilon is the speed model's default: 0.1 for a slope speed (its points' spacing), 0.01
+// Unset, epsilon is the speed model's default: 0.125 for a slope speed (its points' spacing), 0.01
 // for a constant speed (its bound); a set one is used as set, and 0 is refused by name.
 TEST(SlopeSpeedTest, EpsilonDefaultsToTheSpeedModels) {
   TravelCost constant;
@@ -262,7 +262,7 @@ TEST(SlopeSpeedTest, EpsilonDefaultsToTheSpeedModels) {
   EXPECT_EQ(TravelEpsilon(constant), 0.01);
   TravelCost tobler;
   tobler.speed_model = SpeedModel::kTobler;
-  EXPECT_EQ(TravelEpsilon(tobler), 0.1);
+  EXPECT_EQ(TravelEpsilon(tobler), 0.125);
   tobler.epsilon = 0.05;
   EXPECT_EQ(TravelEpsilon(tobler), 0.05);
   const TriangleMesh mesh = Incline(0.05);
@@ -270,7 +270,7 @@ TEST(SlopeSpeedTest, EpsilonDefaultsToTheSpeedModels) {
   options.travel->epsilon.reset();
   absl::StatusOr<DistanceField> field = ComputeDistanceField(mesh, {GridVertex(0, 0)}, options);
   ASSERT_TRUE(field.ok()) << field.status();
-  EXPECT_EQ(field->travel_epsilon, 0.1);
+  EXPECT_EQ(field->travel_epsilon, 0.125);
   options.travel->epsilon = 0;
   field = ComputeDistanceField(mesh, {GridVertex(0, 0)}, options);
   ASSERT_FALSE(field.ok());

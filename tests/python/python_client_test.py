@@ -670,9 +670,10 @@ class ControlLoopTest(unittest.TestCase):
         self.assertGreater(field.distances.max(), 0)
         same = sync.distance_field(mesh.name, sources, travel={"speed": "tobler", "epsilon": 0.05})
         self.assertEqual(same.distances.tobytes(), field.distances.tobytes())
-        # Epsilon unset: the speed model's default, 0.1 for a slope speed (0.01 for a constant one).
+        # Epsilon unset: the speed model's default, 0.125 for a slope speed (0.01 for a constant
+        # one).
         coarse = sync.distance_field(mesh.name, sources, travel=geodex.Travel(speed="tobler"))
-        self.assertEqual(coarse.travel_epsilon, 0.1)
+        self.assertEqual(coarse.travel_epsilon, 0.125)
         numpy.testing.assert_allclose(coarse.distances, field.distances, rtol=0.02)
         self.assertEqual(
             sync.distance_field(mesh.name, sources, travel=geodex.Travel(3.6)).travel_epsilon, 0.01)

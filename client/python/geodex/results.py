@@ -45,7 +45,7 @@ class Travel:
     [-90, 90] with the first <= 0 <= the last, speeds > 0; linear between rows, steeper slopes
     cannot be walked. `inbound`: with a slope-dependent speed, times to REACH the sources instead
     of from them (paths are walked from their start and refuse it). `epsilon`: in (0, 1) (None: the
-    server's default for the speed model, 0.01 constant, 0.1 slope-dependent). `max_slope_deg`: faces steeper than this (degrees from the x-y plane) are
+    server's default for the speed model, 0.01 constant, 0.125 slope-dependent). `max_slope_deg`: faces steeper than this (degrees from the x-y plane) are
     impassable (0: no limit). `face_weights`: one friction per face of the mesh, in order (> 0,
     inf impassable; None: 1). `friction_geojson`: GeoJSON polygons (text or a dict) with a
     numeric "friction" property; each face takes the friction of the polygon holding its
