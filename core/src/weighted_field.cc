@@ -55,7 +55,7 @@ class SteinerGraph {
   // on every edge (spacing epsilon x its length), for a search that crosses between nodes
   // (Search::CrossSegments) and claims no bound: the error then falls about as the spacing
   // squared, so far fewer points reach a given accuracy. Uniform placement is graded near
-  // `seeds` (the positions searches will start from, when known; RefineNear).
+  // `seeds` (the positions searches will start from, when known; GradedCount).
   enum class Placement { kBounded, kUniform };
   absl::Status Build(double epsilon, uint64_t max_points, Placement placement,
                      const std::vector<Vec>& seeds);
