@@ -49,7 +49,7 @@ SOURCES
   rm -rf "$work/rootfs"
 fi
 
-step "docker build (the build stage runs the test suite)"
+step "docker build (geodexd and geodex; GEODEX_TESTS=ON would run the suite too)"
 docker build --network host -t "$tag" . >"$work/build.log" 2>&1 || { tail -40 "$work/build.log"; exit 1; }
 size=$(docker image inspect "$tag" --format '{{.Size}}')
 echo "image $tag: $((size / 1024 / 1024)) MiB"
