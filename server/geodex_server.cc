@@ -253,6 +253,13 @@ void GeodexServer::Wait() { server_->Wait(); }
 GeodexServer::~GeodexServer() {
   if (server_ != nullptr) Shutdown(absl::Now());
   if (metrics_ != nullptr) metrics_->StopHttp();  // no scrape may read a pool being destroyed
+  // Join the compute threads before the gRPC server goes: Shutdown returns once every call is
+  // done, but a worker may still be returning from the StartWrite or Finish that ended its call
+  // (gRPC's code there reads the server object), and only the join orders that before the
+  // server's deletion (ThreadSanitizer reported it). The quick pool first: its tasks may move to
+  // the solve pool.
+  quick_pool_.reset();
+  pool_.reset();
 }
 
 }  // namespace geodex::server

@@ -389,8 +389,12 @@ absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
   // A travel cost: one weighted graph for every row.
   std::optional<TravelPointSolver> travel;
   if (options.solver.travel.has_value()) {
+    // The rows' distinct points grade the graph (a repeated source must not count twice toward
+    // the graded placement's cap on sources).
+    std::vector<SurfacePoint> row_points;
+    for (size_t r : distinct) row_points.push_back(sources[r]);
     absl::StatusOr<TravelPointSolver> solver =
-        TravelPointSolver::Create(mesh, options.solver, sources);
+        TravelPointSolver::Create(mesh, options.solver, row_points);
     if (!solver.ok()) return solver.status();
     travel.emplace(*std::move(solver));
   }

@@ -254,6 +254,25 @@ TEST(SlopeSpeedTest, MatricesAreAsymmetric) {
   }
 }
 
+// A source given many times grades the shared graph once: 66 sources naming 2 points (more than
+// the 64 sources the grading takes) give the 2-point matrix's rows bit for bit.
+TEST(SlopeSpeedTest, RepeatedMatrixSourcesGradeTheGraphOnce) {
+  const TriangleMesh mesh = Incline(0.05);
+  const std::vector<SurfacePoint> points = {GridVertex(5, 0), GridVertex(5, kCells)};
+  std::vector<SurfacePoint> repeated;
+  for (int i = 0; i < 33; ++i) repeated.insert(repeated.end(), points.begin(), points.end());
+  absl::StatusOr<DistanceMatrix> once = ComputeDistanceMatrix(mesh, points, points, Tobler());
+  ASSERT_TRUE(once.ok()) << once.status();
+  absl::StatusOr<DistanceMatrix> many = ComputeDistanceMatrix(mesh, repeated, points, Tobler());
+  ASSERT_TRUE(many.ok()) << many.status();
+  ASSERT_EQ(many->values.size(), repeated.size() * 2);
+  for (size_t row = 0; row < repeated.size(); ++row) {
+    for (size_t c = 0; c < 2; ++c) {
+      EXPECT_EQ(many->values[row * 2 + c], once->values[(row % 2) * 2 + c]) << row << ", " << c;
+    }
+  }
+}
+
 // Unset, epsilon is the speed model's default: 0.125 for a slope speed (its points' spacing), 0.01
 // for a constant speed (its bound); a set one is used as set, and 0 is refused by name.
 TEST(SlopeSpeedTest, EpsilonDefaultsToTheSpeedModels) {
