@@ -124,6 +124,28 @@ TransformPtr FileMeshTransform(const DemInfo& info, bool to_mesh) {
   return TransformPtr(forward->GetInverse(), &OGRCoordinateTransformation::DestroyCT);
 }
 
+// Degrees per angular unit of a geographic CRS given as WKT; 0 when it does not parse or is not
+// geographic.
+double DegreesPerUnit(const std::string& wkt) {
+  OGRSpatialReference crs;
+  if (crs.importFromWkt(wkt.c_str()) != OGRERR_NONE || !crs.IsGeographic()) return 0;
+  const double radians = crs.GetAngularUnits();
+  return std::isfinite(radians) && radians > 0 ? radians * 180 / M_PI : 0;
+}
+
+// Longitudes brought back into a longitude/latitude file's CRS (from UTM, WGS 84), moved by whole
+// turns to the grid's side: PROJ answers in [-180, 180], and a file may count 0 to 360 (found by
+// dem_fuzzer: a stored mesh whose vertices came back a turn away from their cells).
+void LongitudesToGrid(const DemInfo& info, double* xs, size_t n) {
+  const double degrees = info.reprojected ? DegreesPerUnit(info.file_crs_wkt) : 0;
+  if (degrees == 0) return;
+  const double turn = 360 / degrees;
+  const double centre = info.geotransform[0] + info.geotransform[1] * info.grid_width / 2;
+  for (size_t k = 0; k < n; ++k) {
+    if (std::isfinite(xs[k])) xs[k] -= turn * std::round((xs[k] - centre) / turn);
+  }
+}
+
 // Metres per unit of a band's height unit; 0 when the unit is not one geodex knows.
 double MetresPerHeightUnit(std::string unit) {
   unit = absl::AsciiStrToLower(unit);
@@ -730,6 +752,18 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
     if (std::min(std::abs(gt[1]), std::abs(gt[5])) < 1e-7) {
       return bad("cells finer than 1e-7 degrees (about a centimetre)");
     }
+    // The grid must be longitudes and latitudes: at most a turn wide, its rows within the poles
+    // (its centre alone, wrapped by PROJ, could pass with cells a million degrees wide).
+    const double degrees = DegreesPerUnit(info.file_crs_wkt);
+    const double width = std::abs(gt[1]) * info.raster_width * degrees;
+    const double top = gt[3] * degrees, bottom = (gt[3] + gt[5] * info.raster_height) * degrees;
+    if (!(degrees > 0 && width <= 360 && std::abs(top) <= 90 + 1e-9 &&
+          std::abs(bottom) <= 90 + 1e-9)) {
+      return bad(absl::StrFormat(
+          "a longitude/latitude grid %.9g degrees wide, rows from latitude %.9g to %.9g: at most "
+          "360 wide, within [-90, 90]",
+          width, std::min(top, bottom), std::max(top, bottom)));
+    }
     double lon = gt[0] + gt[1] * info.raster_width / 2.0,
            lat = gt[3] + gt[5] * info.raster_height / 2.0;
     OGRSpatialReference wgs84;
@@ -740,10 +774,13 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
       return bad(
           absl::StrCat("cannot find the DEM's centre in WGS 84 (", QuietGdal::LastMessage(), ")"));
     }
-    if (!(std::abs(lon) <= 180 && std::abs(lat) <= 90)) {
-      return bad(
-          absl::StrFormat("its centre (%.9g, %.9g) is not a longitude and latitude", lon, lat));
+    // A file may count longitudes 0 to 360 (or -360 to 0): its zone is found a turn away.
+    if (!(std::abs(lon) <= 360 && std::abs(lat) <= 90)) {
+      return bad(absl::StrFormat(
+          "its centre (%.9g, %.9g) is not a longitude (within [-360, 360]) and latitude", lon,
+          lat));
     }
+    lon = std::remainder(lon, 360.0);
     const int zone = std::clamp(static_cast<int>(std::floor((lon + 180) / 6)) + 1, 1, 60);
     OGRSpatialReference utm;
     utm.importFromEPSG((lat >= 0 ? 32600 : 32700) + zone);
@@ -1054,6 +1091,7 @@ absl::StatusOr<Dem> Dem::FromMesh(MeshData mesh, DemInfo info) {
         std::find(ok.begin(), ok.end(), 0) != ok.end()) {
       return bad("its vertices do not project back to the file's CRS");
     }
+    LongitudesToGrid(info, xs.data(), n);
   } else {
     for (size_t v = 0; v < n; ++v) {
       xs[v] /= info.horizontal_scale;
@@ -1490,6 +1528,7 @@ absl::StatusOr<SurfacePoint> Dem::DropLonLat(double lon, double lat) const {
     return absl::InvalidArgumentError(absl::StrCat(name, ": cannot project it to the DEM's CRS (",
                                                    QuietGdal::LastMessage(), ")"));
   }
+  LongitudesToGrid(info_, &x, 1);
   absl::StatusOr<SurfacePoint> p = DropNamed(x, y, name);
   if (!OutsideTheDem(p.status())) return p;
   std::string message(p.status().message());
@@ -1498,9 +1537,12 @@ absl::StatusOr<SurfacePoint> Dem::DropLonLat(double lon, double lat) const {
                           (*box)[0], (*box)[2], (*box)[1], (*box)[3]);
   }
   double sx = lat, sy = lon;  // longitude and latitude the other way round
-  if (std::abs(lat) <= 180 && std::abs(lon) <= 90 && t->Transform(1, &sx, &sy) && InGrid(sx, sy)) {
-    absl::StrAppend(&message, "; ll:", Shortest(lat), ":", Shortest(lon),
-                    " would be inside (longitude first: ll:LON:LAT)");
+  if (std::abs(lat) <= 180 && std::abs(lon) <= 90 && t->Transform(1, &sx, &sy)) {
+    LongitudesToGrid(info_, &sx, 1);
+    if (InGrid(sx, sy)) {
+      absl::StrAppend(&message, "; ll:", Shortest(lat), ":", Shortest(lon),
+                      " would be inside (longitude first: ll:LON:LAT)");
+    }
   }
   return absl::InvalidArgumentError(message);
 }
@@ -1747,6 +1789,7 @@ absl::StatusOr<std::vector<std::array<double, 2>>> FaceCentresInMap(const MeshDa
       return absl::InvalidArgumentError(
           absl::StrCat(name, ": the faces do not project back to the DEM's CRS"));
     }
+    LongitudesToGrid(*dem, xs.data(), nf);
   } else if (dem != nullptr) {
     for (size_t f = 0; f < nf; ++f) {
       xs[f] /= dem->horizontal_scale;

@@ -9,6 +9,7 @@
 #include <functional>
 #include <limits>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "absl/strings/str_cat.h"
@@ -384,7 +385,8 @@ TEST_F(DemTest, BadRastersAreClearErrors) {
   off_earth.dx = off_earth.dy = 0.001;
   absl::StatusOr<Dem> far = Dem::Read(Write("far.tif", off_earth));
   EXPECT_EQ(far.status().code(), absl::StatusCode::kInvalidArgument);
-  EXPECT_NE(far.status().message().find("not a longitude and latitude"), std::string::npos)
+  EXPECT_NE(far.status().message().find("not a longitude (within [-360, 360]) and latitude"),
+            std::string::npos)
       << far.status();
 }
 
@@ -568,6 +570,69 @@ TEST_P(StoredDatumTest, StoredGeographicMeshGivesTheSameDem) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Datums, StoredDatumTest, ::testing::Values(4326, 4322, 4267));
+
+// A grid that counts longitudes 0 to 360 (common in climate and ocean data): PROJ brings points
+// back in [-180, 180], a turn away from these cells, yet a stored DEM still finds every vertex's
+// cell, and ll: points (always in [-180, 180]) land on it (found by dem_fuzzer).
+TEST_F(DemTest, LongitudesPast180StoreAndTakeWgs84Points) {
+  Grid g;
+  g.epsg = 4326;
+  g.x0 = 189.99;
+  g.y0 = 45.16;
+  g.dx = g.dy = 0.0002;
+  g.width = 25;
+  g.height = 20;
+  g.height_at = [&](double lon, double lat, int, int) {
+    return 1000 * (lon - 189.99) + 300 * (lat - 45);
+  };
+  absl::StatusOr<Dem> file = Dem::Read(Write("east.tif", g));
+  ASSERT_TRUE(file.ok()) << file.status();
+  ASSERT_TRUE(file->info().reprojected);
+  absl::StatusOr<Dem> stored = Dem::FromMesh(file->mesh(), file->info());
+  ASSERT_TRUE(stored.ok()) << stored.status();
+  std::vector<std::array<double, 2>> points;
+  for (double u = 0.1; u < 25; u += 1.37) {
+    for (double v = 0.3; v < 21; v += 2.1) points.push_back({g.x0 + u * g.dx, g.y0 - v * g.dy});
+  }
+  ExpectSameDrops(*file, *stored, points);
+  for (const Dem* dem : {&*file, &*stored}) {
+    for (const auto& [x, y] : points) {
+      absl::StatusOr<SurfacePoint> map = dem->DropMapPoint(x, y), ll = dem->DropLonLat(x - 360, y);
+      ASSERT_EQ(map.ok(), ll.ok()) << x << " " << y << ": " << map.status() << " / " << ll.status();
+      if (!map.ok()) continue;
+      const std::array<double, 3> a = PositionOf(dem->mesh(), *map),
+                                  b = PositionOf(dem->mesh(), *ll);
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 1e-6) << x << " " << y;
+    }
+  }
+}
+
+// A longitude/latitude grid is at most a turn wide and stays within the poles; its centre alone
+// (which PROJ wraps) let a grid of cells 858,225 degrees wide through, whose stored mesh could not
+// find its cells again (dem_fuzzer, tests/fuzz/corpus/dem/dem-stored-round-trip).
+TEST_F(DemTest, LongitudeLatitudeGridPastATurnOrAPoleIsRefused) {
+  Grid wide;
+  wide.epsg = 4326;
+  wide.x0 = 10;
+  wide.y0 = 40;
+  wide.dx = 20;
+  wide.dy = 0.001;
+  wide.width = 25;
+  wide.height = 20;
+  wide.height_at = [](double, double, int, int) { return 1.0; };
+  Grid polar = wide;
+  polar.dx = 0.001;
+  polar.y0 = 90.5;
+  polar.dy = 0.1;
+  for (const auto& [g, name, what] :
+       {std::tuple{wide, "wide.tif", "grid 500 degrees wide"},
+        std::tuple{polar, "polar.tif", "rows from latitude 88.5 to 90.5"}}) {
+    absl::StatusOr<Dem> dem = Dem::Read(Write(name, g));
+    ASSERT_FALSE(dem.ok()) << name;
+    EXPECT_EQ(dem.status().code(), absl::StatusCode::kInvalidArgument) << dem.status();
+    EXPECT_NE(dem.status().message().find(what), std::string::npos) << dem.status();
+  }
+}
 
 }  // namespace
 }  // namespace geodex::terrain
