@@ -372,6 +372,15 @@ absl::StatusOr<terrain::DemOptions> MeshReadOptions(const Args& args, const std:
       args.options.at("crs") != "native") {
     return absl::InvalidArgumentError("--crs must be wgs84 or native");
   }
+  // Friction polygons on a DEM: their outlines are cut into its mesh as it is read, so that
+  // ResolveTravelWeights, reading the same file on it, gives exact region boundaries.
+  if (args.options.count("friction") && terrain::IsDemPath(mesh)) {
+    const std::string& path = args.options.at("friction");
+    const terrain::GisFormat* format = terrain::GisFormatOf(path);
+    if (format == nullptr || format->kind != terrain::GisFileKind::kRaster) {
+      dem.friction_file = path;
+    }
+  }
   return dem;
 }
 

@@ -86,15 +86,17 @@ absl::StatusOr<T> Flagged(
 
 // A DEM, or a mesh with --barrier-below, is read here too (its map, its barrier): what the server
 // gets is then either the GeoTIFF itself (geodexd reads it the same way and keeps its map) or,
-// for other rasters, a barrier file or a mesh file, the mesh made here.
+// for other rasters, a barrier file, friction polygons (their outlines cut in) or a mesh file,
+// the mesh made here.
 bool DerivedHere(const std::string& mesh, const terrain::DemOptions& options) {
   return terrain::IsDemPath(mesh) || std::isfinite(options.barrier_below) ||
-         !options.barrier_file.empty();
+         !options.barrier_file.empty() || !options.friction_file.empty();
 }
 absl::StatusOr<MeshRef> UploadDerived(GeodexClient& client, const std::string& mesh,
                                       const terrain::DemOptions& options, const MeshData& data) {
   // By its content's id, uploaded only if the server lacks it.
-  if (terrain::IsGeoTiffPath(mesh) && options.barrier_file.empty()) {
+  if (terrain::IsGeoTiffPath(mesh) && options.barrier_file.empty() &&
+      options.friction_file.empty()) {
     client::DemUploadOptions dem;
     dem.step = options.step;
     if (std::isfinite(options.barrier_below)) dem.barrier_below = options.barrier_below;

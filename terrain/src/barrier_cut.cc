@@ -516,10 +516,11 @@ struct LineEnd {
 // ends inside a face is joined to one of the face's corners there, by an ordinary edge), and
 // then every vertex on a line (but its ends) is split into one copy per side, so that the two
 // sides of a line share no vertex and no edge: paths go around the line's ends.
+// With `slit` false it stops once the faces are split (friction outlines: both sides stay joined).
 absl::StatusOr<MeshData> SlitLines(const MeshData& mesh, const Geos& geos,
                                    const GEOSGeometry* lines, const std::vector<LineEnd>& ends,
                                    const double origin[2], double reach, uint64_t max_vertices,
-                                   CutStats* stats) {
+                                   CutStats* stats, bool slit = true) {
   GEOSContextHandle_t h = geos.h();
   double box[4];
   if (GEOSisEmpty_r(h, lines) == 1 ||
@@ -641,7 +642,7 @@ absl::StatusOr<MeshData> SlitLines(const MeshData& mesh, const Geos& geos,
     surgery.SetPieces(f, std::move(pieces));
   }
   absl::StatusOr<MeshData> split = surgery.Emit(nullptr);
-  if (!split.ok()) return split;
+  if (!split.ok() || !slit) return split;
   MeshData& out = *split;
 
   // The mesh's edges along a line: both ends and the middle within 1e-9 of the edge's length.
@@ -731,14 +732,16 @@ absl::StatusOr<MeshData> SlitLines(const MeshData& mesh, const Geos& geos,
   return split;
 }
 
-}  // namespace
+// The mesh's local frame and `polygons` in it (times `scale`, less the origin), checked finite.
+struct LocalFrame {
+  double origin[2];
+  double reach;
+  Geos::Ptr shape;
+};
 
-absl::StatusOr<MeshData> CutOutPolygons(const MeshData& mesh, const OGRGeometry& polygons,
-                                        double scale, double width, uint64_t max_vertices,
-                                        CutStats* stats) {
-  *stats = CutStats{};
+absl::StatusOr<LocalFrame> InLocalFrame(const MeshData& mesh, const OGRGeometry& polygons,
+                                        double scale, const Geos& geos) {
   const size_t n = mesh.vertex_count();
-  Geos geos;
   GEOSContextHandle_t h = geos.h();
 
   // Local x y about the middle of the mesh: GEOS's intersections then carry the bits of the
@@ -751,8 +754,10 @@ absl::StatusOr<MeshData> CutOutPolygons(const MeshData& mesh, const OGRGeometry&
       hi[k] = std::max(hi[k], mesh.positions[3 * v + k]);
     }
   }
-  const double origin[2] = {n > 0 ? (lo[0] + hi[0]) / 2 : 0, n > 0 ? (lo[1] + hi[1]) / 2 : 0};
-  const double reach = n > 0 ? std::max({hi[0] - lo[0], hi[1] - lo[1], 1e-300}) : 1;
+  LocalFrame frame{{n > 0 ? (lo[0] + hi[0]) / 2 : 0, n > 0 ? (lo[1] + hi[1]) / 2 : 0},
+                   n > 0 ? std::max({hi[0] - lo[0], hi[1] - lo[1], 1e-300}) : 1,
+                   geos.Own(nullptr)};
+  const double* origin = frame.origin;
 
   Geos::Ptr barrier = geos.Own(polygons.exportToGEOS(h));
   if (barrier == nullptr) return absl::InternalError("GEOS cannot take the barrier polygons");
@@ -764,8 +769,8 @@ absl::StatusOr<MeshData> CutOutPolygons(const MeshData& mesh, const OGRGeometry&
     *y = *y * o[0] - o[2];
     return 1;
   };
-  double frame[3] = {scale, origin[0], origin[1]};
-  barrier = geos.Own(GEOSGeom_transformXY_r(h, barrier.get(), shift, frame));
+  double transform[3] = {scale, origin[0], origin[1]};
+  barrier = geos.Own(GEOSGeom_transformXY_r(h, barrier.get(), shift, transform));
   if (barrier == nullptr)
     return absl::InvalidArgumentError("the polygons' coordinates are not finite numbers here");
   double extent[4];
@@ -775,6 +780,51 @@ absl::StatusOr<MeshData> CutOutPolygons(const MeshData& mesh, const OGRGeometry&
        !std::all_of(extent, extent + 4, [](double v) { return std::isfinite(v); }))) {
     return absl::InvalidArgumentError("the polygons' coordinates are not finite numbers here");
   }
+  frame.shape = std::move(barrier);
+  return frame;
+}
+
+// Every part of `g` that is not a collection.
+std::vector<const GEOSGeometry*> Parts(GEOSContextHandle_t h, const GEOSGeometry* g) {
+  std::vector<const GEOSGeometry*> flat;
+  std::function<void(const GEOSGeometry*)> flatten = [&](const GEOSGeometry* part) {
+    const int type = GEOSGeomTypeId_r(h, part);
+    if (type == GEOS_GEOMETRYCOLLECTION || type == GEOS_MULTIPOLYGON ||
+        type == GEOS_MULTILINESTRING || type == GEOS_MULTIPOINT) {
+      for (int i = 0; i < GEOSGetNumGeometries_r(h, part); ++i)
+        flatten(GEOSGetGeometryN_r(h, part, i));
+    } else {
+      flat.push_back(part);
+    }
+  };
+  flatten(g);
+  return flat;
+}
+
+// A polygon as given when valid; else made valid as areas (shells less holes), collapsed parts
+// (spikes) dropped. Null when GEOS fails.
+GEOSGeometry* ValidPolygon(GEOSContextHandle_t h, const GEOSGeometry* g) {
+  if (GEOSisValid_r(h, g) == 1) return GEOSGeom_clone_r(h, g);
+  GEOSMakeValidParams* params = GEOSMakeValidParams_create_r(h);
+  GEOSMakeValidParams_setMethod_r(h, params, GEOS_MAKE_VALID_STRUCTURE);
+  GEOSMakeValidParams_setKeepCollapsed_r(h, params, 0);
+  GEOSGeometry* valid = GEOSMakeValidWithParams_r(h, g, params);
+  GEOSMakeValidParams_destroy_r(h, params);
+  return valid;
+}
+
+}  // namespace
+
+absl::StatusOr<MeshData> CutOutPolygons(const MeshData& mesh, const OGRGeometry& polygons,
+                                        double scale, double width, uint64_t max_vertices,
+                                        CutStats* stats) {
+  *stats = CutStats{};
+  Geos geos;
+  GEOSContextHandle_t h = geos.h();
+  absl::StatusOr<LocalFrame> frame = InLocalFrame(mesh, polygons, scale, geos);
+  if (!frame.ok()) return frame.status();
+  const double* origin = frame->origin;
+  const double reach = frame->reach;
   // Polygons as they are (made valid); with a width, lines and points buffered into polygons that
   // wide; without one, lines are slits and points are refused.
   std::vector<GEOSGeometry*> areas, lines;  // owned until handed to the collections below
@@ -783,30 +833,11 @@ absl::StatusOr<MeshData> CutOutPolygons(const MeshData& mesh, const OGRGeometry&
     for (GEOSGeometry* p : areas) GEOSGeom_destroy_r(h, p);
     for (GEOSGeometry* p : lines) GEOSGeom_destroy_r(h, p);
   };
-  std::vector<const GEOSGeometry*> flat;
-  std::function<void(const GEOSGeometry*)> flatten = [&](const GEOSGeometry* g) {
-    const int type = GEOSGeomTypeId_r(h, g);
-    if (type == GEOS_GEOMETRYCOLLECTION || type == GEOS_MULTIPOLYGON ||
-        type == GEOS_MULTILINESTRING || type == GEOS_MULTIPOINT) {
-      for (int i = 0; i < GEOSGetNumGeometries_r(h, g); ++i) flatten(GEOSGetGeometryN_r(h, g, i));
-    } else {
-      flat.push_back(g);
-    }
-  };
-  flatten(barrier.get());
-  for (const GEOSGeometry* g : flat) {
+  for (const GEOSGeometry* g : Parts(h, frame->shape.get())) {
     const int type = GEOSGeomTypeId_r(h, g);
     GEOSGeometry* part = nullptr;
     if (type == GEOS_POLYGON) {
-      if (GEOSisValid_r(h, g) == 1) {
-        part = GEOSGeom_clone_r(h, g);
-      } else {  // made valid as areas (shells less holes), collapsed parts (spikes) dropped
-        GEOSMakeValidParams* params = GEOSMakeValidParams_create_r(h);
-        GEOSMakeValidParams_setMethod_r(h, params, GEOS_MAKE_VALID_STRUCTURE);
-        GEOSMakeValidParams_setKeepCollapsed_r(h, params, 0);
-        part = GEOSMakeValidWithParams_r(h, g, params);
-        GEOSMakeValidParams_destroy_r(h, params);
-      }
+      part = ValidPolygon(h, g);
     } else if (width > 0) {
       part = GEOSBuffer_r(h, g, width / 2, 8);
     } else if (type == GEOS_LINESTRING) {
@@ -851,6 +882,40 @@ absl::StatusOr<MeshData> CutOutPolygons(const MeshData& mesh, const OGRGeometry&
       CutPolygons(mesh, geos, area.get(), origin, reach, max_vertices, stats);
   if (!cut.ok() || lines.empty()) return cut;
   return SlitLines(*cut, geos, line.get(), ends, origin, reach, max_vertices, stats);
+}
+
+absl::StatusOr<MeshData> SplitAlongOutlines(const MeshData& mesh, const OGRGeometry& polygons,
+                                            double scale, uint64_t max_vertices, CutStats* stats) {
+  *stats = CutStats{};
+  Geos geos;
+  GEOSContextHandle_t h = geos.h();
+  absl::StatusOr<LocalFrame> frame = InLocalFrame(mesh, polygons, scale, geos);
+  if (!frame.ok()) return frame.status();
+  // Each polygon's outline (valid: rings that do not cross themselves), all noded into one.
+  std::vector<GEOSGeometry*> outlines;  // owned until handed to the collection below
+  for (const GEOSGeometry* g : Parts(h, frame->shape.get())) {
+    if (GEOSGeomTypeId_r(h, g) != GEOS_POLYGON) {
+      for (GEOSGeometry* o : outlines) GEOSGeom_destroy_r(h, o);
+      return absl::InvalidArgumentError("friction regions are polygons (a line or point found)");
+    }
+    Geos::Ptr valid = geos.Own(ValidPolygon(h, g));
+    GEOSGeometry* outline = valid != nullptr ? GEOSBoundary_r(h, valid.get()) : nullptr;
+    if (outline == nullptr) {
+      for (GEOSGeometry* o : outlines) GEOSGeom_destroy_r(h, o);
+      return absl::InternalError("GEOS cannot take a friction polygon's outline");
+    }
+    outlines.push_back(outline);
+  }
+  Geos::Ptr collection = geos.Own(GEOSGeom_createCollection_r(
+      h, GEOS_GEOMETRYCOLLECTION, outlines.data(), static_cast<unsigned>(outlines.size())));
+  Geos::Ptr noded =
+      geos.Own(collection != nullptr ? GEOSUnaryUnion_r(h, collection.get()) : nullptr);
+  if (noded == nullptr) return absl::InternalError("GEOS cannot merge the friction outlines");
+  absl::StatusOr<MeshData> split = SlitLines(mesh, geos, noded.get(), {}, frame->origin,
+                                             frame->reach, max_vertices, stats, /*slit=*/false);
+  stats->faces_split += stats->faces_cut;  // none loses area: each is split, whole
+  stats->faces_cut = 0;
+  return split;
 }
 
 }  // namespace geodex::terrain

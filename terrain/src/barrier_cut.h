@@ -36,4 +36,11 @@ absl::StatusOr<MeshData> CutOutPolygons(const MeshData& mesh, const OGRGeometry&
                                         double scale, double width, uint64_t max_vertices,
                                         CutStats* stats);
 
+// Friction regions (geodex/friction.h): every face that an outline of `polygons` crosses is split
+// along it (the outlines of each polygon as given, overlaps included), and nothing is removed, so
+// that each face of the result lies inside or outside every polygon. Frame, rules and limits as
+// CutOutPolygons; lines and points are refused (InvalidArgument: regions are polygons).
+absl::StatusOr<MeshData> SplitAlongOutlines(const MeshData& mesh, const OGRGeometry& polygons,
+                                            double scale, uint64_t max_vertices, CutStats* stats);
+
 }  // namespace geodex::terrain

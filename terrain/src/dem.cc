@@ -392,11 +392,13 @@ namespace {
 // Polygons in the DEM file's CRS (`dem`) or in the mesh's own x y (no `dem`) cut out of `mesh`:
 // reprojected into the mesh's plane first (a geographic DEM's UTM metres), where their edges are
 // straight.
-absl::StatusOr<MeshData> CutBarrier(const MeshData& mesh, OGRGeometry& polygons, const DemInfo* dem,
-                                    const OGRSpatialReference* file_crs, double width,
-                                    uint64_t max_vertices, const std::string& name,
-                                    CutStats* stats) {
-  double scale = 1;
+// Polygons in the DEM file's CRS (`file_crs`) brought to the mesh's frame: into the mesh's CRS
+// when the DEM was reprojected (their edges then straight there, as the cutter draws them), else
+// left in the file's units with *scale the mesh's metres per unit. No `dem`: the mesh's own x y.
+absl::Status PolygonsToMeshFrame(OGRGeometry& polygons, const DemInfo* dem,
+                                 const OGRSpatialReference* file_crs, const std::string& name,
+                                 double* scale) {
+  *scale = 1;
   if (dem != nullptr && dem->reprojected) {
     OGRSpatialReference mesh_crs;
     if (mesh_crs.importFromWkt(dem->mesh_crs_wkt.c_str()) != OGRERR_NONE) {
@@ -410,9 +412,34 @@ absl::StatusOr<MeshData> CutBarrier(const MeshData& mesh, OGRGeometry& polygons,
                        QuietGdal::LastMessage(), ")"));
     }
   } else if (dem != nullptr) {
-    scale = dem->horizontal_scale;
+    *scale = dem->horizontal_scale;
   }
+  return absl::OkStatus();
+}
+
+absl::StatusOr<MeshData> CutBarrier(const MeshData& mesh, OGRGeometry& polygons, const DemInfo* dem,
+                                    const OGRSpatialReference* file_crs, double width,
+                                    uint64_t max_vertices, const std::string& name,
+                                    CutStats* stats) {
+  double scale = 1;
+  if (absl::Status s = PolygonsToMeshFrame(polygons, dem, file_crs, name, &scale); !s.ok())
+    return s;
   absl::StatusOr<MeshData> cut = CutOutPolygons(mesh, polygons, scale, width, max_vertices, stats);
+  if (absl::IsInvalidArgument(cut.status())) {
+    return absl::InvalidArgumentError(absl::StrCat(name, ": ", cut.status().message()));
+  }
+  return cut;
+}
+
+// Friction regions' outlines cut into the mesh (SplitAlongOutlines), polygons as CutBarrier's.
+absl::StatusOr<MeshData> CutOutlines(const MeshData& mesh, OGRGeometry& polygons,
+                                     const DemInfo* dem, const OGRSpatialReference* file_crs,
+                                     uint64_t max_vertices, const std::string& name,
+                                     CutStats* stats) {
+  double scale = 1;
+  if (absl::Status s = PolygonsToMeshFrame(polygons, dem, file_crs, name, &scale); !s.ok())
+    return s;
+  absl::StatusOr<MeshData> cut = SplitAlongOutlines(mesh, polygons, scale, max_vertices, stats);
   if (absl::IsInvalidArgument(cut.status())) {
     return absl::InvalidArgumentError(absl::StrCat(name, ": ", cut.status().message()));
   }
@@ -884,6 +911,39 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
     if (!polygons.ok()) return polygons.status();
     barrier = *std::move(polygons);
   }
+  // Friction regions: their outlines cut in once the barrier is out (geodex/friction.h).
+  std::unique_ptr<OGRGeometry> outlines;
+  const std::string friction_name = absl::StrCat("--friction ", options.friction_file);
+  if (!options.friction_file.empty()) {
+    absl::StatusOr<GDALDatasetUniquePtr> file =
+        OpenBarrierFile(options.friction_file, friction_name);
+    if (!file.ok()) return file.status();
+    absl::StatusOr<std::unique_ptr<OGRGeometry>> polygons =
+        BarrierPolygonsOf(file->get(), friction_name, &file_crs);
+    if (!polygons.ok()) return polygons.status();
+    outlines = *std::move(polygons);
+  }
+  // What is drawn on the mesh once it is made: the barrier cut out, then the outlines cut in.
+  auto cut_drawn = [&](MeshData mesh) -> absl::StatusOr<MeshData> {
+    if (barrier != nullptr) {
+      CutStats stats;
+      absl::StatusOr<MeshData> cut =
+          CutBarrier(mesh, *barrier, &info, &file_crs, options.barrier_width, options.max_vertices,
+                     barrier_name, &stats);
+      if (!cut.ok()) return cut.status();
+      if (cut->faces.empty()) return bad("the barrier covers every face: nothing is left");
+      info.barrier_faces = stats.faces_removed + stats.faces_cut;
+      mesh = *std::move(cut);
+    }
+    if (outlines != nullptr) {
+      CutStats stats;
+      absl::StatusOr<MeshData> cut = CutOutlines(mesh, *outlines, &info, &file_crs,
+                                                 options.max_vertices, friction_name, &stats);
+      if (!cut.ok()) return cut.status();
+      mesh = *std::move(cut);
+    }
+    return mesh;
+  };
 
   // Faces: per block, corners a (i, j), b (i+1, j), c (i, j+1), d (i+1, j+1), split along a-d:
   // (a, c, d) and (a, d, b), counter-clockwise seen from above when rows run south (gt[5] < 0).
@@ -892,15 +952,9 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
     absl::StatusOr<MeshData> tin = BuildTin(dem, options, flip, file_crs, path, &info);
     if (!tin.ok()) return tin.status();
     info.z_tolerance = options.z_tolerance;
-    if (barrier == nullptr) return FromMesh(*std::move(tin), info);
-    CutStats stats;
-    absl::StatusOr<MeshData> cut =
-        CutBarrier(*tin, *barrier, &info, &file_crs, options.barrier_width, options.max_vertices,
-                   barrier_name, &stats);
-    if (!cut.ok()) return cut.status();
-    if (cut->faces.empty()) return bad("the barrier covers every face: nothing is left");
-    info.barrier_faces = stats.faces_removed + stats.faces_cut;
-    return FromMesh(*std::move(cut), info);
+    absl::StatusOr<MeshData> drawn = cut_drawn(*std::move(tin));
+    if (!drawn.ok()) return drawn.status();
+    return FromMesh(*std::move(drawn), info);
   }
   dem.face_of_block_.assign(2 * size_t{W - 1} * (H - 1), kNoVertex);
   for (uint32_t j = 0; j + 1 < H; ++j) {
@@ -923,15 +977,10 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
                    ? "no 2x2 block of cells above the barrier: nothing to triangulate"
                    : "no 2x2 block of cells with data: nothing to triangulate");
   }
-  if (barrier == nullptr) return dem;
-  CutStats stats;
-  absl::StatusOr<MeshData> cut =
-      CutBarrier(dem.mesh_, *barrier, &info, &file_crs, options.barrier_width, options.max_vertices,
-                 barrier_name, &stats);
-  if (!cut.ok()) return cut.status();
-  if (cut->faces.empty()) return bad("the barrier covers every face: nothing is left");
-  info.barrier_faces = stats.faces_removed + stats.faces_cut;
-  return FromMesh(*std::move(cut), info);
+  if (barrier == nullptr && outlines == nullptr) return dem;
+  absl::StatusOr<MeshData> drawn = cut_drawn(dem.mesh_);
+  if (!drawn.ok()) return drawn.status();
+  return FromMesh(*std::move(drawn), info);
 }
 
 absl::StatusOr<std::array<double, 2>> Dem::CellCentreInMesh(uint32_t col, uint32_t row) const {
@@ -1857,7 +1906,9 @@ class CentreGrid {
 };
 
 // The friction polygons of a vector dataset, in `crs` (null: as they are), each face taking the
-// largest friction of the polygons containing its centroid, 1 elsewhere.
+// largest friction of the polygons containing its centroid, 1 elsewhere. A reprojected DEM's
+// faces are classified in the mesh's CRS, the polygons projected there vertex by vertex as
+// CutOutlines projects them, so that a face of a mesh cut along their outlines lies on one side.
 absl::StatusOr<std::vector<double>> FrictionOfPolygons(GDALDataset& ds, const MeshData& mesh,
                                                        const DemInfo* dem,
                                                        const OGRSpatialReference* crs,
@@ -1874,6 +1925,12 @@ absl::StatusOr<std::vector<double>> FrictionOfPolygons(GDALDataset& ds, const Me
     double friction;
   };
   std::vector<Region> regions;
+  const bool in_mesh_crs = dem != nullptr && dem->reprojected && crs != nullptr;
+  TransformPtr to_mesh(nullptr, &OGRCoordinateTransformation::DestroyCT);
+  if (in_mesh_crs && (to_mesh = FileMeshTransform(*dem, /*to_mesh=*/true)) == nullptr) {
+    return bad(
+        absl::StrCat("cannot project it to the mesh's CRS (", QuietGdal::LastMessage(), ")"));
+  }
   for (OGRLayer* layer : ds.GetLayers()) {
     const OGRSpatialReference* layer_crs = layer->GetSpatialRef();
     OGRSpatialReference from(layer_crs != nullptr ? *layer_crs : wgs84);
@@ -1907,7 +1964,8 @@ absl::StatusOr<std::vector<double>> FrictionOfPolygons(GDALDataset& ds, const Me
             absl::StrCat(which, " is a ", g->getGeometryName(), "; friction regions are polygons"));
       }
       std::unique_ptr<OGRGeometry> copy(g->clone());
-      if (to_dem != nullptr && copy->transform(to_dem.get()) != OGRERR_NONE) {
+      if ((to_dem != nullptr && copy->transform(to_dem.get()) != OGRERR_NONE) ||
+          (to_mesh != nullptr && copy->transform(to_mesh.get()) != OGRERR_NONE)) {
         return bad(absl::StrCat("cannot project ", which, " to the DEM's CRS (",
                                 QuietGdal::LastMessage(), ")"));
       }
@@ -1917,7 +1975,8 @@ absl::StatusOr<std::vector<double>> FrictionOfPolygons(GDALDataset& ds, const Me
     }
   }
   if (regions.empty()) return bad("no friction polygon");
-  absl::StatusOr<std::vector<std::array<double, 2>>> centres = FaceCentresInMap(mesh, dem, name);
+  absl::StatusOr<std::vector<std::array<double, 2>>> centres =
+      FaceCentresInMap(mesh, in_mesh_crs ? nullptr : dem, name);
   if (!centres.ok()) return centres.status();
   std::vector<double> weight(centres->size(), 1.0);
   std::vector<char> inside_any(centres->size(), 0);
@@ -1957,6 +2016,24 @@ absl::StatusOr<std::vector<double>> FrictionFromGeoJson(const MeshData& mesh,
   if (absl::Status s = ParseFileCrs(dem, name, &file_crs); !s.ok()) return s;
   return WithGeoJsonText<std::vector<double>>(geojson, name, [&](GDALDataset& ds) {
     return FrictionOfPolygons(ds, mesh, dem, dem != nullptr ? &file_crs : nullptr, name);
+  });
+}
+
+absl::StatusOr<MeshData> CutFrictionOutlines(const MeshData& mesh, const std::string& geojson,
+                                             const DemInfo* dem, const std::string& name,
+                                             CutStats* stats, uint64_t max_vertices) {
+  QuietGdal quiet;
+  OGRSpatialReference file_crs;
+  if (absl::Status s = ParseFileCrs(dem, name, &file_crs); !s.ok()) return s;
+  return WithGeoJsonText<MeshData>(geojson, name, [&](GDALDataset& ds) -> absl::StatusOr<MeshData> {
+    // The values are checked as FrictionFromGeoJson reads them: a bad one fails here too.
+    absl::StatusOr<std::vector<double>> values =
+        FrictionOfPolygons(ds, mesh, dem, dem != nullptr ? &file_crs : nullptr, name);
+    if (!values.ok()) return values.status();
+    absl::StatusOr<std::unique_ptr<OGRGeometry>> polygons =
+        BarrierPolygonsOf(&ds, name, dem != nullptr ? &file_crs : nullptr);
+    if (!polygons.ok()) return polygons.status();
+    return CutOutlines(mesh, **polygons, dem, &file_crs, max_vertices, name, stats);
   });
 }
 

@@ -3,13 +3,17 @@
 
 #include "geodex/friction.h"
 
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <limits>
 #include <string>
 #include <vector>
 
+#include "absl/strings/str_format.h"
 #include "dem_fixture.h"
+#include "geodex/distance_matrix.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/terrain.h"
 #include "geodex/triangle_mesh.h"
@@ -151,6 +155,87 @@ TEST_F(DemTest, FrictionSlowsTravelAcrossItsBand) {
   const double extra = slowed->distance[39] - plain->distance[39];
   EXPECT_GT(extra, 3 * 90 * 0.95);
   EXPECT_LT(extra, 3 * 110 * 1.05);
+}
+
+// Friction outlines cut into the mesh (CutFrictionOutlines): a half-plane of friction 4 whose
+// boundary runs 20 degrees off the grid's axes. Every face of the cut mesh lies on one side of it
+// (on the uncut grid the centroid rule puts faces across it), the stored DEM comes back, and the
+// least time from a point on one side to a point on the other is Snell's law's minimum within the
+// bound (opt <= time <= 1.05 opt; a raster of the same region on the uncut grid gives 2.9% less).
+TEST_F(DemTest, OutlinesCutIntoTheMeshMakeRegionBoundariesExact) {
+  absl::StatusOr<Dem> dem = Dem::Read(Write("flat.tif", Flat()));
+  ASSERT_TRUE(dem.ok()) << dem.status();
+  const double kSin = std::sin(20 * M_PI / 180), kCos = std::cos(20 * M_PI / 180);
+  const double x0 = 500200, y0 = 4999850;  // a point of the boundary; it runs along (kSin, kCos)
+  auto on_line = [&](double s) { return std::array<double, 2>{x0 + s * kSin, y0 + s * kCos}; };
+  const auto a = on_line(-400), b = on_line(400);
+  const std::string geojson = absl::StrFormat(
+      R"({"type": "Feature", "properties": {"friction": 4},
+      "crs": {"type": "name", "properties": {"name": "EPSG:32633"}},
+      "geometry": {"type": "Polygon", "coordinates": [[[%.17g, %.17g], [%.17g, %.17g],
+                   [%.17g, %.17g], [%.17g, %.17g], [%.17g, %.17g]]]}})",
+      a[0], a[1], a[0] + 1000, a[1], b[0] + 1000, b[1], b[0], b[1], a[0], a[1]);
+  // East of the boundary (the friction side) is > 0.
+  auto side = [&](const MeshData& m, uint32_t v) {
+    return (m.positions[3 * size_t{v}] - x0) * kCos - (m.positions[3 * size_t{v} + 1] - y0) * kSin;
+  };
+  auto faces_across = [&](const MeshData& m, const std::vector<double>& w) {
+    size_t across = 0;
+    for (size_t f = 0; f < w.size(); ++f) {
+      for (int k = 0; k < 3; ++k) {
+        const double d = side(m, m.faces[3 * f + k]);
+        across += (w[f] == 4 && d < -1e-6) || (w[f] == 1 && d > 1e-6);
+      }
+    }
+    return across;
+  };
+  absl::StatusOr<std::vector<double>> uncut =
+      FrictionFromGeoJson(dem->mesh(), geojson, &dem->info(), "--friction");
+  ASSERT_TRUE(uncut.ok()) << uncut.status();
+  EXPECT_GT(faces_across(dem->mesh(), *uncut), 10u);  // what the cut is for
+
+  CutStats stats;
+  absl::StatusOr<MeshData> cut =
+      CutFrictionOutlines(dem->mesh(), geojson, &dem->info(), "--friction", &stats);
+  ASSERT_TRUE(cut.ok()) << cut.status();
+  EXPECT_GT(stats.faces_split, 30u);
+  EXPECT_EQ(stats.faces_removed, 0u);
+  absl::StatusOr<std::vector<double>> w =
+      FrictionFromGeoJson(*cut, geojson, &dem->info(), "--friction");
+  ASSERT_TRUE(w.ok()) << w.status();
+  EXPECT_EQ(faces_across(*cut, *w), 0u);
+  absl::StatusOr<Dem> stored = Dem::FromMesh(*cut, dem->info());
+  ASSERT_TRUE(stored.ok()) << stored.status();
+
+  // Snell: from S (friction 1) to T (friction 4), crossing the boundary at on_line(s).
+  const std::array<double, 2> S = {500050, 4999850}, T = {500330, 4999780};
+  auto cost = [&](double s) {
+    const auto p = on_line(s);
+    return std::hypot(p[0] - S[0], p[1] - S[1]) + 4 * std::hypot(T[0] - p[0], T[1] - p[1]);
+  };
+  double lo = -400, hi = 400;  // convex in s: golden section
+  for (int i = 0; i < 200; ++i) {
+    const double m1 = lo + (hi - lo) * 0.382, m2 = lo + (hi - lo) * 0.618;
+    (cost(m1) < cost(m2) ? hi : lo) = cost(m1) < cost(m2) ? m2 : m1;
+  }
+  const double optimum = cost((lo + hi) / 2);
+  absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(*cut);
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  absl::StatusOr<SurfacePoint> from = stored->DropMapPoint(S[0], S[1]);
+  absl::StatusOr<SurfacePoint> to = stored->DropMapPoint(T[0], T[1]);
+  ASSERT_TRUE(from.ok() && to.ok()) << from.status() << to.status();
+  GeodesicOptions options;
+  options.travel = TravelCost{};
+  options.travel->speed_kmh = 3.6;  // 1 m/s: seconds are cost
+  options.travel->epsilon = 0.05;
+  options.travel->face_weight = std::make_shared<const std::vector<double>>(*w);
+  absl::StatusOr<std::vector<std::pair<double, uint32_t>>> t =
+      ComputeExactDistancesAt(*mesh, {*from}, {*to}, options);
+  ASSERT_TRUE(t.ok()) << t.status();
+  EXPECT_GE((*t)[0].first, optimum * (1 - 1e-9));
+  EXPECT_LE((*t)[0].first, optimum * 1.05);
+  std::printf("Snell across a cut outline: optimum %.6f, engine %.6f (1 + %.3g)\n", optimum,
+              (*t)[0].first, (*t)[0].first / optimum - 1);
 }
 
 }  // namespace

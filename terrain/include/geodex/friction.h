@@ -18,14 +18,24 @@ namespace geodex::terrain {
 // and MultiPolygons, each with a numeric property "friction" (> 0; a barrier is better drawn as
 // one, but "inf" or a huge value works too), RFC 7946 WGS 84 unless it names its CRS, on a DEM's
 // mesh (`dem`: its map), or with `dem` null in the mesh's own x y. Each face takes the friction of
-// the polygon containing its centroid (the largest where polygons overlap) and 1 elsewhere: region
-// boundaries are as fine as the mesh (on a DEM, a cell). InvalidArgument starting with `name` for
+// the polygon containing its centroid (the largest where polygons overlap) and 1 elsewhere: on a
+// mesh cut along the polygons' outlines (CutFrictionOutlines, DemOptions::friction_file) region
+// boundaries are exact, on any other as fine as the mesh. InvalidArgument starting with `name` for
 // text that is not GeoJSON polygons, a feature without a positive numeric friction, or polygons
 // that do not project to the mesh's CRS.
 absl::StatusOr<std::vector<double>> FrictionFromGeoJson(const MeshData& mesh,
                                                         const std::string& geojson,
                                                         const DemInfo* dem,
                                                         const std::string& name);
+
+// The friction polygons' outlines (GeoJSON text as FrictionFromGeoJson's, checked the same way)
+// cut into `mesh`: every face an outline crosses is split along it, nothing is removed, vertices
+// keep their ids and new ones follow (a DEM's polygons are projected to its mesh's CRS vertex by
+// vertex: edges straight there). FrictionFromGeoJson with the same text on the result gives each
+// region its value up to its boundary. `max_vertices` and the errors as CutBarrierPolygons.
+absl::StatusOr<MeshData> CutFrictionOutlines(const MeshData& mesh, const std::string& geojson,
+                                             const DemInfo* dem, const std::string& name,
+                                             CutStats* stats, uint64_t max_vertices = 0);
 
 // A friction file for a DEM's mesh: GeoJSON polygons as above (a .geojson or .json path), or a
 // one-band raster GDAL reads (.tif, ...) in the DEM's CRS: each face takes the value of the cell

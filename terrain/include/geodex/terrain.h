@@ -50,6 +50,11 @@ struct DemOptions {
   std::string barrier_file;
   // The width (metres) of the lines and points in barrier_file; 0: lines are slits, points refused.
   double barrier_width = 0;
+  // Friction polygons (a vector file as barrier_file, each with a "friction" property): their
+  // outlines are cut into the surface, nothing removed, so that each face lies in one region and
+  // the friction read from the same file on this mesh (ReadFrictionFile) has exact region
+  // boundaries (geodex/friction.h). "": none.
+  std::string friction_file;
   // The most cells (width x height of the file) a raster may have, and the most vertices and
   // faces its mesh may have (every used cell with data, two triangles per block); 0: any. What a
   // server sets before GDAL reads untrusted bytes: checked before any row is read, a
