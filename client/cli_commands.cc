@@ -372,14 +372,26 @@ absl::StatusOr<terrain::DemOptions> MeshReadOptions(const Args& args, const std:
       args.options.at("crs") != "native") {
     return absl::InvalidArgumentError("--crs must be wgs84 or native");
   }
-  // Friction polygons on a DEM: their outlines are cut into its mesh as it is read, so that
-  // ResolveTravelWeights, reading the same file on it, gives exact region boundaries.
-  if (args.options.count("friction") && terrain::IsDemPath(mesh)) {
-    const std::string& path = args.options.at("friction");
-    const terrain::GisFormat* format = terrain::GisFormatOf(path);
-    if (format == nullptr || format->kind != terrain::GisFileKind::kRaster) {
-      dem.friction_file = path;
+  // --friction-boundaries exact: friction polygons' outlines are cut into the DEM's mesh as it is
+  // read, so that ResolveTravelWeights, reading the same file on it, gives exact region
+  // boundaries. Not the default: slivers the outlines make multiply the bounded engine's Steiner
+  // points (docs/travel.md has the measured cost).
+  if (args.options.count("friction-boundaries")) {
+    const std::string& how = args.options.at("friction-boundaries");
+    if (how != "exact" && how != "faces") {
+      return absl::InvalidArgumentError(
+          absl::StrCat("--friction-boundaries must be exact or faces, not '", how, "'"));
     }
+    const std::string path = args.options.count("friction") ? args.options.at("friction") : "";
+    const terrain::GisFormat* format = terrain::GisFormatOf(path);
+    const bool polygons = !path.empty() && (format == nullptr ||
+                                            format->kind != terrain::GisFileKind::kRaster);
+    if (how == "exact" && (!polygons || !terrain::IsDemPath(mesh))) {
+      return absl::InvalidArgumentError(
+          "--friction-boundaries exact: cuts friction polygons (--friction F.geojson, .gpkg, "
+          ".shp, .fgb) into a DEM's mesh");
+    }
+    if (how == "exact") dem.friction_file = path;
   }
   return dem;
 }

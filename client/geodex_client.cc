@@ -330,6 +330,7 @@ absl::StatusOr<ServerMesh> GeodexClient::DeriveMesh(const std::string& name,
   v1::DeriveMeshRequest request;
   request.set_mesh(name);
   *request.mutable_barrier() = BarrierToProto(barrier);
+  request.set_friction_geojson(barrier.friction_geojson);
   request.set_display_name(alias);
   v1::Mesh mesh;
   grpc::Status status = Call(IdOfName(name), [&](grpc::ClientContext* context) {

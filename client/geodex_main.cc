@@ -70,7 +70,9 @@ Travel time (distances, path, matrix, isolines, voronoi; docs/travel.md): --spee
       least time (--cost-epsilon E, default 0.01, in (0, 1)); a straight piece in a face takes
       its 3D length x the face's friction / the speed. --friction FILE on a DEM: GeoJSON
       polygons with a numeric "friction" property, or a raster in the DEM's CRS (nodata
-      impassable); each face takes the value under its centroid. --face-weights FILE: one
+      impassable); each face takes the value under its centroid (--friction-boundaries exact:
+      polygons' outlines cut into the DEM's mesh, exact boundaries, often far slower; faces:
+      the default). --face-weights FILE: one
       weight per face, a number a line (inf: impassable). --max-slope DEG: faces steeper than
       DEG (from the x-y plane, z up) are impassable. --max-steiner-points N bounds the engine's
       memory (about 32 bytes a point). Answers say so: a '# travel time in seconds ...' first

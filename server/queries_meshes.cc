@@ -11,6 +11,8 @@
 #include <vector>
 
 #include "absl/strings/str_cat.h"
+#include "absl/strings/strip.h"
+#include "geodex/friction.h"
 #include "geodex/limits.h"
 #include "geodex/mesh_id.h"
 #include "geodex/terrain.h"
@@ -83,8 +85,10 @@ absl::StatusOr<MessageStream<v1::MeshGeometry>> RunGetMeshGeometry(
 absl::Status RunDeriveMesh(const QueryEnv& env, const v1::DeriveMeshRequest& request,
                            v1::Mesh* response) {
   const v1::Barrier& barrier = request.barrier();
-  if (!barrier.has_below() && barrier.polygons_geojson().empty()) {
-    return FieldError("barrier", "empty: set below, polygons_geojson or both");
+  if (!barrier.has_below() && barrier.polygons_geojson().empty() &&
+      request.friction_geojson().empty()) {
+    return FieldError("barrier",
+                      "empty: set below, polygons_geojson or both (or friction_geojson alone)");
   }
   if (barrier.has_below() && !std::isfinite(barrier.below())) {
     return FieldError("barrier.below", "must be finite");
@@ -115,6 +119,22 @@ absl::Status RunDeriveMesh(const QueryEnv& env, const v1::DeriveMeshRequest& req
     barrier_faces += cut_stats.faces_removed + cut_stats.faces_cut;
   }
   if (derived.faces.empty()) return FieldError("barrier", "covers every face of the mesh");
+  if (!request.friction_geojson().empty()) {
+    terrain::CutStats cut_stats;
+    absl::StatusOr<MeshData> cut = terrain::CutFrictionOutlines(
+        derived, request.friction_geojson(), from.terrain ? &*from.terrain : nullptr,
+        "friction_geojson", &cut_stats, env.limits->max_vertices);
+    if (ExceededLimit(cut.status())) return cut.status();
+    if (!cut.ok()) {
+      absl::string_view message = cut.status().message();
+      absl::ConsumePrefix(&message, "friction_geojson: ");  // FieldError names it
+      if (!absl::IsInvalidArgument(cut.status())) {
+        return absl::Status(cut.status().code(), absl::StrCat("friction_geojson: ", message));
+      }
+      return FieldError("friction_geojson", message);
+    }
+    derived = *std::move(cut);
+  }
   // A cut adds vertices and faces where the polygons cross the mesh: the mesh limits still hold.
   if (derived.vertex_count() > env.limits->max_vertices) {
     return LimitExceededError(

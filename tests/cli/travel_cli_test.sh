@@ -68,16 +68,17 @@ t2 = b['points'][0]['time_s']
 assert d / 2 * (1 - 1e-9) <= t2 <= d / 2 * 1.003, (t2, d / 2)"
 
 # Friction: a 100 m band of friction 4 across the map costs 3 x 100 s more to cross at 1 m/s,
-# drawn as polygons or as a raster. A raster's faces take the cell under their centroids, so the
-# band's edges follow the triangles: 90 to 100 m of it are crossed. Polygons' outlines are cut
-# into the DEM's mesh: exactly 100 m (270 + 400 s, within the bound).
-for fr in band.geojson friction.tif; do
+# drawn as polygons or as a raster. Faces take the friction under their centroids, so the band's
+# edges follow the triangles: 90 to 100 m of it are crossed. With --friction-boundaries exact the
+# polygons' outlines are cut into the DEM's mesh: exactly 100 m (270 + 400 s, within the bound).
+for fr in band.geojson friction.tif exact; do
+  extra=()
+  file=$fr low=640
+  [ "$fr" = exact ] && extra=(--friction-boundaries exact) file=band.geojson low=670
   "$GEODEX" distances "$F" --sources g:500015:4999855 --at g:500385:4999855 \
-    --speed constant:3.6 --friction "$tmp/$fr" --format json >"$tmp/band_$fr.json"
+    --speed constant:3.6 --friction "$tmp/$file" "${extra[@]}" --format json >"$tmp/band_$fr.json"
   check "friction $fr: exit 0" test $? -eq 0
-  low=640
-  [ "$fr" = band.geojson ] && low=670
-  check "friction $fr: 370 m with 100 m (raster: 90-100 m) at friction 4 takes $low-670 s" $PY -c "
+  check "friction $fr: 370 m with 100 m (by faces: 90-100 m) at friction 4 takes $low-670 s" $PY -c "
 import json; t = json.load(open('$tmp/band_$fr.json'))['points'][0]['time_s']
 assert $low * (1 - 1e-9) <= t <= 670 * 1.01, t"
 done
@@ -165,6 +166,8 @@ expect_error "speed syntax" "--speed: 'walking' is not constant:KMH" distances "
 expect_error "epsilon" "--cost-epsilon: must be in (0, 1)" distances "$F" --sources 0 --speed constant:5 --cost-epsilon 2
 expect_error "friction CRS" "is not the DEM's" distances "$F" --sources 0 --speed constant:5 --friction "$tmp/friction_utm32.tif"
 expect_error "friction on a mesh" "friction maps need a DEM" distances "$tmp/sq.off" --sources 0 --speed constant:5 --friction "$tmp/band.geojson"
+expect_error "friction-boundaries value" "must be exact or faces" distances "$F" --sources 0 --speed constant:5 --friction "$tmp/band.geojson" --friction-boundaries cut
+expect_error "friction-boundaries on a raster" "cuts friction polygons" distances "$F" --sources 0 --speed constant:5 --friction "$tmp/friction.tif" --friction-boundaries exact
 printf '1\n' >"$tmp/w1.txt"
 expect_error "weights count" "--face-weights:" distances "$tmp/sq.off" --sources 0 --speed constant:5 --face-weights "$tmp/w1.txt"
 expect_error "time level" "--levels: '10min' is a time" isolines "$F" --sources 0 --levels 10min

@@ -274,6 +274,29 @@ class PythonClientTest(unittest.TestCase):
         with self.assertRaises(geodex.InvalidArgumentError) as error:
             self.client.derive_mesh("meshes/slope")
         self.assertEqual(error.exception.field, "barrier")
+        # Friction polygons: their outlines cut into a derived mesh (nothing removed) make the
+        # CLI's --friction mesh, and travel on it with the same polygons the CLI's times.
+        strip = {"type": "FeatureCollection",
+                 "crs": {"type": "name", "properties": {"name": "EPSG:32633"}},
+                 "features": [{"type": "Feature", "properties": {"friction": 3},
+                               "geometry": {"type": "Polygon", "coordinates": [[
+                                   [500080, 4999750], [500130, 4999750], [500230, 5000010],
+                                   [500180, 5000010], [500080, 4999750]]]}}]}
+        banded = self.client.derive_mesh("meshes/slope", friction_geojson=strip, name="banded")
+        self.assertGreater(banded.face_count, self.client.get_mesh("meshes/slope").face_count)
+        band_file = os.path.join(self.tmp.name, "band.geojson")
+        with open(band_file, "w") as f:
+            json.dump(strip, f)
+        slow = self.client.distance_field(
+            "meshes/banded", [geodex.map_point(500031.5, 4999903.5)],
+            travel=geodex.Travel(3.6, epsilon=0.05, friction_geojson=strip))
+        expected = [float(x) for x in self.local(
+            "distances", tif, "--sources", "g:500031.5:4999903.5", "--speed", "constant:3.6",
+            "--cost-epsilon", "0.05", "--friction", band_file).split("\n")[1:] if x]
+        self.assertEqual(slow.distances.tolist(), expected)
+        with self.assertRaises(geodex.InvalidArgumentError) as error:
+            self.client.derive_mesh("meshes/slope", friction_geojson={"type": "Feature"})
+        self.assertEqual(error.exception.field, "friction_geojson")
         # GIS files from the server are the CLI's files, byte for byte.
         source = geodex.map_point(500031.5, 4999903.5)
         for product, args, ext in [("isochrones", ["isolines", "--levels", "40,90"], "geojson"),

@@ -476,6 +476,82 @@ TEST_F(TerrainServiceTest, DeriveMeshByABarrier) {
   }
 }
 
+// Friction polygons as a request: DeriveMesh with friction_geojson cuts their outlines into the
+// DEM's mesh (nothing removed): exactly the mesh the CLI makes for --friction F.geojson (the same
+// id), map points still drop, and a travel field on it with the same polygons equals core's on the
+// CLI's mesh. Bad polygons name the field.
+TEST_F(TerrainServiceTest, DeriveMeshByFrictionOutlines) {
+  StartServer();
+  testing::UploadResult slot = UploadDem(bytes_, "slot");
+  ASSERT_TRUE(slot.status.ok());
+  // A band of friction 3, its edges 20 degrees off the grid, in the DEM's CRS by identifier.
+  const double t = std::tan(20 * M_PI / 180);
+  const std::string geojson = absl::StrFormat(
+      R"({"type": "FeatureCollection", "crs": {"type": "name", "properties": {"name":
+      "EPSG:32633"}}, "features": [{"type": "Feature", "properties": {"friction": 3},
+      "geometry": {"type": "Polygon", "coordinates": [[[%.17g, 4999700], [%.17g, 4999700],
+      [%.17g, 5000100], [%.17g, 5000100], [%.17g, 4999700]]]}}]})",
+      500080.0, 500130.0, 500130 + 400 * t, 500080 + 400 * t, 500080.0);
+  const std::string band_file = (dir_ / "in" / "band.geojson").string();
+  std::ofstream(band_file) << geojson;
+  terrain::DemOptions with_band;
+  with_band.friction_file = band_file;
+  absl::StatusOr<terrain::Dem> local = terrain::Dem::Read(tif_, with_band);
+  ASSERT_TRUE(local.ok()) << local.status();
+
+  auto derive = [&](const std::string& friction, v1::Mesh* out) {
+    grpc::ClientContext context;
+    context.set_deadline(testing::In(120));
+    v1::DeriveMeshRequest request;
+    request.set_mesh("meshes/slot");
+    request.set_friction_geojson(friction);
+    request.set_display_name("banded");
+    return stub_->DeriveMesh(&context, request, out);
+  };
+  v1::Mesh banded;
+  grpc::Status status = derive(geojson, &banded);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(banded.name(), absl::StrCat("meshes/", ComputeMeshId(local->mesh())));
+  EXPECT_EQ(banded.face_count(), local->mesh().face_count());
+  EXPECT_GT(banded.face_count(), slot.mesh.face_count() + 20);  // the faces split along it
+  ASSERT_TRUE(banded.has_terrain());
+
+  // Travel from a map point west of the band: the field equals core's on the CLI's mesh.
+  v1::ComputeDistanceFieldRequest request;
+  request.set_mesh("meshes/banded");
+  request.add_sources()->mutable_map_point()->set_x(500025);
+  request.mutable_sources(0)->mutable_map_point()->set_y(4999945);
+  v1::TravelCost* travel = request.mutable_options()->mutable_travel();
+  travel->set_speed_kmh(3.6);
+  travel->set_epsilon(0.05);
+  travel->set_friction_geojson(geojson);
+  testing::FieldResult got = testing::ReadField(*stub_, request);
+  ASSERT_TRUE(got.status.ok()) << got.status.error_message();
+  absl::StatusOr<std::vector<double>> friction =
+      terrain::FrictionFromGeoJson(local->mesh(), geojson, &local->info(), "friction");
+  ASSERT_TRUE(friction.ok()) << friction.status();
+  absl::StatusOr<TriangleMesh> built = TriangleMesh::Build(local->mesh());
+  ASSERT_TRUE(built.ok());
+  absl::StatusOr<SurfacePoint> west = local->DropMapPoint(500025, 4999945);
+  ASSERT_TRUE(west.ok());
+  GeodesicOptions options;
+  options.travel = TravelCost{};
+  options.travel->speed_kmh = 3.6;
+  options.travel->epsilon = 0.05;
+  options.travel->face_weight = std::make_shared<const std::vector<double>>(*friction);
+  absl::StatusOr<DistanceField> want = ComputeDistanceField(*built, {*west}, options);
+  ASSERT_TRUE(want.ok()) << want.status();
+  EXPECT_EQ(got.distances, want->distance);
+
+  v1::Mesh none;
+  grpc::Status bad = derive(R"({"type": "Feature", "properties": {}, "geometry":
+      {"type": "Polygon", "coordinates": [[[0, 0], [1, 0], [1, 1], [0, 0]]]}})",
+                            &none);
+  EXPECT_EQ(bad.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_EQ(BadField(bad), "friction_geojson") << bad.error_message();
+  EXPECT_TRUE(Contains(bad.error_message(), "no numeric \"friction\"")) << bad.error_message();
+}
+
 // geodexd never reaches out (issue 30): no URL, file or driver that a request names is followed.
 // Each hostile input is refused as INVALID_ARGUMENT naming its field, quickly (a followed link
 // waited 10 s on a silent peer), no connection reaches the listener, and the server goes on

@@ -75,11 +75,14 @@ struct DemUploadOptions {
   double z_tolerance = 0;               // > 0: an adaptive TIN within this height (docs/terrain.md)
 };
 
-// What DeriveMesh removes from a stored mesh (geodex.v1.Barrier).
+// What DeriveMesh removes from a stored mesh (geodex.v1.Barrier), and what it cuts in.
 struct BarrierOptions {
   std::optional<double> below;   // faces with a corner below this height
   std::string polygons_geojson;  // polygons cut out, lines slit (docs/barriers.md)
   double width = 0;              // lines and points widened to this width (map units)
+  // Friction polygons whose outlines are cut in, nothing removed (DeriveMeshRequest's
+  // friction_geojson): travel on the derived mesh with the same text has exact regions.
+  std::string friction_geojson;
 };
 
 // Which distances EstimateDistances answers with.

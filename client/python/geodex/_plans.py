@@ -293,20 +293,25 @@ class Plans:
 
     def derive_mesh(self, mesh: str, below: Optional[float] = None,
                     polygons_geojson: Union[str, dict] = "", name: str = "", pin: bool = False,
-                    width: float = 0.0, timeout: Optional[float] = None) -> Plan[Mesh]:
+                    width: float = 0.0, timeout: Optional[float] = None,
+                    friction_geojson: Union[str, dict] = "") -> Plan[Mesh]:
         """The stored mesh without what a barrier covers, stored by the server (by its content's
         id); returns its Mesh. `below`: faces with a corner lower than this z go (the sea at 0 on
         a DEM's mesh); `polygons_geojson`: the text (or a dict) of GeoJSON polygons, cut exactly
         out of the surface (WGS 84 on a DEM's mesh, the mesh's x y otherwise); lines in it are
         slits (paths go around their ends), or with `width` (metres) walls that wide, as are its
-        points."""
+        points. `friction_geojson`: friction polygons (as Travel's) whose outlines are cut in,
+        nothing removed: travel on the derived mesh with the same polygons has exact regions."""
         if not isinstance(polygons_geojson, str):
             polygons_geojson = json.dumps(polygons_geojson)
+        if not isinstance(friction_geojson, str):
+            friction_geojson = json.dumps(friction_geojson)
         barrier = pb.Barrier(polygons_geojson=polygons_geojson, width=width)
         if below is not None:
             barrier.below = below
         resource = yield Rpc("DeriveMesh", pb.DeriveMeshRequest(
-            mesh=mesh, barrier=barrier, display_name=name, pin=pin), pb.Mesh, mesh=mesh)
+            mesh=mesh, barrier=barrier, display_name=name, pin=pin,
+            friction_geojson=friction_geojson), pb.Mesh, mesh=mesh)
         return Mesh.from_proto(resource)
 
     def delete_mesh(self, mesh: str, timeout: Optional[float] = None) -> Plan[None]:

@@ -49,7 +49,9 @@ class Travel:
     impassable (0: no limit). `face_weights`: one friction per face of the mesh, in order (> 0,
     inf impassable; None: 1). `friction_geojson`: GeoJSON polygons (text or a dict) with a
     numeric "friction" property; each face takes the friction of the polygon holding its
-    centroid (WGS 84 on a DEM's mesh unless the GeoJSON names its CRS, else the mesh's x y). At
+    centroid (WGS 84 on a DEM's mesh unless the GeoJSON names its CRS, else the mesh's x y): on
+    a mesh derived with the same polygons (derive_mesh(friction_geojson=...)) region boundaries
+    are exact, on any other as fine as its faces. At
     most one of face_weights and friction_geojson. Not with want_directions, delaunay() or the
     unfolding estimates (point_distances() then returns exact values only). The server checks
     the values: a bad one is an InvalidArgumentError naming its field
