@@ -384,8 +384,8 @@ absl::StatusOr<terrain::DemOptions> MeshReadOptions(const Args& args, const std:
     }
     const std::string path = args.options.count("friction") ? args.options.at("friction") : "";
     const terrain::GisFormat* format = terrain::GisFormatOf(path);
-    const bool polygons = !path.empty() && (format == nullptr ||
-                                            format->kind != terrain::GisFileKind::kRaster);
+    const bool polygons =
+        !path.empty() && (format == nullptr || format->kind != terrain::GisFileKind::kRaster);
     if (how == "exact" && (!polygons || !terrain::IsDemPath(mesh))) {
       return absl::InvalidArgumentError(
           "--friction-boundaries exact: cuts friction polygons (--friction F.geojson, .gpkg, "

@@ -275,7 +275,8 @@ class PythonClientTest(unittest.TestCase):
             self.client.derive_mesh("meshes/slope")
         self.assertEqual(error.exception.field, "barrier")
         # Friction polygons: their outlines cut into a derived mesh (nothing removed) make the
-        # CLI's --friction mesh, and travel on it with the same polygons the CLI's times.
+        # CLI's --friction-boundaries exact mesh, and travel on it with the same polygons the
+        # CLI's times.
         strip = {"type": "FeatureCollection",
                  "crs": {"type": "name", "properties": {"name": "EPSG:32633"}},
                  "features": [{"type": "Feature", "properties": {"friction": 3},
@@ -292,7 +293,8 @@ class PythonClientTest(unittest.TestCase):
             travel=geodex.Travel(3.6, epsilon=0.05, friction_geojson=strip))
         expected = [float(x) for x in self.local(
             "distances", tif, "--sources", "g:500031.5:4999903.5", "--speed", "constant:3.6",
-            "--cost-epsilon", "0.05", "--friction", band_file).split("\n")[1:] if x]
+            "--cost-epsilon", "0.05", "--friction", band_file, "--friction-boundaries",
+            "exact").split("\n")[1:] if x]
         self.assertEqual(slow.distances.tolist(), expected)
         with self.assertRaises(geodex.InvalidArgumentError) as error:
             self.client.derive_mesh("meshes/slope", friction_geojson={"type": "Feature"})
