@@ -211,6 +211,76 @@ absl::StatusOr<std::unique_ptr<OGRGeometry>> BarrierPolygonsOf(GDALDataset* ds,
   return std::unique_ptr<OGRGeometry>(std::move(all));
 }
 
+// One friction polygon (or multipolygon) with its value.
+struct FrictionRegion {
+  std::unique_ptr<OGRGeometry> shape;
+  double friction;
+};
+
+// The friction polygons of a vector dataset, checked (polygons only, each with a numeric
+// "friction" > 0) and projected to `crs` (null: as they are). Both uses start here: the faces'
+// values (FaceFrictionOf) and the outlines cut into a mesh (OutlinesOf).
+absl::StatusOr<std::vector<FrictionRegion>> ReadFrictionRegions(GDALDataset& ds,
+                                                                const OGRSpatialReference* crs,
+                                                                const std::string& name) {
+  auto bad = [&](const std::string& why) {
+    return absl::InvalidArgumentError(absl::StrCat(name, ": ", why));
+  };
+  OGRSpatialReference wgs84;
+  wgs84.SetWellKnownGeogCS("WGS84");
+  wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  std::vector<FrictionRegion> regions;
+  for (OGRLayer* layer : ds.GetLayers()) {
+    const OGRSpatialReference* layer_crs = layer->GetSpatialRef();
+    OGRSpatialReference from(layer_crs != nullptr ? *layer_crs : wgs84);
+    from.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+    TransformPtr to_dem(nullptr, &OGRCoordinateTransformation::DestroyCT);
+    if (crs != nullptr) {
+      to_dem = MakeTransform(from, *crs);
+      if (to_dem == nullptr) {
+        return bad(
+            absl::StrCat("cannot project it to the DEM's CRS (", QuietGdal::LastMessage(), ")"));
+      }
+    }
+    const int field = layer->GetLayerDefn()->GetFieldIndex("friction");
+    const OGRFieldType type =
+        field >= 0 ? layer->GetLayerDefn()->GetFieldDefn(field)->GetType() : OFTString;
+    for (const auto& feature : *layer) {
+      const std::string which = absl::StrCat("feature ", feature->GetFID());
+      if (field < 0 || !feature->IsFieldSetAndNotNull(field) ||
+          (type != OFTReal && type != OFTInteger && type != OFTInteger64)) {
+        return bad(absl::StrCat(which, " has no numeric \"friction\" property"));
+      }
+      const double friction = feature->GetFieldAsDouble(field);
+      if (!(friction > 0)) {
+        return bad(absl::StrCat(which, ": friction must be > 0, got ", friction));
+      }
+      const OGRGeometry* g = feature->GetGeometryRef();
+      if (g == nullptr) return bad(absl::StrCat(which, " has no geometry"));
+      const OGRwkbGeometryType kind = wkbFlatten(g->getGeometryType());
+      if (kind != wkbPolygon && kind != wkbMultiPolygon) {
+        return bad(
+            absl::StrCat(which, " is a ", g->getGeometryName(), "; friction regions are polygons"));
+      }
+      std::unique_ptr<OGRGeometry> copy(g->clone());
+      if (to_dem != nullptr && copy->transform(to_dem.get()) != OGRERR_NONE) {
+        return bad(absl::StrCat("cannot project ", which, " to the DEM's CRS (",
+                                QuietGdal::LastMessage(), ")"));
+      }
+      regions.push_back({std::move(copy), friction});
+    }
+  }
+  if (regions.empty()) return bad("no friction polygon");
+  return regions;
+}
+
+// The regions' shapes as one collection: what CutOutlines splits the mesh along.
+std::unique_ptr<OGRGeometry> OutlinesOf(const std::vector<FrictionRegion>& regions) {
+  auto all = std::make_unique<OGRGeometryCollection>();
+  for (const FrictionRegion& r : regions) all->addGeometry(r.shape.get());
+  return all;
+}
+
 }  // namespace
 
 Dem::Dem(Dem&&) noexcept = default;
@@ -389,9 +459,6 @@ absl::StatusOr<GDALDatasetUniquePtr> OpenBarrierFile(const std::string& path,
 
 namespace {
 
-// Polygons in the DEM file's CRS (`dem`) or in the mesh's own x y (no `dem`) cut out of `mesh`:
-// reprojected into the mesh's plane first (a geographic DEM's UTM metres), where their edges are
-// straight.
 // Polygons in the DEM file's CRS (`file_crs`) brought to the mesh's frame: into the mesh's CRS
 // when the DEM was reprojected (their edges then straight there, as the cutter draws them), else
 // left in the file's units with *scale the mesh's metres per unit. No `dem`: the mesh's own x y.
@@ -918,10 +985,10 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
     absl::StatusOr<GDALDatasetUniquePtr> file =
         OpenBarrierFile(options.friction_file, friction_name);
     if (!file.ok()) return file.status();
-    absl::StatusOr<std::unique_ptr<OGRGeometry>> polygons =
-        BarrierPolygonsOf(file->get(), friction_name, &file_crs);
-    if (!polygons.ok()) return polygons.status();
-    outlines = *std::move(polygons);
+    absl::StatusOr<std::vector<FrictionRegion>> regions =
+        ReadFrictionRegions(**file, &file_crs, friction_name);
+    if (!regions.ok()) return regions.status();
+    outlines = OutlinesOf(*regions);
   }
   // What is drawn on the mesh once it is made: the barrier cut out, then the outlines cut in.
   auto cut_drawn = [&](MeshData mesh) -> absl::StatusOr<MeshData> {
@@ -1905,76 +1972,29 @@ class CentreGrid {
   std::vector<uint32_t> start_, order_;
 };
 
-// The friction polygons of a vector dataset, in `crs` (null: as they are), each face taking the
-// largest friction of the polygons containing its centroid, 1 elsewhere. A reprojected DEM's
-// faces are classified in the mesh's CRS, the polygons projected there vertex by vertex as
-// CutOutlines projects them, so that a face of a mesh cut along their outlines lies on one side.
-absl::StatusOr<std::vector<double>> FrictionOfPolygons(GDALDataset& ds, const MeshData& mesh,
-                                                       const DemInfo* dem,
-                                                       const OGRSpatialReference* crs,
-                                                       const std::string& name) {
-  auto bad = [&](const std::string& why) {
-    return absl::InvalidArgumentError(absl::StrCat(name, ": ", why));
-  };
-  OGRSpatialReference wgs84;
-  wgs84.SetWellKnownGeogCS("WGS84");
-  wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  struct Region {
-    std::unique_ptr<OGRGeometry> shape;
-    OGREnvelope box;
-    double friction;
-  };
-  std::vector<Region> regions;
-  const bool in_mesh_crs = dem != nullptr && dem->reprojected && crs != nullptr;
-  TransformPtr to_mesh(nullptr, &OGRCoordinateTransformation::DestroyCT);
-  if (in_mesh_crs && (to_mesh = FileMeshTransform(*dem, /*to_mesh=*/true)) == nullptr) {
-    return bad(
-        absl::StrCat("cannot project it to the mesh's CRS (", QuietGdal::LastMessage(), ")"));
-  }
-  for (OGRLayer* layer : ds.GetLayers()) {
-    const OGRSpatialReference* layer_crs = layer->GetSpatialRef();
-    OGRSpatialReference from(layer_crs != nullptr ? *layer_crs : wgs84);
-    from.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-    TransformPtr to_dem(nullptr, &OGRCoordinateTransformation::DestroyCT);
-    if (crs != nullptr) {
-      to_dem = MakeTransform(from, *crs);
-      if (to_dem == nullptr) {
-        return bad(
-            absl::StrCat("cannot project it to the DEM's CRS (", QuietGdal::LastMessage(), ")"));
+// Each face's friction: the largest of the regions (in the DEM file's CRS, or the mesh's own x y
+// without a DEM) containing its centroid, 1 elsewhere. A reprojected DEM's faces are classified
+// in the mesh's CRS, the polygons projected there vertex by vertex as CutOutlines projects them,
+// so that a face of a mesh cut along their outlines lies on one side.
+absl::StatusOr<std::vector<double>> FaceFrictionOf(std::vector<FrictionRegion> regions,
+                                                   const MeshData& mesh, const DemInfo* dem,
+                                                   const std::string& name) {
+  const bool in_mesh_crs = dem != nullptr && dem->reprojected;
+  if (in_mesh_crs) {
+    TransformPtr to_mesh = FileMeshTransform(*dem, /*to_mesh=*/true);
+    if (to_mesh == nullptr) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          name, ": cannot project it to the mesh's CRS (", QuietGdal::LastMessage(), ")"));
+    }
+    for (FrictionRegion& r : regions) {
+      if (r.shape->transform(to_mesh.get()) != OGRERR_NONE) {
+        return absl::InvalidArgumentError(absl::StrCat(
+            name, ": cannot project a polygon to the mesh's CRS (", QuietGdal::LastMessage(), ")"));
       }
     }
-    const int field = layer->GetLayerDefn()->GetFieldIndex("friction");
-    const OGRFieldType type =
-        field >= 0 ? layer->GetLayerDefn()->GetFieldDefn(field)->GetType() : OFTString;
-    for (const auto& feature : *layer) {
-      const std::string which = absl::StrCat("feature ", feature->GetFID());
-      if (field < 0 || !feature->IsFieldSetAndNotNull(field) ||
-          (type != OFTReal && type != OFTInteger && type != OFTInteger64)) {
-        return bad(absl::StrCat(which, " has no numeric \"friction\" property"));
-      }
-      const double friction = feature->GetFieldAsDouble(field);
-      if (!(friction > 0)) {
-        return bad(absl::StrCat(which, ": friction must be > 0, got ", friction));
-      }
-      const OGRGeometry* g = feature->GetGeometryRef();
-      if (g == nullptr) return bad(absl::StrCat(which, " has no geometry"));
-      const OGRwkbGeometryType kind = wkbFlatten(g->getGeometryType());
-      if (kind != wkbPolygon && kind != wkbMultiPolygon) {
-        return bad(
-            absl::StrCat(which, " is a ", g->getGeometryName(), "; friction regions are polygons"));
-      }
-      std::unique_ptr<OGRGeometry> copy(g->clone());
-      if ((to_dem != nullptr && copy->transform(to_dem.get()) != OGRERR_NONE) ||
-          (to_mesh != nullptr && copy->transform(to_mesh.get()) != OGRERR_NONE)) {
-        return bad(absl::StrCat("cannot project ", which, " to the DEM's CRS (",
-                                QuietGdal::LastMessage(), ")"));
-      }
-      Region r{std::move(copy), {}, friction};
-      r.shape->getEnvelope(&r.box);
-      regions.push_back(std::move(r));
-    }
   }
-  if (regions.empty()) return bad("no friction polygon");
+  std::vector<OGREnvelope> boxes(regions.size());
+  for (size_t i = 0; i < regions.size(); ++i) regions[i].shape->getEnvelope(&boxes[i]);
   absl::StatusOr<std::vector<std::array<double, 2>>> centres =
       FaceCentresInMap(mesh, in_mesh_crs ? nullptr : dem, name);
   if (!centres.ok()) return centres.status();
@@ -1985,10 +2005,12 @@ absl::StatusOr<std::vector<double>> FrictionOfPolygons(GDALDataset& ds, const Me
   // (a land-cover layer has thousands of polygons, a DEM a million faces).
   const CentreGrid grid(*centres);
   OGRPoint point;
-  for (const Region& r : regions) {
-    for (const uint32_t f : grid.Near(r.box.MinX, r.box.MinY, r.box.MaxX, r.box.MaxY)) {
+  for (size_t i = 0; i < regions.size(); ++i) {
+    const FrictionRegion& r = regions[i];
+    const OGREnvelope& box = boxes[i];
+    for (const uint32_t f : grid.Near(box.MinX, box.MinY, box.MaxX, box.MaxY)) {
       const auto& [x, y] = (*centres)[f];
-      if (x < r.box.MinX || x > r.box.MaxX || y < r.box.MinY || y > r.box.MaxY) continue;
+      if (x < box.MinX || x > box.MaxX || y < box.MinY || y > box.MaxY) continue;
       point.setX(x);
       point.setY(y);
       bool inside = false;
@@ -2014,9 +2036,13 @@ absl::StatusOr<std::vector<double>> FrictionFromGeoJson(const MeshData& mesh,
   QuietGdal quiet;
   OGRSpatialReference file_crs;
   if (absl::Status s = ParseFileCrs(dem, name, &file_crs); !s.ok()) return s;
-  return WithGeoJsonText<std::vector<double>>(geojson, name, [&](GDALDataset& ds) {
-    return FrictionOfPolygons(ds, mesh, dem, dem != nullptr ? &file_crs : nullptr, name);
-  });
+  return WithGeoJsonText<std::vector<double>>(
+      geojson, name, [&](GDALDataset& ds) -> absl::StatusOr<std::vector<double>> {
+        absl::StatusOr<std::vector<FrictionRegion>> regions =
+            ReadFrictionRegions(ds, dem != nullptr ? &file_crs : nullptr, name);
+        if (!regions.ok()) return regions.status();
+        return FaceFrictionOf(*std::move(regions), mesh, dem, name);
+      });
 }
 
 absl::StatusOr<MeshData> CutFrictionOutlines(const MeshData& mesh, const std::string& geojson,
@@ -2026,14 +2052,11 @@ absl::StatusOr<MeshData> CutFrictionOutlines(const MeshData& mesh, const std::st
   OGRSpatialReference file_crs;
   if (absl::Status s = ParseFileCrs(dem, name, &file_crs); !s.ok()) return s;
   return WithGeoJsonText<MeshData>(geojson, name, [&](GDALDataset& ds) -> absl::StatusOr<MeshData> {
-    // The values are checked as FrictionFromGeoJson reads them: a bad one fails here too.
-    absl::StatusOr<std::vector<double>> values =
-        FrictionOfPolygons(ds, mesh, dem, dem != nullptr ? &file_crs : nullptr, name);
-    if (!values.ok()) return values.status();
-    absl::StatusOr<std::unique_ptr<OGRGeometry>> polygons =
-        BarrierPolygonsOf(&ds, name, dem != nullptr ? &file_crs : nullptr);
-    if (!polygons.ok()) return polygons.status();
-    return CutOutlines(mesh, **polygons, dem, &file_crs, max_vertices, name, stats);
+    // Read and checked as FrictionFromGeoJson reads them: a bad value fails here too.
+    absl::StatusOr<std::vector<FrictionRegion>> regions =
+        ReadFrictionRegions(ds, dem != nullptr ? &file_crs : nullptr, name);
+    if (!regions.ok()) return regions.status();
+    return CutOutlines(mesh, *OutlinesOf(*regions), dem, &file_crs, max_vertices, name, stats);
   });
 }
 
@@ -2049,7 +2072,10 @@ absl::StatusOr<std::vector<double>> ReadFrictionFile(const MeshData& mesh, const
   if (format == nullptr || format->kind != GisFileKind::kRaster) {  // polygons
     absl::StatusOr<GDALDatasetUniquePtr> ds = OpenBarrierFile(path, name);
     if (!ds.ok()) return ds.status();
-    return FrictionOfPolygons(**ds, mesh, &dem, &file_crs, name);
+    absl::StatusOr<std::vector<FrictionRegion>> regions =
+        ReadFrictionRegions(**ds, &file_crs, name);
+    if (!regions.ok()) return regions.status();
+    return FaceFrictionOf(*std::move(regions), mesh, &dem, name);
   }
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) {

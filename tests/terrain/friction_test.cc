@@ -70,19 +70,29 @@ TEST_F(DemTest, PolygonsGiveEachFaceTheFrictionUnderItsCentre) {
   EXPECT_GT(fours, 100u);
   EXPECT_GT(twos, 10u);
 
-  // A feature without a friction, or a line, is an error naming it.
+  // A feature without a friction, a line or a friction of 0 is an error naming it, whether the
+  // regions give faces their values, are cut into the mesh, or are cut in as the DEM is read.
   const std::string no_value = R"({"type": "Feature", "properties": {"name": "x"},
     "geometry": {"type": "Polygon", "coordinates": [[[0, 0], [1, 0], [1, 1], [0, 0]]]}})";
-  absl::Status s = FrictionFromGeoJson(dem->mesh(), no_value, &dem->info(), "--friction").status();
-  EXPECT_NE(s.message().find("no numeric \"friction\""), std::string::npos) << s;
   const std::string line = R"({"type": "Feature", "properties": {"friction": 3},
     "geometry": {"type": "LineString", "coordinates": [[15, 45], [15.1, 45]]}})";
-  s = FrictionFromGeoJson(dem->mesh(), line, &dem->info(), "--friction").status();
-  EXPECT_NE(s.message().find("friction regions are polygons"), std::string::npos) << s;
   const std::string zero = R"({"type": "Feature", "properties": {"friction": 0},
     "geometry": {"type": "Polygon", "coordinates": [[[15, 45], [15.1, 45], [15, 45.1], [15, 45]]]}})";
-  s = FrictionFromGeoJson(dem->mesh(), zero, &dem->info(), "--friction").status();
-  EXPECT_NE(s.message().find("friction must be > 0"), std::string::npos) << s;
+  absl::Status s;
+  for (const auto& [geojson, why] : {std::pair{no_value, "no numeric \"friction\""},
+                                     std::pair{line, "friction regions are polygons"},
+                                     std::pair{zero, "friction must be > 0"}}) {
+    s = FrictionFromGeoJson(dem->mesh(), geojson, &dem->info(), "--friction").status();
+    EXPECT_NE(s.message().find(why), std::string::npos) << s;
+    s = CutFrictionOutlines(dem->mesh(), geojson, &dem->info(), "--friction", nullptr).status();
+    EXPECT_NE(s.message().find(why), std::string::npos) << s;
+    DemOptions options;
+    options.friction_file = (dir_ / "regions.geojson").string();
+    std::ofstream(options.friction_file) << geojson;
+    s = Dem::Read(Write("flat.tif", Flat()), options).status();
+    EXPECT_NE(s.message().find(why), std::string::npos) << s;
+    EXPECT_NE(s.message().find("--friction " + options.friction_file), std::string::npos) << s;
+  }
   const std::string link = R"({"type": "FeatureCollection", "crs": {"type": "link",
     "properties": {"href": "http://example.com/crs"}}, "features": []})";
   s = FrictionFromGeoJson(dem->mesh(), link, &dem->info(), "--friction").status();
