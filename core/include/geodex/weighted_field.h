@@ -50,7 +50,9 @@
 //
 // Memory: 8 bytes per Steiner point for its position on its edge plus, during a solve, 20 bytes
 // per node (cost, label, parent, heap slot) and 4 per heap entry: about 32 bytes per Steiner point,
-// bounded by WeightedOptions::max_steiner_points. Time: settling a node relaxes the nodes of the
+// bounded by WeightedOptions::max_steiner_points. A search that stops at its targets (paths,
+// costs at points) writes a node's state only once the wave reaches its edge, so it touches the
+// memory of the part of the surface it searches. Time: settling a node relaxes the nodes of the
 // other edges of its faces, O(k) each, O(k^2) per face in total.
 
 #include <cstdint>
