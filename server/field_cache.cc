@@ -37,17 +37,11 @@ std::array<uint8_t, 32> WeightsDigest(const Weights& weights) {
   return last_digest;
 }
 
-}  // namespace
-
-std::string FieldCacheKey(const std::string& mesh_id, const std::vector<SurfacePoint>& sources,
-                          const GeodesicOptions& options) {
-  std::string key = mesh_id;
-  Append(&key, options.lambda);
-  Append(&key, static_cast<int>(options.lambda_scale));
-  Append(&key, options.max_distance);
-  // A travel field is never another field: a marker byte, then its speed model, speed, table
-  // (row count, then the rows), direction (inbound, for a slope speed), bound, slope limit and
-  // weights (by their SHA-256; the friction polygons count by the weights they made).
+// A travel field is never another field: a marker byte, then its speed model, speed, table
+// (row count, then the rows), direction (inbound, for a slope speed), bound, slope limit and
+// weights (by their SHA-256; the friction polygons count by the weights they made).
+void AppendTravel(std::string* out, const GeodesicOptions& options) {
+  std::string& key = *out;
   Append(&key, static_cast<uint8_t>(options.travel.has_value()));
   if (options.travel) {
     const TravelCost& travel = *options.travel;
@@ -66,6 +60,17 @@ std::string FieldCacheKey(const std::string& mesh_id, const std::vector<SurfaceP
       Append(&key, WeightsDigest(travel.face_weight));
     }
   }
+}
+
+}  // namespace
+
+std::string FieldCacheKey(const std::string& mesh_id, const std::vector<SurfacePoint>& sources,
+                          const GeodesicOptions& options) {
+  std::string key = mesh_id;
+  Append(&key, options.lambda);
+  Append(&key, static_cast<int>(options.lambda_scale));
+  Append(&key, options.max_distance);
+  AppendTravel(&key, options);
   Append(&key, sources.size());
   for (const SurfacePoint& p : sources) {
     Append(&key, static_cast<uint8_t>(p.kind));
@@ -90,6 +95,12 @@ std::string FieldCacheKey(const std::string& mesh_id, const std::vector<SurfaceP
   return key;
 }
 
+std::string TravelGraphKey(const std::string& mesh_id, const GeodesicOptions& options) {
+  std::string key = "travel graph|" + mesh_id;  // (a field's key starts with the bare id)
+  AppendTravel(&key, options);
+  return key;
+}
+
 uint64_t FieldBytes(const DistanceField& field) {
   return field.distance.capacity() * sizeof(double) + field.source.capacity() * sizeof(uint32_t) +
          field.internal_distance.capacity() * sizeof(double) +
@@ -102,7 +113,7 @@ std::shared_ptr<const DistanceField> FieldCache::Find(const std::string& key) {
   if (!enabled()) return nullptr;
   std::lock_guard<std::mutex> lock(mu_);
   auto it = entries_.find(key);
-  if (it == entries_.end()) {
+  if (it == entries_.end() || it->second.field == nullptr) {
     ++misses_;
     return nullptr;
   }
@@ -115,16 +126,41 @@ void FieldCache::Insert(const std::string& key, std::shared_ptr<const DistanceFi
   const uint64_t bytes = FieldBytes(*field) + key.size();
   if (!enabled() || bytes > budget_bytes_) return;
   std::lock_guard<std::mutex> lock(mu_);
+  InsertLocked(key, Entry{std::move(field), nullptr, bytes, {}});
+}
+
+std::shared_ptr<const WeightedSurface> FieldCache::FindGraph(const std::string& key) {
+  if (!enabled()) return nullptr;
+  std::lock_guard<std::mutex> lock(mu_);
+  auto it = entries_.find(key);
+  if (it == entries_.end() || it->second.graph == nullptr) {
+    ++graph_misses_;
+    return nullptr;
+  }
+  ++graph_hits_;
+  lru_.splice(lru_.begin(), lru_, it->second.lru);
+  return it->second.graph;
+}
+
+void FieldCache::InsertGraph(const std::string& key, std::shared_ptr<const WeightedSurface> graph) {
+  const uint64_t bytes = graph->bytes() + key.size();
+  if (!enabled() || bytes > budget_bytes_) return;
+  std::lock_guard<std::mutex> lock(mu_);
+  InsertLocked(key, Entry{nullptr, std::move(graph), bytes, {}});
+}
+
+void FieldCache::InsertLocked(const std::string& key, Entry entry) {
   if (entries_.contains(key)) return;
-  while (bytes_ + bytes > budget_bytes_ && !lru_.empty()) {
+  while (bytes_ + entry.bytes > budget_bytes_ && !lru_.empty()) {
     auto victim = entries_.find(lru_.back());
     bytes_ -= victim->second.bytes;
     entries_.erase(victim);
     lru_.pop_back();
   }
   lru_.push_front(key);
-  entries_[key] = Entry{std::move(field), bytes, lru_.begin()};
-  bytes_ += bytes;
+  entry.lru = lru_.begin();
+  bytes_ += entry.bytes;
+  entries_[key] = std::move(entry);
 }
 
 bool FieldCache::NotePathSource(const std::string& key) {
@@ -155,6 +191,14 @@ uint64_t FieldCache::hits() const {
 uint64_t FieldCache::misses() const {
   std::lock_guard<std::mutex> lock(mu_);
   return misses_;
+}
+uint64_t FieldCache::graph_hits() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return graph_hits_;
+}
+uint64_t FieldCache::graph_misses() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return graph_misses_;
 }
 
 }  // namespace geodex::server

@@ -4,6 +4,11 @@
 // id, the resolved sources and the solver options. Many queries from one source position (a robot
 // asking for paths to many goals, isolines then Voronoi of the same sites) reuse one solve. Fields
 // are immutable and shared (shared_ptr), so eviction never disturbs a reader. Thread-safe.
+//
+// The same budget holds travel graphs (the weighted engine's Steiner points for one mesh and one
+// constant-speed travel cost, core's BuildTravelGraph), keyed by TravelGraphKey: the travel paths,
+// times at points and matrices on a mesh with one cost layer share one graph instead of each
+// building its own.
 
 #include <cstdint>
 #include <list>
@@ -16,6 +21,7 @@
 #include "geodex/distance_field.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/surface_point.h"
+#include "geodex/weighted_field.h"
 
 namespace geodex::server {
 
@@ -24,6 +30,9 @@ namespace geodex::server {
 // travel field is never served for a plain request, nor for another travel cost.
 std::string FieldCacheKey(const std::string& mesh_id, const std::vector<SurfacePoint>& sources,
                           const GeodesicOptions& options);
+
+// The key of a travel graph: mesh id and the travel cost as FieldCacheKey keys it (no sources).
+std::string TravelGraphKey(const std::string& mesh_id, const GeodesicOptions& options);
 
 // Memory a cached field occupies.
 uint64_t FieldBytes(const DistanceField& field);
@@ -36,6 +45,9 @@ class FieldCache {
   std::shared_ptr<const DistanceField> Find(const std::string& key);
   // Keeps `field` unless it alone exceeds the budget; evicts least recently used fields.
   void Insert(const std::string& key, std::shared_ptr<const DistanceField> field);
+  // A travel graph (the entry keeps what it refers to alive: `graph`'s owner holds the mesh).
+  std::shared_ptr<const WeightedSurface> FindGraph(const std::string& key);
+  void InsertGraph(const std::string& key, std::shared_ptr<const WeightedSurface> graph);
   // Records that a path query started from `key`'s source; true when one did recently (the
   // second query from a point pays for a full field that the following ones reuse).
   bool NotePathSource(const std::string& key);
@@ -46,10 +58,13 @@ class FieldCache {
   size_t entries() const;
   uint64_t hits() const;
   uint64_t misses() const;
+  uint64_t graph_hits() const;
+  uint64_t graph_misses() const;
 
  private:
   struct Entry {
-    std::shared_ptr<const DistanceField> field;
+    std::shared_ptr<const DistanceField> field;  // one of the two
+    std::shared_ptr<const WeightedSurface> graph;
     uint64_t bytes = 0;
     std::list<std::string>::iterator lru;
   };
@@ -61,6 +76,9 @@ class FieldCache {
   uint64_t bytes_ = 0;
   uint64_t hits_ = 0;
   uint64_t misses_ = 0;
+  uint64_t graph_hits_ = 0;
+  uint64_t graph_misses_ = 0;
+  void InsertLocked(const std::string& key, Entry entry);
   // Recent path sources (bounded FIFO of keys).
   absl::flat_hash_map<std::string, uint64_t> path_sources_;
   std::list<std::string> path_source_order_;

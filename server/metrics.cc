@@ -67,14 +67,19 @@ class GaugeCollector final : public prometheus::Collectable {
     add("geodex_mesh_store_disk_loads_total", "Meshes loaded back from the data directory",
         T::Counter, static_cast<double>(store.disk_loads()));
     const FieldCache& cache = *sources_.cache;
-    add("geodex_result_cache_bytes", "Memory of the cached distance fields", T::Gauge,
-        static_cast<double>(cache.bytes()));
-    add("geodex_result_cache_entries", "Cached distance fields", T::Gauge,
+    add("geodex_result_cache_bytes", "Memory of the cached distance fields and travel graphs",
+        T::Gauge, static_cast<double>(cache.bytes()));
+    add("geodex_result_cache_entries", "Cached distance fields and travel graphs", T::Gauge,
         static_cast<double>(cache.entries()));
     add("geodex_result_cache_hits_total", "Queries answered from a cached field", T::Counter,
         static_cast<double>(cache.hits()));
     add("geodex_result_cache_misses_total", "Cache look-ups that found no field", T::Counter,
         static_cast<double>(cache.misses()));
+    add("geodex_travel_graph_hits_total",
+        "Travel paths, point times and matrices that reused a cached travel graph", T::Counter,
+        static_cast<double>(cache.graph_hits()));
+    add("geodex_travel_graph_misses_total", "Travel graph look-ups that built one", T::Counter,
+        static_cast<double>(cache.graph_misses()));
     add("geodex_solves_total", "Geodesic solves run", T::Counter,
         static_cast<double>(sources_.counters->solves.load(std::memory_order_relaxed)));
     add("geodex_windows_processed_total", "ICH windows propagated by all solves", T::Counter,

@@ -72,6 +72,7 @@ absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPath
   if (env.quick) return SolveLaneNeeded();
   PathQueryOptions options;
   options.solver = *solver;
+  ShareTravelGraph(env, **mesh, &options.solver);
   absl::StatusOr<PathQueryResult> result = ComputeShortestPath(*(*mesh)->mesh, *from, *to, options);
   if (result.ok()) {
     env.counters->solves.fetch_add(1, std::memory_order_relaxed);
@@ -135,6 +136,7 @@ absl::Status RunFindShortestPaths(const QueryEnv& env, const v1::FindShortestPat
   }
   PathQueryOptions options;
   options.solver = *solver;
+  ShareTravelGraph(env, **mesh, &options.solver);
   SolveStats total;
   for (size_t g = 0; g < groups.size(); ++g) {
     std::vector<SurfacePoint> targets;
@@ -205,6 +207,7 @@ absl::Status RunEstimateDistances(const QueryEnv& env, const v1::EstimateDistanc
     }
   }
   if (exact) {
+    if (!request.want_directions()) ShareTravelGraph(env, **mesh, &*solver);
     PointQuery query{*std::move(sources), *std::move(points), *solver, request.want_directions()};
     absl::StatusOr<PointValues> values = ComputePointValues(tm, query);
     if (!values.ok()) return NameSolveError(values.status(), "points");

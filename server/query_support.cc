@@ -22,7 +22,9 @@
 #include "geodex/mesh_id.h"
 #include "geodex/point_distance.h"
 #include "geodex/shortest_path.h"
+#include "geodex/travel_cost.h"
 #include "geodex/voronoi.h"
+#include "geodex/weighted_field.h"
 #include "geometry_convert.h"
 #include "proto_convert.h"
 #include "service_limits.h"
@@ -118,6 +120,28 @@ absl::StatusOr<GeodesicOptions> Options(const QueryEnv& env, const StoredMesh& m
     out->travel->face_weight = *std::move(weights);
   }
   return out;
+}
+
+void ShareTravelGraph(const QueryEnv& env, const StoredMesh& mesh, GeodesicOptions* options) {
+  if (!options->travel.has_value() || IsDirectional(*options->travel) || !env.cache->enabled()) {
+    return;
+  }
+  const std::string key = TravelGraphKey(mesh.id, *options);
+  std::shared_ptr<const WeightedSurface> graph = env.cache->FindGraph(key);
+  if (graph == nullptr) {
+    absl::StatusOr<std::shared_ptr<const WeightedSurface>> built =
+        BuildTravelGraph(*mesh.mesh, *options);
+    if (!built.ok() || *built == nullptr) return;
+    // The graph refers to the mesh: its owner keeps the mesh alive as long as the graph lives.
+    struct Held {
+      std::shared_ptr<const TriangleMesh> mesh;
+      std::shared_ptr<const WeightedSurface> graph;
+    };
+    auto held = std::make_shared<const Held>(Held{mesh.mesh, *std::move(built)});
+    graph = std::shared_ptr<const WeightedSurface>(held, held->graph.get());
+    env.cache->InsertGraph(key, graph);
+  }
+  options->travel->graph = std::move(graph);
 }
 
 absl::Status RefuseTravel(const v1::SolverOptions& options, absl::string_view why) {

@@ -44,6 +44,12 @@ void SnapsToProto(const PointSnaps& snaps, Response* out) {
 // (terrain's FrictionFromGeoJson: in the DEM's map on a DEM's mesh, else in the mesh's x y).
 absl::StatusOr<GeodesicOptions> Options(const QueryEnv& env, const StoredMesh& mesh,
                                         const v1::SolverOptions& options);
+// A constant-speed travel cost's graph from the result cache (TravelGraphKey), or built and
+// cached, set in options->travel->graph: the travel paths, times at points and matrices on one
+// mesh with one cost layer then share it. Nothing without a travel cost, for a slope-dependent
+// speed (its graph follows each query's sources) or with the cache off; a graph that cannot be
+// built is left to the query, whose solve names the error. Solve-lane work (it may build).
+void ShareTravelGraph(const QueryEnv& env, const StoredMesh& mesh, GeodesicOptions* options);
 // What an answer's travel_epsilon says: 0 for exact metres, else the epsilon the solve uses
 // (set, or the speed model's default).
 inline double TravelEpsilon(const GeodesicOptions& options) {

@@ -203,20 +203,48 @@ absl::StatusOr<DistanceField> ComputeTravelField(const TriangleMesh& mesh,
   return field;
 }
 
+namespace {
+
+// The caller's graph (TravelCost::graph) when it is the one `weighted` would build, else null.
+std::shared_ptr<const WeightedSurface> SharedGraph(const TriangleMesh& mesh,
+                                                   const GeodesicOptions& options,
+                                                   const WeightedOptions& weighted) {
+  const std::shared_ptr<const WeightedSurface>& graph = options.travel->graph;
+  return graph != nullptr && graph->Serves(mesh, weighted) ? graph : nullptr;
+}
+
+}  // namespace
+
+absl::StatusOr<std::shared_ptr<const WeightedSurface>> BuildTravelGraph(
+    const TriangleMesh& mesh, const GeodesicOptions& options) {
+  absl::StatusOr<WeightedOptions> weighted = WeightedOptionsFor(mesh, options);
+  if (!weighted.ok()) return weighted.status();
+  if (weighted->slope_cost != nullptr) return nullptr;
+  weighted->cancel = nullptr;  // the graph outlives the call that builds it
+  absl::StatusOr<WeightedSurface> surface = WeightedSurface::Build(mesh, *weighted);
+  if (!surface.ok()) return surface.status();
+  return std::make_shared<const WeightedSurface>(*std::move(surface));
+}
+
 absl::StatusOr<TravelPointSolver> TravelPointSolver::Create(
     const TriangleMesh& mesh, const GeodesicOptions& options,
     const std::vector<SurfacePoint>& sources) {
   absl::StatusOr<WeightedOptions> weighted = WeightedOptionsFor(mesh, options);
   if (!weighted.ok()) return weighted.status();
+  const WeightedSurface::Limits limits{weighted->max_distance, weighted->cancel};
+  if (std::shared_ptr<const WeightedSurface> shared = SharedGraph(mesh, options, *weighted)) {
+    return TravelPointSolver(*options.travel, std::move(shared), limits);
+  }
   absl::StatusOr<WeightedSurface> surface = WeightedSurface::Build(mesh, *weighted, sources);
   if (!surface.ok()) return surface.status();
-  return TravelPointSolver(*options.travel, *std::move(surface));
+  return TravelPointSolver(*options.travel,
+                           std::make_shared<const WeightedSurface>(*std::move(surface)), limits);
 }
 
 absl::StatusOr<PointValues> TravelPointSolver::Solve(const std::vector<SurfacePoint>& sources,
                                                      const std::vector<SurfacePoint>& points,
                                                      bool covers_surface) const {
-  absl::StatusOr<WeightedCosts> w = surface_.CostsAt(sources, points, covers_surface);
+  absl::StatusOr<WeightedCosts> w = surface_->CostsAt(sources, points, covers_surface, limits_);
   if (!w.ok()) return w.status();
   PointValues out;
   for (double c : w->cost) out.distance.push_back(Seconds(travel_, c));
@@ -247,8 +275,10 @@ absl::StatusOr<PathsQueryResult> ComputeTravelPaths(const TriangleMesh& mesh,
   }
   absl::StatusOr<WeightedOptions> weighted = WeightedOptionsFor(mesh, options);
   if (!weighted.ok()) return weighted.status();
+  const std::shared_ptr<const WeightedSurface> shared = SharedGraph(mesh, options, *weighted);
   absl::StatusOr<std::vector<WeightedPath>> paths =
-      ComputeWeightedPaths(mesh, from, tos, *weighted);
+      shared != nullptr ? shared->Paths(from, tos, {weighted->max_distance, weighted->cancel})
+                        : ComputeWeightedPaths(mesh, from, tos, *weighted);
   if (!paths.ok()) return paths.status();
   PathsQueryResult out;
   out.distance.assign(tos.size(), kUnreachable);

@@ -5,6 +5,7 @@
 // options carry a travel cost, so every product built on them speaks seconds. Each converts the
 // weighted engine's costs to seconds; none adds a rule of its own.
 
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -43,10 +44,12 @@ class TravelPointSolver {
                                     bool covers_surface = false) const;
 
  private:
-  TravelPointSolver(TravelCost travel, WeightedSurface surface)
-      : travel_(std::move(travel)), surface_(std::move(surface)) {}
+  TravelPointSolver(TravelCost travel, std::shared_ptr<const WeightedSurface> surface,
+                    WeightedSurface::Limits limits)
+      : travel_(std::move(travel)), surface_(std::move(surface)), limits_(limits) {}
   TravelCost travel_;
-  WeightedSurface surface_;
+  std::shared_ptr<const WeightedSurface> surface_;  // built for the query, or TravelCost::graph
+  WeightedSurface::Limits limits_;                  // the query's
 };
 
 // One least-time path per target (each path's `length` is its length in metres; `distance` its

@@ -1592,13 +1592,50 @@ absl::StatusOr<WeightedSurface> WeightedSurface::Build(const TriangleMesh& mesh,
 
 uint64_t WeightedSurface::steiner_points() const { return impl_->graph.steiner_points(); }
 
+uint64_t WeightedSurface::bytes() const {
+  return sizeof(Impl) + impl_->graph.bytes() +
+         impl_->options.face_weight.capacity() * sizeof(double);
+}
+
+bool WeightedSurface::Serves(const TriangleMesh& mesh, const WeightedOptions& options) const {
+  const WeightedOptions& built = impl_->options;
+  return &impl_->graph.mesh() == &mesh && options.slope_cost == nullptr &&
+         built.slope_cost == nullptr && options.epsilon == built.epsilon &&
+         options.face_weight == built.face_weight &&
+         (options.max_steiner_points == 0 || steiner_points() <= options.max_steiner_points);
+}
+
+namespace {
+
+// What a search on a shared surface reads of its options: the query's limits (the surface holds
+// the rest), without copying the surface's weights.
+WeightedOptions SearchOptions(const WeightedOptions& built, const WeightedSurface::Limits& limits) {
+  WeightedOptions out;
+  out.epsilon = built.epsilon;
+  out.max_distance = limits.max_distance;
+  out.cancel = limits.cancel;
+  out.check_optimality = built.check_optimality;
+  return out;
+}
+
+}  // namespace
+
 absl::StatusOr<WeightedCosts> WeightedSurface::CostsAt(const std::vector<SurfacePoint>& sources,
                                                        const std::vector<SurfacePoint>& targets,
                                                        bool whole) const {
+  return CostsAt(sources, targets, whole, {impl_->options.max_distance, impl_->options.cancel});
+}
+
+absl::StatusOr<WeightedCosts> WeightedSurface::CostsAt(const std::vector<SurfacePoint>& sources,
+                                                       const std::vector<SurfacePoint>& targets,
+                                                       bool whole, const Limits& limits) const {
   const auto start = std::chrono::steady_clock::now();
   if (sources.empty()) return absl::InvalidArgumentError("no sources given");
+  if (!(limits.max_distance > 0)) {
+    return OptionError("max_distance", absl::StrFormat("must be > 0, got %g", limits.max_distance));
+  }
   const SteinerGraph& g = impl_->graph;
-  const WeightedOptions& options = impl_->options;
+  const WeightedOptions options = SearchOptions(impl_->options, limits);
   std::vector<Located> from, to;
   if (absl::Status s = Prepare(g.mesh(), sources, &from); !s.ok()) return s;
   if (absl::Status s = Prepare(g.mesh(), targets, &to); !s.ok()) return s;
@@ -1658,25 +1695,18 @@ absl::StatusOr<WeightedCosts> ComputeWeightedCostsAt(const TriangleMesh& mesh,
   return surface->CostsAt(sources, targets);
 }
 
-absl::StatusOr<std::vector<WeightedPath>> ComputeWeightedPaths(const TriangleMesh& mesh,
-                                                               const SurfacePoint& from,
-                                                               const std::vector<SurfacePoint>& tos,
-                                                               const WeightedOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
-  if (absl::Status s = ValidateWeightedOptions(mesh, options); !s.ok()) return s;
-  std::vector<Located> src_list, dsts;
-  if (absl::Status s = Prepare(mesh, {from}, &src_list); !s.ok()) return s;
-  if (absl::Status s = Prepare(mesh, tos, &dsts); !s.ok()) return s;
-  const Located& src = src_list[0];
-  // A path is walked from `from`: the search runs outward whatever options.inbound says. One graph
-  // and one search serve every target; it stops once every target's best is final.
-  WeightedOptions outward = options;
-  outward.inbound = false;
-  absl::StatusOr<std::unique_ptr<WeightedSurface::Impl>> surface =
-      BuildSurface(mesh, outward, src_list);
-  if (!surface.ok()) return surface.status();
-  const SteinerGraph& g = (*surface)->graph;
-  return (*surface)->WithCost([&](const auto& cost) -> absl::StatusOr<std::vector<WeightedPath>> {
+namespace {
+
+// The paths from src to every dst on a surface built outward; `options`: the query's limits.
+absl::StatusOr<std::vector<WeightedPath>> PathsOn(const WeightedSurface::Impl& surface,
+                                                  const Located& src,
+                                                  const std::vector<Located>& dsts,
+                                                  const WeightedOptions& options,
+                                                  std::chrono::steady_clock::time_point start) {
+  const SteinerGraph& g = surface.graph;
+  const TriangleMesh& mesh = g.mesh();
+  const std::vector<Located> src_list = {src};
+  return surface.WithCost([&](const auto& cost) -> absl::StatusOr<std::vector<WeightedPath>> {
     Search<std::decay_t<decltype(cost)>, true> search(g, cost);
     search.HeadFor(GoalOf(g, cost, dsts));
     search.Seed(src, 0);
@@ -1722,6 +1752,42 @@ absl::StatusOr<std::vector<WeightedPath>> ComputeWeightedPaths(const TriangleMes
     for (WeightedPath& path : paths) path.stats = stats;
     return paths;
   });
+}
+
+}  // namespace
+
+absl::StatusOr<std::vector<WeightedPath>> ComputeWeightedPaths(const TriangleMesh& mesh,
+                                                               const SurfacePoint& from,
+                                                               const std::vector<SurfacePoint>& tos,
+                                                               const WeightedOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  if (absl::Status s = ValidateWeightedOptions(mesh, options); !s.ok()) return s;
+  std::vector<Located> src_list, dsts;
+  if (absl::Status s = Prepare(mesh, {from}, &src_list); !s.ok()) return s;
+  if (absl::Status s = Prepare(mesh, tos, &dsts); !s.ok()) return s;
+  // A path is walked from `from`: the search runs outward whatever options.inbound says. One graph
+  // and one search serve every target; it stops once every target's best is final.
+  WeightedOptions outward = options;
+  outward.inbound = false;
+  absl::StatusOr<std::unique_ptr<WeightedSurface::Impl>> surface =
+      BuildSurface(mesh, outward, src_list);
+  if (!surface.ok()) return surface.status();
+  return PathsOn(**surface, src_list[0], dsts, options, start);
+}
+
+absl::StatusOr<std::vector<WeightedPath>> WeightedSurface::Paths(
+    const SurfacePoint& from, const std::vector<SurfacePoint>& tos, const Limits& limits) const {
+  const auto start = std::chrono::steady_clock::now();
+  if (impl_->options.inbound && impl_->options.slope_cost != nullptr) {
+    return OptionError("inbound", "a path is walked from its start: build the surface outward");
+  }
+  if (!(limits.max_distance > 0)) {
+    return OptionError("max_distance", absl::StrFormat("must be > 0, got %g", limits.max_distance));
+  }
+  std::vector<Located> src_list, dsts;
+  if (absl::Status s = Prepare(impl_->graph.mesh(), {from}, &src_list); !s.ok()) return s;
+  if (absl::Status s = Prepare(impl_->graph.mesh(), tos, &dsts); !s.ok()) return s;
+  return PathsOn(*impl_, src_list[0], dsts, SearchOptions(impl_->options, limits), start);
 }
 
 absl::StatusOr<WeightedPath> ComputeWeightedPath(const TriangleMesh& mesh, const SurfacePoint& from,

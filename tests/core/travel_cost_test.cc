@@ -15,6 +15,7 @@
 #include "geodex/geometry_queries.h"
 #include "geodex/point_distance.h"
 #include "geodex/shortest_path.h"
+#include "geodex/weighted_field.h"
 #include "gtest/gtest.h"
 #include "util/mesh_factory.h"
 
@@ -144,6 +145,117 @@ TEST(TravelCostTest, MatrixRowsArePointValues) {
   absl::StatusOr<PointValues> row = ComputePointValues(mesh, {{points[0]}, points, options.solver});
   ASSERT_TRUE(row.ok()) << row.status();
   for (size_t j = 1; j < 3; ++j) EXPECT_EQ(m->values[j], row->distance[j]);
+}
+
+// A graph built once (BuildTravelGraph) and handed to queries in TravelCost::graph gives every
+// path, point value and matrix entry bit for bit what a query building its own gives, under the
+// query's own limits (max_distance, cancel). A graph of other weights, another epsilon or another
+// mesh object is not used (the answers stay those of the query's own options), and a
+// slope-dependent speed has none.
+TEST(TravelCostTest, ASharedGraphAnswersAsEachQuerysOwn) {
+  GridSpec spec;
+  spec.cells_x = spec.cells_y = 8;
+  spec.width = spec.height = 80;
+  spec.jitter = 0.2;
+  const TriangleMesh mesh = BuildMesh(MakeGrid(spec));
+  auto weights = std::make_shared<std::vector<double>>(mesh.face_count(), 1.0);
+  for (uint32_t f = 0; f < mesh.face_count(); f += 3) (*weights)[f] = 2.5;
+  GeodesicOptions own = Travel(3.6, 0.05);
+  own.travel->face_weight = weights;
+  absl::StatusOr<std::shared_ptr<const WeightedSurface>> graph = BuildTravelGraph(mesh, own);
+  ASSERT_TRUE(graph.ok()) << graph.status();
+  ASSERT_NE(*graph, nullptr);
+  GeodesicOptions shared = own;
+  shared.travel->graph = *graph;
+  // What decides whether a query uses it.
+  auto serves = [&](const TriangleMesh& m, const GeodesicOptions& o) {
+    absl::StatusOr<WeightedOptions> w = WeightedOptionsFor(m, o);
+    return w.ok() && (*graph)->Serves(m, *w);
+  };
+  EXPECT_TRUE(serves(mesh, own));
+  GeodesicOptions other = own;
+  other.max_distance = 5;  // a query's limit, not the graph's
+  EXPECT_TRUE(serves(mesh, other));
+  other.travel->max_steiner_points = (*graph)->steiner_points();
+  EXPECT_TRUE(serves(mesh, other));
+  other.travel->max_steiner_points = (*graph)->steiner_points() - 1;  // the query's own error
+  EXPECT_FALSE(serves(mesh, other));
+  EXPECT_FALSE(serves(mesh, Travel(3.6, 0.05)));  // other weights
+  other = own;
+  other.travel->epsilon = 0.02;
+  EXPECT_FALSE(serves(mesh, other));
+  other = own;
+  other.travel->max_slope_deg = 89;  // (no face here is that steep: the same weights)
+  EXPECT_TRUE(serves(mesh, other));
+  const TriangleMesh twin = BuildMesh(MakeGrid(spec));
+  EXPECT_FALSE(serves(twin, own));
+
+  const SurfacePoint from = SurfacePoint::InFace(5, 0.2, 0.3, 0.5);
+  const std::vector<SurfacePoint> tos = {SurfacePoint::AtVertex(80),
+                                         SurfacePoint::InFace(100, 0.6, 0.2, 0.2)};
+  auto same_paths = [&](const GeodesicOptions& a, const GeodesicOptions& b) {
+    absl::StatusOr<PathsQueryResult> pa = ComputeShortestPaths(mesh, from, tos, {a});
+    absl::StatusOr<PathsQueryResult> pb = ComputeShortestPaths(mesh, from, tos, {b});
+    ASSERT_TRUE(pa.ok() && pb.ok()) << pa.status() << pb.status();
+    for (size_t t = 0; t < tos.size(); ++t) {
+      EXPECT_EQ(pa->distance[t], pb->distance[t]) << t;
+      ASSERT_EQ(pa->paths[t].points.size(), pb->paths[t].points.size()) << t;
+      for (size_t k = 0; k < pa->paths[t].points.size(); ++k) {
+        EXPECT_EQ(pa->paths[t].points[k].position, pb->paths[t].points[k].position) << t;
+      }
+    }
+  };
+  same_paths(own, shared);
+  const std::vector<SurfacePoint> points = {SurfacePoint::AtVertex(0), SurfacePoint::AtVertex(40),
+                                            from, tos[1]};
+  absl::StatusOr<PointValues> va = ComputePointValues(mesh, {{from}, points, own});
+  absl::StatusOr<PointValues> vb = ComputePointValues(mesh, {{from}, points, shared});
+  ASSERT_TRUE(va.ok() && vb.ok()) << va.status() << vb.status();
+  EXPECT_EQ(va->distance, vb->distance);
+  MatrixOptions ma, mb;
+  ma.solver = own;
+  mb.solver = shared;
+  absl::StatusOr<DistanceMatrix> xa = ComputeDistanceMatrix(mesh, points, points, ma);
+  absl::StatusOr<DistanceMatrix> xb = ComputeDistanceMatrix(mesh, points, points, mb);
+  ASSERT_TRUE(xa.ok() && xb.ok()) << xa.status() << xb.status();
+  EXPECT_EQ(xa->values, xb->values);
+
+  // The query's limits, not the builder's.
+  GeodesicOptions near = shared;
+  near.max_distance = va->distance[1] / 2;
+  absl::StatusOr<PathsQueryResult> cut = ComputeShortestPaths(mesh, from, tos, {near});
+  ASSERT_TRUE(cut.ok()) << cut.status();
+  EXPECT_EQ(cut->distance[0], kUnreachable);
+  CancelToken cancelled;
+  cancelled.Cancel();
+  GeodesicOptions stop = shared;
+  stop.cancel = &cancelled;
+  EXPECT_TRUE(absl::IsCancelled(ComputePointValues(mesh, {{from}, points, stop}).status()));
+
+  // Not this query's graph: other weights, another epsilon, another mesh object.
+  GeodesicOptions plain = Travel(3.6, 0.05);
+  GeodesicOptions stale = plain;
+  stale.travel->graph = *graph;
+  same_paths(plain, stale);
+  absl::StatusOr<PathsQueryResult> pp = ComputeShortestPaths(mesh, from, tos, {plain});
+  absl::StatusOr<PathsQueryResult> pw = ComputeShortestPaths(mesh, from, tos, {own});
+  ASSERT_TRUE(pp.ok() && pw.ok());
+  EXPECT_NE(pp->distance[0], pw->distance[0]);  // the weights matter here
+  GeodesicOptions finer = shared;
+  finer.travel->epsilon = 0.02;
+  GeodesicOptions finer_own = own;
+  finer_own.travel->epsilon = 0.02;
+  same_paths(finer_own, finer);
+  absl::StatusOr<PointValues> on_twin = ComputePointValues(twin, {{from}, points, shared});
+  ASSERT_TRUE(on_twin.ok()) << on_twin.status();
+  EXPECT_EQ(on_twin->distance, va->distance);
+
+  GeodesicOptions tobler = own;
+  tobler.travel->speed_model = SpeedModel::kTobler;
+  tobler.travel->speed_kmh = 0;
+  absl::StatusOr<std::shared_ptr<const WeightedSurface>> none = BuildTravelGraph(mesh, tobler);
+  ASSERT_TRUE(none.ok()) << none.status();
+  EXPECT_EQ(*none, nullptr);
 }
 
 // Isolines in seconds: a 60 s line lies farther out than a 30 s one.

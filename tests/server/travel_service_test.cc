@@ -368,6 +368,51 @@ TEST_F(TravelServiceTest, FieldPathMatrixAndIsolinesEqualCore) {
       EXPECT_TRUE(BitEqual(response.exact(i), values->distance[i])) << i;
     }
   }
+  // Every answer above that searched a graph searched one: the first path built it (a miss),
+  // the two repeats, the batch, the matrix and the point times reused it, and equal core's own.
+  EXPECT_EQ(server_->cache().graph_misses(), 1u);
+  EXPECT_EQ(server_->cache().graph_hits(), 5u);
+}
+
+// Travel graphs in the result cache: one per mesh and travel cost (another epsilon is another
+// graph; a slope-dependent speed has none), counted in its bytes, and what a graph's answers are
+// does not depend on whether it came from the cache.
+TEST_F(TravelServiceTest, TravelQueriesShareOneGraphPerCost) {
+  auto path = [&](const GeodesicOptions& options, uint32_t to) {
+    PathQuery query{Sites()[1], SurfacePoint::AtVertex(to), {}};
+    query.options.solver = options;
+    v1::FindShortestPathRequest request;
+    request.set_mesh("meshes/hills");
+    api::PathQueryToProto(query, &request);
+    v1::FindShortestPathResponse response;
+    grpc::ClientContext context;
+    grpc::Status status = stub_->FindShortestPath(&context, request, &response);
+    EXPECT_TRUE(status.ok()) << status.error_message();
+    absl::StatusOr<PathQueryResult> want =
+        ComputeShortestPath(*local_, query.from, query.to, query.options);
+    EXPECT_TRUE(want.ok()) << want.status();
+    if (want.ok()) {
+      EXPECT_TRUE(BitEqual(response.distance(), want->distance));
+    }
+  };
+  const uint64_t empty = server_->cache().bytes();
+  path(Travel(), 420);
+  EXPECT_EQ(server_->cache().graph_misses(), 1u);
+  EXPECT_EQ(server_->cache().entries(), 1u);               // the graph
+  EXPECT_GT(server_->cache().bytes(), empty + 8 * 10000);  // (its Steiner points' positions)
+  path(Travel(), 300);
+  path(Travel(), 12);
+  EXPECT_EQ(server_->cache().graph_hits(), 2u);
+  GeodesicOptions finer = Travel();
+  finer.travel->epsilon = 0.03;
+  path(finer, 420);
+  path(finer, 300);
+  EXPECT_EQ(server_->cache().graph_misses(), 2u);
+  EXPECT_EQ(server_->cache().graph_hits(), 3u);
+  EXPECT_EQ(server_->cache().entries(), 2u);
+  path(SlopeTravel(), 420);  // its points follow each query's sources: no graph to share
+  EXPECT_EQ(server_->cache().graph_misses(), 2u);
+  EXPECT_EQ(server_->cache().graph_hits(), 3u);
 }
 
 TEST_F(TravelServiceTest, CacheNeverMixesTravelAndPlainFields) {

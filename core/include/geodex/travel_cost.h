@@ -24,10 +24,13 @@
 #include <vector>
 
 #include "absl/status/status.h"
+#include "absl/status/statusor.h"
 
 namespace geodex {
 
 class TriangleMesh;
+class WeightedSurface;
+struct GeodesicOptions;
 
 enum class SpeedModel {
   kConstant,  // speed_kmh everywhere
@@ -58,6 +61,12 @@ struct TravelCost {
   // 0 = unlimited; else a solve needing more Steiner points fails with ResourceExhausted
   // (Limit::kSteinerPoints) before allocating them.
   uint64_t max_steiner_points = 0;
+  // The weighted engine's graph for this mesh and these options, built once (BuildTravelGraph) and
+  // shared by many queries: paths, times at points and matrices then skip building their own. It
+  // is used only where it is the graph they would build (WeightedSurface::Serves: the same mesh
+  // object, epsilon and weights), so a stale one costs a build, never a wrong answer. Not part of
+  // the cost: caches key on the fields above.
+  std::shared_ptr<const WeightedSurface> graph;
 };
 
 // The one check of a travel cost's own values (speed model, speed, table, epsilon, slope); the
@@ -101,6 +110,13 @@ inline const char* SpeedModelName(SpeedModel model) {
   }
   return "constant";
 }
+
+// The graph a constant-speed travel cost's paths, times at points and matrices on `mesh` search,
+// to be shared through TravelCost::graph (geodexd keeps them in its result cache). `mesh` must
+// outlive it. Null for a slope-dependent speed: its points follow each query's sources. Errors:
+// as the queries' (the options, the Steiner-point limit).
+absl::StatusOr<std::shared_ptr<const WeightedSurface>> BuildTravelGraph(
+    const TriangleMesh& mesh, const GeodesicOptions& options);
 
 // Tobler's hiking function: km/h at s = rise / run along the direction of travel.
 double ToblerKmh(double rise_over_run);

@@ -155,6 +155,8 @@ absl::StatusOr<WeightedCosts> ComputeWeightedCostsAt(const TriangleMesh& mesh,
                                                      const std::vector<SurfacePoint>& targets,
                                                      const WeightedOptions& options);
 
+struct WeightedPath;
+
 // The weighted engine's graph (Steiner points) and cost model (the per-face switchback ranges of
 // a slope cost) for one mesh and one set of options, built once for many queries: a matrix's
 // rows. Immutable once built; CostsAt may run on many threads at once. `mesh` must outlive it.
@@ -177,7 +179,29 @@ class WeightedSurface {
   absl::StatusOr<WeightedCosts> CostsAt(const std::vector<SurfacePoint>& sources,
                                         const std::vector<SurfacePoint>& targets,
                                         bool whole = false) const;
+
+  // What one query on a surface shared by many obeys (CostsAt above takes them from the options
+  // the surface was built with): max_distance in cost units (> 0) and the call's cancel token.
+  struct Limits {
+    double max_distance = std::numeric_limits<double>::infinity();
+    const CancelToken* cancel = nullptr;
+  };
+  absl::StatusOr<WeightedCosts> CostsAt(const std::vector<SurfacePoint>& sources,
+                                        const std::vector<SurfacePoint>& targets, bool whole,
+                                        const Limits& limits) const;
+  // ComputeWeightedPaths on this surface. InvalidArgument naming "inbound" for a slope cost's
+  // surface built inbound (a path is walked from its start).
+  absl::StatusOr<std::vector<WeightedPath>> Paths(const SurfacePoint& from,
+                                                  const std::vector<SurfacePoint>& tos,
+                                                  const Limits& limits) const;
+
+  // Whether a solve with `options` on `mesh` would build this very surface, so a query may use
+  // it instead of building its own: the same mesh object, epsilon and weights, within the
+  // options' Steiner-point limit, and no slope cost on either (its points follow each query's
+  // sources). Costs the comparison of the weights.
+  bool Serves(const TriangleMesh& mesh, const WeightedOptions& options) const;
   uint64_t steiner_points() const;
+  uint64_t bytes() const;  // what it holds: the Steiner points, the graph's arrays, the weights
 
   struct Impl;  // the graph and cost model (weighted_field.cc); every solve builds one
 
