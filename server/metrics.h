@@ -12,6 +12,7 @@
 //   mesh_store_bytes, mesh_store_budget_bytes, mesh_store_meshes, mesh_store_resident_meshes,
 //   mesh_store_evictions_total, mesh_store_disk_loads_total
 //   result_cache_bytes, result_cache_entries, result_cache_hits_total, result_cache_misses_total
+//   travel_graph_hits_total, travel_graph_misses_total (travel graphs, in the result cache)
 //   solves_total, windows_processed_total
 // The gauges are read from the pool, store and cache at scrape time.
 

@@ -159,6 +159,27 @@ double MetresPerHeightUnit(std::string unit) {
   return 0;
 }
 
+// The transform from a vector layer's CRS (WGS 84 when it names none, as GeoJSON's default) to
+// `crs`; null when `crs` is null (the features stay as they are). Errors start with `name`.
+absl::StatusOr<TransformPtr> LayerToCrs(OGRLayer& layer, const OGRSpatialReference* crs,
+                                        const std::string& name) {
+  TransformPtr out(nullptr, &OGRCoordinateTransformation::DestroyCT);
+  if (crs == nullptr) return out;
+  OGRSpatialReference from;
+  if (const OGRSpatialReference* layer_crs = layer.GetSpatialRef(); layer_crs != nullptr) {
+    from = *layer_crs;
+  } else {
+    from.SetWellKnownGeogCS("WGS84");
+  }
+  from.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
+  out = MakeTransform(from, *crs);
+  if (out == nullptr) {
+    return absl::InvalidArgumentError(absl::StrCat(name, ": cannot project it to the DEM's CRS (",
+                                                   QuietGdal::LastMessage(), ")"));
+  }
+  return out;
+}
+
 // Every polygon, line and point of a vector dataset, in `crs` (null: as they are, no CRS), as one
 // collection (a cut buffers the lines and points and unions everything). Errors start with `name`.
 absl::StatusOr<std::unique_ptr<OGRGeometry>> BarrierPolygonsOf(GDALDataset* ds,
@@ -169,26 +190,15 @@ absl::StatusOr<std::unique_ptr<OGRGeometry>> BarrierPolygonsOf(GDALDataset* ds,
   };
   if (ds == nullptr)
     return bad(absl::StrCat("not a vector file GDAL reads (", QuietGdal::LastMessage(), ")"));
-  OGRSpatialReference wgs84;
-  wgs84.SetWellKnownGeogCS("WGS84");
-  wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
   auto all = std::make_unique<OGRGeometryCollection>();
   for (OGRLayer* layer : ds->GetLayers()) {
-    const OGRSpatialReference* layer_crs = layer->GetSpatialRef();
-    OGRSpatialReference from(layer_crs != nullptr ? *layer_crs : wgs84);
-    from.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-    TransformPtr to_dem(nullptr, &OGRCoordinateTransformation::DestroyCT);
-    if (crs != nullptr) {
-      to_dem = MakeTransform(from, *crs);
-      if (to_dem == nullptr)
-        return bad(
-            absl::StrCat("cannot project it to the DEM's CRS (", QuietGdal::LastMessage(), ")"));
-    }
+    absl::StatusOr<TransformPtr> to_dem = LayerToCrs(*layer, crs, name);
+    if (!to_dem.ok()) return to_dem.status();
     for (const auto& feature : *layer) {
       const OGRGeometry* g = feature->GetGeometryRef();
       if (g == nullptr) continue;
       std::unique_ptr<OGRGeometry> copy(g->clone());
-      if (to_dem != nullptr && copy->transform(to_dem.get()) != OGRERR_NONE) {
+      if (*to_dem != nullptr && copy->transform(to_dem->get()) != OGRERR_NONE) {
         return bad(absl::StrCat("cannot project a feature to the DEM's CRS (",
                                 QuietGdal::LastMessage(), ")"));
       }
@@ -226,22 +236,10 @@ absl::StatusOr<std::vector<FrictionRegion>> ReadFrictionRegions(GDALDataset& ds,
   auto bad = [&](const std::string& why) {
     return absl::InvalidArgumentError(absl::StrCat(name, ": ", why));
   };
-  OGRSpatialReference wgs84;
-  wgs84.SetWellKnownGeogCS("WGS84");
-  wgs84.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
   std::vector<FrictionRegion> regions;
   for (OGRLayer* layer : ds.GetLayers()) {
-    const OGRSpatialReference* layer_crs = layer->GetSpatialRef();
-    OGRSpatialReference from(layer_crs != nullptr ? *layer_crs : wgs84);
-    from.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-    TransformPtr to_dem(nullptr, &OGRCoordinateTransformation::DestroyCT);
-    if (crs != nullptr) {
-      to_dem = MakeTransform(from, *crs);
-      if (to_dem == nullptr) {
-        return bad(
-            absl::StrCat("cannot project it to the DEM's CRS (", QuietGdal::LastMessage(), ")"));
-      }
-    }
+    absl::StatusOr<TransformPtr> to_dem = LayerToCrs(*layer, crs, name);
+    if (!to_dem.ok()) return to_dem.status();
     const int field = layer->GetLayerDefn()->GetFieldIndex("friction");
     const OGRFieldType type =
         field >= 0 ? layer->GetLayerDefn()->GetFieldDefn(field)->GetType() : OFTString;
@@ -263,7 +261,7 @@ absl::StatusOr<std::vector<FrictionRegion>> ReadFrictionRegions(GDALDataset& ds,
             absl::StrCat(which, " is a ", g->getGeometryName(), "; friction regions are polygons"));
       }
       std::unique_ptr<OGRGeometry> copy(g->clone());
-      if (to_dem != nullptr && copy->transform(to_dem.get()) != OGRERR_NONE) {
+      if (*to_dem != nullptr && copy->transform(to_dem->get()) != OGRERR_NONE) {
         return bad(absl::StrCat("cannot project ", which, " to the DEM's CRS (",
                                 QuietGdal::LastMessage(), ")"));
       }
