@@ -142,10 +142,16 @@ std::shared_ptr<const WeightedSurface> FieldCache::FindGraph(const std::string& 
   return it->second.graph;
 }
 
-void FieldCache::InsertGraph(const std::string& key, std::shared_ptr<const WeightedSurface> graph) {
-  const uint64_t bytes = graph->bytes() + key.size();
+void FieldCache::InsertGraph(const std::string& key, std::shared_ptr<const WeightedSurface> graph,
+                             uint64_t mesh_bytes) {
+  const uint64_t bytes = graph->bytes() + mesh_bytes + key.size();
   if (!enabled() || bytes > budget_bytes_) return;
   std::lock_guard<std::mutex> lock(mu_);
+  if (auto old = entries_.find(key); old != entries_.end()) {
+    bytes_ -= old->second.bytes;
+    lru_.erase(old->second.lru);
+    entries_.erase(old);
+  }
   InsertLocked(key, Entry{nullptr, std::move(graph), bytes, {}});
 }
 

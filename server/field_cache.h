@@ -45,9 +45,13 @@ class FieldCache {
   std::shared_ptr<const DistanceField> Find(const std::string& key);
   // Keeps `field` unless it alone exceeds the budget; evicts least recently used fields.
   void Insert(const std::string& key, std::shared_ptr<const DistanceField> field);
-  // A travel graph (the entry keeps what it refers to alive: `graph`'s owner holds the mesh).
+  // A travel graph. Its owner keeps the mesh it refers to alive, so the entry counts that mesh's
+  // `mesh_bytes` too (the mesh store may evict or delete the mesh meanwhile: the budget still
+  // bounds what the cache holds). InsertGraph replaces an entry of the same key (a graph of a
+  // mesh since reloaded as another object).
   std::shared_ptr<const WeightedSurface> FindGraph(const std::string& key);
-  void InsertGraph(const std::string& key, std::shared_ptr<const WeightedSurface> graph);
+  void InsertGraph(const std::string& key, std::shared_ptr<const WeightedSurface> graph,
+                   uint64_t mesh_bytes);
   // Records that a path query started from `key`'s source; true when one did recently (the
   // second query from a point pays for a full field that the following ones reuse).
   bool NotePathSource(const std::string& key);

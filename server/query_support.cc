@@ -128,6 +128,7 @@ void ShareTravelGraph(const QueryEnv& env, const StoredMesh& mesh, GeodesicOptio
   }
   const std::string key = TravelGraphKey(mesh.id, *options);
   std::shared_ptr<const WeightedSurface> graph = env.cache->FindGraph(key);
+  if (graph != nullptr && &graph->mesh() != mesh.mesh.get()) graph = nullptr;  // mesh reloaded
   if (graph == nullptr) {
     absl::StatusOr<std::shared_ptr<const WeightedSurface>> built =
         BuildTravelGraph(*mesh.mesh, *options);
@@ -139,7 +140,7 @@ void ShareTravelGraph(const QueryEnv& env, const StoredMesh& mesh, GeodesicOptio
     };
     auto held = std::make_shared<const Held>(Held{mesh.mesh, *std::move(built)});
     graph = std::shared_ptr<const WeightedSurface>(held, held->graph.get());
-    env.cache->InsertGraph(key, graph);
+    env.cache->InsertGraph(key, graph, mesh.memory_bytes);
   }
   options->travel->graph = std::move(graph);
 }

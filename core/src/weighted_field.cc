@@ -1597,6 +1597,8 @@ uint64_t WeightedSurface::bytes() const {
          impl_->options.face_weight.capacity() * sizeof(double);
 }
 
+const TriangleMesh& WeightedSurface::mesh() const { return impl_->graph.mesh(); }
+
 bool WeightedSurface::Serves(const TriangleMesh& mesh, const WeightedOptions& options) const {
   const WeightedOptions& built = impl_->options;
   return &impl_->graph.mesh() == &mesh && options.slope_cost == nullptr &&

@@ -13,13 +13,16 @@
 #include <utility>
 #include <vector>
 
+#include "field_cache.h"
 #include "geodex/distance_matrix.h"
 #include "geodex/friction.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/geometry_queries.h"
 #include "geodex/isolines.h"
 #include "geodex/shortest_path.h"
+#include "geodex/weighted_field.h"
 #include "geometry_convert.h"
+#include "mesh_store.h"
 #include "proto_convert.h"
 #include "server_test_util.h"
 #include "service_limits.h"
@@ -413,6 +416,34 @@ TEST_F(TravelServiceTest, TravelQueriesShareOneGraphPerCost) {
   path(SlopeTravel(), 420);  // its points follow each query's sources: no graph to share
   EXPECT_EQ(server_->cache().graph_misses(), 2u);
   EXPECT_EQ(server_->cache().graph_hits(), 3u);
+
+  // A graph keeps its mesh alive, so its entry counts the mesh's memory as well as its own.
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> stored = server_->store().Get("hills");
+  ASSERT_TRUE(stored.ok()) << stored.status();
+  const std::string key = TravelGraphKey((*stored)->id, Travel());
+  std::shared_ptr<const WeightedSurface> graph = server_->cache().FindGraph(key);
+  ASSERT_NE(graph, nullptr);
+  EXPECT_EQ(&graph->mesh(), (*stored)->mesh.get());
+  const std::string finer_key = TravelGraphKey((*stored)->id, finer);
+  std::shared_ptr<const WeightedSurface> finer_graph = server_->cache().FindGraph(finer_key);
+  ASSERT_NE(finer_graph, nullptr);
+  EXPECT_EQ(server_->cache().bytes() - empty, graph->bytes() + finer_graph->bytes() +
+                                                  2 * (*stored)->memory_bytes + key.size() +
+                                                  finer_key.size());
+  // The mesh deleted and uploaded again is another object: its next travel path replaces the
+  // graph (one entry, on the new mesh) rather than searching the old one.
+  ASSERT_TRUE(server_->store().Delete((*stored)->id).ok());
+  graph.reset();
+  finer_graph.reset();
+  ASSERT_TRUE(Upload(*stub_, off_, "hills").status.ok());
+  path(Travel(), 420);
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> again = server_->store().Get("hills");
+  ASSERT_TRUE(again.ok()) << again.status();
+  EXPECT_NE(again->get(), stored->get());
+  graph = server_->cache().FindGraph(key);
+  ASSERT_NE(graph, nullptr);
+  EXPECT_EQ(&graph->mesh(), (*again)->mesh.get());
+  EXPECT_EQ(server_->cache().entries(), 2u);
 }
 
 TEST_F(TravelServiceTest, CacheNeverMixesTravelAndPlainFields) {

@@ -202,6 +202,7 @@ class WeightedSurface {
   bool Serves(const TriangleMesh& mesh, const WeightedOptions& options) const;
   uint64_t steiner_points() const;
   uint64_t bytes() const;  // what it holds: the Steiner points, the graph's arrays, the weights
+  const TriangleMesh& mesh() const;  // the mesh it was built on
 
   struct Impl;  // the graph and cost model (weighted_field.cc); every solve builds one
 
