@@ -109,17 +109,24 @@ uint64_t FieldBytes(const DistanceField& field) {
          field.sources.capacity() * sizeof(SurfacePoint) + sizeof(DistanceField);
 }
 
-std::shared_ptr<const DistanceField> FieldCache::Find(const std::string& key) {
+template <typename T, typename Usable>
+std::shared_ptr<const T> FieldCache::Lookup(const std::string& key,
+                                            std::shared_ptr<const T> Entry::*slot, uint64_t* hits,
+                                            uint64_t* misses, Usable usable) {
   if (!enabled()) return nullptr;
   std::lock_guard<std::mutex> lock(mu_);
   auto it = entries_.find(key);
-  if (it == entries_.end() || it->second.field == nullptr) {
-    ++misses_;
+  if (it == entries_.end() || it->second.*slot == nullptr || !usable(*(it->second.*slot))) {
+    ++*misses;
     return nullptr;
   }
-  ++hits_;
+  ++*hits;
   lru_.splice(lru_.begin(), lru_, it->second.lru);
-  return it->second.field;
+  return it->second.*slot;
+}
+
+std::shared_ptr<const DistanceField> FieldCache::Find(const std::string& key) {
+  return Lookup(key, &Entry::field, &hits_, &misses_, [](const DistanceField&) { return true; });
 }
 
 void FieldCache::Insert(const std::string& key, std::shared_ptr<const DistanceField> field) {
@@ -129,17 +136,10 @@ void FieldCache::Insert(const std::string& key, std::shared_ptr<const DistanceFi
   InsertLocked(key, Entry{std::move(field), nullptr, bytes, {}});
 }
 
-std::shared_ptr<const WeightedSurface> FieldCache::FindGraph(const std::string& key) {
-  if (!enabled()) return nullptr;
-  std::lock_guard<std::mutex> lock(mu_);
-  auto it = entries_.find(key);
-  if (it == entries_.end() || it->second.graph == nullptr) {
-    ++graph_misses_;
-    return nullptr;
-  }
-  ++graph_hits_;
-  lru_.splice(lru_.begin(), lru_, it->second.lru);
-  return it->second.graph;
+std::shared_ptr<const WeightedSurface> FieldCache::FindGraph(const std::string& key,
+                                                             const TriangleMesh& mesh) {
+  return Lookup(key, &Entry::graph, &graph_hits_, &graph_misses_,
+                [&mesh](const WeightedSurface& graph) { return &graph.mesh() == &mesh; });
 }
 
 void FieldCache::InsertGraph(const std::string& key, std::shared_ptr<const WeightedSurface> graph,

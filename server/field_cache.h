@@ -47,9 +47,10 @@ class FieldCache {
   void Insert(const std::string& key, std::shared_ptr<const DistanceField> field);
   // A travel graph. Its owner keeps the mesh it refers to alive, so the entry counts that mesh's
   // `mesh_bytes` too (the mesh store may evict or delete the mesh meanwhile: the budget still
-  // bounds what the cache holds). InsertGraph replaces an entry of the same key (a graph of a
-  // mesh since reloaded as another object).
-  std::shared_ptr<const WeightedSurface> FindGraph(const std::string& key);
+  // bounds what the cache holds). FindGraph answers only a graph built on `mesh` itself: a graph
+  // of a mesh since reloaded as another object counts as a miss, and InsertGraph replaces it.
+  std::shared_ptr<const WeightedSurface> FindGraph(const std::string& key,
+                                                   const TriangleMesh& mesh);
   void InsertGraph(const std::string& key, std::shared_ptr<const WeightedSurface> graph,
                    uint64_t mesh_bytes);
   // Records that a path query started from `key`'s source; true when one did recently (the
@@ -83,6 +84,11 @@ class FieldCache {
   uint64_t graph_hits_ = 0;
   uint64_t graph_misses_ = 0;
   void InsertLocked(const std::string& key, Entry entry);
+  // The look-up both kinds share: `key`'s entry of one kind (`slot`), when `usable` accepts it,
+  // moved to the front and counted in `*hits`; else nullptr, counted in `*misses`.
+  template <typename T, typename Usable>
+  std::shared_ptr<const T> Lookup(const std::string& key, std::shared_ptr<const T> Entry::*slot,
+                                  uint64_t* hits, uint64_t* misses, Usable usable);
   // Recent path sources (bounded FIFO of keys).
   absl::flat_hash_map<std::string, uint64_t> path_sources_;
   std::list<std::string> path_source_order_;

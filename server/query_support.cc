@@ -127,8 +127,7 @@ void ShareTravelGraph(const QueryEnv& env, const StoredMesh& mesh, GeodesicOptio
     return;
   }
   const std::string key = TravelGraphKey(mesh.id, *options);
-  std::shared_ptr<const WeightedSurface> graph = env.cache->FindGraph(key);
-  if (graph != nullptr && &graph->mesh() != mesh.mesh.get()) graph = nullptr;  // mesh reloaded
+  std::shared_ptr<const WeightedSurface> graph = env.cache->FindGraph(key, *mesh.mesh);
   if (graph == nullptr) {
     absl::StatusOr<std::shared_ptr<const WeightedSurface>> built =
         BuildTravelGraph(*mesh.mesh, *options);

@@ -30,6 +30,16 @@ TriangleMesh BuildMesh(const MeshData& data) {
   return *std::move(mesh);
 }
 
+// A square plane of cells x cells cells, `size` metres a side, its vertices jittered by `jitter`
+// of a cell (0: a regular grid).
+TriangleMesh SquarePlane(int cells, double size, double jitter = 0) {
+  GridSpec spec;
+  spec.cells_x = spec.cells_y = cells;
+  spec.width = spec.height = size;
+  spec.jitter = jitter;
+  return BuildMesh(MakeGrid(spec));
+}
+
 GeodesicOptions Travel(double speed_kmh, double epsilon = 0.05) {
   GeodesicOptions options;
   options.travel = TravelCost{};
@@ -41,11 +51,7 @@ GeodesicOptions Travel(double speed_kmh, double epsilon = 0.05) {
 // A 10 m x 10 m plane: at 3.6 km/h (1 m/s) every time is the exact distance within the bound,
 // and at 7.2 km/h half of it; the field says it is a travel field and its bound.
 TEST(TravelCostTest, APlaneAtOneMetrePerSecondGivesDistancesInSeconds) {
-  GridSpec spec;
-  spec.cells_x = spec.cells_y = 8;
-  spec.width = spec.height = 10;
-  spec.jitter = 0.2;
-  const TriangleMesh mesh = BuildMesh(MakeGrid(spec));
+  const TriangleMesh mesh = SquarePlane(8, 10, 0.2);
   const std::vector<SurfacePoint> sources = {SurfacePoint::AtVertex(0)};
   absl::StatusOr<DistanceField> exact = ComputeDistanceField(mesh, sources);
   ASSERT_TRUE(exact.ok()) << exact.status();
@@ -65,11 +71,7 @@ TEST(TravelCostTest, APlaneAtOneMetrePerSecondGivesDistancesInSeconds) {
 
 // Friction 2 everywhere doubles every time, bit for bit, in the field, at points and in paths.
 TEST(TravelCostTest, FrictionTwoDoublesEveryTime) {
-  GridSpec spec;
-  spec.cells_x = spec.cells_y = 6;
-  spec.width = spec.height = 100;
-  spec.jitter = 0.25;
-  const TriangleMesh mesh = BuildMesh(MakeGrid(spec));
+  const TriangleMesh mesh = SquarePlane(6, 100, 0.25);
   const std::vector<SurfacePoint> sources = {SurfacePoint::AtVertex(3)};
   GeodesicOptions plain = Travel(5), doubled = Travel(5);
   doubled.travel->face_weight = std::make_shared<std::vector<double>>(mesh.face_count(), 2.0);
@@ -127,10 +129,7 @@ TEST(TravelCostTest, MaxSlopeBlocksSteeperFaces) {
 
 // A matrix's entries are the point values of its rows; a symmetric matrix is symmetric.
 TEST(TravelCostTest, MatrixRowsArePointValues) {
-  GridSpec spec;
-  spec.cells_x = spec.cells_y = 5;
-  spec.width = spec.height = 50;
-  const TriangleMesh mesh = BuildMesh(MakeGrid(spec));
+  const TriangleMesh mesh = SquarePlane(5, 50);
   const std::vector<SurfacePoint> points = {SurfacePoint::AtVertex(0), SurfacePoint::AtVertex(17),
                                             SurfacePoint::InFace(9, 0.3, 0.3, 0.4)};
   MatrixOptions options;
@@ -153,11 +152,7 @@ TEST(TravelCostTest, MatrixRowsArePointValues) {
 // mesh object is not used (the answers stay those of the query's own options), and a
 // slope-dependent speed has none.
 TEST(TravelCostTest, ASharedGraphAnswersAsEachQuerysOwn) {
-  GridSpec spec;
-  spec.cells_x = spec.cells_y = 8;
-  spec.width = spec.height = 80;
-  spec.jitter = 0.2;
-  const TriangleMesh mesh = BuildMesh(MakeGrid(spec));
+  const TriangleMesh mesh = SquarePlane(8, 80, 0.2);
   auto weights = std::make_shared<std::vector<double>>(mesh.face_count(), 1.0);
   for (uint32_t f = 0; f < mesh.face_count(); f += 3) (*weights)[f] = 2.5;
   GeodesicOptions own = Travel(3.6, 0.05);
@@ -187,7 +182,7 @@ TEST(TravelCostTest, ASharedGraphAnswersAsEachQuerysOwn) {
   other = own;
   other.travel->max_slope_deg = 89;  // (no face here is that steep: the same weights)
   EXPECT_TRUE(serves(mesh, other));
-  const TriangleMesh twin = BuildMesh(MakeGrid(spec));
+  const TriangleMesh twin = SquarePlane(8, 80, 0.2);  // the same mesh, another object
   EXPECT_FALSE(serves(twin, own));
 
   const SurfacePoint from = SurfacePoint::InFace(5, 0.2, 0.3, 0.5);
@@ -260,10 +255,7 @@ TEST(TravelCostTest, ASharedGraphAnswersAsEachQuerysOwn) {
 
 // Isolines in seconds: a 60 s line lies farther out than a 30 s one.
 TEST(TravelCostTest, IsolinesAreDrawnInSeconds) {
-  GridSpec spec;
-  spec.cells_x = spec.cells_y = 10;
-  spec.width = spec.height = 100;
-  const TriangleMesh mesh = BuildMesh(MakeGrid(spec));
+  const TriangleMesh mesh = SquarePlane(10, 100);
   IsolineQuery query;
   query.sources = {SurfacePoint::AtVertex(0)};
   query.options = Travel(3.6);

@@ -107,6 +107,14 @@ class TravelServiceTest : public testing::ServerFixture {
   static std::vector<std::array<double, 2>> WalkerTable() {
     return {{-35, 1}, {-10, 5.5}, {0, 5}, {10, 3.5}, {35, 0.5}};
   }
+  // FindShortestPath on the uploaded mesh for `query`.
+  grpc::Status PathOverService(const PathQuery& query, v1::FindShortestPathResponse* response) {
+    v1::FindShortestPathRequest request;
+    request.set_mesh("meshes/hills");
+    api::PathQueryToProto(query, &request);
+    grpc::ClientContext context;
+    return stub_->FindShortestPath(&context, request, response);
+  }
   std::vector<SurfacePoint> Sites() const {
     return {SurfacePoint::AtVertex(3), SurfacePoint::OnEdge(400, 401, 0.3),
             SurfacePoint::InFace(700, 0.2, 0.3, 0.5)};
@@ -243,12 +251,8 @@ TEST_F(TravelServiceTest, FieldPathMatrixAndIsolinesEqualCore) {
       ComputeShortestPath(*local_, path_query.from, path_query.to, path_query.options);
   ASSERT_TRUE(want_path.ok()) << want_path.status();
   for (int repeat = 0; repeat < 3; ++repeat) {
-    v1::FindShortestPathRequest request;
-    request.set_mesh("meshes/hills");
-    api::PathQueryToProto(path_query, &request);
     v1::FindShortestPathResponse response;
-    grpc::ClientContext context;
-    grpc::Status status = stub_->FindShortestPath(&context, request, &response);
+    grpc::Status status = PathOverService(path_query, &response);
     ASSERT_TRUE(status.ok()) << status.error_message();
     EXPECT_TRUE(BitEqual(response.distance(), want_path->distance));
     EXPECT_EQ(response.travel_epsilon(), 0.05);
@@ -384,12 +388,8 @@ TEST_F(TravelServiceTest, TravelQueriesShareOneGraphPerCost) {
   auto path = [&](const GeodesicOptions& options, uint32_t to) {
     PathQuery query{Sites()[1], SurfacePoint::AtVertex(to), {}};
     query.options.solver = options;
-    v1::FindShortestPathRequest request;
-    request.set_mesh("meshes/hills");
-    api::PathQueryToProto(query, &request);
     v1::FindShortestPathResponse response;
-    grpc::ClientContext context;
-    grpc::Status status = stub_->FindShortestPath(&context, request, &response);
+    grpc::Status status = PathOverService(query, &response);
     EXPECT_TRUE(status.ok()) << status.error_message();
     absl::StatusOr<PathQueryResult> want =
         ComputeShortestPath(*local_, query.from, query.to, query.options);
@@ -421,26 +421,33 @@ TEST_F(TravelServiceTest, TravelQueriesShareOneGraphPerCost) {
   absl::StatusOr<std::shared_ptr<const StoredMesh>> stored = server_->store().Get("hills");
   ASSERT_TRUE(stored.ok()) << stored.status();
   const std::string key = TravelGraphKey((*stored)->id, Travel());
-  std::shared_ptr<const WeightedSurface> graph = server_->cache().FindGraph(key);
+  std::shared_ptr<const WeightedSurface> graph = server_->cache().FindGraph(key, *(*stored)->mesh);
   ASSERT_NE(graph, nullptr);
   EXPECT_EQ(&graph->mesh(), (*stored)->mesh.get());
   const std::string finer_key = TravelGraphKey((*stored)->id, finer);
-  std::shared_ptr<const WeightedSurface> finer_graph = server_->cache().FindGraph(finer_key);
+  std::shared_ptr<const WeightedSurface> finer_graph =
+      server_->cache().FindGraph(finer_key, *(*stored)->mesh);
   ASSERT_NE(finer_graph, nullptr);
   EXPECT_EQ(server_->cache().bytes() - empty, graph->bytes() + finer_graph->bytes() +
                                                   2 * (*stored)->memory_bytes + key.size() +
                                                   finer_key.size());
   // The mesh deleted and uploaded again is another object: its next travel path replaces the
-  // graph (one entry, on the new mesh) rather than searching the old one.
+  // graph (one entry, on the new mesh) rather than searching the old one, and counts as the miss
+  // it is (it builds).
   ASSERT_TRUE(server_->store().Delete((*stored)->id).ok());
   graph.reset();
   finer_graph.reset();
   ASSERT_TRUE(Upload(*stub_, off_, "hills").status.ok());
+  const uint64_t hits = server_->cache().graph_hits();
+  const uint64_t misses = server_->cache().graph_misses();
   path(Travel(), 420);
+  EXPECT_EQ(server_->cache().graph_misses(), misses + 1);
+  EXPECT_EQ(server_->cache().graph_hits(), hits);
   absl::StatusOr<std::shared_ptr<const StoredMesh>> again = server_->store().Get("hills");
   ASSERT_TRUE(again.ok()) << again.status();
   EXPECT_NE(again->get(), stored->get());
-  graph = server_->cache().FindGraph(key);
+  EXPECT_EQ(server_->cache().FindGraph(key, *(*stored)->mesh), nullptr);  // the old mesh's: gone
+  graph = server_->cache().FindGraph(key, *(*again)->mesh);
   ASSERT_NE(graph, nullptr);
   EXPECT_EQ(&graph->mesh(), (*again)->mesh.get());
   EXPECT_EQ(server_->cache().entries(), 2u);
@@ -589,12 +596,8 @@ TEST_F(TravelServiceTest, SlopeSpeedFieldsPathsAndMatricesEqualCore) {
     absl::StatusOr<PathQueryResult> want =
         ComputeShortestPath(*local_, path_query.from, path_query.to, path_query.options);
     ASSERT_TRUE(want.ok()) << want.status();
-    v1::FindShortestPathRequest request;
-    request.set_mesh("meshes/hills");
-    api::PathQueryToProto(path_query, &request);
     v1::FindShortestPathResponse response;
-    grpc::ClientContext context;
-    grpc::Status status = stub_->FindShortestPath(&context, request, &response);
+    grpc::Status status = PathOverService(path_query, &response);
     ASSERT_TRUE(status.ok()) << status.error_message();
     EXPECT_TRUE(BitEqual(response.distance(), want->distance));
     EXPECT_EQ(response.travel_epsilon(), 0.05);
