@@ -296,6 +296,10 @@ int ResolveTravelWeights(Backend& backend, const Args& args, GeodesicOptions* op
                                            ": friction maps need a DEM as MESH (on another mesh, "
                                            "--face-weights FILE gives one weight per face)"));
     }
+    if (!dem->face_friction().empty()) {  // --friction-boundaries exact: valued as cut in
+      options->travel->face_weight = std::make_shared<std::vector<double>>(dem->face_friction());
+      return 0;
+    }
     absl::StatusOr<const MeshData*> data = backend.Geometry();
     if (!data.ok()) return FailQuery(data.status());
     absl::StatusOr<std::vector<double>> weights =
@@ -392,6 +396,16 @@ absl::StatusOr<terrain::DemOptions> MeshReadOptions(const Args& args, const std:
           ".shp, .fgb) into a DEM's mesh");
     }
     if (how == "exact") dem.friction_file = path;
+  }
+  // --friction-snap F: those outlines snapped onto the vertices within F x the shortest edge at
+  // the vertex (terrain's DemOptions::friction_snap checks the range).
+  if (!GetDouble(args, "friction-snap", &dem.friction_snap, &error)) {
+    return absl::InvalidArgumentError(error);
+  }
+  if (absl::Status s = terrain::CheckFrictionSnap(dem.friction_snap); !s.ok()) return s;
+  if (args.options.count("friction-snap") && dem.friction_file.empty()) {
+    return absl::InvalidArgumentError(
+        "--friction-snap goes with --friction-boundaries exact (it snaps the outlines cut in)");
   }
   return dem;
 }

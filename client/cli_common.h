@@ -64,8 +64,8 @@ inline const std::set<std::string> kMeshReadingFlags = {
 // Travel time instead of length (geodex/travel_cost.h), taken by every command that takes --lambda:
 // --speed constant:KMH turns it on; the others need it.
 inline const std::set<std::string> kTravelFlags = {
-    "speed",        "cost-epsilon",       "max-slope", "friction", "friction-boundaries",
-    "face-weights", "max-steiner-points", "inbound"};
+    "speed",         "cost-epsilon", "max-slope",          "friction", "friction-boundaries",
+    "friction-snap", "face-weights", "max-steiner-points", "inbound"};
 // The flag a core option error is about (InvalidOptionOf: "lambda", "travel.epsilon",
 // "face_weight[3]"; or geodexd's request field under "options.", "travel.face_weights[3]"), as the
 // user typed it: "--lambda", "--cost-epsilon", "--face-weights".

@@ -12,6 +12,8 @@
 #include <set>
 #include <utility>
 
+#include "absl/container/flat_hash_map.h"
+#include "absl/container/flat_hash_set.h"
 #include "absl/strings/ascii.h"
 #include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
@@ -272,6 +274,12 @@ absl::StatusOr<std::vector<FrictionRegion>> ReadFrictionRegions(GDALDataset& ds,
   return regions;
 }
 
+// Each face's friction under its centre: `regions` in the map (the DEM's CRS) with `dem`, in the
+// mesh's own x y without (defined below, with the readers).
+absl::StatusOr<std::vector<double>> FaceFrictionOf(std::vector<FrictionRegion> regions,
+                                                   const MeshData& mesh, const DemInfo* dem,
+                                                   const std::string& name);
+
 // The regions' shapes as one collection: what CutOutlines splits the mesh along.
 std::unique_ptr<OGRGeometry> OutlinesOf(const std::vector<FrictionRegion>& regions) {
   auto all = std::make_unique<OGRGeometryCollection>();
@@ -280,6 +288,14 @@ std::unique_ptr<OGRGeometry> OutlinesOf(const std::vector<FrictionRegion>& regio
 }
 
 }  // namespace
+
+absl::Status CheckFrictionSnap(double friction_snap) {
+  if (friction_snap >= 0 && friction_snap <= 0.25) return absl::OkStatus();
+  return absl::InvalidArgumentError(
+      absl::StrCat("--friction-snap: must be in [0, 0.25] (a fraction of the shortest edge at a "
+                   "vertex; 0: exact), got ",
+                   friction_snap));
+}
 
 Dem::Dem(Dem&&) noexcept = default;
 Dem& Dem::operator=(Dem&&) noexcept = default;
@@ -509,6 +525,150 @@ absl::StatusOr<MeshData> CutOutlines(const MeshData& mesh, OGRGeometry& polygons
     return absl::InvalidArgumentError(absl::StrCat(name, ": ", cut.status().message()));
   }
   return cut;
+}
+
+// Every ring of the polygons in `g` (a polygon, a multipolygon or a collection of them).
+void ForEachRing(OGRGeometry& g, const std::function<void(OGRLinearRing&)>& visit) {
+  if (auto* polygon = dynamic_cast<OGRPolygon*>(&g)) {
+    for (OGRLinearRing* ring : *polygon) visit(*ring);
+  } else if (auto* collection = dynamic_cast<OGRGeometryCollection*>(&g)) {
+    for (OGRGeometry* part : *collection) ForEachRing(*part, visit);
+  }
+}
+
+// Friction regions in the mesh's own x y (projected to its CRS, or scaled to metres): there a
+// snapped outline point is a vertex's very coordinates, and the cut (scale 1) and the faces'
+// values (centres in mesh x y) read the same shapes.
+absl::Status RegionsToMeshFrame(std::vector<FrictionRegion>& regions, const DemInfo& dem,
+                                const OGRSpatialReference& file_crs, const std::string& name) {
+  for (FrictionRegion& region : regions) {
+    double scale = 1;
+    if (absl::Status s = PolygonsToMeshFrame(*region.shape, &dem, &file_crs, name, &scale);
+        !s.ok()) {
+      return s;
+    }
+    if (scale == 1) continue;
+    ForEachRing(*region.shape, [scale](OGRLinearRing& ring) {
+      for (int i = 0; i < ring.getNumPoints(); ++i) {
+        ring.setPoint(i, ring.getX(i) * scale, ring.getY(i) * scale);
+      }
+    });
+  }
+  return absl::OkStatus();
+}
+
+// DemOptions::friction_snap: outlines (in the mesh's x y) moved onto the vertices they pass
+// within `fraction` x the vertex's shortest x-y edge of. Why: an outline crossing an edge that
+// close to its end leaves pieces with a tiny angle (the crossing is shared with the neighbouring
+// face, which must take it as a corner), and the bounded engine's Steiner points per edge grow as
+// 1 / sin(smallest angle), its links per face as their square. Through the vertex, the outline
+// leaves no such piece there. A region whose snapped outline is no longer a valid polygon (two
+// of its stretches closer than the discs) keeps its drawn shape. Returns the points moved or
+// inserted.
+uint64_t SnapOutlinesToVertices(std::vector<FrictionRegion>& regions, const MeshData& mesh,
+                                double fraction) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  const size_t n = mesh.vertex_count();
+  auto xy = [&](uint32_t v) {
+    return std::array<double, 2>{mesh.positions[3 * size_t{v}], mesh.positions[3 * size_t{v} + 1]};
+  };
+  std::vector<double> radius(n, kInf);  // kInf: used by no face, never a snap target
+  std::vector<double> lengths;
+  lengths.reserve(mesh.faces.size());
+  for (size_t c = 0; c < mesh.faces.size(); ++c) {
+    const uint32_t a = mesh.faces[c], b = mesh.faces[c - c % 3 + (c + 1) % 3];
+    const double length = std::hypot(xy(a)[0] - xy(b)[0], xy(a)[1] - xy(b)[1]);
+    radius[a] = std::min(radius[a], fraction * length);
+    radius[b] = std::min(radius[b], fraction * length);
+    lengths.push_back(length);
+  }
+  if (lengths.empty()) return 0;
+  std::nth_element(lengths.begin(), lengths.begin() + lengths.size() / 2, lengths.end());
+  const double cell = lengths[lengths.size() / 2];
+  if (!(cell > 0)) return 0;
+  // Each vertex in every bucket (a square of the median edge length) its disc touches.
+  auto key = [](int64_t i, int64_t j) { return (static_cast<uint64_t>(i) << 32) ^ uint32_t(j); };
+  auto index = [cell](double x) { return static_cast<int64_t>(std::floor(x / cell)); };
+  absl::flat_hash_map<uint64_t, std::vector<uint32_t>> buckets;
+  for (uint32_t v = 0; v < n; ++v) {
+    if (radius[v] == kInf || !(radius[v] > 0)) continue;
+    const auto [x, y] = xy(v);
+    for (int64_t i = index(x - radius[v]); i <= index(x + radius[v]); ++i) {
+      for (int64_t j = index(y - radius[v]); j <= index(y + radius[v]); ++j) {
+        buckets[key(i, j)].push_back(v);
+      }
+    }
+  }
+  const std::vector<uint32_t> none;
+  auto near = [&](double x, double y) -> const std::vector<uint32_t>& {
+    auto it = buckets.find(key(index(x), index(y)));
+    return it == buckets.end() ? none : it->second;
+  };
+  uint64_t moved = 0;
+  auto snap_ring = [&](OGRLinearRing& ring, uint64_t* count) {
+    std::vector<std::array<double, 2>> in(ring.getNumPoints());
+    for (size_t i = 0; i < in.size(); ++i) in[i] = {ring.getX(i), ring.getY(i)};
+    for (auto& p : in) {  // corners onto the nearest vertex whose disc holds them
+      double best = kInf;
+      std::array<double, 2> to = p;
+      for (uint32_t v : near(p[0], p[1])) {
+        const double d = std::hypot(xy(v)[0] - p[0], xy(v)[1] - p[1]);
+        if (d < radius[v] && d < best) best = d, to = xy(v);
+      }
+      *count += to != p;
+      p = to;
+    }
+    std::vector<std::array<double, 2>> out;
+    std::vector<std::pair<double, uint32_t>> on_segment;
+    absl::flat_hash_set<uint64_t> seen;
+    for (size_t s = 0; s + 1 < in.size(); ++s) {
+      const auto p = in[s], q = in[s + 1];
+      out.push_back(p);
+      const double dx = q[0] - p[0], dy = q[1] - p[1], length = std::hypot(dx, dy);
+      if (!(length > 0)) continue;
+      // The buckets the segment passes through (sampled every half bucket, with their
+      // neighbours): a disc the segment enters lists its vertex in the bucket where it does.
+      on_segment.clear();
+      seen.clear();
+      const int steps = static_cast<int>(std::ceil(2 * length / cell));
+      for (int k = 0; k <= steps; ++k) {
+        const int64_t i0 = index(p[0] + dx * k / steps), j0 = index(p[1] + dy * k / steps);
+        for (int64_t i = i0 - 1; i <= i0 + 1; ++i) {
+          for (int64_t j = j0 - 1; j <= j0 + 1; ++j) {
+            if (!seen.insert(key(i, j)).second) continue;
+            auto it = buckets.find(key(i, j));
+            if (it == buckets.end()) continue;
+            for (uint32_t v : it->second) {
+              const double vx = xy(v)[0] - p[0], vy = xy(v)[1] - p[1];
+              const double t = (vx * dx + vy * dy) / (length * length);
+              if (t <= 0 || t >= 1) continue;
+              if (std::abs(vx * dy - vy * dx) / length < radius[v]) on_segment.push_back({t, v});
+            }
+          }
+        }
+      }
+      std::sort(on_segment.begin(), on_segment.end());
+      for (const auto& [t, v] : on_segment) {
+        if (xy(v) == out.back() || xy(v) == q) continue;  // (listed twice, or an end already)
+        out.push_back(xy(v));
+        ++*count;
+      }
+    }
+    out.push_back(in.back());
+    ring.setNumPoints(0);
+    for (const auto& [x, y] : out) ring.addPoint(x, y);
+  };
+  for (FrictionRegion& region : regions) {
+    std::unique_ptr<OGRGeometry> drawn(region.shape->clone());
+    uint64_t count = 0;
+    ForEachRing(*region.shape, [&](OGRLinearRing& ring) { snap_ring(ring, &count); });
+    if (count > 0 && !region.shape->IsValid()) {
+      region.shape = std::move(drawn);
+      continue;
+    }
+    moved += count;
+  }
+  return moved;
 }
 
 }  // namespace
@@ -787,6 +947,12 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
     return absl::InvalidArgumentError(absl::StrCat(
         "--z-tolerance: must be finite and >= 0 (0: the full grid), got ", options.z_tolerance));
   }
+  if (absl::Status s = CheckFrictionSnap(options.friction_snap); !s.ok()) return s;
+  if (options.friction_snap > 0 && options.friction_file.empty()) {
+    return absl::InvalidArgumentError(
+        "--friction-snap: snaps friction outlines cut into the mesh (--friction-boundaries exact "
+        "with polygons); there are none");
+  }
   info.step = options.step;
   info.grid_width = (info.raster_width + options.step - 1) / options.step;
   info.grid_height = (info.raster_height + options.step - 1) / options.step;
@@ -977,7 +1143,7 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
     barrier = *std::move(polygons);
   }
   // Friction regions: their outlines cut in once the barrier is out (geodex/friction.h).
-  std::unique_ptr<OGRGeometry> outlines;
+  std::vector<FrictionRegion> friction_regions;
   const std::string friction_name = absl::StrCat("--friction ", options.friction_file);
   if (!options.friction_file.empty()) {
     absl::StatusOr<GDALDatasetUniquePtr> file =
@@ -986,8 +1152,9 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
     absl::StatusOr<std::vector<FrictionRegion>> regions =
         ReadFrictionRegions(**file, &file_crs, friction_name);
     if (!regions.ok()) return regions.status();
-    outlines = OutlinesOf(*regions);
+    friction_regions = *std::move(regions);
   }
+  std::vector<double> face_friction;  // the cut mesh's (Dem::face_friction)
   // What is drawn on the mesh once it is made: the barrier cut out, then the outlines cut in.
   auto cut_drawn = [&](MeshData mesh) -> absl::StatusOr<MeshData> {
     if (barrier != nullptr) {
@@ -1000,14 +1167,33 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
       info.barrier_faces = stats.faces_removed + stats.faces_cut;
       mesh = *std::move(cut);
     }
-    if (outlines != nullptr) {
+    if (!friction_regions.empty()) {
+      // In the mesh's x y, snapped there (friction_snap), cut in, and every face valued from
+      // those same shapes: a snapped outline is where the values change.
+      if (absl::Status s = RegionsToMeshFrame(friction_regions, info, file_crs, friction_name);
+          !s.ok()) {
+        return s;
+      }
+      if (options.friction_snap > 0) {
+        SnapOutlinesToVertices(friction_regions, mesh, options.friction_snap);
+      }
       CutStats stats;
-      absl::StatusOr<MeshData> cut = CutOutlines(mesh, *outlines, &info, &file_crs,
-                                                 options.max_vertices, friction_name, &stats);
+      absl::StatusOr<MeshData> cut =
+          CutOutlines(mesh, *OutlinesOf(friction_regions), /*dem=*/nullptr, /*file_crs=*/nullptr,
+                      options.max_vertices, friction_name, &stats);
       if (!cut.ok()) return cut.status();
+      absl::StatusOr<std::vector<double>> values =
+          FaceFrictionOf(std::move(friction_regions), *cut, /*dem=*/nullptr, friction_name);
+      if (!values.ok()) return values.status();
+      face_friction = *std::move(values);
       mesh = *std::move(cut);
     }
     return mesh;
+  };
+  auto made = [&](MeshData drawn) {
+    absl::StatusOr<Dem> out = FromMesh(std::move(drawn), info);
+    if (out.ok()) out->face_friction_ = std::move(face_friction);
+    return out;
   };
 
   // Faces: per block, corners a (i, j), b (i+1, j), c (i, j+1), d (i+1, j+1), split along a-d:
@@ -1019,7 +1205,7 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
     info.z_tolerance = options.z_tolerance;
     absl::StatusOr<MeshData> drawn = cut_drawn(*std::move(tin));
     if (!drawn.ok()) return drawn.status();
-    return FromMesh(*std::move(drawn), info);
+    return made(*std::move(drawn));
   }
   dem.face_of_block_.assign(2 * size_t{W - 1} * (H - 1), kNoVertex);
   for (uint32_t j = 0; j + 1 < H; ++j) {
@@ -1042,10 +1228,10 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
                    ? "no 2x2 block of cells above the barrier: nothing to triangulate"
                    : "no 2x2 block of cells with data: nothing to triangulate");
   }
-  if (barrier == nullptr && outlines == nullptr) return dem;
+  if (barrier == nullptr && friction_regions.empty()) return dem;
   absl::StatusOr<MeshData> drawn = cut_drawn(dem.mesh_);
   if (!drawn.ok()) return drawn.status();
-  return FromMesh(*std::move(drawn), info);
+  return made(*std::move(drawn));
 }
 
 absl::StatusOr<std::array<double, 2>> Dem::CellCentreInMesh(uint32_t col, uint32_t row) const {

@@ -71,10 +71,11 @@ assert d / 2 * (1 - 1e-9) <= t2 <= d / 2 * 1.003, (t2, d / 2)"
 # drawn as polygons or as a raster. Faces take the friction under their centroids, so the band's
 # edges follow the triangles: 90 to 100 m of it are crossed. With --friction-boundaries exact the
 # polygons' outlines are cut into the DEM's mesh: exactly 100 m (270 + 400 s, within the bound).
-for fr in band.geojson friction.tif exact; do
+for fr in band.geojson friction.tif exact exact_snap; do
   extra=()
   file=$fr low=640
   [ "$fr" = exact ] && extra=(--friction-boundaries exact) file=band.geojson low=670
+  [ "$fr" = exact_snap ] && extra=(--friction-boundaries exact --friction-snap 0.1) file=band.geojson low=670
   "$GEODEX" distances "$F" --sources g:500015:4999855 --at g:500385:4999855 \
     --speed constant:3.6 --friction "$tmp/$file" "${extra[@]}" --format json >"$tmp/band_$fr.json"
   check "friction $fr: exit 0" test $? -eq 0
@@ -166,6 +167,13 @@ expect_error "speed syntax" "--speed: 'walking' is not constant:KMH" distances "
 expect_error "epsilon" "--cost-epsilon: must be in (0, 1)" distances "$F" --sources 0 --speed constant:5 --cost-epsilon 2
 expect_error "friction CRS" "is not the DEM's" distances "$F" --sources 0 --speed constant:5 --friction "$tmp/friction_utm32.tif"
 expect_error "friction on a mesh" "friction maps need a DEM" distances "$tmp/sq.off" --sources 0 --speed constant:5 --friction "$tmp/band.geojson"
+# --friction-snap: the band's sides lie 5 m from the cell centres, outside its 1 m discs: as drawn.
+check "friction-snap 0.1 leaves outlines its discs do not reach as drawn: the same time" $PY -c "
+import json
+a, b = (json.load(open('$tmp/band_%s.json' % k))['points'][0]['time_s'] for k in ('exact', 'exact_snap'))
+assert a == b, (a, b)"
+expect_error "friction-snap range" "--friction-snap: must be in [0, 0.25]" distances "$F" --sources 0 --speed constant:5 --friction "$tmp/band.geojson" --friction-boundaries exact --friction-snap 0.5
+expect_error "friction-snap without exact" "--friction-snap goes with --friction-boundaries exact" distances "$F" --sources 0 --speed constant:5 --friction "$tmp/band.geojson" --friction-snap 0.1
 expect_error "friction-boundaries value" "must be exact or faces" distances "$F" --sources 0 --speed constant:5 --friction "$tmp/band.geojson" --friction-boundaries cut
 expect_error "friction-boundaries on a raster" "cuts friction polygons" distances "$F" --sources 0 --speed constant:5 --friction "$tmp/friction.tif" --friction-boundaries exact
 printf '1\n' >"$tmp/w1.txt"

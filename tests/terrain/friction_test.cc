@@ -248,5 +248,85 @@ TEST_F(DemTest, OutlinesCutIntoTheMeshMakeRegionBoundariesExact) {
               (*t)[0].first, (*t)[0].first / optimum - 1);
 }
 
+// DemOptions::friction_snap: a rectangle of friction 4 whose west side runs 0.05 m east of a
+// column of cell centres (the mesh's vertices, 10 m apart). Cut in exactly, it leaves new
+// vertices 0.05 m from those (slivers); snapped at 0.1 (discs of 1 m), the side runs through the
+// column and no new vertex comes within 1 m of a grid vertex. The faces' values
+// (Dem::face_friction) follow the outline as cut: exactly the drawn area unsnapped, the drawn area
+// plus what the snap added (0.05 m x 150 m along the column and two 5 m tapers) snapped.
+TEST_F(DemTest, SnappedOutlinesRunThroughNearbyVertices) {
+  const std::string path = Write("flat.tif", Flat());
+  const double west = 500105.05, east = 500208, south = 4999800, north = 4999960;
+  const std::string regions = (dir_ / "rectangle.geojson").string();
+  std::ofstream(regions) << absl::StrFormat(
+      R"({"type": "Feature", "properties": {"friction": 4},
+      "crs": {"type": "name", "properties": {"name": "EPSG:32633"}},
+      "geometry": {"type": "Polygon", "coordinates": [[[%.17g, %.17g], [%.17g, %.17g],
+                   [%.17g, %.17g], [%.17g, %.17g], [%.17g, %.17g]]]}})",
+      west, south, east, south, east, north, west, north, west, south);
+  absl::StatusOr<Dem> grid = Dem::Read(path);
+  ASSERT_TRUE(grid.ok()) << grid.status();
+  const size_t grid_vertices = grid->mesh().vertex_count();
+  // The nearest new vertex to a grid vertex (cell centres at 500005 + 10 i, 4999995 - 10 j).
+  auto closest_new = [&](const MeshData& m) {
+    double closest = std::numeric_limits<double>::infinity();
+    for (size_t v = grid_vertices; v < m.vertex_count(); ++v) {
+      const double x = m.positions[3 * v], y = m.positions[3 * v + 1];
+      const double gx = 500005 + 10 * std::round((x - 500005) / 10);
+      const double gy = 4999995 - 10 * std::round((4999995 - y) / 10);
+      closest = std::min(closest, std::hypot(x - gx, y - gy));
+    }
+    return closest;
+  };
+  // The x-y area of the faces of friction 4, and every face on its side of the outline as cut.
+  auto friction_area = [&](const Dem& dem) {
+    const MeshData& m = dem.mesh();
+    EXPECT_EQ(dem.face_friction().size(), m.face_count());
+    double area = 0;
+    for (size_t f = 0; f < m.face_count() && f < dem.face_friction().size(); ++f) {
+      const double* a = &m.positions[3 * size_t{m.faces[3 * f]}];
+      const double* b = &m.positions[3 * size_t{m.faces[3 * f + 1]}];
+      const double* c = &m.positions[3 * size_t{m.faces[3 * f + 2]}];
+      const double w = dem.face_friction()[f];
+      EXPECT_TRUE(w == 1 || w == 4) << w;
+      if (w == 4) {
+        area += std::abs((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])) / 2;
+      }
+    }
+    return area;
+  };
+  const double drawn = (east - west) * (north - south);
+
+  DemOptions exact;
+  exact.friction_file = regions;
+  absl::StatusOr<Dem> cut = Dem::Read(path, exact);
+  ASSERT_TRUE(cut.ok()) << cut.status();
+  EXPECT_LT(closest_new(cut->mesh()), 0.1);  // the slivers
+  EXPECT_NEAR(friction_area(*cut), drawn, 1e-6 * drawn);
+
+  DemOptions snapped = exact;
+  snapped.friction_snap = 0.1;
+  absl::StatusOr<Dem> snap = Dem::Read(path, snapped);
+  ASSERT_TRUE(snap.ok()) << snap.status();
+  EXPECT_GE(closest_new(snap->mesh()), 1.0);
+  EXPECT_LT(snap->mesh().vertex_count(), cut->mesh().vertex_count());
+  const double added = 0.05 * (north - south - 10) + 2 * (0.5 * 0.05 * 5);
+  EXPECT_NEAR(friction_area(*snap), drawn + added, 1e-6 * drawn);
+
+  // Out of range, or nothing to snap: errors naming the flag.
+  for (double bad : {-0.1, 0.3, std::numeric_limits<double>::quiet_NaN()}) {
+    DemOptions options = exact;
+    options.friction_snap = bad;
+    absl::Status s = Dem::Read(path, options).status();
+    EXPECT_TRUE(absl::IsInvalidArgument(s)) << s;
+    EXPECT_NE(s.message().find("--friction-snap"), std::string::npos) << s;
+  }
+  DemOptions alone;
+  alone.friction_snap = 0.1;
+  absl::Status s = Dem::Read(path, alone).status();
+  EXPECT_TRUE(absl::IsInvalidArgument(s)) << s;
+  EXPECT_NE(s.message().find("--friction-snap"), std::string::npos) << s;
+}
+
 }  // namespace
 }  // namespace geodex::terrain

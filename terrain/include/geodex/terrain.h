@@ -55,6 +55,12 @@ struct DemOptions {
   // the friction read from the same file on this mesh (ReadFrictionFile) has exact region
   // boundaries (geodex/friction.h). "": none.
   std::string friction_file;
+  // With friction_file: outlines snapped onto the mesh's vertices before they are cut in. A
+  // vertex v within friction_snap x the shortest x-y edge at v of an outline is put on it (an
+  // outline corner moved there, or v inserted into the outline's segment), so outlines leave no
+  // sliver at v; the drawn boundary moves by at most that distance (docs/travel.md). 0: exact.
+  // In [0, 0.25] (discs of neighbours stay apart).
+  double friction_snap = 0;
   // The most cells (width x height of the file) a raster may have, and the most vertices and
   // faces its mesh may have (every used cell with data, two triangles per block); 0: any. What a
   // server sets before GDAL reads untrusted bytes: checked before any row is read, a
@@ -73,6 +79,10 @@ struct DemOptions {
 MeshData RemoveFacesBelow(const MeshData& mesh, double z);
 
 // What a DEM mesh knows about its map.
+// DemOptions::friction_snap's range ([0, 0.25]): InvalidArgument naming --friction-snap outside
+// it. Dem::Read checks it; the CLI checks it first, as the flag's usage.
+absl::Status CheckFrictionSnap(double friction_snap);
+
 struct DemInfo {
   std::string driver;                            // GDAL's short name ("GTiff")
   uint32_t raster_width = 0, raster_height = 0;  // the file's grid
@@ -169,13 +179,17 @@ class Dem {
   const MeshData& mesh() const { return mesh_; }
   const DemInfo& info() const { return info_; }
   bool is_tin() const { return info_.z_tolerance > 0; }
+  // Read with DemOptions::friction_file: each face's friction from the regions as they were cut in
+  // (after DemOptions::friction_snap), 1 outside them. Empty otherwise.
+  const std::vector<double>& face_friction() const { return face_friction_; }
   // The memory it holds (mesh copy and grid maps).
   uint64_t MemoryBytes() const {
     return mesh_.positions.capacity() * sizeof(double) +
            (mesh_.faces.capacity() + vertex_of_cell_.capacity() + face_of_block_.capacity() +
             face_of_cell_.capacity() + neighbours_.capacity()) *
                sizeof(uint32_t) +
-           pieces_.capacity() * sizeof(pieces_[0]) + cell_uv_.capacity() * sizeof(cell_uv_[0]);
+           pieces_.capacity() * sizeof(pieces_[0]) + cell_uv_.capacity() * sizeof(cell_uv_[0]) +
+           face_friction_.capacity() * sizeof(double);
   }
   // The vertex of used cell (col, row), or kNoVertex (nodata).
   uint32_t VertexAt(uint32_t col, uint32_t row) const {
@@ -240,6 +254,7 @@ class Dem {
   std::vector<uint32_t> face_of_cell_;
   std::vector<uint32_t> neighbours_;
   std::vector<std::array<double, 2>> cell_uv_;
+  std::vector<double> face_friction_;  // face_friction()
   // ReadDataset's TIN: the adaptive TIN of the grid `grid` (every used cell with data a vertex,
   // no face yet) with its vertices in row order, the grid's holes cut out of it exactly (`file_crs`
   // places them); fills `info`'s deviations.
