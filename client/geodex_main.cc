@@ -71,8 +71,10 @@ Travel time (distances, path, matrix, isolines, voronoi; docs/travel.md): --spee
       its 3D length x the face's friction / the speed. --friction FILE on a DEM: GeoJSON
       polygons with a numeric "friction" property, or a raster in the DEM's CRS (nodata
       impassable); each face takes the value under its centroid (--friction-boundaries exact:
-      polygons' outlines cut into the DEM's mesh, exact boundaries, often far slower; faces:
-      the default). --face-weights FILE: one
+      polygons' outlines cut into the DEM's mesh, exact boundaries, often far slower, and
+      --friction-snap F in [0, 0.25] first moves them onto the vertices within F x the
+      vertex's shortest edge: much faster, boundaries moved that little; faces: the default).
+      --face-weights FILE: one
       weight per face, a number a line (inf: impassable). --max-slope DEG: faces steeper than
       DEG (from the x-y plane, z up) are impassable. --max-steiner-points N bounds the engine's
       memory (about 32 bytes a point). Answers say so: a '# travel time in seconds ...' first

@@ -586,6 +586,16 @@ uint64_t SnapOutlinesToVertices(std::vector<FrictionRegion>& regions, const Mesh
   std::nth_element(lengths.begin(), lengths.begin() + lengths.size() / 2, lengths.end());
   const double cell = lengths[lengths.size() / 2];
   if (!(cell > 0)) return 0;
+  // The discs' box: only the part of a segment inside it is walked (a polygon may reach far
+  // beyond the mesh, and its walk must not grow with that).
+  double box[4] = {kInf, kInf, -kInf, -kInf};  // min x, min y, max x, max y
+  for (uint32_t v = 0; v < n; ++v) {
+    if (radius[v] == kInf) continue;
+    box[0] = std::min(box[0], xy(v)[0] - radius[v]);
+    box[1] = std::min(box[1], xy(v)[1] - radius[v]);
+    box[2] = std::max(box[2], xy(v)[0] + radius[v]);
+    box[3] = std::max(box[3], xy(v)[1] + radius[v]);
+  }
   // Each vertex in every bucket (a square of the median edge length) its disc touches.
   auto key = [](int64_t i, int64_t j) { return (static_cast<uint64_t>(i) << 32) ^ uint32_t(j); };
   auto index = [cell](double x) { return static_cast<int64_t>(std::floor(x / cell)); };
@@ -630,9 +640,22 @@ uint64_t SnapOutlinesToVertices(std::vector<FrictionRegion>& regions, const Mesh
       // neighbours): a disc the segment enters lists its vertex in the bucket where it does.
       on_segment.clear();
       seen.clear();
-      const int steps = static_cast<int>(std::ceil(2 * length / cell));
-      for (int k = 0; k <= steps; ++k) {
-        const int64_t i0 = index(p[0] + dx * k / steps), j0 = index(p[1] + dy * k / steps);
+      double t0 = 0, t1 = 1;  // the segment's part inside the box (Liang and Barsky's clip)
+      for (int axis = 0; axis < 2; ++axis) {
+        const double d = axis == 0 ? dx : dy, from = p[axis];
+        if (d == 0) {
+          if (from < box[axis] || from > box[axis + 2]) t1 = -1;
+          continue;
+        }
+        const double a = (box[axis] - from) / d, b = (box[axis + 2] - from) / d;
+        t0 = std::max(t0, std::min(a, b));
+        t1 = std::min(t1, std::max(a, b));
+      }
+      const double inside = t1 > t0 ? (t1 - t0) * length : 0;
+      const int64_t steps = t1 >= t0 ? static_cast<int64_t>(std::ceil(2 * inside / cell)) + 1 : -1;
+      for (int64_t k = 0; k <= steps; ++k) {
+        const double t = steps > 0 ? t0 + (t1 - t0) * k / steps : t0;
+        const int64_t i0 = index(p[0] + dx * t), j0 = index(p[1] + dy * t);
         for (int64_t i = i0 - 1; i <= i0 + 1; ++i) {
           for (int64_t j = j0 - 1; j <= j0 + 1; ++j) {
             if (!seen.insert(key(i, j)).second) continue;

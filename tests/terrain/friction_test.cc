@@ -253,17 +253,25 @@ TEST_F(DemTest, OutlinesCutIntoTheMeshMakeRegionBoundariesExact) {
 // vertices 0.05 m from those (slivers); snapped at 0.1 (discs of 1 m), the side runs through the
 // column and no new vertex comes within 1 m of a grid vertex. The faces' values
 // (Dem::face_friction) follow the outline as cut: exactly the drawn area unsnapped, the drawn area
-// plus what the snap added (0.05 m x 150 m along the column and two 5 m tapers) snapped.
+// plus what the snap added (0.05 m x 150 m along the column and two 5 m tapers) snapped. A second
+// region (friction 2) runs 0.05 m from another column from 1000 km south of the DEM to 1000 km
+// north of it: only its part over the mesh is walked, and it is snapped there all the same.
 TEST_F(DemTest, SnappedOutlinesRunThroughNearbyVertices) {
   const std::string path = Write("flat.tif", Flat());
   const double west = 500105.05, east = 500208, south = 4999800, north = 4999960;
   const std::string regions = (dir_ / "rectangle.geojson").string();
+  const double far_west = 500305.05, far_south = 4e6, far_north = 6e6, far_east = 6e5;
   std::ofstream(regions) << absl::StrFormat(
-      R"({"type": "Feature", "properties": {"friction": 4},
-      "crs": {"type": "name", "properties": {"name": "EPSG:32633"}},
+      R"({"type": "FeatureCollection",
+      "crs": {"type": "name", "properties": {"name": "EPSG:32633"}}, "features": [
+      {"type": "Feature", "properties": {"friction": 4},
       "geometry": {"type": "Polygon", "coordinates": [[[%.17g, %.17g], [%.17g, %.17g],
-                   [%.17g, %.17g], [%.17g, %.17g], [%.17g, %.17g]]]}})",
-      west, south, east, south, east, north, west, north, west, south);
+                   [%.17g, %.17g], [%.17g, %.17g], [%.17g, %.17g]]]}},
+      {"type": "Feature", "properties": {"friction": 2},
+      "geometry": {"type": "Polygon", "coordinates": [[[%.17g, %.17g], [%.17g, %.17g],
+                   [%.17g, %.17g], [%.17g, %.17g], [%.17g, %.17g]]]}}]})",
+      west, south, east, south, east, north, west, north, west, south, far_west, far_south,
+      far_east, far_south, far_east, far_north, far_west, far_north, far_west, far_south);
   absl::StatusOr<Dem> grid = Dem::Read(path);
   ASSERT_TRUE(grid.ok()) << grid.status();
   const size_t grid_vertices = grid->mesh().vertex_count();
@@ -278,8 +286,8 @@ TEST_F(DemTest, SnappedOutlinesRunThroughNearbyVertices) {
     }
     return closest;
   };
-  // The x-y area of the faces of friction 4, and every face on its side of the outline as cut.
-  auto friction_area = [&](const Dem& dem) {
+  // The x-y area of the faces of friction `value`.
+  auto friction_area = [&](const Dem& dem, double value) {
     const MeshData& m = dem.mesh();
     EXPECT_EQ(dem.face_friction().size(), m.face_count());
     double area = 0;
@@ -288,21 +296,24 @@ TEST_F(DemTest, SnappedOutlinesRunThroughNearbyVertices) {
       const double* b = &m.positions[3 * size_t{m.faces[3 * f + 1]}];
       const double* c = &m.positions[3 * size_t{m.faces[3 * f + 2]}];
       const double w = dem.face_friction()[f];
-      EXPECT_TRUE(w == 1 || w == 4) << w;
-      if (w == 4) {
+      EXPECT_TRUE(w == 1 || w == 2 || w == 4) << w;
+      if (w == value) {
         area += std::abs((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])) / 2;
       }
     }
     return area;
   };
   const double drawn = (east - west) * (north - south);
+  // The mesh spans the cell centres: x in [500005, 500395], y in [4999705, 4999995].
+  const double drawn_far = (500395 - far_west) * 290, snapped_far = (500395 - 500305) * 290;
 
   DemOptions exact;
   exact.friction_file = regions;
   absl::StatusOr<Dem> cut = Dem::Read(path, exact);
   ASSERT_TRUE(cut.ok()) << cut.status();
   EXPECT_LT(closest_new(cut->mesh()), 0.1);  // the slivers
-  EXPECT_NEAR(friction_area(*cut), drawn, 1e-6 * drawn);
+  EXPECT_NEAR(friction_area(*cut, 4), drawn, 1e-6 * drawn);
+  EXPECT_NEAR(friction_area(*cut, 2), drawn_far, 1e-6 * drawn_far);
 
   DemOptions snapped = exact;
   snapped.friction_snap = 0.1;
@@ -311,7 +322,8 @@ TEST_F(DemTest, SnappedOutlinesRunThroughNearbyVertices) {
   EXPECT_GE(closest_new(snap->mesh()), 1.0);
   EXPECT_LT(snap->mesh().vertex_count(), cut->mesh().vertex_count());
   const double added = 0.05 * (north - south - 10) + 2 * (0.5 * 0.05 * 5);
-  EXPECT_NEAR(friction_area(*snap), drawn + added, 1e-6 * drawn);
+  EXPECT_NEAR(friction_area(*snap, 4), drawn + added, 1e-6 * drawn);
+  EXPECT_NEAR(friction_area(*snap, 2), snapped_far, 1e-6 * drawn_far);
 
   // Out of range, or nothing to snap: errors naming the flag.
   for (double bad : {-0.1, 0.3, std::numeric_limits<double>::quiet_NaN()}) {
