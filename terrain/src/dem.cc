@@ -572,7 +572,7 @@ uint64_t SnapOutlinesToVertices(std::vector<FrictionRegion>& regions, const Mesh
   auto xy = [&](uint32_t v) {
     return std::array<double, 2>{mesh.positions[3 * size_t{v}], mesh.positions[3 * size_t{v} + 1]};
   };
-  std::vector<double> radius(n, kInf);  // kInf: used by no face, never a snap target
+  std::vector<double> radius(n, kInf);  // (kInf until an edge is seen; 0 below: no face uses it)
   std::vector<double> lengths;
   lengths.reserve(mesh.faces.size());
   for (size_t c = 0; c < mesh.faces.size(); ++c) {
@@ -586,11 +586,14 @@ uint64_t SnapOutlinesToVertices(std::vector<FrictionRegion>& regions, const Mesh
   std::nth_element(lengths.begin(), lengths.begin() + lengths.size() / 2, lengths.end());
   const double cell = lengths[lengths.size() / 2];
   if (!(cell > 0)) return 0;
+  // A disc reaches at most 4 buckets away: a vertex with only long edges (an adaptive TIN's flat
+  // expanse) snaps less rather than fill thousands of buckets.
+  for (double& r : radius) r = r == kInf ? 0 : std::min(r, 4 * cell);  // 0: never a target
   // The discs' box: only the part of a segment inside it is walked (a polygon may reach far
   // beyond the mesh, and its walk must not grow with that).
   double box[4] = {kInf, kInf, -kInf, -kInf};  // min x, min y, max x, max y
   for (uint32_t v = 0; v < n; ++v) {
-    if (radius[v] == kInf) continue;
+    if (!(radius[v] > 0)) continue;
     box[0] = std::min(box[0], xy(v)[0] - radius[v]);
     box[1] = std::min(box[1], xy(v)[1] - radius[v]);
     box[2] = std::max(box[2], xy(v)[0] + radius[v]);
@@ -601,7 +604,7 @@ uint64_t SnapOutlinesToVertices(std::vector<FrictionRegion>& regions, const Mesh
   auto index = [cell](double x) { return static_cast<int64_t>(std::floor(x / cell)); };
   absl::flat_hash_map<uint64_t, std::vector<uint32_t>> buckets;
   for (uint32_t v = 0; v < n; ++v) {
-    if (radius[v] == kInf || !(radius[v] > 0)) continue;
+    if (!(radius[v] > 0)) continue;
     const auto [x, y] = xy(v);
     for (int64_t i = index(x - radius[v]); i <= index(x + radius[v]); ++i) {
       for (int64_t j = index(y - radius[v]); j <= index(y + radius[v]); ++j) {
@@ -610,13 +613,21 @@ uint64_t SnapOutlinesToVertices(std::vector<FrictionRegion>& regions, const Mesh
     }
   }
   const std::vector<uint32_t> none;
+  auto in_box = [&](double x, double y) {  // (false for NaN)
+    return x >= box[0] && x <= box[2] && y >= box[1] && y <= box[3];
+  };
   auto near = [&](double x, double y) -> const std::vector<uint32_t>& {
+    if (!in_box(x, y)) return none;
     auto it = buckets.find(key(index(x), index(y)));
     return it == buckets.end() ? none : it->second;
   };
   uint64_t moved = 0;
+  // The walk's budget in buckets visited, for all outlines together: a polygon of millions of
+  // edges across a large DEM stops being snapped (what is left stays as drawn) rather than stall.
+  uint64_t budget = 64 * uint64_t{mesh.face_count()} + (uint64_t{1} << 20);
   auto snap_ring = [&](OGRLinearRing& ring, uint64_t* count) {
     std::vector<std::array<double, 2>> in(ring.getNumPoints());
+    if (in.empty()) return;
     for (size_t i = 0; i < in.size(); ++i) in[i] = {ring.getX(i), ring.getY(i)};
     for (auto& p : in) {  // corners onto the nearest vertex whose disc holds them
       double best = kInf;
@@ -651,11 +662,20 @@ uint64_t SnapOutlinesToVertices(std::vector<FrictionRegion>& regions, const Mesh
         t0 = std::max(t0, std::min(a, b));
         t1 = std::min(t1, std::max(a, b));
       }
-      const double inside = t1 > t0 ? (t1 - t0) * length : 0;
-      const int64_t steps = t1 >= t0 ? static_cast<int64_t>(std::ceil(2 * inside / cell)) + 1 : -1;
+      if (!(t1 >= t0)) continue;  // (also NaN: the cutter names coordinates that are not finite)
+      // The clipped ends, clamped into the box (rounding of a huge segment's t stays bounded).
+      auto clamped = [&](double t) {
+        return std::array<double, 2>{std::clamp(p[0] + dx * t, box[0], box[2]),
+                                     std::clamp(p[1] + dy * t, box[1], box[3])};
+      };
+      const auto a = clamped(t0), b = clamped(t1);
+      const int64_t steps =
+          static_cast<int64_t>(std::ceil(2 * std::hypot(b[0] - a[0], b[1] - a[1]) / cell)) + 1;
+      if (budget < uint64_t(steps)) continue;
+      budget -= steps;
       for (int64_t k = 0; k <= steps; ++k) {
-        const double t = steps > 0 ? t0 + (t1 - t0) * k / steps : t0;
-        const int64_t i0 = index(p[0] + dx * t), j0 = index(p[1] + dy * t);
+        const int64_t i0 = index(a[0] + (b[0] - a[0]) * k / steps);
+        const int64_t j0 = index(a[1] + (b[1] - a[1]) * k / steps);
         for (int64_t i = i0 - 1; i <= i0 + 1; ++i) {
           for (int64_t j = j0 - 1; j <= j0 + 1; ++j) {
             if (!seen.insert(key(i, j)).second) continue;
@@ -663,8 +683,8 @@ uint64_t SnapOutlinesToVertices(std::vector<FrictionRegion>& regions, const Mesh
             if (it == buckets.end()) continue;
             for (uint32_t v : it->second) {
               const double vx = xy(v)[0] - p[0], vy = xy(v)[1] - p[1];
-              const double t = (vx * dx + vy * dy) / (length * length);
-              if (t <= 0 || t >= 1) continue;
+              const double t = (vx * dx + vy * dy) / length / length;
+              if (!(t > 0 && t < 1)) continue;
               if (std::abs(vx * dy - vy * dx) / length < radius[v]) on_segment.push_back({t, v});
             }
           }

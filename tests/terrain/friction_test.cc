@@ -333,6 +333,26 @@ TEST_F(DemTest, SnappedOutlinesRunThroughNearbyVertices) {
     EXPECT_TRUE(absl::IsInvalidArgument(s)) << s;
     EXPECT_NE(s.message().find("--friction-snap"), std::string::npos) << s;
   }
+  // Hostile shapes: an empty ring, and a triangle reaching 1e300 m out. Snapped, they are cut
+  // in or refused by name, in bounded time (the walk clipped to the mesh; ASan sees no read of an
+  // empty ring).
+  const std::string hostile = (dir_ / "hostile.geojson").string();
+  std::ofstream(hostile) << R"({"type": "FeatureCollection",
+      "crs": {"type": "name", "properties": {"name": "EPSG:32633"}}, "features": [
+      {"type": "Feature", "properties": {"friction": 3},
+       "geometry": {"type": "Polygon", "coordinates": [[]]}},
+      {"type": "Feature", "properties": {"friction": 2}, "geometry": {"type": "Polygon",
+       "coordinates": [[[500105.05, 4999800], [1e300, 4999800], [1e300, 1e300],
+                        [500105.05, 4999800]]]}}]})";
+  DemOptions wild = snapped;
+  wild.friction_file = hostile;
+  wild.friction_snap = 0.25;
+  absl::StatusOr<Dem> odd = Dem::Read(path, wild);
+  EXPECT_TRUE(odd.ok() || absl::IsInvalidArgument(odd.status())) << odd.status();
+  if (odd.ok()) {
+    EXPECT_EQ(odd->face_friction().size(), odd->mesh().face_count());
+  }
+
   DemOptions alone;
   alone.friction_snap = 0.1;
   absl::Status s = Dem::Read(path, alone).status();
