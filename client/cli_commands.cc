@@ -398,14 +398,13 @@ absl::StatusOr<terrain::DemOptions> MeshReadOptions(const Args& args, const std:
     if (how == "exact") dem.friction_file = path;
   }
   // --friction-snap F: those outlines snapped onto the vertices within F x the shortest edge at
-  // the vertex (terrain's DemOptions::friction_snap checks the range).
+  // the vertex (terrain's CheckFrictionSnap holds its rules).
   if (!GetDouble(args, "friction-snap", &dem.friction_snap, &error)) {
     return absl::InvalidArgumentError(error);
   }
-  if (absl::Status s = terrain::CheckFrictionSnap(dem.friction_snap); !s.ok()) return s;
-  if (args.options.count("friction-snap") && dem.friction_file.empty()) {
-    return absl::InvalidArgumentError(
-        "--friction-snap goes with --friction-boundaries exact (it snaps the outlines cut in)");
+  if (absl::Status s = terrain::CheckFrictionSnap(dem.friction_snap, !dem.friction_file.empty());
+      !s.ok()) {
+    return s;
   }
   return dem;
 }

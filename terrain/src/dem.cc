@@ -289,12 +289,19 @@ std::unique_ptr<OGRGeometry> OutlinesOf(const std::vector<FrictionRegion>& regio
 
 }  // namespace
 
-absl::Status CheckFrictionSnap(double friction_snap) {
-  if (friction_snap >= 0 && friction_snap <= 0.25) return absl::OkStatus();
-  return absl::InvalidArgumentError(
-      absl::StrCat("--friction-snap: must be in [0, 0.25] (a fraction of the shortest edge at a "
-                   "vertex; 0: exact), got ",
-                   friction_snap));
+absl::Status CheckFrictionSnap(double friction_snap, bool has_outlines) {
+  if (!(friction_snap >= 0 && friction_snap <= 0.25)) {
+    return absl::InvalidArgumentError(
+        absl::StrCat("--friction-snap: must be in [0, 0.25] (a fraction of the shortest edge at a "
+                     "vertex; 0: exact), got ",
+                     friction_snap));
+  }
+  if (friction_snap > 0 && !has_outlines) {
+    return absl::InvalidArgumentError(
+        "--friction-snap: snaps friction outlines cut into the mesh (--friction-boundaries exact "
+        "with friction polygons); there are none");
+  }
+  return absl::OkStatus();
 }
 
 Dem::Dem(Dem&&) noexcept = default;
@@ -563,10 +570,9 @@ absl::Status RegionsToMeshFrame(std::vector<FrictionRegion>& regions, const DemI
 // face, which must take it as a corner), and the bounded engine's Steiner points per edge grow as
 // 1 / sin(smallest angle), its links per face as their square. Through the vertex, the outline
 // leaves no such piece there. A region whose snapped outline is no longer a valid polygon (two
-// of its stretches closer than the discs) keeps its drawn shape. Returns the points moved or
-// inserted.
-uint64_t SnapOutlinesToVertices(std::vector<FrictionRegion>& regions, const MeshData& mesh,
-                                double fraction) {
+// of its stretches closer than the discs) keeps its drawn shape.
+void SnapOutlinesToVertices(std::vector<FrictionRegion>& regions, const MeshData& mesh,
+                            double fraction) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
   const size_t n = mesh.vertex_count();
   auto xy = [&](uint32_t v) {
@@ -582,10 +588,10 @@ uint64_t SnapOutlinesToVertices(std::vector<FrictionRegion>& regions, const Mesh
     radius[b] = std::min(radius[b], fraction * length);
     lengths.push_back(length);
   }
-  if (lengths.empty()) return 0;
+  if (lengths.empty()) return;
   std::nth_element(lengths.begin(), lengths.begin() + lengths.size() / 2, lengths.end());
   const double cell = lengths[lengths.size() / 2];
-  if (!(cell > 0)) return 0;
+  if (!(cell > 0)) return;
   // A disc reaches at most 4 buckets away: a vertex with only long edges (an adaptive TIN's flat
   // expanse) snaps less rather than fill thousands of buckets.
   for (double& r : radius) r = r == kInf ? 0 : std::min(r, 4 * cell);  // 0: never a target
@@ -621,7 +627,6 @@ uint64_t SnapOutlinesToVertices(std::vector<FrictionRegion>& regions, const Mesh
     auto it = buckets.find(key(index(x), index(y)));
     return it == buckets.end() ? none : it->second;
   };
-  uint64_t moved = 0;
   // The walk's budget in buckets visited, for all outlines together: a polygon of millions of
   // edges across a large DEM stops being snapped (what is left stays as drawn) rather than stall.
   uint64_t budget = 64 * uint64_t{mesh.face_count()} + (uint64_t{1} << 20);
@@ -707,11 +712,8 @@ uint64_t SnapOutlinesToVertices(std::vector<FrictionRegion>& regions, const Mesh
     ForEachRing(*region.shape, [&](OGRLinearRing& ring) { snap_ring(ring, &count); });
     if (count > 0 && !region.shape->IsValid()) {
       region.shape = std::move(drawn);
-      continue;
     }
-    moved += count;
   }
-  return moved;
 }
 
 }  // namespace
@@ -990,11 +992,9 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
     return absl::InvalidArgumentError(absl::StrCat(
         "--z-tolerance: must be finite and >= 0 (0: the full grid), got ", options.z_tolerance));
   }
-  if (absl::Status s = CheckFrictionSnap(options.friction_snap); !s.ok()) return s;
-  if (options.friction_snap > 0 && options.friction_file.empty()) {
-    return absl::InvalidArgumentError(
-        "--friction-snap: snaps friction outlines cut into the mesh (--friction-boundaries exact "
-        "with polygons); there are none");
+  if (absl::Status s = CheckFrictionSnap(options.friction_snap, !options.friction_file.empty());
+      !s.ok()) {
+    return s;
   }
   info.step = options.step;
   info.grid_width = (info.raster_width + options.step - 1) / options.step;

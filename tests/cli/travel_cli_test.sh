@@ -173,7 +173,7 @@ import json
 a, b = (json.load(open('$tmp/band_%s.json' % k))['points'][0]['time_s'] for k in ('exact', 'exact_snap'))
 assert a == b, (a, b)"
 expect_error "friction-snap range" "--friction-snap: must be in [0, 0.25]" distances "$F" --sources 0 --speed constant:5 --friction "$tmp/band.geojson" --friction-boundaries exact --friction-snap 0.5
-expect_error "friction-snap without exact" "--friction-snap goes with --friction-boundaries exact" distances "$F" --sources 0 --speed constant:5 --friction "$tmp/band.geojson" --friction-snap 0.1
+expect_error "friction-snap without exact" "--friction-snap: snaps friction outlines cut into the mesh (--friction-boundaries exact" distances "$F" --sources 0 --speed constant:5 --friction "$tmp/band.geojson" --friction-snap 0.1
 expect_error "friction-boundaries value" "must be exact or faces" distances "$F" --sources 0 --speed constant:5 --friction "$tmp/band.geojson" --friction-boundaries cut
 expect_error "friction-boundaries on a raster" "cuts friction polygons" distances "$F" --sources 0 --speed constant:5 --friction "$tmp/friction.tif" --friction-boundaries exact
 printf '1\n' >"$tmp/w1.txt"

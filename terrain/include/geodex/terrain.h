@@ -79,9 +79,10 @@ struct DemOptions {
 MeshData RemoveFacesBelow(const MeshData& mesh, double z);
 
 // What a DEM mesh knows about its map.
-// DemOptions::friction_snap's range ([0, 0.25]): InvalidArgument naming --friction-snap outside
-// it. Dem::Read checks it; the CLI checks it first, as the flag's usage.
-absl::Status CheckFrictionSnap(double friction_snap);
+// DemOptions::friction_snap's rules: in [0, 0.25], and above 0 only with friction outlines to
+// snap (`has_outlines`: DemOptions::friction_file given). InvalidArgument naming --friction-snap
+// otherwise. Dem::Read checks them; the CLI checks them first, as the flag's usage.
+absl::Status CheckFrictionSnap(double friction_snap, bool has_outlines);
 
 struct DemInfo {
   std::string driver;                            // GDAL's short name ("GTiff")
