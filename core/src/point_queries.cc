@@ -394,7 +394,7 @@ absl::StatusOr<DistanceMatrix> ComputeDistanceMatrix(const TriangleMesh& mesh,
     std::vector<SurfacePoint> row_points;
     for (size_t r : distinct) row_points.push_back(sources[r]);
     absl::StatusOr<TravelPointSolver> solver =
-        TravelPointSolver::Create(mesh, options.solver, row_points);
+        TravelPointSolver::Create(mesh, options.solver, row_points, solved_targets);
     if (!solver.ok()) return solver.status();
     travel.emplace(*std::move(solver));
   }

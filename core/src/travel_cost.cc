@@ -228,14 +228,15 @@ absl::StatusOr<std::shared_ptr<const WeightedSurface>> BuildTravelGraph(
 
 absl::StatusOr<TravelPointSolver> TravelPointSolver::Create(
     const TriangleMesh& mesh, const GeodesicOptions& options,
-    const std::vector<SurfacePoint>& sources) {
+    const std::vector<SurfacePoint>& sources, const std::vector<SurfacePoint>& points) {
   absl::StatusOr<WeightedOptions> weighted = WeightedOptionsFor(mesh, options);
   if (!weighted.ok()) return weighted.status();
   const WeightedSurface::Limits limits{weighted->max_distance, weighted->cancel};
   if (std::shared_ptr<const WeightedSurface> shared = SharedGraph(mesh, options, *weighted)) {
     return TravelPointSolver(*options.travel, std::move(shared), limits);
   }
-  absl::StatusOr<WeightedSurface> surface = WeightedSurface::Build(mesh, *weighted, sources);
+  absl::StatusOr<WeightedSurface> surface =
+      WeightedSurface::Build(mesh, *weighted, sources, points);
   if (!surface.ok()) return surface.status();
   return TravelPointSolver(*options.travel,
                            std::make_shared<const WeightedSurface>(*std::move(surface)), limits);
@@ -260,7 +261,7 @@ absl::StatusOr<PointValues> ComputeTravelPointValues(const TriangleMesh& mesh,
                        "geodesic directions are read off the exact engine; a travel cost has none");
   }
   absl::StatusOr<TravelPointSolver> solver =
-      TravelPointSolver::Create(mesh, query.options, query.sources);
+      TravelPointSolver::Create(mesh, query.options, query.sources, query.points);
   if (!solver.ok()) return solver.status();
   return solver->Solve(query.sources, query.points, query.covers_surface);
 }

@@ -33,11 +33,13 @@ absl::StatusOr<PointValues> ComputeTravelPointValues(const TriangleMesh& mesh,
 // the weighted graph is built once and shared, read-only, by every query (thread-safe).
 class TravelPointSolver {
  public:
-  // `options` carry the travel cost; `sources`, when known, are the sources Solve will be given
-  // (WeightedSurface::Build's seeds). Errors: as ComputeTravelPointValues.
+  // `options` carry the travel cost; `sources` and `points`, when known, are what Solve will be
+  // given (WeightedSurface::Build's seeds and anchors: a Solve with other points strictly inside
+  // faces or edges builds a graph of its own). Errors: as ComputeTravelPointValues.
   static absl::StatusOr<TravelPointSolver> Create(const TriangleMesh& mesh,
                                                   const GeodesicOptions& options,
-                                                  const std::vector<SurfacePoint>& sources = {});
+                                                  const std::vector<SurfacePoint>& sources = {},
+                                                  const std::vector<SurfacePoint>& points = {});
   // Times from `sources` at `points`, in seconds (ComputeTravelPointValues without directions).
   absl::StatusOr<PointValues> Solve(const std::vector<SurfacePoint>& sources,
                                     const std::vector<SurfacePoint>& points,

@@ -65,6 +65,15 @@ struct UninitializedAllocator : std::allocator<T> {
 template <typename T>
 using LazyVector = std::vector<T, UninitializedAllocator<T>>;
 
+// A source or target resolved onto the mesh.
+struct Located {
+  SurfacePoint canonical;
+  Vec pos{};                         // internal (recentred) coordinates
+  std::vector<uint32_t> vertices;    // kVertex: the internal copies
+  std::vector<uint32_t> half_edges;  // kEdge: one per face on the edge
+  uint32_t face = kNoIndex;          // kFace
+};
+
 // The Steiner points (positions along the edges) and the per-face/per-edge weights. Node ids:
 // internal vertices 0..nv-1, then the Steiner points of edge e at nv + first[e] .. nv +
 // first[e+1] - 1 in order of increasing parameter along the edge's canonical half-edge.
@@ -79,9 +88,12 @@ class SteinerGraph {
   // (Search::CrossSegments) and claims no bound: the error then falls about as the spacing
   // squared, so far fewer points reach a given accuracy. Uniform placement is graded near
   // `seeds` (the positions searches will start from, when known; GradedCount).
+  // The bounded placement is also refined around `anchors`, the points strictly inside faces or
+  // edges that searches will start or end at (AddAnchorPoints): without it, two such points close
+  // together across an edge may cost many times their true least cost.
   enum class Placement { kBounded, kUniform };
   absl::Status Build(double epsilon, uint64_t max_points, Placement placement,
-                     const std::vector<Vec>& seeds);
+                     const std::vector<Vec>& seeds, const std::vector<Located>& anchors);
 
   const TriangleMesh& mesh() const { return mesh_; }
   uint32_t nv() const { return nv_; }
@@ -142,6 +154,17 @@ class SteinerGraph {
     return static_cast<uint32_t>(std::ceil((uniform + 1) * times)) - 1;
   }
 
+  // The anchors' extra points, as (edge, parameter) pairs (Build's bounded placement): the feet's
+  // progressions into *extra, the corners' wanted continuations below r(v) into *reach_down as
+  // (vertex, down to), which AddVicinityPoints places.
+  void AddAnchorPoints(const Located& q, double epsilon, const std::vector<double>& lambda,
+                       const std::vector<double>& radius, const std::vector<double>& w_ratio,
+                       std::vector<std::pair<uint32_t, double>>* extra,
+                       std::vector<std::pair<uint32_t, double>>* reach_down) const;
+  void AddVicinityPoints(std::vector<std::pair<uint32_t, double>> reach_down,
+                         const std::vector<double>& lambda, const std::vector<double>& radius,
+                         std::vector<std::pair<uint32_t, double>>* extra) const;
+
   // Number of i >= 0 with r lambda^i < half.
   static uint32_t SideCount(double r, double lambda, double half) {
     if (!(r < half)) return 0;
@@ -153,6 +176,9 @@ class SteinerGraph {
     return k;
   }
 
+  // Merges the anchors' (edge, parameter) points into the chains, each kept strictly increasing.
+  void MergeExtraPoints(std::vector<std::pair<uint32_t, double>> extra);
+
   const TriangleMesh& mesh_;
   const std::vector<double>& weights_;
   uint32_t nv_;
@@ -161,8 +187,99 @@ class SteinerGraph {
   uint64_t graph_edges_ = 0;
 };
 
+// The bound's argument (weighted_field.h) needs every stretch of an optimal path near a vertex to
+// lie between two long pieces inside the vertex's star, and every crossing of an edge to have
+// pieces at least t sin(theta) long on both sides. A path starting at a point q strictly inside a
+// face or an edge has neither near q: q may lie a hair from an edge, or inside a vertex's vicinity
+// ball, where no node lies (Aleksandrov, Maheshwari and Sack make such points vertices). So, for
+// each face holding q:
+//  * on each of its edges (not q's own): q's foot and points sqrt(epsilon / 2) h mu^i away from it
+//    on both sides (h: q's distance to the edge's line, mu = 1 + sqrt(epsilon / 2)) until that
+//    distance reaches where the edge's own points are as dense (L / 2 x sin theta): a crossing x
+//    at distance rho from the foot has a node within sqrt(epsilon / 8) rho <= sqrt(epsilon / 8)
+//    |q x| of it, the spacing the argument gives a piece |q x| long;
+//  * on each edge at each of its corners v: v's progression r lambda^i continued below r(v), from
+//    r'(v) = (epsilon / 8) |q v| w_min(v) / w_max(v): a stretch rerouted through v then lies in a
+//    ball small against the piece from q to it, as r(v) is against d(v).
+// Both stop at 1e-9 of their scale (a point closer than that to an edge or vertex is on it, for
+// the bound). Extra points per anchor: some hundreds (logarithmic in how close q lies).
+void SteinerGraph::AddAnchorPoints(const Located& q, double epsilon,
+                                   const std::vector<double>& lambda,
+                                   const std::vector<double>& radius,
+                                   const std::vector<double>& w_ratio,
+                                   std::vector<std::pair<uint32_t, double>>* extra,
+                                   std::vector<std::pair<uint32_t, double>>* reach_down) const {
+  std::vector<uint32_t> faces;
+  uint32_t own_edge = kNoIndex;
+  if (q.canonical.kind == SurfacePoint::Kind::kFace) faces.push_back(q.face);
+  if (q.canonical.kind == SurfacePoint::Kind::kEdge) {
+    for (const uint32_t h : q.half_edges) faces.push_back(TriangleMesh::FaceOf(h));
+    own_edge = edge_of_half_[q.half_edges[0]];
+  }
+  const double root = std::sqrt(epsilon / 2);
+  const double mu = 1 + root;
+  for (const uint32_t f : faces) {
+    if (!std::isfinite(FaceWeight(f)) || mesh_.FaceDegenerate(f)) continue;
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t e = edge_of_half_[3 * f + k];
+      if (e == own_edge || lambda[e] == 0) continue;
+      const uint32_t h0 = edge_half_[e];
+      const Vec a = mesh_.Position(mesh_.From(h0)), b = mesh_.Position(mesh_.To(h0));
+      const double len = mesh_.Length(h0);
+      const Vec u = {(b[0] - a[0]) / len, (b[1] - a[1]) / len, (b[2] - a[2]) / len};
+      const Vec aq = {q.pos[0] - a[0], q.pos[1] - a[1], q.pos[2] - a[2]};
+      const double along = aq[0] * u[0] + aq[1] * u[1] + aq[2] * u[2];
+      const Vec off = {aq[0] - along * u[0], aq[1] - along * u[1], aq[2] - along * u[2]};
+      const double height = std::sqrt(off[0] * off[0] + off[1] * off[1] + off[2] * off[2]);
+      const double foot = std::clamp(along, 0.0, len);
+      if (foot > 0 && foot < len) extra->push_back({e, foot / len});
+      const double reach = len / 2 * (lambda[e] - 1) / root;  // L / 2 x sin theta
+      for (double rho = std::max(root * height, 1e-9 * len); rho < reach; rho *= mu) {
+        if (foot - rho > 0) extra->push_back({e, (foot - rho) / len});
+        if (foot + rho < len) extra->push_back({e, (foot + rho) / len});
+      }
+    }
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t v = mesh_.FaceVertex(f, k);
+      if (!std::isfinite(radius[v])) continue;
+      const Vec p = mesh_.Position(v);
+      const double dq =
+          std::sqrt((q.pos[0] - p[0]) * (q.pos[0] - p[0]) + (q.pos[1] - p[1]) * (q.pos[1] - p[1]) +
+                    (q.pos[2] - p[2]) * (q.pos[2] - p[2]));
+      const double start = std::max(epsilon / 8 * dq * w_ratio[v], 1e-9 * radius[v]);
+      if (start < radius[v]) reach_down->push_back({v, start});
+    }
+  }
+}
+
+void SteinerGraph::AddVicinityPoints(std::vector<std::pair<uint32_t, double>> reach_down,
+                                     const std::vector<double>& lambda,
+                                     const std::vector<double>& radius,
+                                     std::vector<std::pair<uint32_t, double>>* extra) const {
+  // One continuation per vertex, down to the smallest start its anchors ask for: anchors around
+  // the same vertex share its points.
+  std::sort(reach_down.begin(), reach_down.end());
+  for (size_t i = 0; i < reach_down.size(); ++i) {
+    const auto [v, start] = reach_down[i];
+    if (i > 0 && reach_down[i - 1].first == v) continue;
+    for (const uint32_t* c = mesh_.CornersBegin(v); c != mesh_.CornersEnd(v); ++c) {
+      for (const uint32_t h : {*c, TriangleMesh::Prev(*c)}) {
+        const uint32_t e = edge_of_half_[h];
+        if (lambda[e] == 0) continue;
+        const uint32_t h0 = edge_half_[e];
+        const bool at_from = mesh_.From(h0) == v;
+        const double len = mesh_.Length(h0);
+        for (double r = radius[v] / lambda[e]; r >= start; r /= lambda[e]) {
+          if (r < len / 2) extra->push_back({e, at_from ? r / len : 1 - r / len});
+        }
+      }
+    }
+  }
+}
+
 absl::Status SteinerGraph::Build(double epsilon, uint64_t max_points, Placement placement,
-                                 const std::vector<Vec>& seeds) {
+                                 const std::vector<Vec>& seeds,
+                                 const std::vector<Located>& anchors) {
   const uint32_t nf = mesh_.face_count();
   auto usable = [&](uint32_t f) {
     return std::isfinite(FaceWeight(f)) && !mesh_.FaceDegenerate(f);
@@ -182,8 +299,12 @@ absl::Status SteinerGraph::Build(double epsilon, uint64_t max_points, Placement 
       wmax[v] = std::max(wmax[v], w);
     }
   }
+  std::vector<double> w_ratio(nv_, 0);
   for (uint32_t v = 0; v < nv_; ++v) {
-    if (std::isfinite(d[v]) && d[v] > 0) radius[v] = epsilon / 8 * d[v] * wmin[v] / wmax[v];
+    if (std::isfinite(d[v]) && d[v] > 0) {
+      w_ratio[v] = wmin[v] / wmax[v];
+      radius[v] = epsilon / 8 * d[v] * w_ratio[v];
+    }
   }
   // Edges: one id per twin pair (or boundary half-edge).
   edge_of_half_.assign(3 * static_cast<size_t>(nf), kNoIndex);
@@ -233,6 +354,18 @@ absl::Status SteinerGraph::Build(double epsilon, uint64_t max_points, Placement 
     count_b[e] = SideCount(radius[mesh_.To(h0)], lambda[e], half);
     total += uint64_t{count_a[e]} + count_b[e] + 1;
   }
+  std::vector<std::pair<uint32_t, double>> extra;
+  if (placement == Placement::kBounded) {
+    std::vector<std::pair<uint32_t, double>> reach_down;
+    for (const Located& q : anchors) {
+      if (q.canonical.kind == SurfacePoint::Kind::kFace ||
+          q.canonical.kind == SurfacePoint::Kind::kEdge) {
+        AddAnchorPoints(q, epsilon, lambda, radius, w_ratio, &extra, &reach_down);
+      }
+    }
+    AddVicinityPoints(std::move(reach_down), lambda, radius, &extra);
+    total += extra.size();  // at most: duplicates go below
+  }
   if (max_points != 0 && total > max_points) {
     return LimitExceededError(
         Limit::kSteinerPoints,
@@ -273,6 +406,8 @@ absl::Status SteinerGraph::Build(double epsilon, uint64_t max_points, Placement 
     }
   }
   first_[ne] = at;
+  param_.resize(at);
+  if (!extra.empty()) MergeExtraPoints(std::move(extra));
   // Implicit edge count: per passable face, node pairs on different edges (Steiner to Steiner and
   // Steiner to the opposite vertex); per passable edge, its chain.
   for (uint32_t f = 0; f < nf; ++f) {
@@ -290,14 +425,33 @@ absl::Status SteinerGraph::Build(double epsilon, uint64_t max_points, Placement 
   return absl::OkStatus();
 }
 
-// A source or target resolved onto the mesh.
-struct Located {
-  SurfacePoint canonical;
-  Vec pos{};                         // internal (recentred) coordinates
-  std::vector<uint32_t> vertices;    // kVertex: the internal copies
-  std::vector<uint32_t> half_edges;  // kEdge: one per face on the edge
-  uint32_t face = kNoIndex;          // kFace
-};
+void SteinerGraph::MergeExtraPoints(std::vector<std::pair<uint32_t, double>> extra) {
+  std::sort(extra.begin(), extra.end());
+  const uint32_t ne = edge_count();
+  std::vector<uint32_t> first(ne + 1, 0);
+  std::vector<double> param;
+  param.reserve(param_.size() + extra.size());
+  size_t x = 0;
+  std::vector<double> chain;
+  for (uint32_t e = 0; e < ne; ++e) {
+    first[e] = static_cast<uint32_t>(param.size());
+    if (x == extra.size() || extra[x].first != e) {
+      param.insert(param.end(), param_.begin() + first_[e], param_.begin() + first_[e + 1]);
+      continue;
+    }
+    chain.assign(param_.begin() + first_[e], param_.begin() + first_[e + 1]);
+    for (; x < extra.size() && extra[x].first == e; ++x) {
+      const double t = extra[x].second;
+      if (t > 0 && t < 1) chain.push_back(t);
+    }
+    std::sort(chain.begin(), chain.end());
+    chain.erase(std::unique(chain.begin(), chain.end()), chain.end());
+    param.insert(param.end(), chain.begin(), chain.end());
+  }
+  first[ne] = static_cast<uint32_t>(param.size());
+  first_ = std::move(first);
+  param_ = std::move(param);
+}
 
 absl::StatusOr<Located> Locate(const TriangleMesh& mesh, const SurfacePoint& p) {
   if (absl::Status s = ValidateSurfacePoint(mesh, p); !s.ok()) return s;
@@ -1468,6 +1622,21 @@ struct WeightedSurface::Impl {
   SteinerGraph graph;
   std::optional<IsotropicCost> isotropic;
   std::optional<DirectionalCost> directional;
+  // The bounded placement's anchors (sorted positions): a search from or to any other point
+  // strictly inside a face or an edge needs a surface refined around it (Anchors).
+  std::vector<Vec> anchored;
+
+  // Whether every point of `points` is a vertex or one of the anchors (or the placement has none).
+  bool Anchors(const std::vector<Located>& points) const {
+    if (isotropic == std::nullopt) return true;
+    for (const Located& l : points) {
+      if (l.canonical.kind != SurfacePoint::Kind::kVertex &&
+          !std::binary_search(anchored.begin(), anchored.end(), l.pos)) {
+        return false;
+      }
+    }
+    return true;
+  }
 
   // Calls fn(cost model).
   template <typename Fn>
@@ -1479,9 +1648,11 @@ struct WeightedSurface::Impl {
 namespace {
 
 // The graph and the cost model of `options` (already validated): the one place the model is
-// chosen. Every solve builds its surface here; `seeds` are the sources when known.
+// chosen. Every solve builds its surface here; `seeds` are the sources when known, `anchors` every
+// point the surface will be searched from or to (the bounded placement is refined around them).
 absl::StatusOr<std::unique_ptr<WeightedSurface::Impl>> BuildSurface(
-    const TriangleMesh& mesh, const WeightedOptions& options, const std::vector<Located>& seeds) {
+    const TriangleMesh& mesh, const WeightedOptions& options, const std::vector<Located>& seeds,
+    const std::vector<Located>& anchors) {
   auto impl = std::make_unique<WeightedSurface::Impl>(mesh, options);
   // The placement goes with the cost model: a model that crosses between points (no bound to
   // keep, kInterpolates) takes them evenly spaced.
@@ -1493,10 +1664,14 @@ absl::StatusOr<std::unique_ptr<WeightedSurface::Impl>> BuildSurface(
                                                 : placement_of(DirectionalCost::kInterpolates);
   std::vector<Vec> seed_positions;
   for (const Located& l : seeds) seed_positions.push_back(l.pos);
-  if (absl::Status s =
-          impl->graph.Build(options.epsilon, options.max_steiner_points, placement, seed_positions);
+  if (absl::Status s = impl->graph.Build(options.epsilon, options.max_steiner_points, placement,
+                                         seed_positions, anchors);
       !s.ok()) {
     return s;
+  }
+  if (placement == SteinerGraph::Placement::kBounded) {
+    for (const Located& l : anchors) impl->anchored.push_back(l.pos);
+    std::sort(impl->anchored.begin(), impl->anchored.end());
   }
   if (options.slope_cost == nullptr) {
     impl->isotropic.emplace(impl->graph);
@@ -1550,7 +1725,7 @@ absl::StatusOr<WeightedField> ComputeWeightedField(const TriangleMesh& mesh,
   std::vector<Located> located;
   if (absl::Status s = Prepare(mesh, sources, &located); !s.ok()) return s;
   absl::StatusOr<std::unique_ptr<WeightedSurface::Impl>> surface =
-      BuildSurface(mesh, options, located);
+      BuildSurface(mesh, options, located, located);
   if (!surface.ok()) return surface.status();
   const SteinerGraph& g = (*surface)->graph;
   return (*surface)->WithCost([&](const auto& cost) -> absl::StatusOr<WeightedField> {
@@ -1581,11 +1756,14 @@ WeightedSurface::~WeightedSurface() = default;
 
 absl::StatusOr<WeightedSurface> WeightedSurface::Build(const TriangleMesh& mesh,
                                                        const WeightedOptions& options,
-                                                       const std::vector<SurfacePoint>& seeds) {
+                                                       const std::vector<SurfacePoint>& seeds,
+                                                       const std::vector<SurfacePoint>& anchors) {
   if (absl::Status s = ValidateWeightedOptions(mesh, options); !s.ok()) return s;
-  std::vector<Located> located;
+  std::vector<Located> located, anchored;
   if (absl::Status s = Prepare(mesh, seeds, &located); !s.ok()) return s;
-  absl::StatusOr<std::unique_ptr<Impl>> impl = BuildSurface(mesh, options, located);
+  if (absl::Status s = Prepare(mesh, anchors, &anchored); !s.ok()) return s;
+  anchored.insert(anchored.end(), located.begin(), located.end());
+  absl::StatusOr<std::unique_ptr<Impl>> impl = BuildSurface(mesh, options, located, anchored);
   if (!impl.ok()) return impl.status();
   return WeightedSurface(*std::move(impl));
 }
@@ -1622,6 +1800,14 @@ WeightedOptions SearchOptions(const WeightedOptions& built, const WeightedSurfac
 
 }  // namespace
 
+namespace {
+absl::StatusOr<WeightedCosts> CostsOn(const WeightedSurface::Impl& surface,
+                                      const std::vector<Located>& from,
+                                      const std::vector<Located>& to, bool whole,
+                                      const WeightedOptions& options,
+                                      std::chrono::steady_clock::time_point start);
+}  // namespace
+
 absl::StatusOr<WeightedCosts> WeightedSurface::CostsAt(const std::vector<SurfacePoint>& sources,
                                                        const std::vector<SurfacePoint>& targets,
                                                        bool whole) const {
@@ -1636,12 +1822,31 @@ absl::StatusOr<WeightedCosts> WeightedSurface::CostsAt(const std::vector<Surface
   if (!(limits.max_distance > 0)) {
     return OptionError("max_distance", absl::StrFormat("must be > 0, got %g", limits.max_distance));
   }
-  const SteinerGraph& g = impl_->graph;
   const WeightedOptions options = SearchOptions(impl_->options, limits);
   std::vector<Located> from, to;
-  if (absl::Status s = Prepare(g.mesh(), sources, &from); !s.ok()) return s;
-  if (absl::Status s = Prepare(g.mesh(), targets, &to); !s.ok()) return s;
-  return impl_->WithCost([&](const auto& cost) -> absl::StatusOr<WeightedCosts> {
+  if (absl::Status s = Prepare(impl_->graph.mesh(), sources, &from); !s.ok()) return s;
+  if (absl::Status s = Prepare(impl_->graph.mesh(), targets, &to); !s.ok()) return s;
+  if (impl_->Anchors(from) && impl_->Anchors(to))
+    return CostsOn(*impl_, from, to, whole, options, start);
+  // Points this surface was not refined around: a surface that is, for this call.
+  std::vector<Located> anchors = from;
+  anchors.insert(anchors.end(), to.begin(), to.end());
+  absl::StatusOr<std::unique_ptr<Impl>> refined =
+      BuildSurface(impl_->graph.mesh(), impl_->options, from, anchors);
+  if (!refined.ok()) return refined.status();
+  return CostsOn(**refined, from, to, whole, options, start);
+}
+
+namespace {
+
+// CostsAt's search on `surface` (refined around every point of `from` and `to`).
+absl::StatusOr<WeightedCosts> CostsOn(const WeightedSurface::Impl& surface,
+                                      const std::vector<Located>& from,
+                                      const std::vector<Located>& to, bool whole,
+                                      const WeightedOptions& options,
+                                      std::chrono::steady_clock::time_point start) {
+  const SteinerGraph& g = surface.graph;
+  return surface.WithCost([&](const auto& cost) -> absl::StatusOr<WeightedCosts> {
     // The answers off a finished search.
     auto answer = [&](const auto& search) {
       WeightedCosts out;
@@ -1688,11 +1893,13 @@ absl::StatusOr<WeightedCosts> WeightedSurface::CostsAt(const std::vector<Surface
   });
 }
 
+}  // namespace
+
 absl::StatusOr<WeightedCosts> ComputeWeightedCostsAt(const TriangleMesh& mesh,
                                                      const std::vector<SurfacePoint>& sources,
                                                      const std::vector<SurfacePoint>& targets,
                                                      const WeightedOptions& options) {
-  absl::StatusOr<WeightedSurface> surface = WeightedSurface::Build(mesh, options, sources);
+  absl::StatusOr<WeightedSurface> surface = WeightedSurface::Build(mesh, options, sources, targets);
   if (!surface.ok()) return surface.status();
   return surface->CostsAt(sources, targets);
 }
@@ -1771,8 +1978,10 @@ absl::StatusOr<std::vector<WeightedPath>> ComputeWeightedPaths(const TriangleMes
   // and one search serve every target; it stops once every target's best is final.
   WeightedOptions outward = options;
   outward.inbound = false;
+  std::vector<Located> anchors = src_list;
+  anchors.insert(anchors.end(), dsts.begin(), dsts.end());
   absl::StatusOr<std::unique_ptr<WeightedSurface::Impl>> surface =
-      BuildSurface(mesh, outward, src_list);
+      BuildSurface(mesh, outward, src_list, anchors);
   if (!surface.ok()) return surface.status();
   return PathsOn(**surface, src_list[0], dsts, options, start);
 }
@@ -1789,7 +1998,17 @@ absl::StatusOr<std::vector<WeightedPath>> WeightedSurface::Paths(
   std::vector<Located> src_list, dsts;
   if (absl::Status s = Prepare(impl_->graph.mesh(), {from}, &src_list); !s.ok()) return s;
   if (absl::Status s = Prepare(impl_->graph.mesh(), tos, &dsts); !s.ok()) return s;
-  return PathsOn(*impl_, src_list[0], dsts, SearchOptions(impl_->options, limits), start);
+  const WeightedOptions options = SearchOptions(impl_->options, limits);
+  if (impl_->Anchors(src_list) && impl_->Anchors(dsts)) {
+    return PathsOn(*impl_, src_list[0], dsts, options, start);
+  }
+  // Points this surface was not refined around: a surface that is, for this call.
+  std::vector<Located> anchors = src_list;
+  anchors.insert(anchors.end(), dsts.begin(), dsts.end());
+  absl::StatusOr<std::unique_ptr<Impl>> refined =
+      BuildSurface(impl_->graph.mesh(), impl_->options, src_list, anchors);
+  if (!refined.ok()) return refined.status();
+  return PathsOn(**refined, src_list[0], dsts, options, start);
 }
 
 absl::StatusOr<WeightedPath> ComputeWeightedPath(const TriangleMesh& mesh, const SurfacePoint& from,

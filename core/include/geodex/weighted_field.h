@@ -42,11 +42,19 @@
 // distance t >= r(v) from its nearer end v) to its nearest Steiner point: the move is
 // <= t (lambda - 1) / 2 <= sqrt(epsilon / 8) t sin theta, both pieces at x are >= t sin theta
 // long, the optimal path is stationary in each crossing point (Snell's law), so first-order
-// changes cancel and the second-order change is <= about (epsilon / 2) x the pieces' cost. What
-// is NOT proved here: (2)'s stationarity next to a stretch rerouted by (1), and sources or targets
-// strictly inside faces or edges close to a vertex (AMS make them vertices). The tests measure the
-// bound on planes (against Euclidean and Snell's-law optima) and on real meshes (against the
-// exact engine) and find the error far inside epsilon (typically < epsilon / 10).
+// changes cancel and the second-order change is <= about (epsilon / 2) x the pieces' cost.
+// Sources and targets strictly inside faces or edges have neither long pieces nor a vicinity ball
+// of their own (AMS make them vertices): two such points a hair from an edge, facing each other
+// across it, would cost the detour through the nearest Steiner point, unboundedly more than their
+// distance. So the graph is refined around them (weighted_field.cc, AddAnchorPoints: each
+// crossing near the point gets a node within sqrt(epsilon / 8) x its distance from the point, and
+// the vertices of the point's faces continue their progressions down to (epsilon / 8) x the
+// point's distance from them), which restores both steps for them; it adds some hundreds of
+// points per such point (logarithmic in how close it lies to an edge or a vertex). What is NOT
+// proved here: (2)'s stationarity next to a stretch rerouted by (1). The tests measure the bound
+// on planes (against Euclidean and Snell's-law optima, and between points 1e-6 from an edge or a
+// corner) and on real meshes (against the exact engine) and find the error far inside epsilon
+// (typically < epsilon / 10).
 //
 // Memory: 8 bytes per Steiner point for its position on its edge plus, during a solve, 20 bytes
 // per node (cost, label, parent, heap slot) and 4 per heap entry: about 32 bytes per Steiner point,
@@ -163,12 +171,17 @@ struct WeightedPath;
 class WeightedSurface {
  public:
   // `seeds`: the sources the surface will be searched from, when known (a slope cost's points are
-  // then denser near them, for the small times there; docs/engine.md). Any sources may still be
-  // given to CostsAt. Errors: as ComputeWeightedField (options, a bad seed, the Steiner-point
+  // then denser near them, for the small times there; docs/engine.md). `anchors`: other points it
+  // will be searched to (targets). Under the bound, the graph is refined around every seed and
+  // anchor strictly inside a face or an edge (the bound's argument needs it there); CostsAt and
+  // Paths given any other such point build a surface refined around it for that call (they answer
+  // within the bound either way, the shared surface just saves the build for vertices and its
+  // anchors). Errors: as ComputeWeightedField (options, a bad seed or anchor, the Steiner-point
   // limit).
   static absl::StatusOr<WeightedSurface> Build(const TriangleMesh& mesh,
                                                const WeightedOptions& options,
-                                               const std::vector<SurfacePoint>& seeds = {});
+                                               const std::vector<SurfacePoint>& seeds = {},
+                                               const std::vector<SurfacePoint>& anchors = {});
   WeightedSurface(WeightedSurface&&) noexcept;
   WeightedSurface& operator=(WeightedSurface&&) noexcept;
   ~WeightedSurface();
