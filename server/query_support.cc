@@ -122,9 +122,13 @@ absl::StatusOr<GeodesicOptions> Options(const QueryEnv& env, const StoredMesh& m
   return out;
 }
 
-void ShareTravelGraph(const QueryEnv& env, const StoredMesh& mesh, GeodesicOptions* options) {
+void ShareTravelGraph(const QueryEnv& env, const StoredMesh& mesh,
+                      const std::vector<SurfacePoint>& points, GeodesicOptions* options) {
   if (!options->travel.has_value() || IsDirectional(*options->travel) || !env.cache->enabled()) {
     return;
+  }
+  for (const SurfacePoint& p : points) {
+    if (p.kind != SurfacePoint::Kind::kVertex) return;  // its graph is refined around it
   }
   const std::string key = TravelGraphKey(mesh.id, *options);
   std::shared_ptr<const WeightedSurface> graph = env.cache->FindGraph(key, *mesh.mesh);

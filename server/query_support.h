@@ -47,9 +47,13 @@ absl::StatusOr<GeodesicOptions> Options(const QueryEnv& env, const StoredMesh& m
 // A constant-speed travel cost's graph from the result cache (TravelGraphKey), or built and
 // cached, set in options->travel->graph: the travel paths, times at points and matrices on one
 // mesh with one cost layer then share it. Nothing without a travel cost, for a slope-dependent
-// speed (its graph follows each query's sources) or with the cache off; a graph that cannot be
-// built is left to the query, whose solve names the error. Solve-lane work (it may build).
-void ShareTravelGraph(const QueryEnv& env, const StoredMesh& mesh, GeodesicOptions* options);
+// speed (its graph follows each query's sources), with the cache off, or when any of the query's
+// `points` (its sources and targets) lies strictly inside a face or an edge: the bound needs a
+// graph refined around such a point (WeightedSurface::Build's anchors), which the query builds.
+// A graph that cannot be built is left to the query, whose solve names the error. Solve-lane
+// work (it may build).
+void ShareTravelGraph(const QueryEnv& env, const StoredMesh& mesh,
+                      const std::vector<SurfacePoint>& points, GeodesicOptions* options);
 // What an answer's travel_epsilon says: 0 for exact metres, else the epsilon the solve uses
 // (set, or the speed model's default).
 inline double TravelEpsilon(const GeodesicOptions& options) {

@@ -375,10 +375,12 @@ TEST_F(TravelServiceTest, FieldPathMatrixAndIsolinesEqualCore) {
       EXPECT_TRUE(BitEqual(response.exact(i), values->distance[i])) << i;
     }
   }
-  // Every answer above that searched a graph searched one: the first path built it (a miss),
-  // the two repeats, the batch, the matrix and the point times reused it, and equal core's own.
+  // The answers above between vertices searched one graph: the first path built it (a miss), the
+  // two repeats and the batch reused it. The matrix and the point times start at the sites on an
+  // edge and in a face, which need a graph refined around them (the bound): they built their own
+  // and left the cache alone. All equal core's own.
   EXPECT_EQ(server_->cache().graph_misses(), 1u);
-  EXPECT_EQ(server_->cache().graph_hits(), 5u);
+  EXPECT_EQ(server_->cache().graph_hits(), 3u);
 }
 
 // Travel graphs in the result cache: one per mesh and travel cost (another epsilon is another
@@ -386,7 +388,7 @@ TEST_F(TravelServiceTest, FieldPathMatrixAndIsolinesEqualCore) {
 // does not depend on whether it came from the cache.
 TEST_F(TravelServiceTest, TravelQueriesShareOneGraphPerCost) {
   auto path = [&](const GeodesicOptions& options, uint32_t to) {
-    PathQuery query{Sites()[1], SurfacePoint::AtVertex(to), {}};
+    PathQuery query{Sites()[0], SurfacePoint::AtVertex(to), {}};
     query.options.solver = options;
     v1::FindShortestPathResponse response;
     grpc::Status status = PathOverService(query, &response);
@@ -416,6 +418,20 @@ TEST_F(TravelServiceTest, TravelQueriesShareOneGraphPerCost) {
   path(SlopeTravel(), 420);  // its points follow each query's sources: no graph to share
   EXPECT_EQ(server_->cache().graph_misses(), 2u);
   EXPECT_EQ(server_->cache().graph_hits(), 3u);
+  {
+    // A point inside a face needs a graph refined around it: the query builds its own (and
+    // answers as core does), the cache is not asked.
+    PathQuery query{Sites()[2], SurfacePoint::AtVertex(420), {}};
+    query.options.solver = Travel();
+    v1::FindShortestPathResponse response;
+    ASSERT_TRUE(PathOverService(query, &response).ok());
+    absl::StatusOr<PathQueryResult> want =
+        ComputeShortestPath(*local_, query.from, query.to, query.options);
+    ASSERT_TRUE(want.ok()) << want.status();
+    EXPECT_TRUE(BitEqual(response.distance(), want->distance));
+    EXPECT_EQ(server_->cache().graph_misses(), 2u);
+    EXPECT_EQ(server_->cache().graph_hits(), 3u);
+  }
 
   // A graph keeps its mesh alive, so its entry counts the mesh's memory as well as its own.
   absl::StatusOr<std::shared_ptr<const StoredMesh>> stored = server_->store().Get("hills");
