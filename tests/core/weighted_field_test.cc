@@ -56,6 +56,14 @@ double CheckBound(const std::vector<double>& cost, const std::vector<double>& re
   return worst;
 }
 
+// A unit square of cells x cells, its vertices jittered by up to 0.2 of a cell.
+MeshData JitteredGrid(uint32_t cells) {
+  GridSpec spec;
+  spec.cells_x = spec.cells_y = cells;
+  spec.jitter = 0.2;
+  return MakeGrid(spec);
+}
+
 class WeightedFieldPlaneTest : public testing::TestWithParam<double> {};
 
 TEST_P(WeightedFieldPlaneTest, EuclideanOnAGrid) {
@@ -178,10 +186,7 @@ std::vector<SurfacePoint> PointsAroundVertex(const MeshData& data, uint32_t vert
 // exact engine on a real mesh; through a surface shared by the queries and built without them
 // too (it must build one refined around them).
 TEST(WeightedFieldTest, PointsNearEdgesAndVerticesKeepTheBound) {
-  GridSpec spec;
-  spec.cells_x = spec.cells_y = 6;
-  spec.jitter = 0.15;
-  const MeshData data = MakeGrid(spec);
+  const MeshData data = JitteredGrid(6);
   const TriangleMesh mesh = BuildMesh(data);
   // (epsilon, delta): the finer epsilon only at one delta (a point a hair from a vertex adds
   // some thousand points there, which its neighbours' links pay for as their square).
@@ -429,10 +434,7 @@ TEST(WeightedFieldTest, SearchSettlesTheGraphsLeastCosts) {
 // Many targets share one graph and one search: each path equals the one-target path bit for bit,
 // an enclosed target is +inf with no points, and the search stops once every target is final.
 TEST(WeightedFieldTest, PathsToManyTargetsShareOneSearch) {
-  GridSpec spec;
-  spec.cells_x = spec.cells_y = 20;
-  spec.jitter = 0.2;
-  const MeshData data = MakeGrid(spec);
+  const MeshData data = JitteredGrid(20);
   const TriangleMesh mesh = BuildMesh(data);
   WeightedOptions options;
   options.epsilon = 0.1;
@@ -556,13 +558,6 @@ TEST(WeightedFieldTest, DeterministicBitForBit) {
 }
 
 // A jittered grid of cells x cells squares on the unit square.
-MeshData JitteredGrid(uint32_t cells) {
-  GridSpec spec;
-  spec.cells_x = spec.cells_y = cells;
-  spec.jitter = 0.2;
-  return MakeGrid(spec);
-}
-
 // Epsilon 0.1 with these weights, constant speed, then with a slope cost 1 on the level rising to
 // 3 straight up or down.
 std::vector<WeightedOptions> WithAndWithoutSlope(const std::vector<double>& weights) {
