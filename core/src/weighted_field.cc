@@ -160,10 +160,23 @@ class SteinerGraph {
   void AddAnchorPoints(const Located& q, double epsilon, const std::vector<double>& lambda,
                        const std::vector<double>& radius, const std::vector<double>& w_ratio,
                        std::vector<std::pair<uint32_t, double>>* extra,
-                       std::vector<std::pair<uint32_t, double>>* reach_down) const;
+                       std::vector<std::pair<uint32_t, double>>* reach_down, uint64_t* room) const;
   void AddVicinityPoints(std::vector<std::pair<uint32_t, double>> reach_down,
                          const std::vector<double>& lambda, const std::vector<double>& radius,
-                         std::vector<std::pair<uint32_t, double>>* extra) const;
+                         std::vector<std::pair<uint32_t, double>>* extra, uint64_t* room) const;
+  // Takes the n points of the progression from `from` by `factor` up to `to` out of *room; false
+  // (and *room 0) when they do not fit (a factor next to 1 under a tiny epsilon), so no loop runs
+  // for ever or fills memory before the Steiner-point limit is checked.
+  static bool Fits(double from, double factor, double to, uint64_t* room) {
+    if (!(from < to)) return true;
+    const double n = std::ceil(std::log(to / from) / std::log(factor)) + 1;
+    if (!(n <= static_cast<double>(*room))) {
+      *room = 0;
+      return false;
+    }
+    *room -= static_cast<uint64_t>(n);
+    return true;
+  }
 
   // Number of i >= 0 with r lambda^i < half.
   static uint32_t SideCount(double r, double lambda, double half) {
@@ -208,7 +221,8 @@ void SteinerGraph::AddAnchorPoints(const Located& q, double epsilon,
                                    const std::vector<double>& radius,
                                    const std::vector<double>& w_ratio,
                                    std::vector<std::pair<uint32_t, double>>* extra,
-                                   std::vector<std::pair<uint32_t, double>>* reach_down) const {
+                                   std::vector<std::pair<uint32_t, double>>* reach_down,
+                                   uint64_t* room) const {
   std::vector<uint32_t> faces;
   uint32_t own_edge = kNoIndex;
   if (q.canonical.kind == SurfacePoint::Kind::kFace) faces.push_back(q.face);
@@ -234,7 +248,9 @@ void SteinerGraph::AddAnchorPoints(const Located& q, double epsilon,
       const double foot = std::clamp(along, 0.0, len);
       if (foot > 0 && foot < len) extra->push_back({e, foot / len});
       const double reach = len / 2 * (lambda[e] - 1) / root;  // L / 2 x sin theta
-      for (double rho = std::max(root * height, 1e-9 * len); rho < reach; rho *= mu) {
+      const double rho0 = std::max(root * height, 1e-9 * len);
+      if (!Fits(rho0, mu, reach, room) || !Fits(rho0, mu, reach, room)) return;
+      for (double rho = rho0; rho < reach; rho *= mu) {
         if (foot - rho > 0) extra->push_back({e, (foot - rho) / len});
         if (foot + rho < len) extra->push_back({e, (foot + rho) / len});
       }
@@ -255,7 +271,8 @@ void SteinerGraph::AddAnchorPoints(const Located& q, double epsilon,
 void SteinerGraph::AddVicinityPoints(std::vector<std::pair<uint32_t, double>> reach_down,
                                      const std::vector<double>& lambda,
                                      const std::vector<double>& radius,
-                                     std::vector<std::pair<uint32_t, double>>* extra) const {
+                                     std::vector<std::pair<uint32_t, double>>* extra,
+                                     uint64_t* room) const {
   // One continuation per vertex, down to the smallest start its anchors ask for: anchors around
   // the same vertex share its points.
   std::sort(reach_down.begin(), reach_down.end());
@@ -269,6 +286,7 @@ void SteinerGraph::AddVicinityPoints(std::vector<std::pair<uint32_t, double>> re
         const uint32_t h0 = edge_half_[e];
         const bool at_from = mesh_.From(h0) == v;
         const double len = mesh_.Length(h0);
+        if (!Fits(start, lambda[e], radius[v], room)) return;
         for (double r = radius[v] / lambda[e]; r >= start; r /= lambda[e]) {
           if (r < len / 2) extra->push_back({e, at_from ? r / len : 1 - r / len});
         }
@@ -355,16 +373,21 @@ absl::Status SteinerGraph::Build(double epsilon, uint64_t max_points, Placement 
     total += uint64_t{count_a[e]} + count_b[e] + 1;
   }
   std::vector<std::pair<uint32_t, double>> extra;
-  if (placement == Placement::kBounded) {
+  const uint64_t limit =
+      max_points != 0 ? std::min<uint64_t>(max_points, kMaxNodes - nv_) : kMaxNodes - nv_;
+  if (placement == Placement::kBounded && !anchors.empty() && total <= limit) {
+    // What the anchors may add before the limit (over it, the check below fails).
+    uint64_t room = limit - total + 1;
     std::vector<std::pair<uint32_t, double>> reach_down;
     for (const Located& q : anchors) {
-      if (q.canonical.kind == SurfacePoint::Kind::kFace ||
-          q.canonical.kind == SurfacePoint::Kind::kEdge) {
-        AddAnchorPoints(q, epsilon, lambda, radius, w_ratio, &extra, &reach_down);
+      if (room > 0 && (q.canonical.kind == SurfacePoint::Kind::kFace ||
+                       q.canonical.kind == SurfacePoint::Kind::kEdge)) {
+        AddAnchorPoints(q, epsilon, lambda, radius, w_ratio, &extra, &reach_down, &room);
       }
     }
-    AddVicinityPoints(std::move(reach_down), lambda, radius, &extra);
-    total += extra.size();  // at most: duplicates go below
+    if (room > 0) AddVicinityPoints(std::move(reach_down), lambda, radius, &extra, &room);
+    // At most what they add (duplicates go below); out of room: over the limit.
+    total += room > 0 ? extra.size() : limit - total + 1;
   }
   if (max_points != 0 && total > max_points) {
     return LimitExceededError(

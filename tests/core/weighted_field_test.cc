@@ -224,6 +224,24 @@ TEST(WeightedFieldTest, PointsNearEdgesAndVerticesKeepTheBound) {
     std::printf("plane, eps %g, delta %g: worst ratio 1 + %.3g\n", eps, delta, worst - 1);
   }
 
+  // The anchors' points count against the Steiner-point limit, and a tiny epsilon (progressions
+  // of factor next to 1) meets the limit rather than a loop that never ends.
+  {
+    const std::vector<SurfacePoint> points = PointsAroundVertex(data, 24, 1e-6);
+    WeightedOptions options;
+    options.epsilon = 0.1;
+    absl::StatusOr<WeightedSurface> bare = WeightedSurface::Build(mesh, options);
+    ASSERT_TRUE(bare.ok()) << bare.status();
+    options.max_steiner_points = bare->steiner_points() + 10;
+    EXPECT_TRUE(WeightedSurface::Build(mesh, options).ok());
+    absl::Status over = WeightedSurface::Build(mesh, options, {}, points).status();
+    EXPECT_TRUE(absl::IsResourceExhausted(over)) << over;
+    options.epsilon = 1e-12;
+    options.max_steiner_points = 0;
+    over = WeightedSurface::Build(mesh, options, {}, points).status();
+    EXPECT_TRUE(absl::IsResourceExhausted(over)) << over;
+  }
+
   absl::StatusOr<TriangleMesh> knight = LoadTestMesh("knight.off");
   ASSERT_TRUE(knight.ok()) << knight.status();
   const MeshData knight_data = knight->ToMeshData();
