@@ -245,7 +245,9 @@ absl::StatusOr<TravelPointSolver> TravelPointSolver::Create(
 absl::StatusOr<PointValues> TravelPointSolver::Solve(const std::vector<SurfacePoint>& sources,
                                                      const std::vector<SurfacePoint>& points,
                                                      bool covers_surface) const {
-  absl::StatusOr<WeightedCosts> w = surface_->CostsAt(sources, points, covers_surface, limits_);
+  WeightedSurface::Limits limits = limits_;
+  limits.anchor_targets = !covers_surface;  // a raster's cells: refined around the sources only
+  absl::StatusOr<WeightedCosts> w = surface_->CostsAt(sources, points, covers_surface, limits);
   if (!w.ok()) return w.status();
   PointValues out;
   for (double c : w->cost) out.distance.push_back(Seconds(travel_, c));
@@ -261,7 +263,8 @@ absl::StatusOr<PointValues> ComputeTravelPointValues(const TriangleMesh& mesh,
                        "geodesic directions are read off the exact engine; a travel cost has none");
   }
   absl::StatusOr<TravelPointSolver> solver =
-      TravelPointSolver::Create(mesh, query.options, query.sources, query.points);
+      TravelPointSolver::Create(mesh, query.options, query.sources,
+                                query.covers_surface ? std::vector<SurfacePoint>{} : query.points);
   if (!solver.ok()) return solver.status();
   return solver->Solve(query.sources, query.points, query.covers_surface);
 }

@@ -1849,11 +1849,12 @@ absl::StatusOr<WeightedCosts> WeightedSurface::CostsAt(const std::vector<Surface
   std::vector<Located> from, to;
   if (absl::Status s = Prepare(impl_->graph.mesh(), sources, &from); !s.ok()) return s;
   if (absl::Status s = Prepare(impl_->graph.mesh(), targets, &to); !s.ok()) return s;
-  if (impl_->Anchors(from) && impl_->Anchors(to))
+  if (impl_->Anchors(from) && (!limits.anchor_targets || impl_->Anchors(to))) {
     return CostsOn(*impl_, from, to, whole, options, start);
+  }
   // Points this surface was not refined around: a surface that is, for this call.
   std::vector<Located> anchors = from;
-  anchors.insert(anchors.end(), to.begin(), to.end());
+  if (limits.anchor_targets) anchors.insert(anchors.end(), to.begin(), to.end());
   absl::StatusOr<std::unique_ptr<Impl>> refined =
       BuildSurface(impl_->graph.mesh(), impl_->options, from, anchors);
   if (!refined.ok()) return refined.status();

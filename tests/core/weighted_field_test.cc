@@ -265,6 +265,35 @@ TEST(WeightedFieldTest, PointsNearEdgesAndVerticesKeepTheBound) {
   std::printf("knight, %zu points, eps 0.03: worst ratio 1 + %.3g\n", points.size(), worst - 1);
 }
 
+// Targets covering the surface (a raster's cells on a TIN) are not anchors: the graph stays the
+// one built around the sources (hundreds of points per cell would not fit), and its times are at
+// least those of the graph refined around every target (a superset of its nodes).
+TEST(WeightedFieldTest, TargetsCoveringTheSurfaceAreNotAnchors) {
+  const MeshData data = JitteredGrid(6);
+  const TriangleMesh mesh = BuildMesh(data);
+  WeightedOptions options;
+  options.epsilon = 0.1;
+  const std::vector<SurfacePoint> sources = {SurfacePoint::AtVertex(24)};
+  std::vector<SurfacePoint> cells;
+  for (uint32_t f = 0; f < data.face_count(); ++f) {
+    cells.push_back(SurfacePoint::InFace(f, 0.2, 0.3, 0.5));
+  }
+  absl::StatusOr<WeightedSurface> surface = WeightedSurface::Build(mesh, options, sources);
+  ASSERT_TRUE(surface.ok()) << surface.status();
+  WeightedSurface::Limits limits;
+  limits.anchor_targets = false;
+  absl::StatusOr<WeightedCosts> raster = surface->CostsAt(sources, cells, true, limits);
+  absl::StatusOr<WeightedCosts> anchored = ComputeWeightedCostsAt(mesh, sources, cells, options);
+  ASSERT_TRUE(raster.ok() && anchored.ok()) << raster.status() << anchored.status();
+  EXPECT_EQ(raster->steiner_points, surface->steiner_points());
+  EXPECT_GT(anchored->steiner_points, raster->steiner_points);
+  for (size_t c = 0; c < cells.size(); ++c) {
+    EXPECT_LE(anchored->cost[c], raster->cost[c]) << c;
+    const double euclid = Distance3(VertexPosition(data, 24), PositionOf(data, cells[c]));
+    EXPECT_GE(raster->cost[c], euclid * (1 - 1e-12)) << c;
+  }
+}
+
 TEST(WeightedFieldTest, FrictionTwoDoublesEveryCost) {
   absl::StatusOr<TriangleMesh> mesh = LoadTestMesh("knight.off");
   ASSERT_TRUE(mesh.ok()) << mesh.status();

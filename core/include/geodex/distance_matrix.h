@@ -91,6 +91,8 @@ struct PointQuery {
   bool directions = false;
   // The points cover the surface (a raster's cells on a TIN): the whole field is solved, without
   // A* towards them or the early stop, whose bookkeeping costs O(points) whenever one improves.
+  // A travel cost's graph is then refined around the sources only, not every cell
+  // (WeightedSurface::Limits::anchor_targets).
   bool covers_surface = false;
 };
 // Its answer, one entry per point, in order.

@@ -198,6 +198,12 @@ class WeightedSurface {
   struct Limits {
     double max_distance = std::numeric_limits<double>::infinity();
     const CancelToken* cancel = nullptr;
+    // False for targets that cover the surface (a raster's cells on a TIN, up to millions): the
+    // graph is then refined around the sources only, as before the anchors, since refining it
+    // around every cell would add hundreds of points each. Such a target's time keeps the bound
+    // once its path is long against the edges around it (a few edge lengths at epsilon 0.01); a
+    // cell a hair from an edge and next to a source may exceed it.
+    bool anchor_targets = true;
   };
   absl::StatusOr<WeightedCosts> CostsAt(const std::vector<SurfacePoint>& sources,
                                         const std::vector<SurfacePoint>& targets, bool whole,
