@@ -164,12 +164,12 @@ class SteinerGraph {
   void AddVicinityPoints(std::vector<std::pair<uint32_t, double>> reach_down,
                          const std::vector<double>& lambda, const std::vector<double>& radius,
                          std::vector<std::pair<uint32_t, double>>* extra, uint64_t* room) const;
-  // Takes the n points of the progression from `from` by `factor` up to `to` out of *room; false
-  // (and *room 0) when they do not fit (a factor next to 1 under a tiny epsilon), so no loop runs
-  // for ever or fills memory before the Steiner-point limit is checked.
-  static bool Fits(double from, double factor, double to, uint64_t* room) {
+  // Takes the n points of the progression from `from` by `factor` up to `to` (on each of `sides`
+  // sides) out of *room; false (and *room 0) when they do not fit (a factor next to 1 under a tiny
+  // epsilon), so no loop runs for ever or fills memory before the Steiner-point limit is checked.
+  static bool Fits(double from, double factor, double to, uint64_t* room, int sides = 1) {
     if (!(from < to)) return true;
-    const double n = std::ceil(std::log(to / from) / std::log(factor)) + 1;
+    const double n = sides * (std::ceil(std::log(to / from) / std::log(factor)) + 1);
     if (!(n <= static_cast<double>(*room))) {
       *room = 0;
       return false;
@@ -249,7 +249,7 @@ void SteinerGraph::AddAnchorPoints(const Located& q, double epsilon,
       if (foot > 0 && foot < len) extra->push_back({e, foot / len});
       const double reach = len / 2 * (lambda[e] - 1) / root;  // L / 2 x sin theta
       const double rho0 = std::max(root * height, 1e-9 * len);
-      if (!Fits(rho0, mu, reach, room) || !Fits(rho0, mu, reach, room)) return;
+      if (!Fits(rho0, mu, reach, room, /*sides=*/2)) return;
       for (double rho = rho0; rho < reach; rho *= mu) {
         if (foot - rho > 0) extra->push_back({e, (foot - rho) / len});
         if (foot + rho < len) extra->push_back({e, (foot + rho) / len});
@@ -259,10 +259,7 @@ void SteinerGraph::AddAnchorPoints(const Located& q, double epsilon,
       const uint32_t v = mesh_.FaceVertex(f, k);
       if (!std::isfinite(radius[v])) continue;
       const Vec p = mesh_.Position(v);
-      const double dq =
-          std::sqrt((q.pos[0] - p[0]) * (q.pos[0] - p[0]) + (q.pos[1] - p[1]) * (q.pos[1] - p[1]) +
-                    (q.pos[2] - p[2]) * (q.pos[2] - p[2]));
-      const double start = std::max(epsilon / 8 * dq * w_ratio[v], 1e-9 * radius[v]);
+      const double start = std::max(epsilon / 8 * Dist(q.pos, p) * w_ratio[v], 1e-9 * radius[v]);
       if (start < radius[v]) reach_down->push_back({v, start});
     }
   }
@@ -1704,6 +1701,23 @@ absl::StatusOr<std::unique_ptr<WeightedSurface::Impl>> BuildSurface(
   return impl;
 }
 
+// The surface to search from `from` to `to` on: `surface` itself when every point of both (of
+// `from` only, without `anchor_targets`) is a vertex or one of its anchors; else one refined
+// around them, built for this call and kept in *refined.
+absl::StatusOr<const WeightedSurface::Impl*> SurfaceFor(
+    const WeightedSurface::Impl& surface, const std::vector<Located>& from,
+    const std::vector<Located>& to, bool anchor_targets,
+    std::unique_ptr<WeightedSurface::Impl>* refined) {
+  if (surface.Anchors(from) && (!anchor_targets || surface.Anchors(to))) return &surface;
+  std::vector<Located> anchors = from;
+  if (anchor_targets) anchors.insert(anchors.end(), to.begin(), to.end());
+  absl::StatusOr<std::unique_ptr<WeightedSurface::Impl>> built =
+      BuildSurface(surface.graph.mesh(), surface.options, from, anchors);
+  if (!built.ok()) return built.status();
+  *refined = std::move(*built);
+  return refined->get();
+}
+
 }  // namespace
 
 absl::Status ValidateWeightedOptions(const TriangleMesh& mesh, const WeightedOptions& options) {
@@ -1849,16 +1863,11 @@ absl::StatusOr<WeightedCosts> WeightedSurface::CostsAt(const std::vector<Surface
   std::vector<Located> from, to;
   if (absl::Status s = Prepare(impl_->graph.mesh(), sources, &from); !s.ok()) return s;
   if (absl::Status s = Prepare(impl_->graph.mesh(), targets, &to); !s.ok()) return s;
-  if (impl_->Anchors(from) && (!limits.anchor_targets || impl_->Anchors(to))) {
-    return CostsOn(*impl_, from, to, whole, options, start);
-  }
-  // Points this surface was not refined around: a surface that is, for this call.
-  std::vector<Located> anchors = from;
-  if (limits.anchor_targets) anchors.insert(anchors.end(), to.begin(), to.end());
-  absl::StatusOr<std::unique_ptr<Impl>> refined =
-      BuildSurface(impl_->graph.mesh(), impl_->options, from, anchors);
-  if (!refined.ok()) return refined.status();
-  return CostsOn(**refined, from, to, whole, options, start);
+  std::unique_ptr<Impl> refined;
+  absl::StatusOr<const Impl*> surface =
+      SurfaceFor(*impl_, from, to, limits.anchor_targets, &refined);
+  if (!surface.ok()) return surface.status();
+  return CostsOn(**surface, from, to, whole, options, start);
 }
 
 namespace {
@@ -2023,16 +2032,11 @@ absl::StatusOr<std::vector<WeightedPath>> WeightedSurface::Paths(
   if (absl::Status s = Prepare(impl_->graph.mesh(), {from}, &src_list); !s.ok()) return s;
   if (absl::Status s = Prepare(impl_->graph.mesh(), tos, &dsts); !s.ok()) return s;
   const WeightedOptions options = SearchOptions(impl_->options, limits);
-  if (impl_->Anchors(src_list) && impl_->Anchors(dsts)) {
-    return PathsOn(*impl_, src_list[0], dsts, options, start);
-  }
-  // Points this surface was not refined around: a surface that is, for this call.
-  std::vector<Located> anchors = src_list;
-  anchors.insert(anchors.end(), dsts.begin(), dsts.end());
-  absl::StatusOr<std::unique_ptr<Impl>> refined =
-      BuildSurface(impl_->graph.mesh(), impl_->options, src_list, anchors);
-  if (!refined.ok()) return refined.status();
-  return PathsOn(**refined, src_list[0], dsts, options, start);
+  std::unique_ptr<Impl> refined;
+  absl::StatusOr<const Impl*> surface =
+      SurfaceFor(*impl_, src_list, dsts, /*anchor_targets=*/true, &refined);
+  if (!surface.ok()) return surface.status();
+  return PathsOn(**surface, src_list[0], dsts, options, start);
 }
 
 absl::StatusOr<WeightedPath> ComputeWeightedPath(const TriangleMesh& mesh, const SurfacePoint& from,
