@@ -12,6 +12,7 @@
 #include "geodex/triangle_mesh.h"
 #include "geodex/weighted_field.h"
 #include "travel_queries.h"
+#include "weighted_regions.h"
 
 namespace geodex {
 namespace {
@@ -181,7 +182,15 @@ absl::StatusOr<DistanceField> ComputeTravelField(const TriangleMesh& mesh,
                                                  const GeodesicOptions& options) {
   absl::StatusOr<WeightedOptions> weighted = WeightedOptionsFor(mesh, options);
   if (!weighted.ok()) return weighted.status();
-  absl::StatusOr<WeightedField> w = ComputeWeightedField(mesh, sources, *weighted);
+  absl::StatusOr<WeightedField> w;
+  if (RegionsServe(*weighted)) {
+    absl::StatusOr<std::shared_ptr<const RegionSurface>> regions =
+        RegionSurface::Build(mesh, *weighted, sources);
+    if (!regions.ok()) return regions.status();
+    w = (*regions)->Field(sources, {weighted->max_distance, weighted->cancel});
+  } else {
+    w = ComputeWeightedField(mesh, sources, *weighted);
+  }
   if (!w.ok()) return w.status();
   DistanceField field;
   field.sources = sources;
@@ -219,7 +228,8 @@ absl::StatusOr<std::shared_ptr<const WeightedSurface>> BuildTravelGraph(
     const TriangleMesh& mesh, const GeodesicOptions& options) {
   absl::StatusOr<WeightedOptions> weighted = WeightedOptionsFor(mesh, options);
   if (!weighted.ok()) return weighted.status();
-  if (weighted->slope_cost != nullptr) return nullptr;
+  // A slope cost builds its own per query; the regions need no graph.
+  if (weighted->slope_cost != nullptr || RegionsServe(*weighted)) return nullptr;
   weighted->cancel = nullptr;  // the graph outlives the call that builds it
   absl::StatusOr<WeightedSurface> surface = WeightedSurface::Build(mesh, *weighted);
   if (!surface.ok()) return surface.status();
@@ -232,14 +242,23 @@ absl::StatusOr<TravelPointSolver> TravelPointSolver::Create(
   absl::StatusOr<WeightedOptions> weighted = WeightedOptionsFor(mesh, options);
   if (!weighted.ok()) return weighted.status();
   const WeightedSurface::Limits limits{weighted->max_distance, weighted->cancel};
+  if (RegionsServe(*weighted)) {
+    std::vector<SurfacePoint> anchors = sources;
+    anchors.insert(anchors.end(), points.begin(), points.end());
+    absl::StatusOr<std::shared_ptr<const RegionSurface>> regions =
+        RegionSurface::Build(mesh, *weighted, anchors);
+    if (!regions.ok()) return regions.status();
+    return TravelPointSolver(*options.travel, nullptr, *std::move(regions), limits);
+  }
   if (std::shared_ptr<const WeightedSurface> shared = SharedGraph(mesh, options, *weighted)) {
-    return TravelPointSolver(*options.travel, std::move(shared), limits);
+    return TravelPointSolver(*options.travel, std::move(shared), nullptr, limits);
   }
   absl::StatusOr<WeightedSurface> surface =
       WeightedSurface::Build(mesh, *weighted, sources, points);
   if (!surface.ok()) return surface.status();
   return TravelPointSolver(*options.travel,
-                           std::make_shared<const WeightedSurface>(*std::move(surface)), limits);
+                           std::make_shared<const WeightedSurface>(*std::move(surface)), nullptr,
+                           limits);
 }
 
 absl::StatusOr<PointValues> TravelPointSolver::Solve(const std::vector<SurfacePoint>& sources,
@@ -247,7 +266,9 @@ absl::StatusOr<PointValues> TravelPointSolver::Solve(const std::vector<SurfacePo
                                                      bool covers_surface) const {
   WeightedSurface::Limits limits = limits_;
   limits.anchor_targets = !covers_surface;  // a raster's cells: refined around the sources only
-  absl::StatusOr<WeightedCosts> w = surface_->CostsAt(sources, points, covers_surface, limits);
+  absl::StatusOr<WeightedCosts> w =
+      regions_ != nullptr ? regions_->CostsAt(sources, points, covers_surface, limits)
+                          : surface_->CostsAt(sources, points, covers_surface, limits);
   if (!w.ok()) return w.status();
   PointValues out;
   for (double c : w->cost) out.distance.push_back(Seconds(travel_, c));
@@ -279,10 +300,21 @@ absl::StatusOr<PathsQueryResult> ComputeTravelPaths(const TriangleMesh& mesh,
   }
   absl::StatusOr<WeightedOptions> weighted = WeightedOptionsFor(mesh, options);
   if (!weighted.ok()) return weighted.status();
-  const std::shared_ptr<const WeightedSurface> shared = SharedGraph(mesh, options, *weighted);
-  absl::StatusOr<std::vector<WeightedPath>> paths =
-      shared != nullptr ? shared->Paths(from, tos, {weighted->max_distance, weighted->cancel})
-                        : ComputeWeightedPaths(mesh, from, tos, *weighted);
+  const WeightedSurface::Limits limits{weighted->max_distance, weighted->cancel};
+  absl::StatusOr<std::vector<WeightedPath>> paths;
+  if (RegionsServe(*weighted)) {
+    std::vector<SurfacePoint> anchors = tos;
+    anchors.push_back(from);
+    absl::StatusOr<std::shared_ptr<const RegionSurface>> regions =
+        RegionSurface::Build(mesh, *weighted, anchors);
+    if (!regions.ok()) return regions.status();
+    paths = (*regions)->Paths(from, tos, limits);
+  } else if (const std::shared_ptr<const WeightedSurface> shared =
+                 SharedGraph(mesh, options, *weighted)) {
+    paths = shared->Paths(from, tos, limits);
+  } else {
+    paths = ComputeWeightedPaths(mesh, from, tos, *weighted);
+  }
   if (!paths.ok()) return paths.status();
   PathsQueryResult out;
   out.distance.assign(tos.size(), kUnreachable);

@@ -29,8 +29,11 @@ absl::StatusOr<DistanceField> ComputeTravelField(const TriangleMesh& mesh,
 absl::StatusOr<PointValues> ComputeTravelPointValues(const TriangleMesh& mesh,
                                                      const PointQuery& query);
 
+class RegionSurface;
+
 // Travel times at points for many queries with one mesh and one travel cost (a matrix's rows):
-// the weighted graph is built once and shared, read-only, by every query (thread-safe).
+// the weighted graph (or, where every passable face weighs the same, the exact engine's union mesh,
+// weighted_regions.h) is built once and shared, read-only, by every query (thread-safe).
 class TravelPointSolver {
  public:
   // `options` carry the travel cost; `sources` and `points`, when known, are what Solve will be
@@ -47,10 +50,14 @@ class TravelPointSolver {
 
  private:
   TravelPointSolver(TravelCost travel, std::shared_ptr<const WeightedSurface> surface,
-                    WeightedSurface::Limits limits)
-      : travel_(std::move(travel)), surface_(std::move(surface)), limits_(limits) {}
+                    std::shared_ptr<const RegionSurface> regions, WeightedSurface::Limits limits)
+      : travel_(std::move(travel)),
+        surface_(std::move(surface)),
+        regions_(std::move(regions)),
+        limits_(limits) {}
   TravelCost travel_;
   std::shared_ptr<const WeightedSurface> surface_;  // built for the query, or TravelCost::graph
+  std::shared_ptr<const RegionSurface> regions_;    // instead, where RegionsServe
   WeightedSurface::Limits limits_;                  // the query's
 };
 

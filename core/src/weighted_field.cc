@@ -23,6 +23,7 @@
 #include "geodex/geodesic_solver.h"
 #include "geodex/limits.h"
 #include "mesh_lookup.h"
+#include "weighted_regions.h"
 
 namespace geodex {
 namespace {
@@ -94,6 +95,10 @@ class SteinerGraph {
   enum class Placement { kBounded, kUniform };
   absl::Status Build(double epsilon, uint64_t max_points, Placement placement,
                      const std::vector<Vec>& seeds, const std::vector<Located>& anchors);
+  // Before Build: points only on the edges whose half-edge edge_half (the one of the lower id)
+  // is marked, placed exactly as on the whole graph (the regions' boundaries, weighted_regions.h).
+  void PlaceOnlyOn(std::vector<uint8_t> marked_half) { only_half_ = std::move(marked_half); }
+  bool Placed(uint32_t e) const { return only_half_.empty() || only_half_[edge_half_[e]]; }
 
   const TriangleMesh& mesh() const { return mesh_; }
   uint32_t nv() const { return nv_; }
@@ -197,6 +202,7 @@ class SteinerGraph {
   uint32_t nv_;
   std::vector<uint32_t> edge_of_half_, edge_half_, first_;
   std::vector<double> edge_weight_, param_;
+  std::vector<uint8_t> only_half_;
   uint64_t graph_edges_ = 0;
 };
 
@@ -352,6 +358,7 @@ absl::Status SteinerGraph::Build(double epsilon, uint64_t max_points, Placement 
     }
     if (!std::isfinite(sin_theta) || !(sin_theta > 0)) continue;  // no passable face: no points
     lambda[e] = 1 + root * sin_theta;
+    if (!Placed(e)) continue;
     if (placement == Placement::kUniform) {  // (count_b stays 0)
       count_a[e] = uniform;
       if (!seeds.empty() && seeds.size() <= kMaxSeeds) {
@@ -404,7 +411,7 @@ absl::Status SteinerGraph::Build(double epsilon, uint64_t max_points, Placement 
   uint32_t at = 0;
   for (uint32_t e = 0; e < ne; ++e) {
     first_[e] = at;
-    if (lambda[e] == 0) continue;
+    if (lambda[e] == 0 || !Placed(e)) continue;
     const uint32_t h0 = edge_half_[e];
     const double len = mesh_.Length(h0);
     if (placement == Placement::kUniform) {
@@ -2052,6 +2059,46 @@ absl::StatusOr<WeightedPath> ComputeWeightedPath(const TriangleMesh& mesh, const
                         std::isfinite(options.max_distance) ? " within max_distance" : ""));
   }
   return std::move(path);
+}
+
+}  // namespace geodex
+
+namespace geodex {
+
+absl::StatusOr<RegionBoundaryPoints> PlaceRegionBoundaryPoints(
+    const TriangleMesh& mesh, const WeightedOptions& options,
+    const std::vector<SurfacePoint>& anchors) {
+  std::vector<Located> located;
+  if (absl::Status s = Prepare(mesh, anchors, &located); !s.ok()) return s;
+  SteinerGraph graph(mesh, options);
+  const uint32_t nh = 3 * mesh.face_count();
+  std::vector<uint8_t> marked(nh, 0);
+  auto weight = [&](uint32_t f) { return graph.FaceWeight(f); };
+  for (uint32_t h = 0; h < nh; ++h) {
+    const uint32_t t = mesh.Twin(h);
+    if (t == kNoIndex || t < h) continue;
+    const double a = weight(TriangleMesh::FaceOf(h)), b = weight(TriangleMesh::FaceOf(t));
+    if (std::isfinite(a) && std::isfinite(b) && a != b) marked[h] = 1;
+  }
+  RegionBoundaryPoints out;
+  if (std::find(marked.begin(), marked.end(), 1) == marked.end()) {
+    out.first.push_back(0);  // one weight: no boundary
+    return out;
+  }
+  graph.PlaceOnlyOn(std::move(marked));
+  if (absl::Status s = graph.Build(options.epsilon, options.max_steiner_points,
+                                   SteinerGraph::Placement::kBounded, {}, located);
+      !s.ok()) {
+    return s;
+  }
+  for (uint32_t e = 0; e < graph.edge_count(); ++e) {
+    if (!graph.Placed(e) || graph.First(e) == graph.End(e)) continue;
+    out.half_edge.push_back(graph.EdgeHalf(e));
+    out.first.push_back(static_cast<uint32_t>(out.param.size()));
+    for (uint32_t n = graph.First(e); n < graph.End(e); ++n) out.param.push_back(graph.Param(n));
+  }
+  out.first.push_back(static_cast<uint32_t>(out.param.size()));
+  return out;
 }
 
 }  // namespace geodex

@@ -70,6 +70,7 @@ TEST(TravelCostTest, APlaneAtOneMetrePerSecondGivesDistancesInSeconds) {
 }
 
 // Friction 2 everywhere doubles every time, bit for bit, in the field, at points and in paths.
+// One weight: every answer is exact (weighted_regions.h), the exact engine's / the speed.
 TEST(TravelCostTest, FrictionTwoDoublesEveryTime) {
   const TriangleMesh mesh = SquarePlane(6, 100, 0.25);
   const std::vector<SurfacePoint> sources = {SurfacePoint::AtVertex(3)};
@@ -88,7 +89,14 @@ TEST(TravelCostTest, FrictionTwoDoublesEveryTime) {
   EXPECT_NEAR(pa->distance, pa->path.length * 3.6 / 5, 1e-9 * pa->distance);
   absl::StatusOr<PointValues> at = ComputePointValues(mesh, {sources, {to}, doubled});
   ASSERT_TRUE(at.ok()) << at.status();
-  EXPECT_NEAR(at->distance[0], pb->distance, 1e-9 * pb->distance);
+  EXPECT_NEAR(at->distance[0], pb->distance, 1e-12 * pb->distance);
+  absl::StatusOr<PathQueryResult> exact = ComputeShortestPath(mesh, {sources[0], to, {}});
+  ASSERT_TRUE(exact.ok()) << exact.status();
+  EXPECT_NEAR(pa->distance, exact->distance * 3.6 / 5, 1e-12 * pa->distance);
+  EXPECT_NEAR(pa->path.length, exact->path.length, 1e-9 * exact->path.length);
+  absl::StatusOr<PointValues> at_plain = ComputePointValues(mesh, {sources, {to}, plain});
+  ASSERT_TRUE(at_plain.ok()) << at_plain.status();
+  EXPECT_EQ(at->distance[0], 2 * at_plain->distance[0]);
 }
 
 // A ridge: two 40-degree ramps meeting at the top, between flat ground on both sides. With a slope

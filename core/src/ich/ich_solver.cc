@@ -63,6 +63,7 @@ void IchSolver::SeedVertex(uint32_t v, uint32_t label) {
   const uint32_t id = NewPseudoSourceWindow(v, 0, label, 0);
   ++stats_.pseudo_sources;
   Push(id, 0);
+  if (regions_ != nullptr) ShareWithCopies(v, 0, label);
 }
 
 void IchSolver::SeedFacePoint(const ResolvedSource& s) {
@@ -105,7 +106,10 @@ void IchSolver::EmitFromPointInFace(uint32_t parent, uint32_t frame_edge, double
     const double qy = -(px - cx[k]) * uy + (py - cy[k]) * ux;
     UpdateVertex(mesh_.From(h), sigma + Hypot(qx, qy), parent, h, qx, qy);
     const uint32_t t = mesh_.Twin(h);
-    if (t == kNoIndex) continue;
+    if (t == kNoIndex) {
+      if (regions_ != nullptr) ReachBoundary(h, 0, len, len - qx, -qy, sigma, source);
+      continue;
+    }
     // In the twin's frame the point lies behind the edge: (len - x, -y).
     MakeInterval(parent, t, 0, len, len - qx, -qy, WindowSide::kInitial, pseudo_source, sigma,
                  source);
@@ -123,6 +127,7 @@ bool IchSolver::UpdateVertex(uint32_t v, double d, uint32_t parent, uint32_t hal
   label_[v] = p.source;
   origin_[v] = VertexOrigin{
       half_edge, p.kind == WindowKind::kPseudoSource ? p.element : p.pseudo_source, ix, iy};
+  if (regions_ != nullptr) ShareWithCopies(v, d, p.source);
   // Paths bend only at saddle and boundary vertices (P4); with lambda > 0 every vertex also passes
   // its distance along its edges, so it gets a (relax-only) pseudo-source window too.
   if (mesh_.IsPseudoSourceCandidate(v) || epsilon_ > 0) {
@@ -149,6 +154,7 @@ void IchSolver::RelaxNeighbors(uint32_t v, double d, uint32_t source) {
     if (has_targets_ && vertex_is_target_[u]) targets_dirty_ = true;
     label_[u] = source;
     origin_[u] = VertexOrigin{kNoIndex, v, 0, 0};
+    if (regions_ != nullptr) ShareWithCopies(u, du, source);
     if ((mesh_.IsPseudoSourceCandidate(u) || epsilon_ > 0) && du <= options_.max_distance) {
       // The neighbour becomes a pseudo-source of its own (a root: it does not depend on any
       // interval window's survival).
@@ -296,12 +302,16 @@ double IchSolver::IntervalKey(double b0, double b1, double ix, double iy, double
   if (t0 <= 0 && w.b0 <= kTinyWindowRel * len && d1 < dist_[mesh_.From(h)] * (1 - kFilterRelTol)) {
     UpdateVertex(mesh_.From(h), d1, id, h, w.ix, w.iy);
   }
-  if (t != kNoIndex && t1 > t0) {
+  if (t1 > t0) {
     const double ux = x3 / el, uy = y3 / el;
     const double nix = w.ix * ux + w.iy * uy;
     const double niy = -w.ix * uy + w.iy * ux;
-    MakeInterval(id, t, t0 * el, t1 * el, nix, niy, WindowSide::kLeft, w.pseudo_source, w.sigma,
-                 w.source);
+    if (t != kNoIndex) {
+      MakeInterval(id, t, t0 * el, t1 * el, nix, niy, WindowSide::kLeft, w.pseudo_source, w.sigma,
+                   w.source);
+    } else if (regions_ != nullptr) {
+      ReachBoundary(e, t0 * el, t1 * el, nix, niy, w.sigma, w.source);
+    }
   }
 }
 
@@ -321,13 +331,17 @@ double IchSolver::IntervalKey(double b0, double b1, double ix, double iy, double
       d2 < dist_[mesh_.To(h)] * (1 - kFilterRelTol)) {
     UpdateVertex(mesh_.To(h), d2, id, h, w.ix, w.iy);
   }
-  if (t != kNoIndex && t1 > t0) {
+  if (t1 > t0) {
     const double ux = wx / el, uy = wy / el;
     const double rx = w.ix - x3, ry = w.iy - y3;
     const double nix = rx * ux + ry * uy;
     const double niy = -rx * uy + ry * ux;
-    MakeInterval(id, t, t0 * el, t1 * el, nix, niy, WindowSide::kRight, w.pseudo_source, w.sigma,
-                 w.source);
+    if (t != kNoIndex) {
+      MakeInterval(id, t, t0 * el, t1 * el, nix, niy, WindowSide::kRight, w.pseudo_source, w.sigma,
+                   w.source);
+    } else if (regions_ != nullptr) {
+      ReachBoundary(e, t0 * el, t1 * el, nix, niy, w.sigma, w.source);
+    }
   }
 }
 
@@ -445,9 +459,9 @@ absl::Status IchSolver::Run(const std::vector<ResolvedSource>& sources,
     stop_early_ = stop_early;
     unfinished_.clear();
     for (uint32_t t = 0; t < targets->size(); ++t) unfinished_.push_back(t);
-    heuristic_ = use_heuristic && FitGoal();
+    heuristic_ = use_heuristic && regions_ == nullptr && FitGoal();
     // Refitting needs the stop test's bookkeeping (TargetsBound), hence stop_early.
-    refit_goal_ = use_heuristic && stop_early && targets->size() > 1;
+    refit_goal_ = use_heuristic && regions_ == nullptr && stop_early && targets->size() > 1;
     next_final_ = kUnreachable;
     for (uint32_t t = 0; t < targets->size(); ++t) {
       for (uint32_t v : (*targets)[t].vertices) {
@@ -467,6 +481,10 @@ absl::Status IchSolver::Run(const std::vector<ResolvedSource>& sources,
   const uint32_t nv = mesh_.vertex_count();
   queue_.Reset(kQueueResolutionEdges * mesh_.MeanEdgeLength());
   queue_.reserve(4 * size_t{nv});
+  if (regions_ != nullptr) {
+    point_cost_.assign(regions_->point_count(), kUnreachable);
+    point_from_.assign(regions_->point_count(), kNoIndex);
+  }
 
   for (const ResolvedSource& s : sources) {
     if (s.is_vertex) {
@@ -510,8 +528,11 @@ absl::Status IchSolver::Run(const std::vector<ResolvedSource>& sources,
               stats_.windows_created, options_.max_windows));
       break;
     }
-    if (pool_[e.window].kind == WindowKind::kPseudoSource) {
+    const WindowKind kind = pool_[e.window].kind;
+    if (kind == WindowKind::kPseudoSource) {
       ProcessPseudoSource(e.window);
+    } else if (kind == WindowKind::kBoundaryPoint) {
+      ProcessBoundaryPoint(e.window);
     } else {
       ProcessInterval(e.window, e.key);
     }

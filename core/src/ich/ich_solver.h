@@ -12,6 +12,7 @@
 #include "geodex/distance_field.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/triangle_mesh.h"
+#include "ich/region_links.h"
 #include "ich/solve_workspace.h"
 #include "ich/window.h"
 
@@ -84,6 +85,12 @@ class IchSolver {
   // other targets' results are then upper bounds, or +inf).
   void set_final_needed(uint32_t k) { final_needed_ = k; }
 
+  // Runs on the union of a weighted surface's regions (weighted_regions.h): vertex copies share
+  // their cost and boundary points pass theirs on to both regions. `links` must outlive the
+  // solver; the solver then uses no A* key (costs in different regions are not comparable by
+  // position) and the paper's tree is not supported (Method::kExact only).
+  void set_regions(const RegionLinks* links) { regions_ = links; }
+
   // The last solve's per-vertex arrays (internal ids), for backtracing paths.
   const std::vector<double>& distances() const { return dist_; }
   const std::vector<uint32_t>& labels() const { return label_; }
@@ -155,6 +162,19 @@ class IchSolver {
   void ReleaseIfDone(uint32_t id);
   void RelaxNeighbors(uint32_t v, double d, uint32_t source);
 
+  // --- regions (region_links.h) ---
+  // A window's rays meeting the boundary half-edge e over [x0, x1] (measured from e's end, the
+  // image at (ix, iy) as MakeInterval takes it on e's twin): the chain's points there get costs.
+  void ReachBoundary(uint32_t e, double x0, double x1, double ix, double iy, double sigma,
+                     uint32_t source);
+  // Lowers boundary point p's cost to d (reached from half-edge `from`, kNoIndex: along its chain).
+  void ReachPoint(uint32_t p, double d, uint32_t source, uint32_t from);
+  void ProcessBoundaryPoint(uint32_t id);
+  // A copy of v got cost d: its other copies get it too, and spawn their own windows.
+  void ShareWithCopies(uint32_t v, double d, uint32_t source);
+  // From boundary vertex v along each boundary edge at it, to the chain's point nearest v.
+  void RelaxChainEnds(uint32_t v, double d, uint32_t source);
+
   // --- targets ---
   // The queue key of an interval window: its smallest distance, plus the A* term when enabled.
   double WindowKey(uint32_t half_edge, double b0, double b1, double ix, double iy, double sigma,
@@ -221,6 +241,10 @@ class IchSolver {
   WindowQueue& queue_;
   std::vector<uint32_t>& scratch_;  // reused stack for subtree deletion
   SolveStats stats_;
+
+  const RegionLinks* regions_ = nullptr;
+  std::vector<double> point_cost_;    // per boundary point
+  std::vector<uint32_t> point_from_;  // the half-edge whose window set it (kNoIndex: its chain)
 };
 
 }  // namespace geodex::ich

@@ -45,6 +45,7 @@ void IchSolver::ProcessPseudoSource(uint32_t id) {
   }
   // Neighbours first: the filter of the windows below then already sees their distances.
   RelaxNeighbors(v, w.sigma, w.source);
+  if (regions_ != nullptr && regions_->point_count() > 0) RelaxChainEnds(v, w.sigma, w.source);
   // Sources (distance 0) and saddle/boundary vertices spawn windows; with lambda > 0 other
   // vertices only pass their distance along edges.
   const bool spawns_windows = mesh_.IsPseudoSourceCandidate(v) || w.sigma == 0;
@@ -61,8 +62,14 @@ void IchSolver::ProcessPseudoSource(uint32_t id) {
       }
       const uint32_t opposite = TriangleMesh::Next(corner);  // the edge facing v in this face
       const uint32_t t = mesh_.Twin(opposite);
-      if (t == kNoIndex) continue;
       const double len = mesh_.Length(opposite);
+      if (t == kNoIndex) {
+        if (regions_ != nullptr) {
+          ReachBoundary(opposite, 0, len, len - mesh_.OppX(opposite), -mesh_.OppY(opposite),
+                        w.sigma, w.source);
+        }
+        continue;
+      }
       MakeInterval(id, t, 0, len, len - mesh_.OppX(opposite), -mesh_.OppY(opposite),
                    WindowSide::kInitial, v, w.sigma, w.source);
     }
@@ -90,7 +97,7 @@ void IchSolver::SpawnShadowWindows(uint32_t id, uint32_t v, double sigma, uint32
     const uint32_t corner = *c;
     const uint32_t opposite = TriangleMesh::Next(corner);
     const uint32_t t = mesh_.Twin(opposite);
-    if (t == kNoIndex) continue;
+    if (t == kNoIndex && regions_ == nullptr) continue;
     const double start = mesh_.CornerStartAngle(corner), span = mesh_.CornerAngle(corner);
     // The sector may wrap around the fan: test it shifted by -total, 0 and +total.
     for (int wrap = -1; wrap <= 1; ++wrap) {
@@ -111,8 +118,12 @@ void IchSolver::SpawnShadowWindows(uint32_t id, uint32_t v, double sigma, uint32
       const double x0 = s0 <= 0 ? 0.0 : hit(s0);
       const double x1 = s1 >= span ? len : hit(s1);
       // In the twin's frame positions run the other way.
-      MakeInterval(id, t, len - x1, len - x0, len - px, -py, WindowSide::kInitial, v, sigma,
-                   source);
+      if (t == kNoIndex) {
+        ReachBoundary(opposite, len - x1, len - x0, len - px, -py, sigma, source);
+      } else {
+        MakeInterval(id, t, len - x1, len - x0, len - px, -py, WindowSide::kInitial, v, sigma,
+                     source);
+      }
     }
   }
 }

@@ -50,7 +50,9 @@ struct HugePageAllocator {
 template <typename T>
 using HugeVector = std::vector<T, HugePageAllocator<T>>;
 
-enum class WindowKind : uint8_t { kInterval, kPseudoSource };
+// kBoundaryPoint: a point on an edge between two regions of a weighted surface (region_links.h)
+// whose cost is final once popped; `element` is the point's index.
+enum class WindowKind : uint8_t { kInterval, kPseudoSource, kBoundaryPoint };
 // Which child of its parent an interval window is: the one on the edge from the parent edge's
 // start to the opposite vertex (left), from the opposite vertex to the parent edge's end (right),
 // or one of the windows a pseudo-source spawns on its opposite edges (initial).

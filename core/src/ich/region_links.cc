@@ -1,0 +1,116 @@
+// Where the regions of a weighted surface meet (region_links.h): boundary points and vertex
+// copies. Inside a region the engine's own rules apply unchanged (lengths there are costs).
+
+#include <algorithm>
+#include <cmath>
+
+#include "ich/ich_solver.h"
+#include "ich/numerics.h"
+
+namespace geodex::ich {
+
+void IchSolver::ReachBoundary(uint32_t e, double x0, double x1, double ix, double iy, double sigma,
+                              uint32_t source) {
+  const uint32_t c = regions_->chain_of_half[e];
+  if (c == kNoIndex) return;  // a true boundary, or an impassable face beyond
+  const double len = mesh_.Length(e);
+  if (iy > -kGrazingRel * len) return;  // rays along the edge: the chain's own links carry them
+  if (sigma - iy > key_cap_) return;
+  // Positions are measured from e's end; a point at parameter t along the chain lies at
+  // len x (1 - t) from it, or len x t when the chain runs from e's end.
+  const bool reversed = regions_->chain_reversed[e];
+  const double tol = kCoverRelTol * len;
+  const double lo = (x0 - tol) / len, hi = (x1 + tol) / len;
+  const double t_lo = reversed ? lo : 1 - hi, t_hi = reversed ? hi : 1 - lo;
+  const double* begin = regions_->point_param.data() + regions_->chain_first[c];
+  const double* end = regions_->point_param.data() + regions_->chain_first[c + 1];
+  const double* it = std::lower_bound(begin, end, t_lo);
+  for (; it != end && *it <= t_hi; ++it) {
+    const double x = len * (reversed ? *it : 1 - *it);
+    ReachPoint(static_cast<uint32_t>(it - regions_->point_param.data()),
+               sigma + Hypot(x - ix, iy), source, e);
+  }
+}
+
+void IchSolver::ReachPoint(uint32_t p, double d, uint32_t source, uint32_t from) {
+  if (!(d < point_cost_[p]) || d > key_cap_) return;
+  point_cost_[p] = d;
+  point_from_[p] = from;
+  const uint32_t id = pool_.Allocate();
+  Window& w = pool_[id];
+  pool_.SetKind(id, WindowKind::kBoundaryPoint, WindowSide::kInitial);
+  w.element = p;
+  w.sigma = d;
+  w.b0 = w.b1 = w.ix = w.iy = 0;
+  w.pseudo_source = kNoIndex;
+  w.source = source;
+  w.level = 0;
+  ++stats_.pseudo_sources;
+  Push(id, d);
+}
+
+void IchSolver::ProcessBoundaryPoint(uint32_t id) {
+  const Window w = pool_[id];
+  const uint32_t p = w.element;
+  pool_.MarkProcessed(id);
+  if (w.sigma != point_cost_[p]) {  // superseded
+    ReleaseIfDone(id);
+    return;
+  }
+  const uint32_t c = regions_->point_chain[p];
+  const double t = regions_->point_param[p];
+  // Into both regions as a point source on their edge; the side whose window set the cost needs
+  // nothing more from it (straight on from that window's image is never longer).
+  for (const uint32_t e : regions_->chain_halves[c]) {
+    if (e == kNoIndex || e == point_from_[p]) continue;
+    const double len = mesh_.Length(e);
+    EmitFromPointInFace(id, e, len * (regions_->chain_reversed[e] ? 1 - t : t), 0, w.sigma,
+                        kNoIndex, w.source);
+  }
+  // Along the edge, to its neighbours (the ends are the edge's vertices, reached straight above).
+  const double cost = regions_->chain_cost[c];
+  if (p > regions_->chain_first[c]) {
+    ReachPoint(p - 1, w.sigma + cost * (t - regions_->point_param[p - 1]), w.source, kNoIndex);
+  }
+  if (p + 1 < regions_->chain_first[c + 1]) {
+    ReachPoint(p + 1, w.sigma + cost * (regions_->point_param[p + 1] - t), w.source, kNoIndex);
+  }
+  ReleaseIfDone(id);
+}
+
+void IchSolver::ShareWithCopies(uint32_t v, double d, uint32_t source) {
+  for (uint32_t u = regions_->next_copy[v]; u != v; u = regions_->next_copy[u]) {
+    if (!(d < dist_[u])) continue;
+    if (dist_[u] == kUnreachable) TouchVertex(u);
+    dist_[u] = d;
+    straight_through_[u] = 0;
+    if (has_targets_ && vertex_is_target_[u]) targets_dirty_ = true;
+    label_[u] = source;
+    origin_[u] = VertexOrigin{kNoIndex, v, 0, 0};
+    if (d > options_.max_distance) continue;
+    // A copy lies on its region's boundary: a pseudo-source, its windows all around.
+    const uint32_t id = NewPseudoSourceWindow(u, d, source, 0);
+    ++stats_.pseudo_sources;
+    Push(id, d);
+  }
+}
+
+void IchSolver::RelaxChainEnds(uint32_t v, double d, uint32_t source) {
+  for (const uint32_t* corner = mesh_.CornersBegin(v); corner != mesh_.CornersEnd(v); ++corner) {
+    // The face's two edges at v: the one leaving v and the one arriving.
+    for (const uint32_t e : {*corner, TriangleMesh::Prev(*corner)}) {
+      const uint32_t c = regions_->chain_of_half[e];
+      if (c == kNoIndex) continue;
+      const uint32_t first = regions_->chain_first[c], last = regions_->chain_first[c + 1];
+      if (first == last) continue;
+      // The chain's start is e's start unless reversed; v is e's start when e leaves v.
+      const bool v_at_chain_start = (e == *corner) != (regions_->chain_reversed[e] != 0);
+      const uint32_t p = v_at_chain_start ? first : last - 1;
+      const double t = regions_->point_param[p];
+      ReachPoint(p, d + regions_->chain_cost[c] * (v_at_chain_start ? t : 1 - t), source,
+                 kNoIndex);
+    }
+  }
+}
+
+}  // namespace geodex::ich

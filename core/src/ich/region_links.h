@@ -1,0 +1,34 @@
+#pragma once
+
+// How the regions of a weighted surface meet, for the engine running on their union
+// (weighted_regions.h): each region of one weight is its own component of the mesh the engine
+// runs on, scaled by its weight, so every length there is a cost; the components touch only
+// through these links.
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace geodex::ich {
+
+struct RegionLinks {
+  // Per half-edge of the union mesh: the chain of boundary points on it (kNoIndex: none), and
+  // whether the chain runs from the half-edge's end to its start.
+  std::vector<uint32_t> chain_of_half;
+  std::vector<uint8_t> chain_reversed;
+  // Chain c's points are [chain_first[c], chain_first[c + 1]), at increasing parameters in (0, 1).
+  std::vector<uint32_t> chain_first;
+  std::vector<double> point_param;
+  std::vector<uint32_t> point_chain;
+  // Chain c: the cost of running along it per unit of parameter (its length x the smaller weight
+  // of its two faces), and its half-edges in the two regions it separates.
+  std::vector<double> chain_cost;
+  std::vector<std::array<uint32_t, 2>> chain_halves;
+  // Per vertex of the union mesh: the next copy of the same vertex of the surface, in a ring
+  // (itself when it has none). Copies share their cost.
+  std::vector<uint32_t> next_copy;
+
+  uint32_t point_count() const { return static_cast<uint32_t>(point_param.size()); }
+};
+
+}  // namespace geodex::ich

@@ -1,0 +1,271 @@
+// Travel costs by regions (weighted_regions.h): exact where every passable face weighs the same
+// (against the exact engine, an analytic detour round a wall, a path through a vertex where two
+// passable parts meet only there), and with several weights within the bound (Snell's law) and
+// never above the bounded graph on the same boundary points.
+
+#include "weighted_regions.h"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include "geodex/geodesic_solver.h"
+#include "geodex/travel_cost.h"
+#include "geodex/weighted_field.h"
+#include "gtest/gtest.h"
+#include "util/mesh_factory.h"
+#include "util/test_meshes.h"
+
+namespace geodex {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+TriangleMesh BuildMesh(const MeshData& data) {
+  absl::StatusOr<TriangleMesh> mesh = TriangleMesh::Build(data);
+  EXPECT_TRUE(mesh.ok()) << mesh.status();
+  return *std::move(mesh);
+}
+
+Vec3 Centroid(const MeshData& data, uint32_t f) {
+  Vec3 c{0, 0, 0};
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 p = VertexPosition(data, data.faces[3 * f + k]);
+    for (int j = 0; j < 3; ++j) c[j] += p[j] / 3;
+  }
+  return c;
+}
+
+absl::StatusOr<WeightedCosts> CostsAt(const TriangleMesh& mesh, const WeightedOptions& options,
+                                      const std::vector<SurfacePoint>& sources,
+                                      const std::vector<SurfacePoint>& targets) {
+  std::vector<SurfacePoint> anchors = sources;
+  anchors.insert(anchors.end(), targets.begin(), targets.end());
+  absl::StatusOr<std::shared_ptr<const RegionSurface>> regions =
+      RegionSurface::Build(mesh, options, anchors);
+  if (!regions.ok()) return regions.status();
+  return (*regions)->CostsAt(sources, targets, false, {});
+}
+
+TEST(WeightedRegionsTest, WhoServes) {
+  WeightedOptions options;
+  EXPECT_TRUE(RegionsServe(options));
+  options.face_weight = {2, kInf, 2, 2};
+  EXPECT_TRUE(RegionsServe(options));
+  options.face_weight = {2, kInf, 1, 2};
+  EXPECT_FALSE(RegionsServe(options));
+  options.face_weight = {kInf, kInf};
+  EXPECT_TRUE(RegionsServe(options));
+  options.face_weight.clear();
+  options.slope_cost = std::make_shared<SlopeCost>(SlopeCost{{1, 1}});
+  EXPECT_FALSE(RegionsServe(options));
+}
+
+// One friction everywhere, through the public query: the exact field x the friction / the speed.
+TEST(WeightedRegionsTest, OneWeightIsTheExactFieldScaled) {
+  absl::StatusOr<TriangleMesh> mesh = LoadTestMesh("knight.off");
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  const std::vector<SurfacePoint> sources{SurfacePoint::AtVertex(7),
+                                          SurfacePoint::InFace(100, 0.2, 0.3, 0.5)};
+  absl::StatusOr<DistanceField> exact = ComputeDistanceField(*mesh, sources);
+  ASSERT_TRUE(exact.ok()) << exact.status();
+  GeodesicOptions options;
+  TravelCost travel;
+  travel.speed_kmh = 3.6;  // 1 m/s
+  travel.face_weight = std::make_shared<std::vector<double>>(mesh->face_count(), 2.5);
+  options.travel = travel;
+  absl::StatusOr<DistanceField> field = ComputeDistanceField(*mesh, sources, options);
+  ASSERT_TRUE(field.ok()) << field.status();
+  ASSERT_EQ(field->distance.size(), exact->distance.size());
+  for (size_t v = 0; v < field->distance.size(); ++v) {
+    EXPECT_NEAR(field->distance[v], 2.5 * exact->distance[v], 1e-12 * (1 + exact->distance[v]))
+        << "vertex " << v;
+    EXPECT_EQ(field->source[v], exact->source[v]) << "vertex " << v;
+  }
+}
+
+// A wall with a gap, impassable: the way round it, exactly.
+TEST(WeightedRegionsTest, ImpassableWallIsGoneAroundExactly) {
+  GridSpec spec;
+  spec.cells_x = spec.cells_y = 20;
+  const MeshData data = MakeGrid(spec);
+  const TriangleMesh mesh = BuildMesh(data);
+  WeightedOptions options;
+  for (uint32_t f = 0; f < data.face_count(); ++f) {
+    const Vec3 c = Centroid(data, f);
+    const bool wall = c[0] > 0.45 && c[0] < 0.55 && c[1] < 0.8;
+    options.face_weight.push_back(wall ? kInf : 1.0);
+  }
+  ASSERT_TRUE(RegionsServe(options));
+  const uint32_t s = 4 * 21 + 4, t = 4 * 21 + 16;  // (0.2, 0.2) and (0.8, 0.2)
+  const double detour = 2 * 0.65 + 0.1;            // via (0.45, 0.8) and (0.55, 0.8)
+  absl::StatusOr<WeightedCosts> costs =
+      CostsAt(mesh, options, {SurfacePoint::AtVertex(s)}, {SurfacePoint::AtVertex(t)});
+  ASSERT_TRUE(costs.ok()) << costs.status();
+  EXPECT_NEAR(costs->cost[0], detour, 1e-12);
+  EXPECT_EQ(costs->steiner_points, 0u);
+}
+
+// Two passable cells that meet only at a vertex (every other face impassable): paths pass
+// through it, as the graph's do, though the passable faces split there.
+TEST(WeightedRegionsTest, PathsPassWherePassableFacesMeetAtAVertex) {
+  GridSpec spec;
+  spec.cells_x = spec.cells_y = 2;
+  spec.width = spec.height = 2;
+  const MeshData data = MakeGrid(spec);
+  const TriangleMesh mesh = BuildMesh(data);
+  WeightedOptions options;
+  for (uint32_t f = 0; f < data.face_count(); ++f) {
+    const Vec3 c = Centroid(data, f);
+    const bool passable = (c[0] < 1) == (c[1] < 1);  // cells (0, 0) and (1, 1)
+    options.face_weight.push_back(passable ? 3.0 : kInf);
+  }
+  // (1, 0) to (2, 1) and to the far corner (2, 2), through the vertex (1, 1).
+  const std::vector<SurfacePoint> targets{SurfacePoint::AtVertex(5), SurfacePoint::AtVertex(8),
+                                          SurfacePoint::AtVertex(2)};
+  absl::StatusOr<WeightedCosts> costs =
+      CostsAt(mesh, options, {SurfacePoint::AtVertex(1)}, targets);
+  ASSERT_TRUE(costs.ok()) << costs.status();
+  EXPECT_NEAR(costs->cost[0], 3 * 2, 1e-12);
+  EXPECT_NEAR(costs->cost[1], 3 * (1 + std::sqrt(2.0)), 1e-12);
+  EXPECT_EQ(costs->cost[2], kInf);  // (2, 0): impassable all round
+  // The path passes through (1, 1), named on the surface, and costs what it says.
+  absl::StatusOr<std::shared_ptr<const RegionSurface>> surface = RegionSurface::Build(mesh, options);
+  ASSERT_TRUE(surface.ok()) << surface.status();
+  absl::StatusOr<std::vector<WeightedPath>> paths =
+      (*surface)->Paths(SurfacePoint::AtVertex(1), {targets[1], targets[2]}, {});
+  ASSERT_TRUE(paths.ok()) << paths.status();
+  const WeightedPath& path = (*paths)[0];
+  EXPECT_NEAR(path.cost, costs->cost[1], 1e-12);
+  ASSERT_GE(path.points.size(), 3u);
+  EXPECT_EQ(path.points.front().where.vertex, 1u);
+  EXPECT_EQ(path.points.back().where.vertex, 8u);
+  int at_junction = 0;
+  double cost = 0;
+  for (size_t k = 0; k < path.points.size(); ++k) {
+    const PathPoint& p = path.points[k];
+    if (p.where.kind == SurfacePoint::Kind::kVertex && p.where.vertex == 4) {
+      ++at_junction;
+      EXPECT_EQ(p.position, (std::array<double, 3>{1, 1, 0}));
+    }
+    if (k > 0) cost += 3 * Distance3(path.points[k - 1].position, p.position);
+  }
+  EXPECT_EQ(at_junction, 1);  // once: the copies' repeat is dropped
+  EXPECT_NEAR(cost, path.cost, 1e-12);
+  EXPECT_EQ((*paths)[1].cost, kInf);
+  EXPECT_TRUE((*paths)[1].points.empty());
+  // The graph agrees within its bound.
+  absl::StatusOr<WeightedCosts> graph =
+      ComputeWeightedCostsAt(mesh, {SurfacePoint::AtVertex(1)}, targets, options);
+  ASSERT_TRUE(graph.ok()) << graph.status();
+  EXPECT_LE(graph->cost[0], costs->cost[0] * (1 + options.epsilon));
+  EXPECT_GE(graph->cost[0], costs->cost[0] * (1 - 1e-12));
+  // Every face impassable: nothing is reached, and the points are still checked.
+  options.face_weight.assign(data.face_count(), kInf);
+  absl::StatusOr<WeightedCosts> none =
+      CostsAt(mesh, options, {SurfacePoint::AtVertex(1)}, {SurfacePoint::AtVertex(5)});
+  ASSERT_TRUE(none.ok()) << none.status();
+  EXPECT_EQ(none->cost[0], kInf);
+  EXPECT_FALSE(CostsAt(mesh, options, {SurfacePoint::AtVertex(99)}, {}).ok());
+}
+
+template <typename F>
+double GoldenSection(F f, double lo, double hi) {
+  const double g = (std::sqrt(5.0) - 1) / 2;
+  double a = lo, b = hi;
+  for (int i = 0; i < 200; ++i) {
+    const double c = b - g * (b - a), d = a + g * (b - a);
+    if (f(c) < f(d)) {
+      b = d;
+    } else {
+      a = c;
+    }
+  }
+  return (a + b) / 2;
+}
+
+// Several weights: friction 4 beyond x = 1. Every vertex there against its refracted optimum
+// (Snell's law), within the bound and never below.
+TEST(WeightedRegionsTest, SnellsLawAcrossAFrictionFourHalfPlane) {
+  GridSpec spec;
+  spec.cells_x = 10;
+  spec.cells_y = 5;
+  spec.width = 2;
+  spec.height = 1;
+  spec.alternate_diagonals = true;
+  const MeshData data = MakeGrid(spec);
+  const TriangleMesh mesh = BuildMesh(data);
+  for (const double eps : {0.1, 0.01}) {
+    WeightedOptions options;
+    options.epsilon = eps;
+    for (uint32_t f = 0; f < data.face_count(); ++f) {
+      options.face_weight.push_back(Centroid(data, f)[0] > 1 ? 4.0 : 1.0);
+    }
+    const uint32_t s = 1 * 11 + 1;
+    std::vector<SurfacePoint> targets;
+    std::vector<double> best;
+    for (uint32_t v = 0; v < data.vertex_count(); ++v) {
+      const Vec3 ps = VertexPosition(data, s), pt = VertexPosition(data, v);
+      if (pt[0] < 1 + 1e-9) continue;
+      auto cost = [&](double y) {
+        return std::hypot(1 - ps[0], y - ps[1]) + 4 * std::hypot(pt[0] - 1, pt[1] - y);
+      };
+      targets.push_back(SurfacePoint::AtVertex(v));
+      best.push_back(cost(GoldenSection(cost, 0, 1)));
+    }
+    absl::StatusOr<WeightedCosts> costs =
+        CostsAt(mesh, options, {SurfacePoint::AtVertex(s)}, targets);
+    ASSERT_TRUE(costs.ok()) << costs.status();
+    EXPECT_GT(costs->steiner_points, 0u);
+    double worst = 0;
+    for (size_t t = 0; t < targets.size(); ++t) {
+      EXPECT_GE(costs->cost[t], best[t] * (1 - 1e-12)) << "target " << t;
+      EXPECT_LE(costs->cost[t], best[t] * (1 + eps)) << "target " << t;
+      worst = std::max(worst, costs->cost[t] / best[t] - 1);
+    }
+    std::printf("Snell eps %g: %llu boundary points, worst 1 + %.3g\n", eps,
+                static_cast<unsigned long long>(costs->steiner_points), worst);
+  }
+}
+
+// Several weights on a real mesh (bands of 1 to 4 by height): never above the bounded graph's
+// cost (the same boundary points, exact inside regions) and never below its lower bound.
+TEST(WeightedRegionsTest, SeveralWeightsAgainstTheBoundedGraph) {
+  absl::StatusOr<TriangleMesh> mesh = LoadTestMesh("knight.off");
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  const std::vector<SurfacePoint> sources{SurfacePoint::AtVertex(7)};
+  WeightedOptions options;
+  options.epsilon = 0.1;
+  for (uint32_t f = 0; f < mesh->face_count(); ++f) {
+    double y = 0;
+    for (int k = 0; k < 3; ++k) y += mesh->Position(mesh->FaceVertex(f, k))[1] / 3;
+    options.face_weight.push_back(1 + std::fmod(std::abs(std::floor(y * 7)), 4));
+  }
+  ASSERT_FALSE(RegionsServe(options));
+  absl::StatusOr<WeightedField> graph = ComputeWeightedField(*mesh, sources, options);
+  ASSERT_TRUE(graph.ok()) << graph.status();
+  absl::StatusOr<std::shared_ptr<const RegionSurface>> surface =
+      RegionSurface::Build(*mesh, options, sources);
+  ASSERT_TRUE(surface.ok()) << surface.status();
+  absl::StatusOr<WeightedField> regions = (*surface)->Field(sources, {});
+  ASSERT_TRUE(regions.ok()) << regions.status();
+  double below = 0;
+  for (size_t v = 0; v < graph->cost.size(); ++v) {
+    const double g = graph->cost[v], r = regions->cost[v];
+    if (g == 0) {
+      EXPECT_EQ(r, 0);
+      continue;
+    }
+    EXPECT_GE(r, g / (1 + options.epsilon) * (1 - 1e-12)) << "vertex " << v;
+    EXPECT_LE(r, g * (1 + 1e-12)) << "vertex " << v;
+    below = std::max(below, 1 - r / g);
+  }
+  std::printf("knight: %llu boundary points (graph %llu); regions below the graph by up to %.3g\n",
+              static_cast<unsigned long long>(regions->steiner_points),
+              static_cast<unsigned long long>(graph->steiner_points), below);
+}
+
+}  // namespace
+}  // namespace geodex
