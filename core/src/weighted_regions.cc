@@ -28,10 +28,9 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // (the impassable ones left out) and the surface's corner order.
 struct RegionSurface::Impl {
  public:
-  Impl(const TriangleMesh& mesh, const WeightedOptions& options)
-      : mesh_(mesh), options_(options) {}
+  Impl(const TriangleMesh& mesh, const WeightedOptions& options) : mesh_(mesh), options_(options) {}
 
-  bool empty() const { return union_ == nullptr; }  // every face impassable
+  bool empty() const { return union_ == nullptr; }      // every face impassable
   const TriangleMesh& mesh() const { return *union_; }  // the union (not empty())
   const TriangleMesh& surface() const { return mesh_; }
   double epsilon() const { return options_.epsilon; }
@@ -199,7 +198,8 @@ struct RegionSurface::Impl {
     }
 
     // The boundary points, and the union half-edges they lie on.
-    absl::StatusOr<RegionBoundaryPoints> points = PlaceRegionBoundaryPoints(mesh_, options_, anchors);
+    absl::StatusOr<RegionBoundaryPoints> points =
+        PlaceRegionBoundaryPoints(mesh_, options_, anchors);
     if (!points.ok()) return points.status();
     links_.chain_of_half.assign(3 * size_t{u.face_count()}, kNoIndex);
     links_.chain_reversed.assign(3 * size_t{u.face_count()}, 0);
@@ -240,10 +240,10 @@ struct RegionSurface::Impl {
   const WeightedOptions options_;
   std::unique_ptr<TriangleMesh> union_;
   ich::RegionLinks links_;
-  std::vector<uint32_t> vertex_first_;  // surface vertex v's copies: [first[v], first[v + 1])
-  std::vector<double> copy_weight_;     // per copy
-  std::vector<uint32_t> union_face_;    // per surface face (kNoIndex: impassable)
-  std::vector<uint32_t> surface_face_;  // per union face
+  std::vector<uint32_t> vertex_first_;    // surface vertex v's copies: [first[v], first[v + 1])
+  std::vector<double> copy_weight_;       // per copy
+  std::vector<uint32_t> union_face_;      // per surface face (kNoIndex: impassable)
+  std::vector<uint32_t> surface_face_;    // per union face
   std::vector<uint32_t> surface_vertex_;  // per union file vertex: the surface's internal vertex
 };
 

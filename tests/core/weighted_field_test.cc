@@ -29,16 +29,6 @@ TriangleMesh BuildMesh(const MeshData& data) {
   return *std::move(mesh);
 }
 
-// The centroid of file face f.
-Vec3 Centroid(const MeshData& data, uint32_t f) {
-  Vec3 c{0, 0, 0};
-  for (int k = 0; k < 3; ++k) {
-    const Vec3 p = VertexPosition(data, data.faces[3 * f + k]);
-    for (int j = 0; j < 3; ++j) c[j] += p[j] / 3;
-  }
-  return c;
-}
-
 // Every cost within [d (1 - 1e-12), (1 + eps) d] of the reference; returns the largest ratio.
 double CheckBound(const std::vector<double>& cost, const std::vector<double>& reference,
                   double eps) {
@@ -311,22 +301,6 @@ TEST(WeightedFieldTest, FrictionTwoDoublesEveryCost) {
   }
 }
 
-// Minimises f over [lo, hi] (unimodal) by golden-section search; returns the argmin.
-template <typename F>
-double GoldenSection(F f, double lo, double hi) {
-  const double g = (std::sqrt(5.0) - 1) / 2;
-  double a = lo, b = hi;
-  for (int i = 0; i < 200; ++i) {
-    const double c = b - g * (b - a), d = a + g * (b - a);
-    if (f(c) < f(d)) {
-      b = d;
-    } else {
-      a = c;
-    }
-  }
-  return (a + b) / 2;
-}
-
 TEST(WeightedFieldTest, SnellsLawAcrossAFrictionFourHalfPlane) {
   GridSpec spec;
   spec.cells_x = 10;
@@ -340,14 +314,14 @@ TEST(WeightedFieldTest, SnellsLawAcrossAFrictionFourHalfPlane) {
   WeightedOptions options;
   options.epsilon = eps;
   for (uint32_t f = 0; f < data.face_count(); ++f) {
-    options.face_weight.push_back(Centroid(data, f)[0] > 1 ? 4.0 : 1.0);
+    options.face_weight.push_back(FaceCentroid(data, f)[0] > 1 ? 4.0 : 1.0);
   }
   const uint32_t s = 1 * 11 + 1, t = 4 * 11 + 8;  // (0.2, 0.2) and (1.6, 0.8)
   const Vec3 ps = VertexPosition(data, s), pt = VertexPosition(data, t);
   auto cost = [&](double y) {
     return std::hypot(1 - ps[0], y - ps[1]) + 4 * std::hypot(pt[0] - 1, pt[1] - y);
   };
-  const double y_best = GoldenSection(cost, 0, 1);
+  const double y_best = GoldenSectionArgMin(cost, 0, 1);
   const double best = cost(y_best);
   absl::StatusOr<WeightedPath> path =
       ComputeWeightedPath(mesh, SurfacePoint::AtVertex(s), SurfacePoint::AtVertex(t), options);
@@ -382,7 +356,7 @@ TEST(WeightedFieldTest, ImpassableWallIsGoneAroundThroughItsGap) {
   WeightedOptions options;
   options.epsilon = 0.05;
   for (uint32_t f = 0; f < data.face_count(); ++f) {
-    const Vec3 c = Centroid(data, f);
+    const Vec3 c = FaceCentroid(data, f);
     const bool wall = c[0] > 0.45 && c[0] < 0.55 && c[1] < 0.8;
     options.face_weight.push_back(wall ? kInf : 1.0);
   }
@@ -409,7 +383,7 @@ TEST(WeightedFieldTest, ImpassableWallIsGoneAroundThroughItsGap) {
 std::vector<double> RingWeights(const MeshData& data, int lo, int hi) {
   std::vector<double> w;
   for (uint32_t f = 0; f < data.face_count(); ++f) {
-    const Vec3 c = Centroid(data, f);
+    const Vec3 c = FaceCentroid(data, f);
     const int i = static_cast<int>(c[0] * 20), j = static_cast<int>(c[1] * 20);
     const bool ring =
         i >= lo && i <= hi && j >= lo && j <= hi && (i == lo || i == hi || j == lo || j == hi);
@@ -487,7 +461,7 @@ TEST(WeightedFieldTest, PathsToManyTargetsShareOneSearch) {
   options.epsilon = 0.1;
   options.face_weight = RingWeights(data, 14, 18);
   for (uint32_t f = 0; f < data.face_count(); ++f) {  // friction 3 on the right half
-    if (Centroid(data, f)[0] > 0.5) options.face_weight[f] *= 3;
+    if (FaceCentroid(data, f)[0] > 0.5) options.face_weight[f] *= 3;
   }
   const SurfacePoint from = SurfacePoint::InFace(7, 0.2, 0.3, 0.5);
   const std::vector<SurfacePoint> tos = {SurfacePoint::AtVertex(3 * 21 + 15),
@@ -627,7 +601,7 @@ TEST(WeightedFieldTest, CostsAtPointsStopEarlyOnASharedSurface) {
   const TriangleMesh mesh = BuildMesh(data);
   std::vector<double> weights;
   for (uint32_t f = 0; f < data.face_count(); ++f) {
-    weights.push_back(Centroid(data, f)[0] > 0.3 ? 2 : 1);
+    weights.push_back(FaceCentroid(data, f)[0] > 0.3 ? 2 : 1);
   }
   for (const WeightedOptions& options : WithAndWithoutSlope(weights)) {
     const int variant = options.slope_cost != nullptr;
@@ -672,7 +646,7 @@ TEST(WeightedFieldTest, PathsHeadForTheirTargets) {
   const TriangleMesh mesh = BuildMesh(data);
   std::vector<double> weights;
   for (uint32_t f = 0; f < data.face_count(); ++f) {
-    weights.push_back(1 + (Centroid(data, f)[1] > 0.6) + (f * 7919 % 5 == 0));
+    weights.push_back(1 + (FaceCentroid(data, f)[1] > 0.6) + (f * 7919 % 5 == 0));
   }
   for (const WeightedOptions& options : WithAndWithoutSlope(weights)) {
     const int variant = options.slope_cost != nullptr;

@@ -29,15 +29,6 @@ TriangleMesh BuildMesh(const MeshData& data) {
   return *std::move(mesh);
 }
 
-Vec3 Centroid(const MeshData& data, uint32_t f) {
-  Vec3 c{0, 0, 0};
-  for (int k = 0; k < 3; ++k) {
-    const Vec3 p = VertexPosition(data, data.faces[3 * f + k]);
-    for (int j = 0; j < 3; ++j) c[j] += p[j] / 3;
-  }
-  return c;
-}
-
 absl::StatusOr<WeightedCosts> CostsAt(const TriangleMesh& mesh, const WeightedOptions& options,
                                       const std::vector<SurfacePoint>& sources,
                                       const std::vector<SurfacePoint>& targets) {
@@ -94,7 +85,7 @@ TEST(WeightedRegionsTest, ImpassableWallIsGoneAroundExactly) {
   const TriangleMesh mesh = BuildMesh(data);
   WeightedOptions options;
   for (uint32_t f = 0; f < data.face_count(); ++f) {
-    const Vec3 c = Centroid(data, f);
+    const Vec3 c = FaceCentroid(data, f);
     const bool wall = c[0] > 0.45 && c[0] < 0.55 && c[1] < 0.8;
     options.face_weight.push_back(wall ? kInf : 1.0);
   }
@@ -118,7 +109,7 @@ TEST(WeightedRegionsTest, PathsPassWherePassableFacesMeetAtAVertex) {
   const TriangleMesh mesh = BuildMesh(data);
   WeightedOptions options;
   for (uint32_t f = 0; f < data.face_count(); ++f) {
-    const Vec3 c = Centroid(data, f);
+    const Vec3 c = FaceCentroid(data, f);
     const bool passable = (c[0] < 1) == (c[1] < 1);  // cells (0, 0) and (1, 1)
     options.face_weight.push_back(passable ? 3.0 : kInf);
   }
@@ -132,7 +123,8 @@ TEST(WeightedRegionsTest, PathsPassWherePassableFacesMeetAtAVertex) {
   EXPECT_NEAR(costs->cost[1], 3 * (1 + std::sqrt(2.0)), 1e-12);
   EXPECT_EQ(costs->cost[2], kInf);  // (2, 0): impassable all round
   // The path passes through (1, 1), named on the surface, and costs what it says.
-  absl::StatusOr<std::shared_ptr<const RegionSurface>> surface = RegionSurface::Build(mesh, options);
+  absl::StatusOr<std::shared_ptr<const RegionSurface>> surface =
+      RegionSurface::Build(mesh, options);
   ASSERT_TRUE(surface.ok()) << surface.status();
   absl::StatusOr<std::vector<WeightedPath>> paths =
       (*surface)->Paths(SurfacePoint::AtVertex(1), {targets[1], targets[2]}, {});
@@ -171,21 +163,6 @@ TEST(WeightedRegionsTest, PathsPassWherePassableFacesMeetAtAVertex) {
   EXPECT_FALSE(CostsAt(mesh, options, {SurfacePoint::AtVertex(99)}, {}).ok());
 }
 
-template <typename F>
-double GoldenSection(F f, double lo, double hi) {
-  const double g = (std::sqrt(5.0) - 1) / 2;
-  double a = lo, b = hi;
-  for (int i = 0; i < 200; ++i) {
-    const double c = b - g * (b - a), d = a + g * (b - a);
-    if (f(c) < f(d)) {
-      b = d;
-    } else {
-      a = c;
-    }
-  }
-  return (a + b) / 2;
-}
-
 // Several weights: friction 4 beyond x = 1. Every vertex there against its refracted optimum
 // (Snell's law), within the bound and never below.
 TEST(WeightedRegionsTest, SnellsLawAcrossAFrictionFourHalfPlane) {
@@ -201,7 +178,7 @@ TEST(WeightedRegionsTest, SnellsLawAcrossAFrictionFourHalfPlane) {
     WeightedOptions options;
     options.epsilon = eps;
     for (uint32_t f = 0; f < data.face_count(); ++f) {
-      options.face_weight.push_back(Centroid(data, f)[0] > 1 ? 4.0 : 1.0);
+      options.face_weight.push_back(FaceCentroid(data, f)[0] > 1 ? 4.0 : 1.0);
     }
     const uint32_t s = 1 * 11 + 1;
     std::vector<SurfacePoint> targets;
@@ -213,7 +190,7 @@ TEST(WeightedRegionsTest, SnellsLawAcrossAFrictionFourHalfPlane) {
         return std::hypot(1 - ps[0], y - ps[1]) + 4 * std::hypot(pt[0] - 1, pt[1] - y);
       };
       targets.push_back(SurfacePoint::AtVertex(v));
-      best.push_back(cost(GoldenSection(cost, 0, 1)));
+      best.push_back(cost(GoldenSectionArgMin(cost, 0, 1)));
     }
     absl::StatusOr<WeightedCosts> costs =
         CostsAt(mesh, options, {SurfacePoint::AtVertex(s)}, targets);

@@ -212,6 +212,14 @@ class CubeUnfolder {
 Vec3 VertexPosition(const MeshData& mesh, uint32_t v) {
   return {mesh.positions[3 * v], mesh.positions[3 * v + 1], mesh.positions[3 * v + 2]};
 }
+Vec3 FaceCentroid(const MeshData& mesh, uint32_t f) {
+  Vec3 c{0, 0, 0};
+  for (int k = 0; k < 3; ++k) {
+    const Vec3 p = VertexPosition(mesh, mesh.faces[3 * f + k]);
+    for (int j = 0; j < 3; ++j) c[j] += p[j] / 3;
+  }
+  return c;
+}
 double Distance3(const Vec3& a, const Vec3& b) { return Norm(Sub(a, b)); }
 double Distance2(const Vec2& a, const Vec2& b) { return std::hypot(a[0] - b[0], a[1] - b[1]); }
 

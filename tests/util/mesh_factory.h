@@ -21,8 +21,26 @@ using Vec2 = std::array<double, 2>;
 using Vec3 = std::array<double, 3>;
 
 Vec3 VertexPosition(const MeshData& mesh, uint32_t v);
+Vec3 FaceCentroid(const MeshData& mesh, uint32_t f);
 double Distance3(const Vec3& a, const Vec3& b);
 double Distance2(const Vec2& a, const Vec2& b);
+
+// Where a unimodal f is least on [lo, hi], by golden-section search (200 steps): the analytic
+// optima of the refraction tests (Snell's law).
+template <typename F>
+double GoldenSectionArgMin(F f, double lo, double hi) {
+  const double g = 0.6180339887498949;  // (sqrt(5) - 1) / 2
+  double a = lo, b = hi;
+  for (int i = 0; i < 200; ++i) {
+    const double c = b - g * (b - a), d = a + g * (b - a);
+    if (f(c) < f(d)) {
+      b = d;
+    } else {
+      a = c;
+    }
+  }
+  return (a + b) / 2;
+}
 
 // ---------------------------------------------------------------------------------------------
 // Flat grid: cells_x x cells_y cells over [0, width] x [0, height] in the plane z = 0, vertex

@@ -27,8 +27,8 @@ void IchSolver::ReachBoundary(uint32_t e, double x0, double x1, double ix, doubl
   const double* it = std::lower_bound(begin, end, t_lo);
   for (; it != end && *it <= t_hi; ++it) {
     const double x = len * (reversed ? *it : 1 - *it);
-    ReachPoint(static_cast<uint32_t>(it - regions_->point_param.data()),
-               sigma + Hypot(x - ix, iy), source, e);
+    ReachPoint(static_cast<uint32_t>(it - regions_->point_param.data()), sigma + Hypot(x - ix, iy),
+               source, e);
   }
 }
 
@@ -107,8 +107,7 @@ void IchSolver::RelaxChainEnds(uint32_t v, double d, uint32_t source) {
       const bool v_at_chain_start = (e == *corner) != (regions_->chain_reversed[e] != 0);
       const uint32_t p = v_at_chain_start ? first : last - 1;
       const double t = regions_->point_param[p];
-      ReachPoint(p, d + regions_->chain_cost[c] * (v_at_chain_start ? t : 1 - t), source,
-                 kNoIndex);
+      ReachPoint(p, d + regions_->chain_cost[c] * (v_at_chain_start ? t : 1 - t), source, kNoIndex);
     }
   }
 }
