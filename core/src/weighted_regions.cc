@@ -393,7 +393,8 @@ absl::StatusOr<WeightedCosts> RegionSurface::CostsAt(const std::vector<SurfacePo
   std::vector<ich::TargetResult> results(targets.size());
   SolveStats stats;
   if (!impl_->empty()) {
-    ich::IchSolver solver(impl_->mesh(), UnionOptions(limits));
+    const GeodesicOptions options = UnionOptions(limits);  // the solver keeps a reference
+    ich::IchSolver solver(impl_->mesh(), options);
     solver.set_regions(&impl_->links());
     if (absl::Status s = solver.SolveForTargets(*src, resolved, /*use_heuristic=*/false,
                                                 /*stop_early=*/!whole, &results, &stats);
@@ -428,7 +429,8 @@ absl::StatusOr<std::vector<WeightedPath>> RegionSurface::Paths(
   if (impl_->empty()) return out;
   std::vector<ich::TargetResult> results;
   SolveStats stats;
-  ich::IchSolver solver(impl_->mesh(), UnionOptions(limits));
+  const GeodesicOptions options = UnionOptions(limits);  // the solver keeps a reference
+  ich::IchSolver solver(impl_->mesh(), options);
   solver.set_regions(&impl_->links());
   if (absl::Status s = solver.SolveForTargets(*src, resolved, /*use_heuristic=*/false,
                                               /*stop_early=*/true, &results, &stats);
