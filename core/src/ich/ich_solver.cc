@@ -120,13 +120,10 @@ bool IchSolver::UpdateVertex(uint32_t v, double d, uint32_t parent, uint32_t hal
                              double iy) {
   if (!(d < dist_[v])) return false;
   const Window& p = pool_[parent];
-  if (dist_[v] == kUnreachable) TouchVertex(v);
-  dist_[v] = d;
-  straight_through_[v] = 0;
-  if (has_targets_ && vertex_is_target_[v]) targets_dirty_ = true;
-  label_[v] = p.source;
-  origin_[v] = VertexOrigin{
-      half_edge, p.kind == WindowKind::kPseudoSource ? p.element : p.pseudo_source, ix, iy};
+  SetVertex(
+      v, d, p.source,
+      VertexOrigin{half_edge, p.kind == WindowKind::kPseudoSource ? p.element : p.pseudo_source, ix,
+                   iy});
   if (regions_ != nullptr) ShareWithCopies(v, d, p.source);
   // Paths bend only at saddle and boundary vertices (P4); with lambda > 0 every vertex also passes
   // its distance along its edges, so it gets a (relax-only) pseudo-source window too.
@@ -148,12 +145,7 @@ void IchSolver::RelaxNeighbors(uint32_t v, double d, uint32_t source) {
     const double du = d + mesh_.NeighborLength(i);
     if (!(du < dist_[u])) continue;
     ++stats_.edge_relaxations;
-    if (dist_[u] == kUnreachable) TouchVertex(u);
-    dist_[u] = du;
-    straight_through_[u] = 0;
-    if (has_targets_ && vertex_is_target_[u]) targets_dirty_ = true;
-    label_[u] = source;
-    origin_[u] = VertexOrigin{kNoIndex, v, 0, 0};
+    SetVertex(u, du, source, VertexOrigin{kNoIndex, v, 0, 0});
     if (regions_ != nullptr) ShareWithCopies(u, du, source);
     if ((mesh_.IsPseudoSourceCandidate(u) || epsilon_ > 0) && du <= options_.max_distance) {
       // The neighbour becomes a pseudo-source of its own (a root: it does not depend on any

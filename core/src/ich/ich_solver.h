@@ -103,7 +103,22 @@ class IchSolver {
   void TouchVertex(uint32_t v) { workspace_->touched_vertices.push_back(v); }
   void SeedVertex(uint32_t v, uint32_t label);
   // A pseudo-source window at `vertex` (kNoIndex: a source point's root), not yet queued.
-  uint32_t NewPseudoSourceWindow(uint32_t vertex, double sigma, uint32_t source, uint32_t level);
+  uint32_t NewPseudoSourceWindow(uint32_t vertex, double sigma, uint32_t source, uint32_t level) {
+    return NewPointWindow(WindowKind::kPseudoSource, vertex, vertex, sigma, source, level);
+  }
+  // A window emitting from one point (`element`: a vertex, or a boundary point), not yet queued.
+  uint32_t NewPointWindow(WindowKind kind, uint32_t element, uint32_t pseudo_source, double sigma,
+                          uint32_t source, uint32_t level);
+  // Sets vertex v's distance, label and origin (d below its distance): the one place a vertex's
+  // state changes after seeding.
+  void SetVertex(uint32_t v, double d, uint32_t source, const VertexOrigin& origin) {
+    if (dist_[v] == kUnreachable) TouchVertex(v);
+    dist_[v] = d;
+    straight_through_[v] = 0;
+    if (has_targets_ && vertex_is_target_[v]) targets_dirty_ = true;
+    label_[v] = source;
+    origin_[v] = origin;
+  }
   void SeedFacePoint(const ResolvedSource& s);
   void ProcessPseudoSource(uint32_t id);
   void ProcessInterval(uint32_t id, double popped_key);

@@ -8,15 +8,15 @@
 
 namespace geodex::ich {
 
-uint32_t IchSolver::NewPseudoSourceWindow(uint32_t vertex, double sigma, uint32_t source,
-                                          uint32_t level) {
+uint32_t IchSolver::NewPointWindow(WindowKind kind, uint32_t element, uint32_t pseudo_source,
+                                   double sigma, uint32_t source, uint32_t level) {
   const uint32_t id = pool_.Allocate();
   Window& w = pool_[id];
-  pool_.SetKind(id, WindowKind::kPseudoSource, WindowSide::kInitial);
-  w.element = vertex;
+  pool_.SetKind(id, kind, WindowSide::kInitial);
+  w.element = element;
   w.sigma = sigma;
   w.b0 = w.b1 = w.ix = w.iy = 0;
-  w.pseudo_source = vertex;
+  w.pseudo_source = pseudo_source;
   w.source = source;
   w.level = level;
   return id;

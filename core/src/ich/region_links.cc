@@ -36,15 +36,7 @@ void IchSolver::ReachPoint(uint32_t p, double d, uint32_t source, uint32_t from)
   if (!(d < point_cost_[p]) || d > key_cap_) return;
   point_cost_[p] = d;
   point_from_[p] = from;
-  const uint32_t id = pool_.Allocate();
-  Window& w = pool_[id];
-  pool_.SetKind(id, WindowKind::kBoundaryPoint, WindowSide::kInitial);
-  w.element = p;
-  w.sigma = d;
-  w.b0 = w.b1 = w.ix = w.iy = 0;
-  w.pseudo_source = kNoIndex;
-  w.source = source;
-  w.level = 0;
+  const uint32_t id = NewPointWindow(WindowKind::kBoundaryPoint, p, kNoIndex, d, source, 0);
   ++stats_.pseudo_sources;
   Push(id, d);
 }
@@ -81,12 +73,7 @@ void IchSolver::ProcessBoundaryPoint(uint32_t id) {
 void IchSolver::ShareWithCopies(uint32_t v, double d, uint32_t source) {
   for (uint32_t u = regions_->next_copy[v]; u != v; u = regions_->next_copy[u]) {
     if (!(d < dist_[u])) continue;
-    if (dist_[u] == kUnreachable) TouchVertex(u);
-    dist_[u] = d;
-    straight_through_[u] = 0;
-    if (has_targets_ && vertex_is_target_[u]) targets_dirty_ = true;
-    label_[u] = source;
-    origin_[u] = VertexOrigin{kNoIndex, v, 0, 0};
+    SetVertex(u, d, source, VertexOrigin{kNoIndex, v, 0, 0});
     if (d > options_.max_distance) continue;
     // A copy lies on its region's boundary: a pseudo-source, its windows all around.
     const uint32_t id = NewPseudoSourceWindow(u, d, source, 0);
