@@ -158,6 +158,7 @@ absl::StatusOr<WeightedOptions> WeightedOptionsFor(const TriangleMesh& mesh,
   WeightedOptions out;
   out.epsilon = TravelEpsilon(travel);
   out.max_steiner_points = travel.max_steiner_points;
+  out.max_windows = options.max_windows;
   out.cancel = options.cancel;
   out.max_distance = options.max_distance / SecondsPerUnit(travel);
   if (IsDirectional(travel)) {

@@ -2068,12 +2068,11 @@ namespace geodex {
 absl::StatusOr<RegionBoundaryPoints> PlaceRegionBoundaryPoints(
     const TriangleMesh& mesh, const WeightedOptions& options,
     const std::vector<SurfacePoint>& anchors) {
-  std::vector<Located> located;
-  if (absl::Status s = Prepare(mesh, anchors, &located); !s.ok()) return s;
-  SteinerGraph graph(mesh, options);
   const uint32_t nh = 3 * mesh.face_count();
   std::vector<uint8_t> marked(nh, 0);
-  auto weight = [&](uint32_t f) { return graph.FaceWeight(f); };
+  auto weight = [&](uint32_t f) {
+    return options.face_weight.empty() ? 1.0 : options.face_weight[f];
+  };
   for (uint32_t h = 0; h < nh; ++h) {
     const uint32_t t = mesh.Twin(h);
     if (t == kNoIndex || t < h) continue;
@@ -2082,9 +2081,12 @@ absl::StatusOr<RegionBoundaryPoints> PlaceRegionBoundaryPoints(
   }
   RegionBoundaryPoints out;
   if (std::find(marked.begin(), marked.end(), 1) == marked.end()) {
-    out.first.push_back(0);  // one weight: no boundary
+    out.first.push_back(0);  // one weight: no boundary (the anchors are checked where mapped)
     return out;
   }
+  std::vector<Located> located;
+  if (absl::Status s = Prepare(mesh, anchors, &located); !s.ok()) return s;
+  SteinerGraph graph(mesh, options);
   graph.PlaceOnlyOn(std::move(marked));
   if (absl::Status s = graph.Build(options.epsilon, options.max_steiner_points,
                                    SteinerGraph::Placement::kBounded, {}, located);

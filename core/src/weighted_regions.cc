@@ -6,8 +6,10 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <utility>
 
+#include "absl/strings/str_format.h"
 #include "geodex/mesh_data.h"
 #include "ich/ich_solver.h"
 #include "ich/region_links.h"
@@ -20,6 +22,10 @@ namespace geodex {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+
+double Distance(const std::array<double, 3>& a, const std::array<double, 3>& b) {
+  return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+}
 
 }  // namespace
 
@@ -34,6 +40,7 @@ struct RegionSurface::Impl {
   const TriangleMesh& mesh() const { return *union_; }  // the union (not empty())
   const TriangleMesh& surface() const { return mesh_; }
   double epsilon() const { return options_.epsilon; }
+  uint64_t max_windows() const { return options_.max_windows; }
   const ich::RegionLinks& links() const { return links_; }
   uint64_t boundary_points() const { return links_.point_count(); }
 
@@ -53,27 +60,95 @@ struct RegionSurface::Impl {
           }
         }
         break;
-      case SurfacePoint::Kind::kEdge:
+      case SurfacePoint::Kind::kEdge: {
         HalfEdgesOfFileEdge(mesh_, c.edge_from, c.edge_to, &list);
+        if (list.empty()) {  // the resolvers' error, in the surface's ids
+          return absl::InvalidArgumentError(
+              absl::StrFormat("point %s: the mesh has no edge between vertices %d and %d",
+                              SurfacePointToString(p), c.edge_from, c.edge_to));
+        }
+        bool degenerate_only = true;
         for (const uint32_t h : list) {
           const uint32_t f = TriangleMesh::FaceOf(h);
+          if (Flat(f)) continue;
+          degenerate_only = false;
           if (union_face_[f] == kNoIndex) continue;
           const double w = Weight(f);
           const bool forward = mesh_.FileVertex(mesh_.From(h)) == c.edge_from;
           out->push_back(SurfacePoint::OnEdge(Copy(mesh_.From(h), w), Copy(mesh_.To(h), w),
                                               forward ? c.t : 1 - c.t));
         }
-        break;
-      case SurfacePoint::Kind::kFace:
-        if (union_face_[c.face] != kNoIndex) {
-          out->push_back(
-              SurfacePoint::InFace(union_face_[c.face], c.bary[0], c.bary[1], c.bary[2]));
+        if (degenerate_only) {
+          // On a zero-area face's edge: the same position on a neighbouring edge with area.
+          const std::array<double, 3> a = mesh_.Position(c.edge_from),
+                                      b = mesh_.Position(c.edge_to);
+          std::array<double, 3> at;
+          for (int j = 0; j < 3; ++j) at[j] = a[j] + c.t * (b[j] - a[j]);
+          if (const std::optional<SurfacePoint> on =
+                  OnSegmentEdge(TriangleMesh::FaceOf(list[0]), at)) {
+            return Map(*on, out);
+          }
+          return absl::InvalidArgumentError(absl::StrFormat(
+              "point %s: the edge %d-%d belongs only to degenerate (zero-area) faces",
+              SurfacePointToString(p), c.edge_from, c.edge_to));
         }
+        break;
+      }
+      case SurfacePoint::Kind::kFace:
+        if (union_face_[c.face] == kNoIndex) break;
+        // A zero-area face is a segment: its points are on its edges (the graph takes them too;
+        // the exact engine places nothing inside such a face).
+        if (Flat(c.face)) {
+          std::array<double, 3> at{0, 0, 0};
+          const std::array<uint32_t, 3> k = mesh_.FileCorners(c.face);
+          for (int i = 0; i < 3; ++i) {
+            for (int j = 0; j < 3; ++j) at[j] += c.bary[i] * mesh_.Position(k[i])[j];
+          }
+          const std::optional<SurfacePoint> on = OnSegmentEdge(c.face, at);
+          // None: every edge of it is of zero-area faces only (refused there, by name).
+          return Map(on.value_or(SurfacePoint::OnEdge(k[0], k[1], 0.5)), out);
+        }
+        out->push_back(SurfacePoint::InFace(union_face_[c.face], c.bary[0], c.bary[1], c.bary[2]));
         break;
       case SurfacePoint::Kind::kPosition:
         break;  // rejected by ValidateSurfacePoint
     }
     return absl::OkStatus();
+  }
+
+  // Whether surface face f has zero area as the engine sees it (the union's flag where it has
+  // the face: its positions are scaled).
+  bool Flat(uint32_t f) const {
+    return union_face_[f] != kNoIndex ? union_->FaceDegenerate(union_face_[f])
+                                      : mesh_.FaceDegenerate(f);
+  }
+
+  // A position `at` on zero-area face f (a segment) as the nearest point of one of its edges that
+  // has a face of some area (the position lies on two of the three edges); none if none has.
+  std::optional<SurfacePoint> OnSegmentEdge(uint32_t f, const std::array<double, 3>& at) const {
+    const std::array<uint32_t, 3> k = mesh_.FileCorners(f);
+    std::vector<uint32_t> halves;
+    std::optional<SurfacePoint> nearest;
+    double nearest_gap = kInf;
+    for (int i = 0; i < 3; ++i) {
+      const uint32_t u = k[i], v = k[(i + 1) % 3];
+      HalfEdgesOfFileEdge(mesh_, u, v, &halves);
+      bool has_area = false;
+      for (const uint32_t h : halves) has_area |= !Flat(TriangleMesh::FaceOf(h));
+      const std::array<double, 3> a = mesh_.Position(u), b = mesh_.Position(v);
+      const double len = Distance(a, b);
+      if (!has_area || len == 0) continue;
+      double t = 0;
+      for (int j = 0; j < 3; ++j) t += (at[j] - a[j]) * (b[j] - a[j]);
+      t = std::clamp(t / (len * len), 0.0, 1.0);
+      std::array<double, 3> foot;
+      for (int j = 0; j < 3; ++j) foot[j] = a[j] + t * (b[j] - a[j]);
+      if (Distance(at, foot) < nearest_gap) {
+        nearest = CanonicalPoint(mesh_, SurfacePoint::OnEdge(u, v, t));
+        nearest_gap = Distance(at, foot);
+      }
+    }
+    return nearest;
   }
 
   // A point of the union (file terms), named on the surface, and its position there (file
@@ -249,32 +324,33 @@ struct RegionSurface::Impl {
 
 namespace {
 
-GeodesicOptions UnionOptions(const WeightedSurface::Limits& limits) {
-  GeodesicOptions g;
-  g.method = Method::kExact;
-  g.max_distance = limits.max_distance;
-  g.cancel = limits.cancel;
-  return g;
-}
+// The sources as the union's, and those it has no copy of: a vertex whose faces are all
+// impassable is still where its source stands (cost 0 there, as on the graph), reaching nothing.
+struct UnionSourceSet {
+  std::vector<ich::ResolvedSource> resolved;
+  std::vector<std::pair<uint32_t, uint32_t>> stranded;  // (file vertex, label)
+};
 
-absl::StatusOr<std::vector<ich::ResolvedSource>> UnionSources(
-    const RegionSurface::Impl& regions, const std::vector<SurfacePoint>& sources) {
+absl::StatusOr<UnionSourceSet> UnionSources(const RegionSurface::Impl& regions,
+                                            const std::vector<SurfacePoint>& sources) {
   if (sources.empty()) return absl::InvalidArgumentError("no sources given");
+  UnionSourceSet out;
   std::vector<SurfacePoint> mapped;
-  if (regions.empty()) {  // still checked against the surface
-    for (const SurfacePoint& p : sources) {
-      if (absl::Status s = regions.Map(p, &mapped); !s.ok()) return s;
-    }
-    return std::vector<ich::ResolvedSource>{};
-  }
-  SourceResolver resolver(regions.mesh());
+  std::optional<SourceResolver> resolver;
+  if (!regions.empty()) resolver.emplace(regions.mesh());
   for (uint32_t i = 0; i < sources.size(); ++i) {
     if (absl::Status s = regions.Map(sources[i], &mapped); !s.ok()) return s;
+    if (mapped.empty()) {
+      const SurfacePoint c = CanonicalPoint(regions.surface(), sources[i]);
+      if (c.kind == SurfacePoint::Kind::kVertex) out.stranded.push_back({c.vertex, i});
+      continue;
+    }
     for (const SurfacePoint& p : mapped) {
-      if (absl::Status s = resolver.Add(p, i); !s.ok()) return s;
+      if (absl::Status s = resolver->Add(p, i); !s.ok()) return s;
     }
   }
-  return resolver.sources();
+  if (resolver.has_value()) out.resolved = resolver->sources();
+  return out;
 }
 
 // Each target as one engine target over all the union's points standing for it; `first` (if
@@ -304,6 +380,42 @@ absl::Status UnionTargets(const RegionSurface::Impl& regions,
   }
   return absl::OkStatus();
 }
+
+// The label of the stranded source at target point p, if any (cost 0 there).
+std::optional<uint32_t> StrandedAt(const TriangleMesh& surface, const UnionSourceSet& sources,
+                                   const SurfacePoint& p) {
+  if (sources.stranded.empty()) return std::nullopt;
+  const SurfacePoint c = CanonicalPoint(surface, p);
+  if (c.kind != SurfacePoint::Kind::kVertex) return std::nullopt;
+  for (const auto& [vertex, label] : sources.stranded) {
+    if (vertex == c.vertex) return label;
+  }
+  return std::nullopt;
+}
+
+// The exact engine over the union, its copies linked, under the caller's limits. Not empty().
+class UnionSolver {
+ public:
+  UnionSolver(const RegionSurface::Impl& regions, const WeightedSurface::Limits& limits)
+      : options_(OptionsFor(regions, limits)), solver_(regions.mesh(), options_) {
+    solver_.set_regions(&regions.links());
+  }
+  ich::IchSolver& operator*() { return solver_; }
+  ich::IchSolver* operator->() { return &solver_; }
+
+ private:
+  static GeodesicOptions OptionsFor(const RegionSurface::Impl& regions,
+                                    const WeightedSurface::Limits& limits) {
+    GeodesicOptions g;
+    g.method = Method::kExact;
+    g.max_distance = limits.max_distance;
+    g.cancel = limits.cancel;
+    g.max_windows = regions.max_windows();
+    return g;
+  }
+  const GeodesicOptions options_;  // before solver_, which keeps a reference to it
+  ich::IchSolver solver_;
+};
 
 double Since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
@@ -346,17 +458,12 @@ uint64_t RegionSurface::boundary_points() const { return impl_->boundary_points(
 absl::StatusOr<WeightedField> RegionSurface::Field(const std::vector<SurfacePoint>& sources,
                                                    const WeightedSurface::Limits& limits) const {
   const auto start = std::chrono::steady_clock::now();
-  absl::StatusOr<std::vector<ich::ResolvedSource>> src = UnionSources(*impl_, sources);
+  absl::StatusOr<UnionSourceSet> src = UnionSources(*impl_, sources);
   if (!src.ok()) return src.status();
-  const GeodesicOptions g = UnionOptions(limits);
   DistanceField field;
-  if (impl_->empty()) {
-    field.internal_distance.assign(impl_->surface().vertex_count(), kInf);
-    field.internal_source.assign(impl_->surface().vertex_count(), kNoIndex);
-  } else {
-    ich::IchSolver solver(impl_->mesh(), g);
-    solver.set_regions(&impl_->links());
-    if (absl::Status s = solver.Solve(*src, &field); !s.ok()) return s;
+  if (!impl_->empty()) {
+    UnionSolver solver(*impl_, limits);
+    if (absl::Status s = solver->Solve(src->resolved, &field); !s.ok()) return s;
   }
   const TriangleMesh& mesh = impl_->surface();
   WeightedField out;
@@ -376,6 +483,12 @@ absl::StatusOr<WeightedField> RegionSurface::Field(const std::vector<SurfacePoin
       out.source[fv] = label;
     }
   }
+  for (const auto& [vertex, label] : src->stranded) {
+    if (out.cost[vertex] > 0) {  // the first such source, as the engine labels ties
+      out.cost[vertex] = 0;
+      out.source[vertex] = label;
+    }
+  }
   CopyStats(field.stats, &out.stats);
   out.stats.solve_ms = Since(start);
   return out;
@@ -386,18 +499,16 @@ absl::StatusOr<WeightedCosts> RegionSurface::CostsAt(const std::vector<SurfacePo
                                                      bool whole,
                                                      const WeightedSurface::Limits& limits) const {
   const auto start = std::chrono::steady_clock::now();
-  absl::StatusOr<std::vector<ich::ResolvedSource>> src = UnionSources(*impl_, sources);
+  absl::StatusOr<UnionSourceSet> src = UnionSources(*impl_, sources);
   if (!src.ok()) return src.status();
   std::vector<ich::ResolvedTarget> resolved;
   if (absl::Status s = UnionTargets(*impl_, targets, &resolved, nullptr); !s.ok()) return s;
   std::vector<ich::TargetResult> results(targets.size());
   SolveStats stats;
   if (!impl_->empty()) {
-    const GeodesicOptions options = UnionOptions(limits);  // the solver keeps a reference
-    ich::IchSolver solver(impl_->mesh(), options);
-    solver.set_regions(&impl_->links());
-    if (absl::Status s = solver.SolveForTargets(*src, resolved, /*use_heuristic=*/false,
-                                                /*stop_early=*/!whole, &results, &stats);
+    UnionSolver solver(*impl_, limits);
+    if (absl::Status s = solver->SolveForTargets(src->resolved, resolved, /*use_heuristic=*/false,
+                                                 /*stop_early=*/!whole, &results, &stats);
         !s.ok()) {
       return s;
     }
@@ -407,6 +518,11 @@ absl::StatusOr<WeightedCosts> RegionSurface::CostsAt(const std::vector<SurfacePo
   out.cost.assign(targets.size(), kInf);
   out.source.assign(targets.size(), kNoIndex);
   for (size_t t = 0; t < targets.size(); ++t) {
+    if (const std::optional<uint32_t> label = StrandedAt(impl_->surface(), *src, targets[t])) {
+      out.cost[t] = 0;
+      out.source[t] = *label;
+      continue;
+    }
     out.cost[t] = results[t].distance;
     out.source[t] = std::isfinite(results[t].distance) ? results[t].label : kNoIndex;
   }
@@ -419,27 +535,40 @@ absl::StatusOr<std::vector<WeightedPath>> RegionSurface::Paths(
     const SurfacePoint& from, const std::vector<SurfacePoint>& tos,
     const WeightedSurface::Limits& limits) const {
   const auto start = std::chrono::steady_clock::now();
-  absl::StatusOr<std::vector<ich::ResolvedSource>> src = UnionSources(*impl_, {from});
+  // Windows leaving a boundary point record no vertex to trace back through, so paths are
+  // traced only where there are none (one weight: every product that serves paths this way).
+  if (impl_->boundary_points() > 0) {
+    return absl::FailedPreconditionError(
+        "paths across region boundaries are not traced by the regions (the graph serves them)");
+  }
+  absl::StatusOr<UnionSourceSet> src = UnionSources(*impl_, {from});
   if (!src.ok()) return src.status();
   std::vector<ich::ResolvedTarget> resolved;
   std::vector<SurfacePoint> first;
   if (absl::Status s = UnionTargets(*impl_, tos, &resolved, &first); !s.ok()) return s;
   std::vector<WeightedPath> out(tos.size());
-  for (WeightedPath& p : out) p.cost = kInf;
+  for (size_t i = 0; i < tos.size(); ++i) {
+    out[i].cost = kInf;
+    if (StrandedAt(impl_->surface(), *src, tos[i]).has_value()) {  // from itself, going nowhere
+      out[i].cost = 0;
+      PathPoint p;
+      p.where = tos[i];
+      p.position = impl_->PositionOn(CanonicalPoint(impl_->surface(), tos[i]));
+      out[i].points = {p, p};
+    }
+  }
   if (impl_->empty()) return out;
   std::vector<ich::TargetResult> results;
   SolveStats stats;
-  const GeodesicOptions options = UnionOptions(limits);  // the solver keeps a reference
-  ich::IchSolver solver(impl_->mesh(), options);
-  solver.set_regions(&impl_->links());
-  if (absl::Status s = solver.SolveForTargets(*src, resolved, /*use_heuristic=*/false,
-                                              /*stop_early=*/true, &results, &stats);
+  UnionSolver solver(*impl_, limits);
+  if (absl::Status s = solver->SolveForTargets(src->resolved, resolved, /*use_heuristic=*/false,
+                                               /*stop_early=*/true, &results, &stats);
       !s.ok()) {
     return s;
   }
-  const VertexPaths paths{solver.distances().data(), solver.origins().data()};
+  const VertexPaths paths{solver->distances().data(), solver->origins().data()};
   for (size_t i = 0; i < tos.size(); ++i) {
-    if (!std::isfinite(results[i].distance)) continue;
+    if (!std::isfinite(results[i].distance) || out[i].cost == 0) continue;
     absl::StatusOr<GeodesicPath> traced =
         TraceFromTarget(impl_->mesh(), paths, results[i], first[i]);
     if (absl::IsNotFound(traced.status())) continue;

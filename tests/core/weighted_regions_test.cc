@@ -9,9 +9,11 @@
 #include <cstdio>
 #include <limits>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "geodex/geodesic_solver.h"
+#include "geodex/limits.h"
 #include "geodex/travel_cost.h"
 #include "geodex/weighted_field.h"
 #include "gtest/gtest.h"
@@ -161,6 +163,125 @@ TEST(WeightedRegionsTest, PathsPassWherePassableFacesMeetAtAVertex) {
   ASSERT_TRUE(none.ok()) << none.status();
   EXPECT_EQ(none->cost[0], kInf);
   EXPECT_FALSE(CostsAt(mesh, options, {SurfacePoint::AtVertex(99)}, {}).ok());
+}
+
+// A source vertex whose faces are all impassable (a summit under --max-slope) stands where it is:
+// cost 0 there, as on the graph, and nothing else is reached from it.
+TEST(WeightedRegionsTest, StrandedSourceVertexCostsNothingAtItself) {
+  GridSpec spec;
+  spec.cells_x = spec.cells_y = 2;
+  spec.width = spec.height = 2;
+  const MeshData data = MakeGrid(spec);
+  const TriangleMesh mesh = BuildMesh(data);
+  WeightedOptions options;
+  for (uint32_t f = 0; f < data.face_count(); ++f) {
+    const Vec3 c = FaceCentroid(data, f);
+    options.face_weight.push_back((c[0] < 1) == (c[1] < 1) ? 1.0 : kInf);
+  }
+  const std::vector<SurfacePoint> sources{SurfacePoint::AtVertex(1), SurfacePoint::AtVertex(2)};
+  absl::StatusOr<std::shared_ptr<const RegionSurface>> surface =
+      RegionSurface::Build(mesh, options, sources);
+  ASSERT_TRUE(surface.ok()) << surface.status();
+  absl::StatusOr<WeightedField> field = (*surface)->Field(sources, {});
+  absl::StatusOr<WeightedField> graph = ComputeWeightedField(mesh, sources, options);
+  ASSERT_TRUE(field.ok()) << field.status();
+  ASSERT_TRUE(graph.ok()) << graph.status();
+  EXPECT_EQ(field->cost[2], 0);  // (2, 0): impassable all round, a source itself
+  EXPECT_EQ(field->source[2], 1u);
+  EXPECT_EQ(graph->cost[2], 0);
+  EXPECT_EQ(graph->source[2], 1u);
+  EXPECT_EQ(field->cost[1], 0);
+  EXPECT_EQ(field->source[1], 0u);
+  EXPECT_EQ(field->cost[6], kInf);  // (0, 2): impassable all round, not a source
+  // At points: the stranded source's vertex is 0, the rest only from the other source.
+  absl::StatusOr<WeightedCosts> costs = (*surface)->CostsAt(
+      {SurfacePoint::AtVertex(2)},
+      {SurfacePoint::AtVertex(2), SurfacePoint::OnEdge(2, 1, 1.0), SurfacePoint::AtVertex(4)},
+      false, {});
+  ASSERT_TRUE(costs.ok()) << costs.status();
+  EXPECT_EQ(costs->cost, (std::vector<double>{0, kInf, kInf}));
+  EXPECT_EQ(costs->source[0], 0u);
+  // A path from it to itself: no way to go, nothing to walk.
+  absl::StatusOr<std::vector<WeightedPath>> paths =
+      (*surface)->Paths(SurfacePoint::AtVertex(2), {SurfacePoint::AtVertex(2)}, {});
+  ASSERT_TRUE(paths.ok()) << paths.status();
+  EXPECT_EQ((*paths)[0].cost, 0);
+  ASSERT_FALSE((*paths)[0].points.empty());
+  EXPECT_EQ((*paths)[0].points.front().position, (std::array<double, 3>{2, 0, 0}));
+}
+
+// A point in a zero-area face (or on its edge) lies on an edge beside it with area: taken there
+// (the exact engine places nothing inside such a face); errors name the surface's own vertices.
+TEST(WeightedRegionsTest, PointsInZeroAreaFacesAndMissingEdges) {
+  MeshData data;
+  data.positions = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0.5, 0, 0};
+  data.faces = {0, 4, 3, 4, 1, 2, 4, 2, 3, 0, 1, 4};  // the last: (0, 0) - (1, 0) - (0.5, 0)
+  const TriangleMesh mesh = BuildMesh(data);
+  ASSERT_TRUE(mesh.FaceDegenerate(3));
+  WeightedOptions options;
+  options.face_weight.assign(4, 2.0);
+  const SurfacePoint in_sliver = SurfacePoint::InFace(3, 0.25, 0.75, 0);  // (0.75, 0)
+  absl::StatusOr<WeightedCosts> costs =
+      CostsAt(mesh, options, {SurfacePoint::AtVertex(3)}, {in_sliver, SurfacePoint::AtVertex(2)});
+  ASSERT_TRUE(costs.ok()) << costs.status();
+  EXPECT_NEAR(costs->cost[0], 2 * 1.25, 1e-12);  // (0, 1) to (0.75, 0), straight
+  EXPECT_NEAR(costs->cost[1], 2 * 1.0, 1e-12);
+  costs = CostsAt(mesh, options, {in_sliver}, {SurfacePoint::AtVertex(2)});
+  ASSERT_TRUE(costs.ok()) << costs.status();
+  EXPECT_NEAR(costs->cost[0], 2 * std::hypot(0.25, 1.0), 1e-12);
+  // On the edge of the zero-area face only: the same position on the edge beside it.
+  costs = CostsAt(mesh, options, {SurfacePoint::AtVertex(3)}, {SurfacePoint::OnEdge(0, 1, 0.3)});
+  ASSERT_TRUE(costs.ok()) << costs.status();
+  EXPECT_NEAR(costs->cost[0], 2 * std::hypot(0.3, 1.0), 1e-12);
+  // An edge the mesh does not have.
+  absl::StatusOr<std::shared_ptr<const RegionSurface>> surface =
+      RegionSurface::Build(mesh, options);
+  ASSERT_TRUE(surface.ok()) << surface.status();
+  absl::StatusOr<WeightedCosts> bad =
+      (*surface)->CostsAt({SurfacePoint::AtVertex(3)}, {SurfacePoint::OnEdge(0, 2, 0.5)}, true, {});
+  EXPECT_EQ(bad.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_NE(bad.status().message().find("no edge between vertices 0 and 2"), std::string::npos)
+      << bad.status();
+}
+
+// geodexd's window budget (--max_windows) bounds one-weight travel solves as it bounds fields.
+TEST(WeightedRegionsTest, WindowBudgetBoundsOneWeightSolves) {
+  absl::StatusOr<TriangleMesh> mesh = LoadTestMesh("knight.off");
+  ASSERT_TRUE(mesh.ok()) << mesh.status();
+  GeodesicOptions options;
+  TravelCost travel;
+  travel.speed_kmh = 3.6;
+  travel.face_weight = std::make_shared<std::vector<double>>(mesh->face_count(), 2.0);
+  options.travel = travel;
+  options.max_windows = 100;
+  absl::StatusOr<DistanceField> field =
+      ComputeDistanceField(*mesh, {SurfacePoint::AtVertex(0)}, options);
+  EXPECT_EQ(field.status().code(), absl::StatusCode::kResourceExhausted) << field.status();
+  EXPECT_EQ(ExceededLimit(field.status()), Limit::kWindows);
+  options.max_windows = 0;
+  field = ComputeDistanceField(*mesh, {SurfacePoint::AtVertex(0)}, options);
+  EXPECT_TRUE(field.ok()) << field.status();
+}
+
+// Several weights: paths are the graph's (windows from a boundary point record no vertex to
+// trace back through); the regions refuse rather than stop short.
+TEST(WeightedRegionsTest, PathsRefusedAcrossRegionBoundaries) {
+  GridSpec spec;
+  spec.cells_x = spec.cells_y = 4;
+  const MeshData data = MakeGrid(spec);
+  const TriangleMesh mesh = BuildMesh(data);
+  WeightedOptions options;
+  options.epsilon = 0.1;
+  for (uint32_t f = 0; f < data.face_count(); ++f) {
+    options.face_weight.push_back(FaceCentroid(data, f)[0] < 0.5 ? 1.0 : 4.0);
+  }
+  absl::StatusOr<std::shared_ptr<const RegionSurface>> surface =
+      RegionSurface::Build(mesh, options);
+  ASSERT_TRUE(surface.ok()) << surface.status();
+  ASSERT_GT((*surface)->boundary_points(), 0u);
+  absl::StatusOr<std::vector<WeightedPath>> paths =
+      (*surface)->Paths(SurfacePoint::AtVertex(0), {SurfacePoint::AtVertex(24)}, {});
+  EXPECT_EQ(paths.status().code(), absl::StatusCode::kFailedPrecondition) << paths.status();
 }
 
 // Several weights: friction 4 beyond x = 1. Every vertex there against its refracted optimum
