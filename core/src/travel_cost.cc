@@ -229,9 +229,16 @@ absl::StatusOr<std::shared_ptr<const WeightedSurface>> BuildTravelGraph(
     const TriangleMesh& mesh, const GeodesicOptions& options) {
   absl::StatusOr<WeightedOptions> weighted = WeightedOptionsFor(mesh, options);
   if (!weighted.ok()) return weighted.status();
-  // A slope cost builds its own per query; the regions need no graph.
-  if (weighted->slope_cost != nullptr || RegionsServe(*weighted)) return nullptr;
-  weighted->cancel = nullptr;  // the graph outlives the call that builds it
+  // A slope cost builds its own per query.
+  if (weighted->slope_cost != nullptr) return nullptr;
+  weighted->cancel = nullptr;     // the graph outlives the call that builds it
+  if (RegionsServe(*weighted)) {  // one weight: the exact engine's surface, shared the same way
+    absl::StatusOr<std::shared_ptr<const RegionSurface>> regions =
+        RegionSurface::Build(mesh, *weighted);
+    if (!regions.ok()) return regions.status();
+    return std::make_shared<const WeightedSurface>(
+        WeightedSurface::OnRegions(mesh, *weighted, *std::move(regions)));
+  }
   absl::StatusOr<WeightedSurface> surface = WeightedSurface::Build(mesh, *weighted);
   if (!surface.ok()) return surface.status();
   return std::make_shared<const WeightedSurface>(*std::move(surface));
@@ -243,6 +250,9 @@ absl::StatusOr<TravelPointSolver> TravelPointSolver::Create(
   absl::StatusOr<WeightedOptions> weighted = WeightedOptionsFor(mesh, options);
   if (!weighted.ok()) return weighted.status();
   const WeightedSurface::Limits limits{weighted->max_distance, weighted->cancel};
+  if (std::shared_ptr<const WeightedSurface> shared = SharedGraph(mesh, options, *weighted)) {
+    return TravelPointSolver(*options.travel, std::move(shared), nullptr, limits);
+  }
   if (RegionsServe(*weighted)) {
     std::vector<SurfacePoint> anchors = sources;
     anchors.insert(anchors.end(), points.begin(), points.end());
@@ -250,9 +260,6 @@ absl::StatusOr<TravelPointSolver> TravelPointSolver::Create(
         RegionSurface::Build(mesh, *weighted, anchors);
     if (!regions.ok()) return regions.status();
     return TravelPointSolver(*options.travel, nullptr, *std::move(regions), limits);
-  }
-  if (std::shared_ptr<const WeightedSurface> shared = SharedGraph(mesh, options, *weighted)) {
-    return TravelPointSolver(*options.travel, std::move(shared), nullptr, limits);
   }
   absl::StatusOr<WeightedSurface> surface =
       WeightedSurface::Build(mesh, *weighted, sources, points);
@@ -303,16 +310,15 @@ absl::StatusOr<PathsQueryResult> ComputeTravelPaths(const TriangleMesh& mesh,
   if (!weighted.ok()) return weighted.status();
   const WeightedSurface::Limits limits{weighted->max_distance, weighted->cancel};
   absl::StatusOr<std::vector<WeightedPath>> paths;
-  if (RegionsServe(*weighted)) {
+  if (const std::shared_ptr<const WeightedSurface> shared = SharedGraph(mesh, options, *weighted)) {
+    paths = shared->Paths(from, tos, limits);
+  } else if (RegionsServe(*weighted)) {
     std::vector<SurfacePoint> anchors = tos;
     anchors.push_back(from);
     absl::StatusOr<std::shared_ptr<const RegionSurface>> regions =
         RegionSurface::Build(mesh, *weighted, anchors);
     if (!regions.ok()) return regions.status();
     paths = (*regions)->Paths(from, tos, limits);
-  } else if (const std::shared_ptr<const WeightedSurface> shared =
-                 SharedGraph(mesh, options, *weighted)) {
-    paths = shared->Paths(from, tos, limits);
   } else {
     paths = ComputeWeightedPaths(mesh, from, tos, *weighted);
   }

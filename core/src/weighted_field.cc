@@ -1652,6 +1652,8 @@ struct WeightedSurface::Impl {
   // The bounded placement's anchors (sorted positions): a search from or to any other point
   // strictly inside a face or an edge needs a surface refined around it (Anchors).
   std::vector<Vec> anchored;
+  // Set: one weight, the exact engine answers (OnRegions) and the graph stays unbuilt.
+  std::shared_ptr<const RegionSurface> regions;
 
   // Whether every point of `points` is a vertex or one of the anchors (or the placement has none).
   bool Anchors(const std::vector<Located>& points) const {
@@ -1812,11 +1814,21 @@ absl::StatusOr<WeightedSurface> WeightedSurface::Build(const TriangleMesh& mesh,
   return WeightedSurface(*std::move(impl));
 }
 
-uint64_t WeightedSurface::steiner_points() const { return impl_->graph.steiner_points(); }
+WeightedSurface WeightedSurface::OnRegions(const TriangleMesh& mesh, const WeightedOptions& options,
+                                           std::shared_ptr<const RegionSurface> regions) {
+  auto impl = std::make_unique<Impl>(mesh, options);
+  impl->regions = std::move(regions);
+  return WeightedSurface(std::move(impl));
+}
+
+uint64_t WeightedSurface::steiner_points() const {
+  return impl_->regions != nullptr ? 0 : impl_->graph.steiner_points();
+}
 
 uint64_t WeightedSurface::bytes() const {
   return sizeof(Impl) + impl_->graph.bytes() +
-         impl_->options.face_weight.capacity() * sizeof(double);
+         2 * impl_->options.face_weight.capacity() * sizeof(double) +  // the options', the graph's
+         (impl_->regions != nullptr ? impl_->regions->bytes() : 0);
 }
 
 const TriangleMesh& WeightedSurface::mesh() const { return impl_->graph.mesh(); }
@@ -1826,7 +1838,8 @@ bool WeightedSurface::Serves(const TriangleMesh& mesh, const WeightedOptions& op
   return &impl_->graph.mesh() == &mesh && options.slope_cost == nullptr &&
          built.slope_cost == nullptr && options.epsilon == built.epsilon &&
          options.face_weight == built.face_weight &&
-         (options.max_steiner_points == 0 || steiner_points() <= options.max_steiner_points);
+         (options.max_steiner_points == 0 || steiner_points() <= options.max_steiner_points) &&
+         (impl_->regions == nullptr || options.max_windows == built.max_windows);
 }
 
 namespace {
@@ -1861,6 +1874,7 @@ absl::StatusOr<WeightedCosts> WeightedSurface::CostsAt(const std::vector<Surface
 absl::StatusOr<WeightedCosts> WeightedSurface::CostsAt(const std::vector<SurfacePoint>& sources,
                                                        const std::vector<SurfacePoint>& targets,
                                                        bool whole, const Limits& limits) const {
+  if (impl_->regions != nullptr) return impl_->regions->CostsAt(sources, targets, whole, limits);
   const auto start = std::chrono::steady_clock::now();
   if (sources.empty()) return absl::InvalidArgumentError("no sources given");
   if (!(limits.max_distance > 0)) {
@@ -2028,6 +2042,7 @@ absl::StatusOr<std::vector<WeightedPath>> ComputeWeightedPaths(const TriangleMes
 
 absl::StatusOr<std::vector<WeightedPath>> WeightedSurface::Paths(
     const SurfacePoint& from, const std::vector<SurfacePoint>& tos, const Limits& limits) const {
+  if (impl_->regions != nullptr) return impl_->regions->Paths(from, tos, limits);
   const auto start = std::chrono::steady_clock::now();
   if (impl_->options.inbound && impl_->options.slope_cost != nullptr) {
     return OptionError("inbound", "a path is walked from its start: build the surface outward");

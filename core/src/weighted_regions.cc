@@ -43,6 +43,12 @@ struct RegionSurface::Impl {
   uint64_t max_windows() const { return options_.max_windows; }
   const ich::RegionLinks& links() const { return links_; }
   uint64_t boundary_points() const { return links_.point_count(); }
+  uint64_t bytes() const {
+    auto of = [](const auto& v) { return uint64_t{v.capacity()} * sizeof(v[0]); };
+    return sizeof(*this) + (union_ != nullptr ? union_->MemoryBytes() : 0) + links_.bytes() +
+           of(options_.face_weight) + of(vertex_first_) + of(copy_weight_) + of(union_face_) +
+           of(surface_face_) + of(surface_vertex_);
+  }
 
   // The union's points standing for surface point p (a vertex: each copy; an edge point: one per
   // passable face on the edge; a face point: its face's), none when p is in impassable faces only.
@@ -454,6 +460,8 @@ absl::StatusOr<std::shared_ptr<const RegionSurface>> RegionSurface::Build(
 }
 
 uint64_t RegionSurface::boundary_points() const { return impl_->boundary_points(); }
+
+uint64_t RegionSurface::bytes() const { return impl_->bytes(); }
 
 absl::StatusOr<WeightedField> RegionSurface::Field(const std::vector<SurfacePoint>& sources,
                                                    const WeightedSurface::Limits& limits) const {

@@ -53,6 +53,7 @@ class RegionSurface {
                                                   const std::vector<SurfacePoint>& tos,
                                                   const WeightedSurface::Limits& limits) const;
   uint64_t boundary_points() const;
+  uint64_t bytes() const;  // the union mesh, its links and the point maps (for caches)
 
   struct Impl;
 

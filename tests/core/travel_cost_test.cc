@@ -261,6 +261,57 @@ TEST(TravelCostTest, ASharedGraphAnswersAsEachQuerysOwn) {
   EXPECT_EQ(*none, nullptr);
 }
 
+// One weight (the exact engine, no graph): BuildTravelGraph wraps the exact engine's surface to be
+// shared the same way; a query handed it answers bit for bit as one building its own, and it
+// serves only queries of the same weights and window budget.
+TEST(TravelCostTest, ASharedOneWeightSurfaceAnswersAsEachQuerysOwn) {
+  const TriangleMesh mesh = SquarePlane(8, 80, 0.2);
+  GeodesicOptions own = Travel(3.6);
+  std::vector<double> weights(mesh.face_count(), 2.0);
+  weights[7] = kInf;
+  own.travel->face_weight = std::make_shared<std::vector<double>>(std::move(weights));
+  absl::StatusOr<std::shared_ptr<const WeightedSurface>> surface = BuildTravelGraph(mesh, own);
+  ASSERT_TRUE(surface.ok()) << surface.status();
+  ASSERT_NE(*surface, nullptr);
+  EXPECT_EQ((*surface)->steiner_points(), 0u);
+  EXPECT_GT((*surface)->bytes(), mesh.MemoryBytes() / 2);  // (the union mesh, about the mesh)
+  auto serves = [&](const GeodesicOptions& o) {
+    absl::StatusOr<WeightedOptions> w = WeightedOptionsFor(mesh, o);
+    return w.ok() && (*surface)->Serves(mesh, *w);
+  };
+  EXPECT_TRUE(serves(own));
+  GeodesicOptions other = own;
+  other.max_windows = 1000;  // another budget: its own surface
+  EXPECT_FALSE(serves(other));
+  EXPECT_FALSE(serves(Travel(3.6)));  // other weights
+
+  GeodesicOptions shared = own;
+  shared.travel->graph = *surface;
+  const SurfacePoint from = SurfacePoint::InFace(5, 0.2, 0.3, 0.5);
+  const std::vector<SurfacePoint> tos = {SurfacePoint::AtVertex(80),
+                                         SurfacePoint::InFace(100, 0.6, 0.2, 0.2)};
+  absl::StatusOr<PathsQueryResult> pa = ComputeShortestPaths(mesh, from, tos, {own});
+  absl::StatusOr<PathsQueryResult> pb = ComputeShortestPaths(mesh, from, tos, {shared});
+  ASSERT_TRUE(pa.ok() && pb.ok()) << pa.status() << pb.status();
+  EXPECT_EQ(pa->distance, pb->distance);
+  ASSERT_EQ(pa->paths[0].points.size(), pb->paths[0].points.size());
+  for (size_t k = 0; k < pa->paths[0].points.size(); ++k) {
+    EXPECT_EQ(pa->paths[0].points[k].position, pb->paths[0].points[k].position) << k;
+  }
+  const std::vector<SurfacePoint> points = {SurfacePoint::AtVertex(0), SurfacePoint::AtVertex(40),
+                                            from, tos[1]};
+  absl::StatusOr<PointValues> va = ComputePointValues(mesh, {{from}, points, own});
+  absl::StatusOr<PointValues> vb = ComputePointValues(mesh, {{from}, points, shared});
+  ASSERT_TRUE(va.ok() && vb.ok()) << va.status() << vb.status();
+  EXPECT_EQ(va->distance, vb->distance);
+  // The query's own limits, not the builder's.
+  GeodesicOptions near = shared;
+  near.max_distance = va->distance[1] / 2;
+  absl::StatusOr<PointValues> cut = ComputePointValues(mesh, {{from}, points, near});
+  ASSERT_TRUE(cut.ok()) << cut.status();
+  EXPECT_EQ(cut->distance[1], kUnreachable);
+}
+
 // Isolines in seconds: a 60 s line lies farther out than a 30 s one.
 TEST(TravelCostTest, IsolinesAreDrawnInSeconds) {
   const TriangleMesh mesh = SquarePlane(10, 100);

@@ -383,6 +383,32 @@ TEST_F(TravelServiceTest, FieldPathMatrixAndIsolinesEqualCore) {
   EXPECT_EQ(server_->cache().graph_hits(), 3u);
 }
 
+// One weight (no friction, steep faces impassable): the exact engine's surface, no Steiner graph,
+// cached and shared as a graph is; its answers are core's, bit for bit.
+TEST_F(TravelServiceTest, OneWeightSurfaceIsSharedAsAGraphIs) {
+  GeodesicOptions one = Travel();
+  one.travel->face_weight = nullptr;
+  for (const uint32_t to : {420u, 300u}) {
+    PathQuery query{Sites()[0], SurfacePoint::AtVertex(to), {}};
+    query.options.solver = one;
+    v1::FindShortestPathResponse response;
+    grpc::Status status = PathOverService(query, &response);
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    absl::StatusOr<PathQueryResult> want =
+        ComputeShortestPath(*local_, query.from, query.to, query.options);
+    ASSERT_TRUE(want.ok()) << want.status();
+    EXPECT_TRUE(BitEqual(response.distance(), want->distance)) << to;
+  }
+  EXPECT_EQ(server_->cache().graph_misses(), 1u);
+  EXPECT_EQ(server_->cache().graph_hits(), 1u);
+  absl::StatusOr<std::shared_ptr<const StoredMesh>> stored = server_->store().Get("hills");
+  ASSERT_TRUE(stored.ok()) << stored.status();
+  std::shared_ptr<const WeightedSurface> surface =
+      server_->cache().FindGraph(TravelGraphKey((*stored)->id, one), *(*stored)->mesh);
+  ASSERT_NE(surface, nullptr);
+  EXPECT_EQ(surface->steiner_points(), 0u);
+}
+
 // Travel graphs in the result cache: one per mesh and travel cost (another epsilon is another
 // graph; a slope-dependent speed has none), counted in its bytes, and what a graph's answers are
 // does not depend on whether it came from the cache.

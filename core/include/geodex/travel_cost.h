@@ -113,8 +113,10 @@ inline const char* SpeedModelName(SpeedModel model) {
 
 // The graph a constant-speed travel cost's paths, times at points and matrices on `mesh` search,
 // to be shared through TravelCost::graph (geodexd keeps them in its result cache). `mesh` must
-// outlive it. Null for a slope-dependent speed: its points follow each query's sources. Errors:
-// as the queries' (the options, the Steiner-point limit).
+// outlive it. Null for a slope-dependent speed: its points follow each query's sources. Where
+// every passable face weighs the same it holds the exact engine's surface instead of a graph
+// (WeightedSurface::OnRegions, no Steiner points), shared the same way. Errors: as the queries'
+// (the options, the Steiner-point limit).
 absl::StatusOr<std::shared_ptr<const WeightedSurface>> BuildTravelGraph(
     const TriangleMesh& mesh, const GeodesicOptions& options);
 

@@ -168,6 +168,7 @@ absl::StatusOr<WeightedCosts> ComputeWeightedCostsAt(const TriangleMesh& mesh,
                                                      const WeightedOptions& options);
 
 struct WeightedPath;
+class RegionSurface;  // core/src/weighted_regions.h
 
 // The weighted engine's graph (Steiner points) and cost model (the per-face switchback ranges of
 // a slope cost) for one mesh and one set of options, built once for many queries: a matrix's
@@ -186,6 +187,11 @@ class WeightedSurface {
                                                const WeightedOptions& options,
                                                const std::vector<SurfacePoint>& seeds = {},
                                                const std::vector<SurfacePoint>& anchors = {});
+  // The surface of one weight, answered by the exact engine (core's RegionSurface: every passable
+  // face weighs the same, so no Steiner point is needed), wrapped to be shared and cached as a
+  // graph is (BuildTravelGraph): CostsAt and Paths answer from it, steiner_points() is 0.
+  static WeightedSurface OnRegions(const TriangleMesh& mesh, const WeightedOptions& options,
+                                   std::shared_ptr<const RegionSurface> regions);
   WeightedSurface(WeightedSurface&&) noexcept;
   WeightedSurface& operator=(WeightedSurface&&) noexcept;
   ~WeightedSurface();
@@ -221,7 +227,8 @@ class WeightedSurface {
   // Whether a solve with `options` on `mesh` would build this very surface, so a query may use
   // it instead of building its own: the same mesh object, epsilon and weights, within the
   // options' Steiner-point limit, and no slope cost on either (its points follow each query's
-  // sources). Costs the comparison of the weights.
+  // sources), and for a surface OnRegions the same window budget (max_windows). Costs the
+  // comparison of the weights.
   bool Serves(const TriangleMesh& mesh, const WeightedOptions& options) const;
   uint64_t steiner_points() const;
   uint64_t bytes() const;  // what it holds: the Steiner points, the graph's arrays, the weights

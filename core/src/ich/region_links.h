@@ -29,6 +29,11 @@ struct RegionLinks {
   std::vector<uint32_t> next_copy;
 
   uint32_t point_count() const { return static_cast<uint32_t>(point_param.size()); }
+  uint64_t bytes() const {
+    auto of = [](const auto& v) { return uint64_t{v.capacity()} * sizeof(v[0]); };
+    return of(chain_of_half) + of(chain_reversed) + of(chain_first) + of(point_param) +
+           of(point_chain) + of(chain_cost) + of(chain_halves) + of(next_copy);
+  }
 };
 
 }  // namespace geodex::ich
