@@ -42,6 +42,24 @@ absl::StatusOr<WeightedCosts> CostsAt(const TriangleMesh& mesh, const WeightedOp
   return (*regions)->CostsAt(sources, targets, false, {});
 }
 
+// A 2 x 2 grid of unit cells, vertex (i, j) = 3 j + i.
+MeshData TwoByTwoGrid() {
+  GridSpec spec;
+  spec.cells_x = spec.cells_y = 2;
+  spec.width = spec.height = 2;
+  return MakeGrid(spec);
+}
+
+// Weight w on cells (0, 0) and (1, 1), which meet only at the vertex (1, 1); the rest impassable.
+std::vector<double> DiagonalCellsPassable(const MeshData& grid, double w) {
+  std::vector<double> weights;
+  for (uint32_t f = 0; f < grid.face_count(); ++f) {
+    const Vec3 c = FaceCentroid(grid, f);
+    weights.push_back((c[0] < 1) == (c[1] < 1) ? w : kInf);
+  }
+  return weights;
+}
+
 TEST(WeightedRegionsTest, WhoServes) {
   WeightedOptions options;
   EXPECT_TRUE(RegionsServe(options));
@@ -104,17 +122,10 @@ TEST(WeightedRegionsTest, ImpassableWallIsGoneAroundExactly) {
 // Two passable cells that meet only at a vertex (every other face impassable): paths pass
 // through it, as the graph's do, though the passable faces split there.
 TEST(WeightedRegionsTest, PathsPassWherePassableFacesMeetAtAVertex) {
-  GridSpec spec;
-  spec.cells_x = spec.cells_y = 2;
-  spec.width = spec.height = 2;
-  const MeshData data = MakeGrid(spec);
+  const MeshData data = TwoByTwoGrid();
   const TriangleMesh mesh = BuildMesh(data);
   WeightedOptions options;
-  for (uint32_t f = 0; f < data.face_count(); ++f) {
-    const Vec3 c = FaceCentroid(data, f);
-    const bool passable = (c[0] < 1) == (c[1] < 1);  // cells (0, 0) and (1, 1)
-    options.face_weight.push_back(passable ? 3.0 : kInf);
-  }
+  options.face_weight = DiagonalCellsPassable(data, 3.0);
   // (1, 0) to (2, 1) and to the far corner (2, 2), through the vertex (1, 1).
   const std::vector<SurfacePoint> targets{SurfacePoint::AtVertex(5), SurfacePoint::AtVertex(8),
                                           SurfacePoint::AtVertex(2)};
@@ -168,16 +179,10 @@ TEST(WeightedRegionsTest, PathsPassWherePassableFacesMeetAtAVertex) {
 // A source vertex whose faces are all impassable (a summit under --max-slope) stands where it is:
 // cost 0 there, as on the graph, and nothing else is reached from it.
 TEST(WeightedRegionsTest, StrandedSourceVertexCostsNothingAtItself) {
-  GridSpec spec;
-  spec.cells_x = spec.cells_y = 2;
-  spec.width = spec.height = 2;
-  const MeshData data = MakeGrid(spec);
+  const MeshData data = TwoByTwoGrid();
   const TriangleMesh mesh = BuildMesh(data);
   WeightedOptions options;
-  for (uint32_t f = 0; f < data.face_count(); ++f) {
-    const Vec3 c = FaceCentroid(data, f);
-    options.face_weight.push_back((c[0] < 1) == (c[1] < 1) ? 1.0 : kInf);
-  }
+  options.face_weight = DiagonalCellsPassable(data, 1.0);
   const std::vector<SurfacePoint> sources{SurfacePoint::AtVertex(1), SurfacePoint::AtVertex(2)};
   absl::StatusOr<std::shared_ptr<const RegionSurface>> surface =
       RegionSurface::Build(mesh, options, sources);
