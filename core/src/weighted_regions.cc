@@ -86,12 +86,8 @@ struct RegionSurface::Impl {
         }
         if (degenerate_only) {
           // On a zero-area face's edge: the same position on a neighbouring edge with area.
-          const std::array<double, 3> a = mesh_.Position(c.edge_from),
-                                      b = mesh_.Position(c.edge_to);
-          std::array<double, 3> at;
-          for (int j = 0; j < 3; ++j) at[j] = a[j] + c.t * (b[j] - a[j]);
           if (const std::optional<SurfacePoint> on =
-                  OnSegmentEdge(TriangleMesh::FaceOf(list[0]), at)) {
+                  OnSegmentEdge(TriangleMesh::FaceOf(list[0]), Recentred(c))) {
             return Map(*on, out);
           }
           return absl::InvalidArgumentError(absl::StrFormat(
@@ -105,13 +101,9 @@ struct RegionSurface::Impl {
         // A zero-area face is a segment: its points are on its edges (the graph takes them too;
         // the exact engine places nothing inside such a face).
         if (Flat(c.face)) {
-          std::array<double, 3> at{0, 0, 0};
-          const std::array<uint32_t, 3> k = mesh_.FileCorners(c.face);
-          for (int i = 0; i < 3; ++i) {
-            for (int j = 0; j < 3; ++j) at[j] += c.bary[i] * mesh_.Position(k[i])[j];
-          }
-          const std::optional<SurfacePoint> on = OnSegmentEdge(c.face, at);
+          const std::optional<SurfacePoint> on = OnSegmentEdge(c.face, Recentred(c));
           // None: every edge of it is of zero-area faces only (refused there, by name).
+          const std::array<uint32_t, 3> k = mesh_.FileCorners(c.face);
           return Map(on.value_or(SurfacePoint::OnEdge(k[0], k[1], 0.5)), out);
         }
         out->push_back(SurfacePoint::InFace(union_face_[c.face], c.bary[0], c.bary[1], c.bary[2]));
@@ -176,6 +168,12 @@ struct RegionSurface::Impl {
     return p;
   }
   std::array<double, 3> PositionOn(const SurfacePoint& p) const {
+    std::array<double, 3> out = Recentred(p);
+    for (int k = 0; k < 3; ++k) out[k] += mesh_.Center()[k];
+    return out;
+  }
+  // Surface point p's position in the mesh's own (recentred) coordinates, as Position gives.
+  std::array<double, 3> Recentred(const SurfacePoint& p) const {
     std::array<double, 3> out{0, 0, 0};
     auto add = [&](uint32_t file_vertex, double w) {
       const std::array<double, 3> q = mesh_.Position(file_vertex);
@@ -190,7 +188,6 @@ struct RegionSurface::Impl {
       const std::array<uint32_t, 3> c = mesh_.FileCorners(p.face);
       for (int k = 0; k < 3; ++k) add(c[k], p.bary[k]);
     }
-    for (int k = 0; k < 3; ++k) out[k] += mesh_.Center()[k];
     return out;
   }
 

@@ -154,6 +154,22 @@ TEST(TravelCostTest, MatrixRowsArePointValues) {
   for (size_t j = 1; j < 3; ++j) EXPECT_EQ(m->values[j], row->distance[j]);
 }
 
+// Paths from `from` to `tos` under options a and b: the same times and points, bit for bit.
+void ExpectSamePaths(const TriangleMesh& mesh, const SurfacePoint& from,
+                     const std::vector<SurfacePoint>& tos, const GeodesicOptions& a,
+                     const GeodesicOptions& b) {
+  absl::StatusOr<PathsQueryResult> pa = ComputeShortestPaths(mesh, from, tos, {a});
+  absl::StatusOr<PathsQueryResult> pb = ComputeShortestPaths(mesh, from, tos, {b});
+  ASSERT_TRUE(pa.ok() && pb.ok()) << pa.status() << pb.status();
+  for (size_t t = 0; t < tos.size(); ++t) {
+    EXPECT_EQ(pa->distance[t], pb->distance[t]) << t;
+    ASSERT_EQ(pa->paths[t].points.size(), pb->paths[t].points.size()) << t;
+    for (size_t k = 0; k < pa->paths[t].points.size(); ++k) {
+      EXPECT_EQ(pa->paths[t].points[k].position, pb->paths[t].points[k].position) << t;
+    }
+  }
+}
+
 // A graph built once (BuildTravelGraph) and handed to queries in TravelCost::graph gives every
 // path, point value and matrix entry bit for bit what a query building its own gives, under the
 // query's own limits (max_distance, cancel). A graph of other weights, another epsilon or another
@@ -197,16 +213,7 @@ TEST(TravelCostTest, ASharedGraphAnswersAsEachQuerysOwn) {
   const std::vector<SurfacePoint> tos = {SurfacePoint::AtVertex(80),
                                          SurfacePoint::InFace(100, 0.6, 0.2, 0.2)};
   auto same_paths = [&](const GeodesicOptions& a, const GeodesicOptions& b) {
-    absl::StatusOr<PathsQueryResult> pa = ComputeShortestPaths(mesh, from, tos, {a});
-    absl::StatusOr<PathsQueryResult> pb = ComputeShortestPaths(mesh, from, tos, {b});
-    ASSERT_TRUE(pa.ok() && pb.ok()) << pa.status() << pb.status();
-    for (size_t t = 0; t < tos.size(); ++t) {
-      EXPECT_EQ(pa->distance[t], pb->distance[t]) << t;
-      ASSERT_EQ(pa->paths[t].points.size(), pb->paths[t].points.size()) << t;
-      for (size_t k = 0; k < pa->paths[t].points.size(); ++k) {
-        EXPECT_EQ(pa->paths[t].points[k].position, pb->paths[t].points[k].position) << t;
-      }
-    }
+    ExpectSamePaths(mesh, from, tos, a, b);
   };
   same_paths(own, shared);
   const std::vector<SurfacePoint> points = {SurfacePoint::AtVertex(0), SurfacePoint::AtVertex(40),
@@ -290,14 +297,7 @@ TEST(TravelCostTest, ASharedOneWeightSurfaceAnswersAsEachQuerysOwn) {
   const SurfacePoint from = SurfacePoint::InFace(5, 0.2, 0.3, 0.5);
   const std::vector<SurfacePoint> tos = {SurfacePoint::AtVertex(80),
                                          SurfacePoint::InFace(100, 0.6, 0.2, 0.2)};
-  absl::StatusOr<PathsQueryResult> pa = ComputeShortestPaths(mesh, from, tos, {own});
-  absl::StatusOr<PathsQueryResult> pb = ComputeShortestPaths(mesh, from, tos, {shared});
-  ASSERT_TRUE(pa.ok() && pb.ok()) << pa.status() << pb.status();
-  EXPECT_EQ(pa->distance, pb->distance);
-  ASSERT_EQ(pa->paths[0].points.size(), pb->paths[0].points.size());
-  for (size_t k = 0; k < pa->paths[0].points.size(); ++k) {
-    EXPECT_EQ(pa->paths[0].points[k].position, pb->paths[0].points[k].position) << k;
-  }
+  ExpectSamePaths(mesh, from, tos, own, shared);
   const std::vector<SurfacePoint> points = {SurfacePoint::AtVertex(0), SurfacePoint::AtVertex(40),
                                             from, tos[1]};
   absl::StatusOr<PointValues> va = ComputePointValues(mesh, {{from}, points, own});
