@@ -5,9 +5,13 @@
 # uploads a DEM (idempotent) and asks CALLS travel paths at a constant speed, optionally with
 # friction polygons, each from a seeded random cell to one up to 12 cells away (a planner's local
 # goals: a long path's search costs far more than the graph, so sharing it gains little there).
+# POINTS=map (environment) takes each end as a map point a fraction of a cell off the vertex (inside
+# a face, as a GIS user's clicks are): without friction (one weight) the exact engine's cached
+# surface serves those too; with friction each query builds a graph refined around them.
 # One benchmark at a time.
 #
-# Usage: bench/travel_graph_bench.sh DEM.tif [DEM_STEP] [FRICTION.geojson] [CALLS] [PAIRS]
+# Usage: [POINTS=vertices|map] bench/travel_graph_bench.sh DEM.tif [DEM_STEP] [FRICTION.geojson]
+#        [CALLS] [PAIRS]
 #   e.g. bench/travel_graph_bench.sh /tmp/jacksboro.tif 4 /tmp/friction.geojson 20 5
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -16,6 +20,8 @@ step="${2:-4}"
 friction="${3:-}"
 calls="${4:-20}"
 pairs="${5:-5}"
+points="${POINTS:-vertices}"
+case "$points" in vertices | map) ;; *) echo "POINTS: vertices or map, not '$points'" >&2; exit 2 ;; esac
 build="${BUILD_DIR:-build}"
 tmp=$(mktemp -d)
 pids=()
@@ -42,23 +48,32 @@ uncached=$port
 cat >"$tmp/paths.py" <<'EOF'
 import random, sys
 import geodex
-server, dem, step, friction, calls = sys.argv[1:6]
+server, dem, step, friction, calls, points = sys.argv[1:7]
 with geodex.GeodexClient(server) as c:
     mesh = c.upload(dem, dem_step=int(step))
     travel = geodex.Travel(speed_kmh=4, friction_geojson=open(friction).read() if friction else None)
     # A planner's local goals: from a random cell centre to one up to 12 cells (at the step)
     # away; a DEM's vertices run row by row (no nodata here).
     from osgeo import gdal
-    width = (gdal.Open(dem).RasterXSize - 1) // int(step) + 1
+    ds = gdal.Open(dem)
+    gt, s = ds.GetGeoTransform(), int(step)
+    width = (ds.RasterXSize - 1) // s + 1
     r = random.Random(2010)
+    def point(v):  # the vertex, or a map point 0.3 and 0.4 of a step east and south of it
+        if points == "vertices":
+            return geodex.vertex(v)
+        col, row = v % width, v // width
+        col, row = min(col, width - 2), min(row, mesh.vertex_count // width - 2)
+        return geodex.map_point(gt[0] + ((col + 0.3) * s + 0.5) * gt[1],
+                                gt[3] + ((row + 0.4) * s + 0.5) * gt[5])
     for _ in range(int(calls)):
         a = r.randrange(mesh.vertex_count)
         b = a + r.randint(-12, 12) + width * r.randint(-12, 12)
         b = min(max(b, 0), mesh.vertex_count - 1)
-        c.shortest_path(mesh.name, geodex.vertex(a), geodex.vertex(b), travel=travel)
+        c.shortest_path(mesh.name, point(a), point(b), travel=travel)
 EOF
-run() { echo "env PYTHONPATH=client/python:$build/python /usr/bin/python3 $tmp/paths.py 127.0.0.1:$1 $dem $step '$friction' $calls"; }
-echo "commit $(git rev-parse --short HEAD); $calls travel paths per run (4 km/h, epsilon 0.01${friction:+, friction $friction}) on $dem, step $step"
+run() { echo "env PYTHONPATH=client/python:$build/python /usr/bin/python3 $tmp/paths.py 127.0.0.1:$1 $dem $step '$friction' $calls $points"; }
+echo "commit $(git rev-parse --short HEAD); $calls travel paths per run (4 km/h, epsilon 0.01${friction:+, friction $friction}) between $points on $dem, step $step"
 echo "A: result cache on (shared travel graphs); B: --result_cache_bytes 0"
 # One run first, so that an error shows (farm-bench keeps only the exit codes).
 bash -c "$(run "$cached")"

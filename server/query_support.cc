@@ -127,14 +127,16 @@ void ShareTravelGraph(const QueryEnv& env, const StoredMesh& mesh,
   if (!options->travel.has_value() || IsDirectional(*options->travel) || !env.cache->enabled()) {
     return;
   }
-  for (const SurfacePoint& p : points) {
-    if (p.kind != SurfacePoint::Kind::kVertex) return;  // its graph is refined around it
-  }
+  // A point inside a face or an edge: a graph is refined around it per query, so only the
+  // one-weight surface (which takes any point) is worth sharing.
+  const bool vertices = std::all_of(points.begin(), points.end(), [](const SurfacePoint& p) {
+    return p.kind == SurfacePoint::Kind::kVertex;
+  });
   const std::string key = TravelGraphKey(mesh.id, *options);
-  std::shared_ptr<const WeightedSurface> graph = env.cache->FindGraph(key, *mesh.mesh);
+  std::shared_ptr<const WeightedSurface> graph = env.cache->FindGraph(key, *mesh.mesh, !vertices);
   if (graph == nullptr) {
-    absl::StatusOr<std::shared_ptr<const WeightedSurface>> built =
-        BuildTravelGraph(*mesh.mesh, *options);
+    absl::StatusOr<std::shared_ptr<const WeightedSurface>> built = BuildTravelGraph(
+        *mesh.mesh, *options, vertices ? SharedPoints::kVertices : SharedPoints::kAny);
     if (!built.ok() || *built == nullptr) return;
     // The graph refers to the mesh: its owner keeps the mesh alive as long as the graph lives.
     struct Held {

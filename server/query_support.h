@@ -48,8 +48,9 @@ absl::StatusOr<GeodesicOptions> Options(const QueryEnv& env, const StoredMesh& m
 // cached, set in options->travel->graph: the travel paths, times at points and matrices on one
 // mesh with one cost layer then share it. Nothing without a travel cost, for a slope-dependent
 // speed (its graph follows each query's sources), with the cache off, or when any of the query's
-// `points` (its sources and targets) lies strictly inside a face or an edge: the bound needs a
-// graph refined around such a point (WeightedSurface::Build's anchors), which the query builds.
+// `points` (its sources and targets) lies strictly inside a face or an edge and the cost has
+// several weights: the bound needs a graph refined around such a point (WeightedSurface::Build's
+// anchors), which the query builds. With one weight the exact engine's surface takes any point.
 // A graph that cannot be built is left to the query, whose solve names the error. Solve-lane
 // work (it may build).
 void ShareTravelGraph(const QueryEnv& env, const StoredMesh& mesh,

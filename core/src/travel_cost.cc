@@ -226,7 +226,7 @@ std::shared_ptr<const WeightedSurface> SharedGraph(const TriangleMesh& mesh,
 }  // namespace
 
 absl::StatusOr<std::shared_ptr<const WeightedSurface>> BuildTravelGraph(
-    const TriangleMesh& mesh, const GeodesicOptions& options) {
+    const TriangleMesh& mesh, const GeodesicOptions& options, SharedPoints points) {
   absl::StatusOr<WeightedOptions> weighted = WeightedOptionsFor(mesh, options);
   if (!weighted.ok()) return weighted.status();
   // A slope cost builds its own per query.
@@ -239,6 +239,8 @@ absl::StatusOr<std::shared_ptr<const WeightedSurface>> BuildTravelGraph(
     return std::make_shared<const WeightedSurface>(
         WeightedSurface::OnRegions(mesh, *weighted, *std::move(regions)));
   }
+  if (points == SharedPoints::kAny)
+    return nullptr;  // a graph: refined around such points per query
   absl::StatusOr<WeightedSurface> surface = WeightedSurface::Build(mesh, *weighted);
   if (!surface.ok()) return surface.status();
   return std::make_shared<const WeightedSurface>(*std::move(surface));

@@ -377,19 +377,26 @@ TEST_F(TravelServiceTest, FieldPathMatrixAndIsolinesEqualCore) {
   }
   // The answers above between vertices searched one graph: the first path built it (a miss), the
   // two repeats and the batch reused it. The matrix and the point times start at the sites on an
-  // edge and in a face, which need a graph refined around them (the bound): they built their own
-  // and left the cache alone. All equal core's own.
-  EXPECT_EQ(server_->cache().graph_misses(), 1u);
+  // edge and in a face, which need a graph refined around them (the bound): the cached graph does
+  // not serve them (a miss each), they built their own and added nothing. All equal core's own.
+  EXPECT_EQ(server_->cache().graph_misses(), 3u);
   EXPECT_EQ(server_->cache().graph_hits(), 3u);
+  EXPECT_EQ(server_->cache().entries(), 3u);  // the field, the matrix and the one graph
 }
 
 // One weight (no friction, steep faces impassable): the exact engine's surface, no Steiner graph,
-// cached and shared as a graph is; its answers are core's, bit for bit.
+// cached and shared as a graph is, also by queries from and to points inside faces and on edges
+// (it needs no refining around them); its answers are core's, bit for bit.
 TEST_F(TravelServiceTest, OneWeightSurfaceIsSharedAsAGraphIs) {
   GeodesicOptions one = Travel();
   one.travel->face_weight = nullptr;
-  for (const uint32_t to : {420u, 300u}) {
-    PathQuery query{Sites()[0], SurfacePoint::AtVertex(to), {}};
+  // The first query starts inside a face: it builds the surface all the others share.
+  const std::vector<std::pair<SurfacePoint, SurfacePoint>> queries = {
+      {Sites()[2], SurfacePoint::AtVertex(420)},
+      {Sites()[0], SurfacePoint::AtVertex(300)},
+      {Sites()[1], Sites()[2]}};
+  for (size_t i = 0; i < queries.size(); ++i) {
+    PathQuery query{queries[i].first, queries[i].second, {}};
     query.options.solver = one;
     v1::FindShortestPathResponse response;
     grpc::Status status = PathOverService(query, &response);
@@ -397,10 +404,10 @@ TEST_F(TravelServiceTest, OneWeightSurfaceIsSharedAsAGraphIs) {
     absl::StatusOr<PathQueryResult> want =
         ComputeShortestPath(*local_, query.from, query.to, query.options);
     ASSERT_TRUE(want.ok()) << want.status();
-    EXPECT_TRUE(BitEqual(response.distance(), want->distance)) << to;
+    EXPECT_TRUE(BitEqual(response.distance(), want->distance)) << i;
   }
   EXPECT_EQ(server_->cache().graph_misses(), 1u);
-  EXPECT_EQ(server_->cache().graph_hits(), 1u);
+  EXPECT_EQ(server_->cache().graph_hits(), 2u);
   absl::StatusOr<std::shared_ptr<const StoredMesh>> stored = server_->store().Get("hills");
   ASSERT_TRUE(stored.ok()) << stored.status();
   std::shared_ptr<const WeightedSurface> surface =
@@ -446,7 +453,7 @@ TEST_F(TravelServiceTest, TravelQueriesShareOneGraphPerCost) {
   EXPECT_EQ(server_->cache().graph_hits(), 3u);
   {
     // A point inside a face needs a graph refined around it: the query builds its own (and
-    // answers as core does), the cache is not asked.
+    // answers as core does); the cached graph does not serve it (a miss) and nothing is added.
     PathQuery query{Sites()[2], SurfacePoint::AtVertex(420), {}};
     query.options.solver = Travel();
     v1::FindShortestPathResponse response;
@@ -455,8 +462,9 @@ TEST_F(TravelServiceTest, TravelQueriesShareOneGraphPerCost) {
         ComputeShortestPath(*local_, query.from, query.to, query.options);
     ASSERT_TRUE(want.ok()) << want.status();
     EXPECT_TRUE(BitEqual(response.distance(), want->distance));
-    EXPECT_EQ(server_->cache().graph_misses(), 2u);
+    EXPECT_EQ(server_->cache().graph_misses(), 3u);
     EXPECT_EQ(server_->cache().graph_hits(), 3u);
+    EXPECT_EQ(server_->cache().entries(), 2u);
   }
 
   // A graph keeps its mesh alive, so its entry counts the mesh's memory as well as its own.

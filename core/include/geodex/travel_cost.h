@@ -115,10 +115,18 @@ inline const char* SpeedModelName(SpeedModel model) {
 // to be shared through TravelCost::graph (geodexd keeps them in its result cache). `mesh` must
 // outlive it. Null for a slope-dependent speed: its points follow each query's sources. Where
 // every passable face weighs the same it holds the exact engine's surface instead of a graph
-// (WeightedSurface::OnRegions, no Steiner points), shared the same way. Errors: as the queries'
-// (the options, the Steiner-point limit).
+// (WeightedSurface::OnRegions, no Steiner points), shared the same way. `points`: what the
+// queries sharing it search from and to; for kAny the result is null unless it serves any point
+// (the one-weight surface: a graph is refined around each point inside a face or an edge, so a
+// query with such a point builds its own). Errors: as the queries' (the options, the
+// Steiner-point limit).
+enum class SharedPoints {
+  kVertices,  // vertices only: every surface serves them
+  kAny,       // also points inside faces and edges (map points): the one-weight surface only
+};
 absl::StatusOr<std::shared_ptr<const WeightedSurface>> BuildTravelGraph(
-    const TriangleMesh& mesh, const GeodesicOptions& options);
+    const TriangleMesh& mesh, const GeodesicOptions& options,
+    SharedPoints points = SharedPoints::kVertices);
 
 // Tobler's hiking function: km/h at s = rise / run along the direction of travel.
 double ToblerKmh(double rise_over_run);
