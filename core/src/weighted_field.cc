@@ -1655,6 +1655,11 @@ struct WeightedSurface::Impl {
   // Set: one weight, the exact engine answers (OnRegions) and the graph stays unbuilt.
   std::shared_ptr<const RegionSurface> regions;
 
+  // The weights it was built with: the options', or, OnRegions, the region surface's.
+  const std::vector<double>& Weights() const {
+    return regions != nullptr ? regions->face_weight() : options.face_weight;
+  }
+
   // Whether every point of `points` is a vertex or one of the anchors (or the placement has none).
   bool Anchors(const std::vector<Located>& points) const {
     if (isotropic == std::nullopt) return true;
@@ -1816,7 +1821,10 @@ absl::StatusOr<WeightedSurface> WeightedSurface::Build(const TriangleMesh& mesh,
 
 WeightedSurface WeightedSurface::OnRegions(const TriangleMesh& mesh, const WeightedOptions& options,
                                            std::shared_ptr<const RegionSurface> regions) {
-  auto impl = std::make_unique<Impl>(mesh, options);
+  // The weights stay in `regions` only (Impl::Weights): the unbuilt graph never reads them.
+  WeightedOptions rest = options;
+  std::vector<double>().swap(rest.face_weight);
+  auto impl = std::make_unique<Impl>(mesh, std::move(rest));
   impl->regions = std::move(regions);
   return WeightedSurface(std::move(impl));
 }
@@ -1826,8 +1834,9 @@ uint64_t WeightedSurface::steiner_points() const {
 }
 
 uint64_t WeightedSurface::bytes() const {
+  // (the graph reads the options' weights; a surface OnRegions keeps them in `regions`)
   return sizeof(Impl) + impl_->graph.bytes() +
-         2 * impl_->options.face_weight.capacity() * sizeof(double) +  // the options', the graph's
+         impl_->options.face_weight.capacity() * sizeof(double) +
          (impl_->regions != nullptr ? impl_->regions->bytes() : 0);
 }
 
@@ -1837,7 +1846,7 @@ bool WeightedSurface::Serves(const TriangleMesh& mesh, const WeightedOptions& op
   const WeightedOptions& built = impl_->options;
   return &impl_->graph.mesh() == &mesh && options.slope_cost == nullptr &&
          built.slope_cost == nullptr && options.epsilon == built.epsilon &&
-         options.face_weight == built.face_weight &&
+         options.face_weight == impl_->Weights() &&
          (options.max_steiner_points == 0 || steiner_points() <= options.max_steiner_points) &&
          (impl_->regions == nullptr || options.max_windows == built.max_windows);
 }

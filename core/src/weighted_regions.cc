@@ -41,6 +41,7 @@ struct RegionSurface::Impl {
   const TriangleMesh& surface() const { return mesh_; }
   double epsilon() const { return options_.epsilon; }
   uint64_t max_windows() const { return options_.max_windows; }
+  const std::vector<double>& face_weight() const { return options_.face_weight; }
   const ich::RegionLinks& links() const { return links_; }
   uint64_t boundary_points() const { return links_.point_count(); }
   uint64_t bytes() const {
@@ -459,6 +460,8 @@ absl::StatusOr<std::shared_ptr<const RegionSurface>> RegionSurface::Build(
 uint64_t RegionSurface::boundary_points() const { return impl_->boundary_points(); }
 
 uint64_t RegionSurface::bytes() const { return impl_->bytes(); }
+
+const std::vector<double>& RegionSurface::face_weight() const { return impl_->face_weight(); }
 
 absl::StatusOr<WeightedField> RegionSurface::Field(const std::vector<SurfacePoint>& sources,
                                                    const WeightedSurface::Limits& limits) const {

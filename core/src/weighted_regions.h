@@ -54,6 +54,9 @@ class RegionSurface {
                                                   const WeightedSurface::Limits& limits) const;
   uint64_t boundary_points() const;
   uint64_t bytes() const;  // the union mesh, its links and the point maps (for caches)
+  // The weights it was built with (WeightedOptions::face_weight): a WeightedSurface OnRegions
+  // compares against these rather than keep a copy.
+  const std::vector<double>& face_weight() const;
 
   struct Impl;
 
