@@ -333,6 +333,54 @@ TEST(WeightedRegionsTest, SnellsLawAcrossAFrictionFourHalfPlane) {
   }
 }
 
+// A boundary point whose neighbour on the edge, plus the way along it, is no dearer covers
+// nothing its neighbour does not, so it emits nothing into that side (docs/engine.md). Out of a
+// friction-10 half-plane into a friction-1 half only the points near the foot of the source's
+// perpendicular emit: fewer windows than the mirror image (friction 1 into 10, where every point
+// emits; 0.53x here), where without the rule there are more (1.8x: from the heavy side every
+// point's windows cross the light half), with the same boundary points and geometry, and answers
+// within the bound.
+TEST(WeightedRegionsTest, CoveredBoundaryPointsEmitNothing) {
+  GridSpec spec;
+  spec.cells_x = 20;
+  spec.cells_y = 10;
+  spec.width = 2;
+  spec.height = 1;
+  spec.alternate_diagonals = true;
+  const MeshData data = MakeGrid(spec);
+  const TriangleMesh mesh = BuildMesh(data);
+  auto windows = [&](double west, double east) -> uint64_t {
+    WeightedOptions options;
+    options.epsilon = 0.05;
+    for (uint32_t f = 0; f < data.face_count(); ++f) {
+      options.face_weight.push_back(FaceCentroid(data, f)[0] > 1 ? east : west);
+    }
+    const std::vector<SurfacePoint> sources{SurfacePoint::AtVertex(5 * 21 + 1)};  // (0.1, 0.5)
+    absl::StatusOr<std::shared_ptr<const RegionSurface>> regions =
+        RegionSurface::Build(mesh, options, sources);
+    EXPECT_TRUE(regions.ok()) << regions.status();
+    if (!regions.ok()) return 0;
+    absl::StatusOr<WeightedField> field = (*regions)->Field(sources, {});
+    EXPECT_TRUE(field.ok()) << field.status();
+    if (!field.ok()) return 0;
+    // The far corner, against the refracted optimum (Snell's law through the boundary x = 1).
+    const Vec3 ps = VertexPosition(data, sources[0].vertex), pt = VertexPosition(data, 20);
+    auto cost = [&](double y) {
+      return west * std::hypot(1 - ps[0], y - ps[1]) + east * std::hypot(pt[0] - 1, pt[1] - y);
+    };
+    const double best = cost(GoldenSectionArgMin(cost, 0, 1));
+    EXPECT_GE(field->cost[20], best * (1 - 1e-12));
+    EXPECT_LE(field->cost[20], best * (1 + options.epsilon));
+    return field->stats.edge_relaxations;
+  };
+  const uint64_t heavy_to_light = windows(10, 1), light_to_heavy = windows(1, 10);
+  std::printf("windows: friction 10 into 1: %llu, 1 into 10: %llu\n",
+              static_cast<unsigned long long>(heavy_to_light),
+              static_cast<unsigned long long>(light_to_heavy));
+  EXPECT_GT(heavy_to_light, 0u);
+  EXPECT_LT(heavy_to_light, light_to_heavy * 3 / 4);
+}
+
 // Several weights on a real mesh (bands of 1 to 4 by height): never above the bounded graph's
 // cost (the same boundary points, exact inside regions) and never below its lower bound.
 TEST(WeightedRegionsTest, SeveralWeightsAgainstTheBoundedGraph) {

@@ -51,20 +51,33 @@ void IchSolver::ProcessBoundaryPoint(uint32_t id) {
   }
   const uint32_t c = regions_->point_chain[p];
   const double t = regions_->point_param[p];
+  const uint32_t first = regions_->chain_first[c], end = regions_->chain_first[c + 1];
   // Into both regions as a point source on their edge; the side whose window set the cost needs
-  // nothing more from it (straight on from that window's image is never longer).
+  // nothing more from it (straight on from that window's image is never longer). Nor does a side
+  // where a neighbour on the chain plus the way along the edge at that side's cost is no dearer
+  // than p: by the triangle inequality in that region, what p would reach there the neighbour
+  // reaches for no more (it emitted, or is covered the same way). An edge is its region copy's
+  // cost per unit length, so Length(e) x the parameter step is that way's cost.
+  auto covered_by_neighbour = [&](uint32_t e) {
+    const double len = mesh_.Length(e);
+    for (const uint32_t k : {p - 1, p + 1}) {
+      if (k < first || k >= end) continue;  // (p - 1 wraps at 0: above end)
+      if (point_cost_[k] + len * std::abs(t - regions_->point_param[k]) <= w.sigma) return true;
+    }
+    return false;
+  };
   for (const uint32_t e : regions_->chain_halves[c]) {
-    if (e == kNoIndex || e == point_from_[p]) continue;
+    if (e == kNoIndex || e == point_from_[p] || covered_by_neighbour(e)) continue;
     const double len = mesh_.Length(e);
     EmitFromPointInFace(id, e, len * (regions_->chain_reversed[e] ? 1 - t : t), 0, w.sigma,
                         kNoIndex, w.source);
   }
   // Along the edge, to its neighbours (the ends are the edge's vertices, reached straight above).
   const double cost = regions_->chain_cost[c];
-  if (p > regions_->chain_first[c]) {
+  if (p > first) {
     ReachPoint(p - 1, w.sigma + cost * (t - regions_->point_param[p - 1]), w.source, kNoIndex);
   }
-  if (p + 1 < regions_->chain_first[c + 1]) {
+  if (p + 1 < end) {
     ReachPoint(p + 1, w.sigma + cost * (regions_->point_param[p + 1] - t), w.source, kNoIndex);
   }
   ReleaseIfDone(id);
