@@ -184,7 +184,7 @@ absl::StatusOr<DistanceField> ComputeTravelField(const TriangleMesh& mesh,
   absl::StatusOr<WeightedOptions> weighted = WeightedOptionsFor(mesh, options);
   if (!weighted.ok()) return weighted.status();
   absl::StatusOr<WeightedField> w;
-  if (RegionsServe(*weighted)) {
+  if (RegionsServeFields(*weighted)) {
     absl::StatusOr<std::shared_ptr<const RegionSurface>> regions =
         RegionSurface::Build(mesh, *weighted, sources);
     if (!regions.ok()) return regions.status();

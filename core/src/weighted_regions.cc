@@ -445,6 +445,8 @@ bool RegionsServe(const WeightedOptions& options) {
   return true;
 }
 
+bool RegionsServeFields(const WeightedOptions& options) { return options.slope_cost == nullptr; }
+
 RegionSurface::RegionSurface(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 RegionSurface::~RegionSurface() = default;
 

@@ -20,13 +20,18 @@
 
 namespace geodex {
 
-// Whether the regions serve `options`: direction-independent costs (no slope cost) whose passable
-// faces all weigh the same (every weight 1 with impassable steep faces, one friction everywhere,
-// or no weights). There are then no boundary points: every answer is exact, in a fraction of the
-// graph's time. With several weights the regions are as correct (the tests) but slower than the
-// graph, since each boundary point's windows run on through its whole region (docs/engine.md,
-// "Weighted regions"), so the graph serves those.
+// Whether the regions serve every product with `options`: direction-independent costs (no slope
+// cost) whose passable faces all weigh the same (every weight 1 with impassable steep faces, one
+// friction everywhere, or no weights). There are then no boundary points: every answer is exact,
+// in a fraction of the graph's time.
 bool RegionsServe(const WeightedOptions& options);
+// Whether a whole field with `options` is solved by regions: any weights without a slope cost.
+// With several weights the answers keep the graph's bound and are never above it (the boundary
+// points are the graph's; inside a region propagation is exact), in 0.23x its time on the target
+// case (docs/performance.md). Paths, times at points and matrices with several weights stay on
+// the graph: a path cannot yet be traced back through a boundary point, and geodexd shares one
+// graph between them.
+bool RegionsServeFields(const WeightedOptions& options);
 
 // The union mesh and its links for one mesh and one set of options (already validated), built
 // once for many queries (a matrix's rows); immutable, CostsAt may run on many threads at once.
