@@ -476,6 +476,7 @@ absl::Status IchSolver::Run(const std::vector<ResolvedSource>& sources,
   if (regions_ != nullptr) {
     point_cost_.assign(regions_->point_count(), kUnreachable);
     point_from_.assign(regions_->point_count(), kNoIndex);
+    block_max_.assign((regions_->point_count() + kPointBlock - 1) / kPointBlock, kUnreachable);
   }
 
   for (const ResolvedSource& s : sources) {

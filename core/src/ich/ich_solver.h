@@ -260,6 +260,11 @@ class IchSolver {
   const RegionLinks* regions_ = nullptr;
   std::vector<double> point_cost_;    // per boundary point
   std::vector<uint32_t> point_from_;  // the half-edge whose window set it (kNoIndex: its chain)
+  // The largest point_cost_ of each run of kPointBlock boundary points (by index): a window whose
+  // least cost over a run's stretch of its edge is no less prices none of its points
+  // (ReachBoundary skips the run without a square root per point).
+  static constexpr uint32_t kPointBlock = 16;
+  std::vector<double> block_max_;
 };
 
 }  // namespace geodex::ich

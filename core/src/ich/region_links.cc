@@ -22,19 +22,40 @@ void IchSolver::ReachBoundary(uint32_t e, double x0, double x1, double ix, doubl
   const double tol = kCoverRelTol * len;
   const double lo = (x0 - tol) / len, hi = (x1 + tol) / len;
   const double t_lo = reversed ? lo : 1 - hi, t_hi = reversed ? hi : 1 - lo;
-  const double* begin = regions_->point_param.data() + regions_->chain_first[c];
-  const double* end = regions_->point_param.data() + regions_->chain_first[c + 1];
-  const double* it = std::lower_bound(begin, end, t_lo);
-  for (; it != end && *it <= t_hi; ++it) {
-    const double x = len * (reversed ? *it : 1 - *it);
-    ReachPoint(static_cast<uint32_t>(it - regions_->point_param.data()), sigma + Hypot(x - ix, iy),
-               source, e);
+  const double* param = regions_->point_param.data();
+  const double* begin = param + regions_->chain_first[c];
+  const double* end = param + regions_->chain_first[c + 1];
+  auto i = static_cast<uint32_t>(std::lower_bound(begin, end, t_lo) - param);
+  const auto stop = static_cast<uint32_t>(std::upper_bound(param + i, end, t_hi) - param);
+  auto x_of = [&](uint32_t p) { return len * (reversed ? param[p] : 1 - param[p]); };
+  while (i < stop) {
+    const uint32_t b = i / kPointBlock;
+    const uint32_t run_end = std::min(stop, (b + 1) * kPointBlock);
+    // The window's least cost over the run's stretch [lo, hi] of the edge (rounding is monotone,
+    // so no point of the run costs less than this as ReachPoint would compute it).
+    const double xa = x_of(i), xb = x_of(run_end - 1);
+    const double lo = std::min(xa, xb), hi = std::max(xa, xb);
+    const double dx = ix < lo ? lo - ix : (ix > hi ? ix - hi : 0.0);
+    if (sigma + Hypot(dx, iy) >= block_max_[b]) {
+      i = run_end;
+      continue;
+    }
+    for (; i < run_end; ++i) ReachPoint(i, sigma + Hypot(x_of(i) - ix, iy), source, e);
   }
 }
 
 void IchSolver::ReachPoint(uint32_t p, double d, uint32_t source, uint32_t from) {
   if (!(d < point_cost_[p]) || d > key_cap_) return;
+  const double old = point_cost_[p];
   point_cost_[p] = d;
+  // Keep the run's largest cost: it can only have dropped if p held it.
+  double& run_max = block_max_[p / kPointBlock];
+  if (old == run_max) {
+    const uint32_t first = p / kPointBlock * kPointBlock;
+    const uint32_t last =
+        std::min<uint32_t>(first + kPointBlock, static_cast<uint32_t>(point_cost_.size()));
+    run_max = *std::max_element(point_cost_.begin() + first, point_cost_.begin() + last);
+  }
   point_from_[p] = from;
   const uint32_t id = NewPointWindow(WindowKind::kBoundaryPoint, p, kNoIndex, d, source, 0);
   ++stats_.pseudo_sources;
