@@ -27,7 +27,7 @@ namespace geodex {
 bool RegionsServe(const WeightedOptions& options);
 // Whether a whole field with `options` is solved by regions: any weights without a slope cost.
 // With several weights the answers keep the graph's bound and are never above it (the boundary
-// points are the graph's; inside a region propagation is exact), in 0.23x its time on the target
+// points are the graph's; inside a region propagation is exact), in 0.14x its time on the target
 // case (docs/performance.md). Paths, times at points and matrices with several weights stay on
 // the graph: a path cannot yet be traced back through a boundary point, and geodexd shares one
 // graph between them.
