@@ -382,7 +382,8 @@ TEST(WeightedRegionsTest, CoveredBoundaryPointsEmitNothing) {
 }
 
 // Several weights on a real mesh (bands of 1 to 4 by height): never above the bounded graph's
-// cost (the same boundary points, exact inside regions) and never below its lower bound.
+// cost (the same boundary points, exact inside regions) and never below its lower bound; a
+// travel field with those weights is the regions'.
 TEST(WeightedRegionsTest, SeveralWeightsAgainstTheBoundedGraph) {
   absl::StatusOr<TriangleMesh> mesh = LoadTestMesh("knight.off");
   ASSERT_TRUE(mesh.ok()) << mesh.status();
@@ -416,6 +417,24 @@ TEST(WeightedRegionsTest, SeveralWeightsAgainstTheBoundedGraph) {
   std::printf("knight: %llu boundary points (graph %llu); regions below the graph by up to %.3g\n",
               static_cast<unsigned long long>(regions->steiner_points),
               static_cast<unsigned long long>(graph->steiner_points), below);
+  EXPECT_GT(below, 1e-9);  // the regions gain somewhere, so the field below cannot be the graph's
+
+  // The product: a travel field with these weights is the regions' (RegionsServeFields; at
+  // 3.6 km/h a second is a unit of cost).
+  ASSERT_TRUE(RegionsServeFields(options));
+  TravelCost travel;
+  travel.speed_kmh = 3.6;
+  travel.epsilon = options.epsilon;
+  travel.face_weight = std::make_shared<std::vector<double>>(options.face_weight);
+  GeodesicOptions travel_options;
+  travel_options.travel = travel;
+  absl::StatusOr<DistanceField> field = ComputeDistanceField(*mesh, sources, travel_options);
+  ASSERT_TRUE(field.ok()) << field.status();
+  ASSERT_EQ(field->distance.size(), regions->cost.size());
+  for (size_t v = 0; v < regions->cost.size(); ++v) {
+    EXPECT_NEAR(field->distance[v], regions->cost[v], 1e-12 * (1 + regions->cost[v]))
+        << "vertex " << v;
+  }
 }
 
 }  // namespace
