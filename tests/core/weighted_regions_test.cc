@@ -42,6 +42,27 @@ absl::StatusOr<WeightedCosts> CostsAt(const TriangleMesh& mesh, const WeightedOp
   return (*regions)->CostsAt(sources, targets, false, {});
 }
 
+// A 2 m x 1 m plane of cells_x x cells_y cells, diagonals alternating (vertex (i, j) =
+// (cells_x + 1) j + i): two weights meet along x = 1.
+MeshData TwoByOnePlane(uint32_t cells_x, uint32_t cells_y) {
+  GridSpec spec;
+  spec.cells_x = cells_x;
+  spec.cells_y = cells_y;
+  spec.width = 2;
+  spec.height = 1;
+  spec.alternate_diagonals = true;
+  return MakeGrid(spec);
+}
+
+// The least cost from `a` (x < 1, weight `west`) to `b` (x > 1, weight `east`) on that plane:
+// straight to the crossing on x = 1 that Snell's law picks, straight on from there.
+double RefractedAtXOne(const Vec3& a, const Vec3& b, double west, double east) {
+  auto cost = [&](double y) {
+    return west * std::hypot(1 - a[0], y - a[1]) + east * std::hypot(b[0] - 1, b[1] - y);
+  };
+  return cost(GoldenSectionArgMin(cost, 0, 1));
+}
+
 // A 2 x 2 grid of unit cells, vertex (i, j) = 3 j + i.
 MeshData TwoByTwoGrid() {
   GridSpec spec;
@@ -292,13 +313,7 @@ TEST(WeightedRegionsTest, PathsRefusedAcrossRegionBoundaries) {
 // Several weights: friction 4 beyond x = 1. Every vertex there against its refracted optimum
 // (Snell's law), within the bound and never below.
 TEST(WeightedRegionsTest, SnellsLawAcrossAFrictionFourHalfPlane) {
-  GridSpec spec;
-  spec.cells_x = 10;
-  spec.cells_y = 5;
-  spec.width = 2;
-  spec.height = 1;
-  spec.alternate_diagonals = true;
-  const MeshData data = MakeGrid(spec);
+  const MeshData data = TwoByOnePlane(10, 5);
   const TriangleMesh mesh = BuildMesh(data);
   for (const double eps : {0.1, 0.01}) {
     WeightedOptions options;
@@ -312,11 +327,8 @@ TEST(WeightedRegionsTest, SnellsLawAcrossAFrictionFourHalfPlane) {
     for (uint32_t v = 0; v < data.vertex_count(); ++v) {
       const Vec3 ps = VertexPosition(data, s), pt = VertexPosition(data, v);
       if (pt[0] < 1 + 1e-9) continue;
-      auto cost = [&](double y) {
-        return std::hypot(1 - ps[0], y - ps[1]) + 4 * std::hypot(pt[0] - 1, pt[1] - y);
-      };
       targets.push_back(SurfacePoint::AtVertex(v));
-      best.push_back(cost(GoldenSectionArgMin(cost, 0, 1)));
+      best.push_back(RefractedAtXOne(ps, pt, 1, 4));
     }
     absl::StatusOr<WeightedCosts> costs =
         CostsAt(mesh, options, {SurfacePoint::AtVertex(s)}, targets);
@@ -341,13 +353,7 @@ TEST(WeightedRegionsTest, SnellsLawAcrossAFrictionFourHalfPlane) {
 // point's windows cross the light half), with the same boundary points and geometry, and answers
 // within the bound.
 TEST(WeightedRegionsTest, CoveredBoundaryPointsEmitNothing) {
-  GridSpec spec;
-  spec.cells_x = 20;
-  spec.cells_y = 10;
-  spec.width = 2;
-  spec.height = 1;
-  spec.alternate_diagonals = true;
-  const MeshData data = MakeGrid(spec);
+  const MeshData data = TwoByOnePlane(20, 10);
   const TriangleMesh mesh = BuildMesh(data);
   auto windows = [&](double west, double east) -> uint64_t {
     WeightedOptions options;
@@ -364,11 +370,8 @@ TEST(WeightedRegionsTest, CoveredBoundaryPointsEmitNothing) {
     EXPECT_TRUE(field.ok()) << field.status();
     if (!field.ok()) return 0;
     // The far corner, against the refracted optimum (Snell's law through the boundary x = 1).
-    const Vec3 ps = VertexPosition(data, sources[0].vertex), pt = VertexPosition(data, 20);
-    auto cost = [&](double y) {
-      return west * std::hypot(1 - ps[0], y - ps[1]) + east * std::hypot(pt[0] - 1, pt[1] - y);
-    };
-    const double best = cost(GoldenSectionArgMin(cost, 0, 1));
+    const double best = RefractedAtXOne(VertexPosition(data, sources[0].vertex),
+                                        VertexPosition(data, 20), west, east);
     EXPECT_GE(field->cost[20], best * (1 - 1e-12));
     EXPECT_LE(field->cost[20], best * (1 + options.epsilon));
     return field->stats.edge_relaxations;
