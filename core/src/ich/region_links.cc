@@ -83,7 +83,11 @@ void IchSolver::ProcessBoundaryPoint(uint32_t id) {
     const double len = mesh_.Length(e);
     for (const uint32_t k : {p - 1, p + 1}) {
       if (k < first || k >= end) continue;  // (p - 1 wraps at 0: above end)
-      if (point_cost_[k] + len * std::abs(t - regions_->point_param[k]) <= w.sigma) return true;
+      // (strictly cheaper, so two points a rounding apart cannot each leave the side to the other)
+      if (point_cost_[k] < w.sigma &&
+          point_cost_[k] + len * std::abs(t - regions_->point_param[k]) <= w.sigma) {
+        return true;
+      }
     }
     return false;
   };
