@@ -49,8 +49,8 @@ struct GeodesicOptions {
   // Ablation switches for tests and benchmarks; both are exact either way.
   bool use_filter = true;               // Lemma 2, the filter theorem
   bool use_one_angle_one_split = true;  // Lemma 1, Chen & Han
-  // Travel time instead of length (travel_cost.h): set, every answer is in seconds from the
-  // weighted engine, within (1 + travel->epsilon) of the least time.
+  // Travel time instead of length (travel_cost.h): set, every answer is in seconds, within
+  // (1 + travel->epsilon) of the least time at a constant speed.
   std::optional<TravelCost> travel;
 };
 

@@ -1,11 +1,13 @@
 #pragma once
 
 // Travel time instead of length (docs/travel.md): a query whose GeodesicOptions carry a TravelCost
-// is answered by the weighted engine (weighted_field.h) in SECONDS: a straight piece inside face f
-// takes its 3D length x w(f) / v. Every product built on a distance field (values at vertices and
-// points, paths, matrices, isolines, Voronoi regions) then speaks seconds, and max_distance is a
-// time too. Approximate with a stated bound: every time is at least the true least time and at
-// most (1 + epsilon) times it.
+// is answered in SECONDS: a straight piece inside face f takes its 3D length x w(f) / v. At a
+// constant speed, by the exact engine inside regions of one weight (weighted_regions.h: every
+// product with one weight; fields with several, joined at the graph's boundary points), else by
+// the weighted engine's graph (weighted_field.h). Every product built on a distance field (values
+// at vertices and points, paths, matrices, isolines, Voronoi regions) then speaks seconds, and
+// max_distance is a time too. Approximate with a stated bound: every time is at least the true
+// least time and at most (1 + epsilon) times it.
 //
 // The speed is constant (times are direction-independent: from the sources equals towards them)
 // or depends on the slope along the direction of travel (Tobler's hiking function or a table): a
