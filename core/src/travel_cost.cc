@@ -237,7 +237,7 @@ absl::StatusOr<std::shared_ptr<const WeightedSurface>> BuildTravelGraph(
         RegionSurface::Build(mesh, *weighted);
     if (!regions.ok()) return regions.status();
     return std::make_shared<const WeightedSurface>(
-        WeightedSurface::OnRegions(mesh, *weighted, *std::move(regions)));
+        WeightedSurface::OnRegions(mesh, *std::move(weighted), *std::move(regions)));
   }
   if (points == SharedPoints::kAny)
     return nullptr;  // a graph: refined around such points per query

@@ -1819,12 +1819,11 @@ absl::StatusOr<WeightedSurface> WeightedSurface::Build(const TriangleMesh& mesh,
   return WeightedSurface(*std::move(impl));
 }
 
-WeightedSurface WeightedSurface::OnRegions(const TriangleMesh& mesh, const WeightedOptions& options,
+WeightedSurface WeightedSurface::OnRegions(const TriangleMesh& mesh, WeightedOptions options,
                                            std::shared_ptr<const RegionSurface> regions) {
   // The weights stay in `regions` only (Impl::Weights): the unbuilt graph never reads them.
-  WeightedOptions rest = options;
-  std::vector<double>().swap(rest.face_weight);
-  auto impl = std::make_unique<Impl>(mesh, std::move(rest));
+  std::vector<double>().swap(options.face_weight);
+  auto impl = std::make_unique<Impl>(mesh, std::move(options));
   impl->regions = std::move(regions);
   return WeightedSurface(std::move(impl));
 }

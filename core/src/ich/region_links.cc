@@ -79,8 +79,7 @@ void IchSolver::ProcessBoundaryPoint(uint32_t id) {
   // than p: by the triangle inequality in that region, what p would reach there the neighbour
   // reaches for no more (it emitted, or is covered the same way). An edge is its region copy's
   // cost per unit length, so Length(e) x the parameter step is that way's cost.
-  auto covered_by_neighbour = [&](uint32_t e) {
-    const double len = mesh_.Length(e);
+  auto covered_by_neighbour = [&](double len) {
     for (const uint32_t k : {p - 1, p + 1}) {
       if (k < first || k >= end) continue;  // (p - 1 wraps at 0: above end)
       // (strictly cheaper, so two points a rounding apart cannot each leave the side to the other)
@@ -92,8 +91,9 @@ void IchSolver::ProcessBoundaryPoint(uint32_t id) {
     return false;
   };
   for (const uint32_t e : regions_->chain_halves[c]) {
-    if (e == kNoIndex || e == point_from_[p] || covered_by_neighbour(e)) continue;
+    if (e == kNoIndex || e == point_from_[p]) continue;
     const double len = mesh_.Length(e);
+    if (covered_by_neighbour(len)) continue;
     EmitFromPointInFace(id, e, len * (regions_->chain_reversed[e] ? 1 - t : t), 0, w.sigma,
                         kNoIndex, w.source);
   }
