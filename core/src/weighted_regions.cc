@@ -303,9 +303,11 @@ struct RegionSurface::Impl {
         ++side;
       }
       links_.chain_halves.push_back(halves);
-      links_.chain_cost.push_back(
-          std::min(Weight(TriangleMesh::FaceOf(h0)), Weight(TriangleMesh::FaceOf(mesh_.Twin(h0)))) *
-          mesh_.Length(h0));
+      const std::array<double, 2> side_cost{
+          Weight(TriangleMesh::FaceOf(h0)) * mesh_.Length(h0),
+          Weight(TriangleMesh::FaceOf(mesh_.Twin(h0))) * mesh_.Length(h0)};
+      links_.side_cost.push_back(side_cost);
+      links_.chain_cost.push_back(std::min(side_cost[0], side_cost[1]));
       for (uint32_t i = points->first[k]; i < points->first[k + 1]; ++i) {
         links_.point_param.push_back(points->param[i]);
         links_.point_chain.push_back(c);

@@ -348,10 +348,10 @@ TEST(WeightedRegionsTest, SnellsLawAcrossAFrictionFourHalfPlane) {
 // A boundary point whose neighbour on the edge, plus the way along it, is no dearer covers
 // nothing its neighbour does not, so it emits nothing into that side (docs/engine.md). Out of a
 // friction-10 half-plane into a friction-1 half only the points near the foot of the source's
-// perpendicular emit: fewer windows than the mirror image (friction 1 into 10, where every point
-// emits; 0.53x here), where without the rule there are more (1.8x: from the heavy side every
-// point's windows cross the light half), with the same boundary points and geometry, and answers
-// within the bound.
+// perpendicular emit: 0.32x the windows of the mirror image (friction 1 into 10, where every
+// point emits), against 0.51x without the rule (from the heavy side every point's windows enter
+// the light half), with the same boundary points and geometry, and answers within the bound. A
+// point priced along the chain is covered exactly, not just within a rounding.
 TEST(WeightedRegionsTest, CoveredBoundaryPointsEmitNothing) {
   const MeshData data = TwoByOnePlane(20, 10);
   const TriangleMesh mesh = BuildMesh(data);
@@ -381,7 +381,7 @@ TEST(WeightedRegionsTest, CoveredBoundaryPointsEmitNothing) {
               static_cast<unsigned long long>(heavy_to_light),
               static_cast<unsigned long long>(light_to_heavy));
   EXPECT_GT(heavy_to_light, 0u);
-  EXPECT_LT(heavy_to_light, light_to_heavy * 3 / 4);
+  EXPECT_LT(heavy_to_light, light_to_heavy * 2 / 5);
 }
 
 // Several weights on a real mesh (bands of 1 to 4 by height): never above the bounded graph's

@@ -471,11 +471,22 @@ absl::Status IchSolver::Run(const std::vector<ResolvedSource>& sources,
     targets_dirty_ = true;
   }
   const uint32_t nv = mesh_.vertex_count();
-  queue_.Reset(kQueueResolutionEdges * mesh_.MeanEdgeLength());
+  const bool has_points = regions_ != nullptr && regions_->point_count() > 0;
+  queue_.Reset((has_points ? kRegionQueueResolutionEdges : kQueueResolutionEdges) *
+               mesh_.MeanEdgeLength());
   queue_.reserve(4 * size_t{nv});
   if (regions_ != nullptr) {
+    if (regions_->point_count() >= kPointEntry) {
+      return LimitExceededError(
+          Limit::kSteinerPoints,
+          absl::StrFormat("%d boundary points, more than a solve can queue (%d)",
+                          regions_->point_count(), kPointEntry - 1));
+    }
     point_cost_.assign(regions_->point_count(), kUnreachable);
     point_from_.assign(regions_->point_count(), kNoIndex);
+    point_source_.assign(regions_->point_count(), kNoIndex);
+    point_slot_.assign(regions_->point_count(), kNoSlot);
+    point_seq_.assign(regions_->point_count(), 0);
     block_max_.assign((regions_->point_count() + kPointBlock - 1) / kPointBlock, kUnreachable);
   }
 
@@ -491,12 +502,21 @@ absl::Status IchSolver::Run(const std::vector<ResolvedSource>& sources,
   uint32_t polls = 0;
   while (!queue_.empty()) {
     const QueueEntry e = queue_.Pop();
-    // The next window is most likely the new top: fetch it while this one is processed.
-    if (const QueueEntry* next = queue_.Peek()) pool_.Prefetch(next->window);
-    // Only the paper's tree deletes queued windows (Lemma 1's subtrees); without it every entry
-    // is a live queued window, and its links are not even read.
-    if (pool_.IsStale(e.window, e.generation)) {
-      continue;  // deleted (Lemma 1) or recycled since it was queued
+    // A boundary point (regions only: no window id reaches kPointEntry, see below).
+    const bool is_point = regions_ != nullptr && e.window >= kPointEntry;
+    if (is_point) {
+      const uint32_t p = e.window - kPointEntry;
+      if (e.generation != point_seq_[p] || point_slot_[p] == kNoSlot) continue;  // superseded
+    } else {
+      // The next window is most likely the new top: fetch it while this one is processed.
+      if (const QueueEntry* next = queue_.Peek(); next != nullptr && next->window < kPointEntry) {
+        pool_.Prefetch(next->window);
+      }
+      // Only the paper's tree deletes queued windows (Lemma 1's subtrees); without it every
+      // entry is a live queued window, and its links are not even read.
+      if (pool_.IsStale(e.window, e.generation)) {
+        continue;  // deleted (Lemma 1) or recycled since it was queued
+      }
     }
     // Every queued key is at least LowerBound() (entries of near-equal keys pop in any order).
     const double floor = queue_.LowerBound();
@@ -511,6 +531,16 @@ absl::Status IchSolver::Run(const std::vector<ResolvedSource>& sources,
         status = absl::CancelledError("geodesic solve cancelled");
         break;
       }
+      // Window ids must stay below the boundary points' tag (a poll interval makes far fewer
+      // windows than the margin).
+      if (regions_ != nullptr && pool_.ids_issued() >= kPointEntry / 2) {
+        status = LimitExceededError(
+            Limit::kWindows,
+            absl::StrFormat("%d windows made, more than a solve on regions can index; use "
+                            "max_windows or a max_distance",
+                            pool_.ids_issued()));
+        break;
+      }
     }
     if (options_.max_windows != 0 && stats_.windows_created > options_.max_windows) {
       status = LimitExceededError(
@@ -521,11 +551,13 @@ absl::Status IchSolver::Run(const std::vector<ResolvedSource>& sources,
               stats_.windows_created, options_.max_windows));
       break;
     }
+    if (is_point) {
+      ProcessBoundaryPoint(e.window - kPointEntry);
+      continue;
+    }
     const WindowKind kind = pool_[e.window].kind;
     if (kind == WindowKind::kPseudoSource) {
       ProcessPseudoSource(e.window);
-    } else if (kind == WindowKind::kBoundaryPoint) {
-      ProcessBoundaryPoint(e.window);
     } else {
       ProcessInterval(e.window, e.key);
     }

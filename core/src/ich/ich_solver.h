@@ -184,7 +184,7 @@ class IchSolver {
                      uint32_t source);
   // Lowers boundary point p's cost to d (reached from half-edge `from`, kNoIndex: along its chain).
   void ReachPoint(uint32_t p, double d, uint32_t source, uint32_t from);
-  void ProcessBoundaryPoint(uint32_t id);
+  void ProcessBoundaryPoint(uint32_t p);
   // A copy of v got cost d: its other copies get it too, and spawn their own windows.
   void ShareWithCopies(uint32_t v, double d, uint32_t source);
   // From boundary vertex v along each boundary edge at it, to the chain's point nearest v.
@@ -258,8 +258,17 @@ class IchSolver {
   SolveStats stats_;
 
   const RegionLinks* regions_ = nullptr;
-  std::vector<double> point_cost_;    // per boundary point
-  std::vector<uint32_t> point_from_;  // the half-edge whose window set it (kNoIndex: its chain)
+  std::vector<double> point_cost_;      // per boundary point
+  std::vector<uint32_t> point_from_;    // the half-edge whose window set it (kNoIndex: its chain)
+  std::vector<uint32_t> point_source_;  // the label of its cost
+  // A boundary point is queued as itself, not as a window (queue entries name it as
+  // kPointEntry | p): at most one live entry per point, the one numbered point_seq_[p], in queue
+  // slot point_slot_[p] (kNoSlot: none). A cost that drops within that slot needs no new entry,
+  // and a window is made only when the point is processed.
+  static constexpr uint32_t kPointEntry = 1u << 31;
+  static constexpr uint64_t kNoSlot = ~uint64_t{0};
+  std::vector<uint64_t> point_slot_;
+  std::vector<uint32_t> point_seq_;
   // The largest point_cost_ of each run of kPointBlock boundary points (by index): a window whose
   // least cost over a run's stretch of its edge is no less prices none of its points
   // (ReachBoundary skips the run without a square root per point).

@@ -25,6 +25,12 @@ constexpr double kSplitTieRel = 1e-12;
 // Windows whose keys differ by less than this fraction of the mean edge length are processed in
 // any (deterministic) order: see WindowQueue.
 constexpr double kQueueResolutionEdges = 0.5;
+// On regions with boundary points (region_links.h) the order must be far finer: the points lie
+// closer than an edge (geometrically closer towards each vertex), a point's cost passes to the
+// next along the chain within a slot, and every drop after a point was processed makes it emit
+// again. On the friction case half an edge processed each point 33 times; a thousandth,
+// about once, for a quarter of the time and the same answers (docs/performance.md).
+constexpr double kRegionQueueResolutionEdges = 1e-3;
 // Cancellation is polled every this many dequeued windows.
 constexpr uint32_t kCancelPollInterval = 1024;
 

@@ -57,19 +57,23 @@ void IchSolver::ReachPoint(uint32_t p, double d, uint32_t source, uint32_t from)
     run_max = *std::max_element(point_cost_.begin() + first, point_cost_.begin() + last);
   }
   point_from_[p] = from;
-  const uint32_t id = NewPointWindow(WindowKind::kBoundaryPoint, p, kNoIndex, d, source, 0);
+  point_source_[p] = source;
+  // Its queued entry, if it pops in this slot anyway, serves: the point is processed at the cost
+  // it has then.
+  const uint64_t slot = queue_.SlotOf(d);
+  if (point_slot_[p] == slot) return;
+  point_slot_[p] = slot;
   ++stats_.pseudo_sources;
-  Push(id, d);
+  queue_.Push({d, kPointEntry | p, ++point_seq_[p]});
 }
 
-void IchSolver::ProcessBoundaryPoint(uint32_t id) {
+void IchSolver::ProcessBoundaryPoint(uint32_t p) {
+  point_slot_[p] = kNoSlot;
+  // Its window exists only while it emits (the parent of what it makes).
+  const uint32_t id =
+      NewPointWindow(WindowKind::kBoundaryPoint, p, kNoIndex, point_cost_[p], point_source_[p], 0);
   const Window w = pool_[id];
-  const uint32_t p = w.element;
   pool_.MarkProcessed(id);
-  if (w.sigma != point_cost_[p]) {  // superseded
-    ReleaseIfDone(id);
-    return;
-  }
   const uint32_t c = regions_->point_chain[p];
   const double t = regions_->point_param[p];
   const uint32_t first = regions_->chain_first[c], end = regions_->chain_first[c + 1];
@@ -77,23 +81,25 @@ void IchSolver::ProcessBoundaryPoint(uint32_t id) {
   // nothing more from it (straight on from that window's image is never longer). Nor does a side
   // where a neighbour on the chain plus the way along the edge at that side's cost is no dearer
   // than p: by the triangle inequality in that region, what p would reach there the neighbour
-  // reaches for no more (it emitted, or is covered the same way). An edge is its region copy's
-  // cost per unit length, so Length(e) x the parameter step is that way's cost.
-  auto covered_by_neighbour = [&](double len) {
+  // reaches for no more (it emitted, or is covered the same way). The way's cost is the side's
+  // cost per unit of parameter x the step, computed as a cost passed along the chain is (on the
+  // lighter side the two agree bit for bit, so a point priced by its neighbour is covered).
+  auto covered_by_neighbour = [&](double side_cost) {
     for (const uint32_t k : {p - 1, p + 1}) {
       if (k < first || k >= end) continue;  // (p - 1 wraps at 0: above end)
       // (strictly cheaper, so two points a rounding apart cannot each leave the side to the other)
       if (point_cost_[k] < w.sigma &&
-          point_cost_[k] + len * std::abs(t - regions_->point_param[k]) <= w.sigma) {
+          point_cost_[k] + side_cost * std::abs(t - regions_->point_param[k]) <= w.sigma) {
         return true;
       }
     }
     return false;
   };
-  for (const uint32_t e : regions_->chain_halves[c]) {
+  for (int side = 0; side < 2; ++side) {
+    const uint32_t e = regions_->chain_halves[c][side];
     if (e == kNoIndex || e == point_from_[p]) continue;
+    if (covered_by_neighbour(regions_->side_cost[c][side])) continue;
     const double len = mesh_.Length(e);
-    if (covered_by_neighbour(len)) continue;
     EmitFromPointInFace(id, e, len * (regions_->chain_reversed[e] ? 1 - t : t), 0, w.sigma,
                         kNoIndex, w.source);
   }

@@ -21,9 +21,12 @@ struct RegionLinks {
   std::vector<double> point_param;
   std::vector<uint32_t> point_chain;
   // Chain c: the cost of running along it per unit of parameter (its length x the smaller weight
-  // of its two faces), and its half-edges in the two regions it separates.
+  // of its two faces), and its half-edges in the two regions it separates with the same cost at
+  // each one's weight (the smaller one is chain_cost bit for bit, so a cost passed along the chain
+  // compares exactly with a way along the edge at that side's weight).
   std::vector<double> chain_cost;
   std::vector<std::array<uint32_t, 2>> chain_halves;
+  std::vector<std::array<double, 2>> side_cost;
   // Per vertex of the union mesh: the next copy of the same vertex of the surface, in a ring
   // (itself when it has none). Copies share their cost.
   std::vector<uint32_t> next_copy;
@@ -32,7 +35,7 @@ struct RegionLinks {
   uint64_t bytes() const {
     auto of = [](const auto& v) { return uint64_t{v.capacity()} * sizeof(v[0]); };
     return of(chain_of_half) + of(chain_reversed) + of(chain_first) + of(point_param) +
-           of(point_chain) + of(chain_cost) + of(chain_halves) + of(next_copy);
+           of(point_chain) + of(chain_cost) + of(chain_halves) + of(side_cost) + of(next_copy);
   }
 };
 

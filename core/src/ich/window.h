@@ -194,6 +194,7 @@ class WindowPool {
   }
 
   uint64_t live() const { return live_; }
+  uint64_t ids_issued() const { return windows_.size(); }  // every id so far is below this
   uint64_t peak_live() const { return peak_live_; }
   uint64_t CapacityBytes() const {
     return windows_.capacity() * sizeof(Window) + links_.capacity() * sizeof(WindowLinks) +
@@ -253,6 +254,10 @@ class WindowQueue {
     for (const auto& b : buckets_) bytes += b.capacity() * sizeof(QueueEntry);
     return bytes;
   }
+
+  // The quantised key an entry pushed now with `key` is popped at (keys below the bucket being
+  // popped are queued at it). Two entries of one slot pop in either order.
+  uint64_t SlotOf(double key) const { return std::max(Quantise(key), last_); }
 
   void Push(QueueEntry e) {
     uint64_t q = Quantise(e.key);
