@@ -50,8 +50,8 @@ struct HugePageAllocator {
 template <typename T>
 using HugeVector = std::vector<T, HugePageAllocator<T>>;
 
-// kBoundaryPoint: a point on an edge between two regions of a weighted surface (region_links.h)
-// whose cost is final once popped; `element` is the point's index.
+// kBoundaryPoint: a point on an edge between two regions of a weighted surface (region_links.h),
+// made only while it emits (the point itself is queued, not this window); `element` is its index.
 enum class WindowKind : uint8_t { kInterval, kPseudoSource, kBoundaryPoint };
 // Which child of its parent an interval window is: the one on the edge from the parent edge's
 // start to the opposite vertex (left), from the opposite vertex to the parent edge's end (right),
