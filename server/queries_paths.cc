@@ -72,7 +72,7 @@ absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPath
   if (env.quick) return SolveLaneNeeded();
   PathQueryOptions options;
   options.solver = *solver;
-  ShareTravelGraph(env, **mesh, {*from, *to}, &options.solver);
+  ShareTravelGraph(env, **mesh, {*from, *to}, SharedUse::kPaths, &options.solver);
   absl::StatusOr<PathQueryResult> result = ComputeShortestPath(*(*mesh)->mesh, *from, *to, options);
   if (result.ok()) {
     env.counters->solves.fetch_add(1, std::memory_order_relaxed);
@@ -138,7 +138,7 @@ absl::Status RunFindShortestPaths(const QueryEnv& env, const v1::FindShortestPat
   options.solver = *solver;
   std::vector<SurfacePoint> points = froms;
   points.insert(points.end(), tos.begin(), tos.end());
-  ShareTravelGraph(env, **mesh, points, &options.solver);
+  ShareTravelGraph(env, **mesh, points, SharedUse::kPaths, &options.solver);
   SolveStats total;
   for (size_t g = 0; g < groups.size(); ++g) {
     std::vector<SurfacePoint> targets;
@@ -212,7 +212,7 @@ absl::Status RunEstimateDistances(const QueryEnv& env, const v1::EstimateDistanc
     if (!request.want_directions()) {
       std::vector<SurfacePoint> all = *sources;
       all.insert(all.end(), points->begin(), points->end());
-      ShareTravelGraph(env, **mesh, all, &*solver);
+      ShareTravelGraph(env, **mesh, all, SharedUse::kCosts, &*solver);
     }
     PointQuery query{*std::move(sources), *std::move(points), *solver, request.want_directions()};
     absl::StatusOr<PointValues> values = ComputePointValues(tm, query);

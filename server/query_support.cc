@@ -123,10 +123,12 @@ absl::StatusOr<GeodesicOptions> Options(const QueryEnv& env, const StoredMesh& m
 }
 
 void ShareTravelGraph(const QueryEnv& env, const StoredMesh& mesh,
-                      const std::vector<SurfacePoint>& points, GeodesicOptions* options) {
+                      const std::vector<SurfacePoint>& points, SharedUse use,
+                      GeodesicOptions* options) {
   if (!options->travel.has_value() || IsDirectional(*options->travel) || !env.cache->enabled()) {
     return;
   }
+  if (use == SharedUse::kCosts && !CostsUseSharedGraph(*options->travel)) return;
   // A point inside a face or an edge: a graph is refined around it per query, so only the
   // one-weight surface (which takes any point) is worth sharing.
   const bool vertices = std::all_of(points.begin(), points.end(), [](const SurfacePoint& p) {

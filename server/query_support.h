@@ -53,8 +53,13 @@ absl::StatusOr<GeodesicOptions> Options(const QueryEnv& env, const StoredMesh& m
 // anchors), which the query builds. With one weight the exact engine's surface takes any point.
 // A graph that cannot be built is left to the query, whose solve names the error. Solve-lane
 // work (it may build).
+// `use`: what the query reads from it. Times at points and matrices with several weights run on
+// regions built for their points (core's CostsUseSharedGraph), so nothing is shared or built
+// for them.
+enum class SharedUse { kPaths, kCosts };
 void ShareTravelGraph(const QueryEnv& env, const StoredMesh& mesh,
-                      const std::vector<SurfacePoint>& points, GeodesicOptions* options);
+                      const std::vector<SurfacePoint>& points, SharedUse use,
+                      GeodesicOptions* options);
 // What an answer's travel_epsilon says: 0 for exact metres, else the epsilon the solve uses
 // (set, or the speed model's default).
 inline double TravelEpsilon(const GeodesicOptions& options) {

@@ -246,16 +246,32 @@ absl::StatusOr<std::shared_ptr<const WeightedSurface>> BuildTravelGraph(
   return std::make_shared<const WeightedSurface>(*std::move(surface));
 }
 
+bool CostsUseSharedGraph(const TravelCost& travel) {
+  if (IsDirectional(travel) || travel.face_weight == nullptr) return !IsDirectional(travel);
+  double weight = kInf;
+  for (const double w : *travel.face_weight) {
+    if (!std::isfinite(w)) continue;
+    if (std::isfinite(weight) && w != weight) return false;
+    weight = w;
+  }
+  return true;
+}
+
 absl::StatusOr<TravelPointSolver> TravelPointSolver::Create(
     const TriangleMesh& mesh, const GeodesicOptions& options,
     const std::vector<SurfacePoint>& sources, const std::vector<SurfacePoint>& points) {
   absl::StatusOr<WeightedOptions> weighted = WeightedOptionsFor(mesh, options);
   if (!weighted.ok()) return weighted.status();
   const WeightedSurface::Limits limits{weighted->max_distance, weighted->cancel};
-  if (std::shared_ptr<const WeightedSurface> shared = SharedGraph(mesh, options, *weighted)) {
-    return TravelPointSolver(*options.travel, std::move(shared), nullptr, limits);
+  // Several weights: regions built for these points, not a shared graph (the exact engine inside
+  // each region answers a matrix in a fraction of the graph's search; CostsUseSharedGraph).
+  const bool several = RegionsServeFields(*weighted) && !RegionsServe(*weighted);
+  if (!several) {
+    if (std::shared_ptr<const WeightedSurface> shared = SharedGraph(mesh, options, *weighted)) {
+      return TravelPointSolver(*options.travel, std::move(shared), nullptr, limits);
+    }
   }
-  if (RegionsServe(*weighted)) {
+  if (RegionsServeFields(*weighted)) {
     std::vector<SurfacePoint> anchors = sources;
     anchors.insert(anchors.end(), points.begin(), points.end());
     absl::StatusOr<std::shared_ptr<const RegionSurface>> regions =

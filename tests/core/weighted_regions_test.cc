@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "geodex/distance_matrix.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/limits.h"
 #include "geodex/travel_cost.h"
@@ -407,6 +408,7 @@ TEST(WeightedRegionsTest, SeveralWeightsAgainstTheBoundedGraph) {
   absl::StatusOr<WeightedField> regions = (*surface)->Field(sources, {});
   ASSERT_TRUE(regions.ok()) << regions.status();
   double below = 0;
+  uint32_t most_below = 0;
   for (size_t v = 0; v < graph->cost.size(); ++v) {
     const double g = graph->cost[v], r = regions->cost[v];
     if (g == 0) {
@@ -415,7 +417,10 @@ TEST(WeightedRegionsTest, SeveralWeightsAgainstTheBoundedGraph) {
     }
     EXPECT_GE(r, g / (1 + options.epsilon) * (1 - 1e-12)) << "vertex " << v;
     EXPECT_LE(r, g * (1 + 1e-12)) << "vertex " << v;
-    below = std::max(below, 1 - r / g);
+    if (1 - r / g > below) {
+      below = 1 - r / g;
+      most_below = static_cast<uint32_t>(v);
+    }
   }
   std::printf("knight: %llu boundary points (graph %llu); regions below the graph by up to %.3g\n",
               static_cast<unsigned long long>(regions->steiner_points),
@@ -438,6 +443,25 @@ TEST(WeightedRegionsTest, SeveralWeightsAgainstTheBoundedGraph) {
     EXPECT_NEAR(field->distance[v], regions->cost[v], 1e-12 * (1 + regions->cost[v]))
         << "vertex " << v;
   }
+
+  // Times at points and matrices too (CostsUseSharedGraph is false): at the vertex where the
+  // regions gain most on the graph, and two others, they are the regions' field, not the graph's.
+  EXPECT_FALSE(CostsUseSharedGraph(travel));
+  const std::vector<uint32_t> at = {most_below, 0, static_cast<uint32_t>(mesh->vertex_count() / 2)};
+  std::vector<SurfacePoint> targets;
+  for (const uint32_t v : at) targets.push_back(SurfacePoint::AtVertex(v));
+  absl::StatusOr<PointValues> values =
+      ComputePointValues(*mesh, PointQuery{sources, targets, travel_options, false});
+  ASSERT_TRUE(values.ok()) << values.status();
+  absl::StatusOr<DistanceMatrix> matrix =
+      ComputeDistanceMatrix(*mesh, sources, targets, travel_options);
+  ASSERT_TRUE(matrix.ok()) << matrix.status();
+  for (size_t t = 0; t < at.size(); ++t) {
+    const double want = regions->cost[at[t]];
+    EXPECT_NEAR(values->distance[t], want, 1e-12 * (1 + want)) << "vertex " << at[t];
+    EXPECT_NEAR(matrix->values[t], want, 1e-12 * (1 + want)) << "vertex " << at[t];
+  }
+  EXPECT_LT(values->distance[0], graph->cost[most_below] * (1 - 1e-9));
 }
 
 }  // namespace

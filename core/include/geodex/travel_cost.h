@@ -130,6 +130,14 @@ absl::StatusOr<std::shared_ptr<const WeightedSurface>> BuildTravelGraph(
     const TriangleMesh& mesh, const GeodesicOptions& options,
     SharedPoints points = SharedPoints::kVertices);
 
+// Whether times at points and matrices under `travel` read a graph shared through
+// TravelCost::graph: a constant speed with one weight (the exact engine's surface). With several
+// weights they run on regions built for their own points (docs/engine.md "Several weights by
+// regions"), far faster than a search of the shared graph, which then serves paths only; a
+// slope-dependent speed builds its own per query. Reads the face weights only (a --max-slope
+// leaving one weight is still counted as several: that only forgoes sharing).
+bool CostsUseSharedGraph(const TravelCost& travel);
+
 // Tobler's hiking function: km/h at s = rise / run along the direction of travel.
 double ToblerKmh(double rise_over_run);
 
