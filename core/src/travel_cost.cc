@@ -247,14 +247,8 @@ absl::StatusOr<std::shared_ptr<const WeightedSurface>> BuildTravelGraph(
 }
 
 bool CostsUseSharedGraph(const TravelCost& travel) {
-  if (IsDirectional(travel) || travel.face_weight == nullptr) return !IsDirectional(travel);
-  double weight = kInf;
-  for (const double w : *travel.face_weight) {
-    if (!std::isfinite(w)) continue;
-    if (std::isfinite(weight) && w != weight) return false;
-    weight = w;
-  }
-  return true;
+  return !IsDirectional(travel) &&
+         (travel.face_weight == nullptr || OneFiniteWeight(*travel.face_weight));
 }
 
 absl::StatusOr<TravelPointSolver> TravelPointSolver::Create(

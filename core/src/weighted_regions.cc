@@ -436,15 +436,18 @@ void CopyStats(const SolveStats& s, WeightedStats* out) {
 
 }  // namespace
 
-bool RegionsServe(const WeightedOptions& options) {
-  if (options.slope_cost != nullptr) return false;
+bool OneFiniteWeight(const std::vector<double>& weights) {
   double weight = kInf;
-  for (const double w : options.face_weight) {
+  for (const double w : weights) {
     if (!std::isfinite(w)) continue;
     if (std::isfinite(weight) && w != weight) return false;
     weight = w;
   }
   return true;
+}
+
+bool RegionsServe(const WeightedOptions& options) {
+  return options.slope_cost == nullptr && OneFiniteWeight(options.face_weight);
 }
 
 bool RegionsServeFields(const WeightedOptions& options) { return options.slope_cost == nullptr; }
