@@ -44,6 +44,23 @@ namespace geodex::cli {
 bool ParseArgs(int argc, char** argv, int first, const std::vector<std::string>& boolean_flags,
                Args* out, std::string* error) {
   const std::set<std::string> booleans(boolean_flags.begin(), boolean_flags.end());
+  const std::set<std::string> repeatable(std::begin(kRepeatableFlags), std::end(kRepeatableFlags));
+  auto add = [&](const std::string& key, const std::string& value) {
+    if (!out->options.count(key)) {
+      out->options[key] = value;
+    } else if (!repeatable.count(key)) {
+      *error = absl::StrFormat(
+          "option --%s given twice: it takes one value (only %s add up when repeated)", key,
+          absl::StrJoin(repeatable, ", ",
+                        [](std::string* o, const std::string& f) { absl::StrAppend(o, "--", f); }));
+      return false;
+    } else if (key == "sources" || key == "targets") {
+      // A SPEC list: the repeats are more points of the same list.
+      absl::StrAppend(&out->options[key], ",", value);
+    }
+    if (repeatable.count(key)) out->lists[key].push_back(value);
+    return true;
+  };
   for (int i = first; i < argc; ++i) {
     std::string a = argv[i];
     if (a.rfind("--", 0) != 0 || a == "--") {
@@ -52,18 +69,26 @@ bool ParseArgs(int argc, char** argv, int first, const std::vector<std::string>&
     }
     a = a.substr(2);
     const size_t eq = a.find('=');
+    bool ok = true;
     if (eq != std::string::npos) {
-      out->options[a.substr(0, eq)] = a.substr(eq + 1);
+      ok = add(a.substr(0, eq), a.substr(eq + 1));
     } else if (booleans.count(a)) {
-      out->options[a] = "";
+      ok = add(a, "");
     } else if (i + 1 < argc) {
-      out->options[a] = argv[++i];
+      ok = add(a, argv[++i]);
     } else {
       *error = absl::StrFormat("option --%s needs a value", a);
       return false;
     }
+    if (!ok) return false;
   }
   return true;
+}
+
+std::vector<std::string> Args::All(const std::string& key) const {
+  if (auto it = lists.find(key); it != lists.end()) return it->second;
+  if (auto it = options.find(key); it != options.end()) return {it->second};
+  return {};
 }
 
 absl::Status ResolvePoints(Backend& backend, const Args& args, const std::string& option,
@@ -136,21 +161,20 @@ absl::Status ExpandPointFiles(Args* args) {
   for (const auto& [flag, option] :
        {std::pair<std::string, std::string>{"sources-file", "sources"},
         std::pair<std::string, std::string>{"targets-file", "targets"}}) {
-    auto it = args->options.find(flag);
-    if (it == args->options.end()) continue;
-    const std::string name = absl::StrCat("--", flag, " ", it->second);
-    absl::StatusOr<std::vector<terrain::FilePoint>> points =
-        terrain::ReadPointsFile(it->second, name);
-    if (!points.ok()) return points.status();
-    std::string spec = args->options.count(option) ? args->options.at(option) : "";
-    for (const terrain::FilePoint& p : *points) {
-      absl::StatusOr<std::string> item = terrain::FilePointSpec(p);
-      if (!item.ok())
-        return absl::InvalidArgumentError(absl::StrCat(p.name, ": ", item.status().message()));
-      absl::StrAppend(&spec, spec.empty() ? "" : ",", *item);
-      FilePointNames()[*item] = p.name;
+    for (const std::string& path : args->All(flag)) {
+      const std::string name = absl::StrCat("--", flag, " ", path);
+      absl::StatusOr<std::vector<terrain::FilePoint>> points = terrain::ReadPointsFile(path, name);
+      if (!points.ok()) return points.status();
+      std::string spec = args->options.count(option) ? args->options.at(option) : "";
+      for (const terrain::FilePoint& p : *points) {
+        absl::StatusOr<std::string> item = terrain::FilePointSpec(p);
+        if (!item.ok())
+          return absl::InvalidArgumentError(absl::StrCat(p.name, ": ", item.status().message()));
+        absl::StrAppend(&spec, spec.empty() ? "" : ",", *item);
+        FilePointNames()[*item] = p.name;
+      }
+      args->options[option] = spec;
     }
-    args->options[option] = spec;
   }
   return absl::OkStatus();
 }
@@ -289,7 +313,7 @@ int ResolveTravelWeights(Backend& backend, const Args& args, GeodesicOptions* op
     }
     options->travel->face_weight = std::move(weights);  // count and values: core's check
   } else if (args.options.count("friction")) {
-    const std::string& path = args.options.at("friction");
+    const std::string path = absl::StrJoin(args.All("friction"), ", --friction ");
     const terrain::Dem* dem = backend.Terrain();
     if (dem == nullptr) {
       return Fail(kExitUsage, absl::StrCat("--friction ", path,
@@ -303,7 +327,7 @@ int ResolveTravelWeights(Backend& backend, const Args& args, GeodesicOptions* op
     absl::StatusOr<const MeshData*> data = backend.Geometry();
     if (!data.ok()) return FailQuery(data.status());
     absl::StatusOr<std::vector<double>> weights =
-        terrain::ReadFrictionFile(**data, path, dem->info(), absl::StrCat("--friction ", path));
+        terrain::ReadFrictionFiles(**data, args.All("friction"), dem->info());
     if (!weights.ok()) return FailQuery(weights.status());
     options->travel->face_weight = std::make_shared<std::vector<double>>(*std::move(weights));
   }
@@ -346,14 +370,14 @@ absl::StatusOr<terrain::DemOptions> MeshReadOptions(const Args& args, const std:
   if (std::isnan(dem.barrier_below)) {
     return absl::InvalidArgumentError("--barrier-below must be a number");
   }
-  if (args.options.count("barrier")) dem.barrier_file = args.options.at("barrier");
+  dem.barrier_files = args.All("barrier");
   if (!GetDouble(args, "barrier-width", &dem.barrier_width, &error))
     return absl::InvalidArgumentError(error);
   if (!(dem.barrier_width >= 0) || !std::isfinite(dem.barrier_width)) {
     return absl::InvalidArgumentError(
         "--barrier-width must be a finite number of metres, 0 or more");
   }
-  if (args.options.count("barrier-width") && dem.barrier_file.empty()) {
+  if (args.options.count("barrier-width") && dem.barrier_files.empty()) {
     return absl::InvalidArgumentError(
         "--barrier-width goes with --barrier (the width of its lines and points)");
   }
@@ -394,6 +418,11 @@ absl::StatusOr<terrain::DemOptions> MeshReadOptions(const Args& args, const std:
       return absl::InvalidArgumentError(
           "--friction-boundaries exact: cuts friction polygons (--friction F.geojson, .gpkg, "
           ".shp, .fgb) into a DEM's mesh");
+    }
+    if (how == "exact" && args.All("friction").size() > 1) {
+      return absl::InvalidArgumentError(
+          "--friction-boundaries exact: cuts one --friction file in (merge the polygon files into "
+          "one, or leave out --friction-boundaries: repeated polygon files add up by faces)");
     }
     if (how == "exact") dem.friction_file = path;
   }
@@ -886,8 +915,10 @@ std::string FormatPathJson(const PathQueryResult& result, const GeodesicOptions&
       options.travel.has_value()
           ? absl::StrCat("{", TravelJsonMembers(options),
                          "\"time_s\": ", JsonNumber(result.distance),
+                         ", \"length_m\": ", JsonNumber(result.path.length),
                          ", \"length\": ", JsonNumber(result.path.length), ", \"points\": [")
-          : "{\"length\": " + JsonNumber(result.distance) + ", \"points\": [";
+          : absl::StrCat("{\"length_m\": ", JsonNumber(result.distance),
+                         ", \"length\": ", JsonNumber(result.distance), ", \"points\": [");
   for (size_t i = 0; i < result.path.points.size(); ++i) {
     text += (i ? ", " : "") + PathPointJson(result.path.points[i]);
   }
@@ -956,8 +987,11 @@ int RunPath(Backend& backend, const Args& args) {
   absl::StatusOr<PathQueryResult> result = backend.Path({froms[nearest], to, options});
   if (!result.ok()) return FailQuery(result.status());
   if (IsVectorPath(args)) {  // a 3D LineString with its length
-    if (int code = WriteVectorOutput(backend, args,
-                                     {terrain::PathFeature(result->path.points, result->distance)});
+    if (int code = WriteVectorOutput(
+            backend, args,
+            {terrain::PathFeature(
+                result->path.points, result->path.length,
+                options.solver.travel.has_value() ? result->distance : std::nan(""))});
         code != kExitOk) {
       return code;
     }

@@ -23,8 +23,20 @@ enum ExitCode : int {
 // `--key value` / `--key=value` / `--flag` arguments after the command and its positionals.
 struct Args {
   std::vector<std::string> positional;
-  std::map<std::string, std::string> options;  // flags without a value map to ""
+  // Flags without a value map to "". A flag of kRepeatableFlags given several times maps to its
+  // first value here, and to all of them, in order, in `lists`.
+  std::map<std::string, std::string> options;
+  std::map<std::string, std::vector<std::string>> lists;
+  // Every value of `key`: lists' when repeatable, else the one value (none when absent).
+  std::vector<std::string> All(const std::string& key) const;
 };
+
+// The flags that add up when given again: each --barrier file cuts, each --friction polygon file
+// counts, each --sources / --targets list (joined) and --sources-file / --targets-file adds its
+// points. Any other flag given twice is refused, naming it (a second --speed or --output must not
+// silently win).
+inline const char* const kRepeatableFlags[] = {"barrier", "friction",     "sources",
+                                               "targets", "sources-file", "targets-file"};
 
 // Parses argv[first..]; `boolean_flags` take no value. Returns false with *error set on failure.
 bool ParseArgs(int argc, char** argv, int first, const std::vector<std::string>& boolean_flags,

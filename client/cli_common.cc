@@ -69,16 +69,16 @@ absl::StatusOr<std::string> ReadBarrierText(const std::string& path) {
 
 // A barrier that cuts nothing is most often drawn in the wrong place or CRS: said, not an error.
 void WarnBarrierMisses(const terrain::DemOptions& dem_options) {
-  std::fprintf(
-      stderr,
-      "geodex: warning: --barrier %s cuts nothing: it misses the surface (drawn in another CRS, or "
-      "lon/lat swapped?)\n",
-      dem_options.barrier_file.c_str());
+  std::fprintf(stderr,
+               "geodex: warning: %s: the barrier cuts nothing: it misses the surface (drawn in "
+               "another CRS, or "
+               "lon/lat swapped?)\n",
+               terrain::BarrierFilesName(dem_options.barrier_files).c_str());
 }
 
 void WarnIfBarrierSplits(const terrain::DemOptions& dem_options, uint64_t components) {
   const bool barrier =
-      std::isfinite(dem_options.barrier_below) || !dem_options.barrier_file.empty();
+      std::isfinite(dem_options.barrier_below) || !dem_options.barrier_files.empty();
   if (!barrier || components < 2) return;
   std::fprintf(
       stderr,
@@ -94,7 +94,7 @@ absl::StatusOr<MeshData> LoadMeshData(const std::string& path,
   if (terrain::IsDemPath(path) && path.rfind("sample:", 0) != 0) {
     absl::StatusOr<terrain::Dem> read = terrain::Dem::Read(path, dem_options);
     if (!read.ok()) return read.status();
-    if (!dem_options.barrier_file.empty() && read->info().barrier_faces == 0)
+    if (!dem_options.barrier_files.empty() && read->info().barrier_faces == 0)
       WarnBarrierMisses(dem_options);
     auto shared = std::make_shared<const terrain::Dem>(*std::move(read));
     MeshData data = shared->mesh();
@@ -107,12 +107,16 @@ absl::StatusOr<MeshData> LoadMeshData(const std::string& path,
   if (std::isfinite(dem_options.barrier_below)) {
     data = terrain::RemoveFacesBelow(*data, dem_options.barrier_below);
   }
-  if (!dem_options.barrier_file.empty()) {  // polygons in the mesh's own x y
-    absl::StatusOr<std::string> text = ReadBarrierText(dem_options.barrier_file);
-    if (!text.ok()) return text.status();
+  if (!dem_options.barrier_files.empty()) {  // polygons in the mesh's own x y
+    std::vector<terrain::NamedText> texts;
+    for (const std::string& path : dem_options.barrier_files) {
+      absl::StatusOr<std::string> text = ReadBarrierText(path);
+      if (!text.ok()) return text.status();
+      texts.push_back({*std::move(text), "--barrier " + path});
+    }
     terrain::CutStats cut_stats;
-    data = terrain::CutBarrierPolygons(*data, *text, nullptr, dem_options.barrier_width,
-                                       "--barrier " + dem_options.barrier_file, &cut_stats);
+    data =
+        terrain::CutBarrierPolygons(*data, texts, nullptr, dem_options.barrier_width, &cut_stats);
     if (data.ok() && cut_stats.faces_removed + cut_stats.faces_cut == 0)
       WarnBarrierMisses(dem_options);
   }
@@ -253,9 +257,44 @@ bool GetTravelFlags(const Args& args, GeodesicOptions* options, std::string* err
 
 // --lambda, --lambda-scale, --max-distance and --max-windows, shared by every command
 // that solves (distances, path, matrix, isolines, voronoi, delaunay), and the travel flags.
+namespace {
+
+// One cost amount as --levels and --max-distance take it: metres (or the mesh's unit), or with a
+// travel cost a time in seconds, or with a unit (10min, 1.5h, 90s). False with *error naming
+// --`flag`.
+bool ParseAmount(const Args& args, const std::string& flag, absl::string_view item, double* out,
+                 std::string* error) {
+  double unit = 1;
+  absl::string_view number = item;
+  for (const auto& [suffix, seconds] :
+       {std::pair<absl::string_view, double>{"min", 60}, {"h", 3600}, {"s", 1}}) {
+    if (absl::ConsumeSuffix(&number, suffix)) {
+      unit = seconds;
+      break;
+    }
+  }
+  double value;
+  if (!absl::SimpleAtod(number, &value)) {
+    *error = absl::StrFormat("--%s: '%s' is not a number", flag, item);
+    return false;
+  }
+  if (number.size() != item.size() && !args.options.count("speed")) {
+    *error = absl::StrFormat("--%s: '%s' is a time; times need --speed constant:KMH", flag, item);
+    return false;
+  }
+  *out = value * unit;
+  return true;
+}
+
+}  // namespace
+
 bool GetSolverFlags(const Args& args, GeodesicOptions* options, std::string* error) {
+  if (args.options.count("max-distance") &&
+      !ParseAmount(args, "max-distance", args.options.at("max-distance"), &options->max_distance,
+                   error)) {
+    return false;
+  }
   if (!GetDouble(args, "lambda", &options->lambda, error) ||
-      !GetDouble(args, "max-distance", &options->max_distance, error) ||
       !GetUint(args, "max-windows", &options->max_windows, error) ||
       !GetTravelFlags(args, options, error)) {
     return false;
@@ -282,26 +321,9 @@ bool GetLevels(const Args& args, const std::string& count_flag, IsolineOptions* 
                std::string* error) {
   if (args.options.count("levels")) {
     for (absl::string_view item : absl::StrSplit(args.options.at("levels"), ',')) {
-      // With a travel cost, levels are times: seconds, or with a unit (10min, 1.5h, 90s).
-      double unit = 1;
-      absl::string_view number = item;
-      for (const auto& [suffix, seconds] :
-           {std::pair<absl::string_view, double>{"min", 60}, {"h", 3600}, {"s", 1}}) {
-        if (absl::ConsumeSuffix(&number, suffix)) {
-          unit = seconds;
-          break;
-        }
-      }
       double level;
-      if (!absl::SimpleAtod(number, &level)) {
-        *error = absl::StrFormat("--levels: '%s' is not a number", item);
-        return false;
-      }
-      if (number.size() != item.size() && !args.options.count("speed")) {
-        *error = absl::StrFormat("--levels: '%s' is a time; times need --speed constant:KMH", item);
-        return false;
-      }
-      options->levels.push_back(level * unit);
+      if (!ParseAmount(args, "levels", item, &level, error)) return false;
+      options->levels.push_back(level);
     }
   } else if (args.options.count(count_flag)) {
     if (!absl::SimpleAtoi(args.options.at(count_flag), &options->count)) {

@@ -264,6 +264,8 @@ int RunIsolines(Backend& backend, const Args& args) {
   absl::StatusOr<Isolines> iso;
   if (int code = Prepare(backend, args, "sources", &s, &query.options)) return code;
   query.sources = s.points;
+  // Solved just past the top level, by both calls below (one field): never cut by --max-distance.
+  query.options = IsolineFieldOptions(*s.data, query.options, query.levels);
   iso = backend.ComputeIsolines(query);
   if (!iso.ok()) return FailQuery(iso.status());
 

@@ -139,7 +139,8 @@ class LocalBackend final : public Backend {
 
   absl::StatusOr<Isolines> ComputeIsolines(const IsolineQuery& query) override {
     if (absl::Status s = ValidateIsolineQuery(query); !s.ok()) return s;
-    absl::StatusOr<const DistanceField*> field = CachedField(query.sources, query.options);
+    absl::StatusOr<const DistanceField*> field = CachedFieldWithin(
+        query.sources, IsolineFieldOptions(loaded_->mesh, query.options, query.levels));
     if (!field.ok()) return field.status();
     return ExtractIsolines(loaded_->mesh, **field, query.levels);
   }
@@ -147,7 +148,8 @@ class LocalBackend final : public Backend {
   absl::StatusOr<VoronoiDiagram> ComputeVoronoi(const VoronoiQuery& query) override {
     absl::StatusOr<const DistanceField*> field = CachedField(query.sites, query.options);
     if (!field.ok()) return field.status();
-    return BuildVoronoi(loaded_->mesh, **field);
+    return BuildVoronoi(loaded_->mesh, **field,
+                        query.options.travel.has_value() ? &*query.options.travel : nullptr);
   }
 
   absl::StatusOr<DelaunayTriangulation> ComputeDelaunay(const DelaunayQuery& query) override {
@@ -174,13 +176,33 @@ class LocalBackend final : public Backend {
     if (!field.ok()) return field.status();
     field_ = std::make_unique<DistanceField>(*std::move(field));
     field_key_ = key;
+    field_unlimited_key_ = Key(sources, Unlimited(options));
+    field_max_distance_ = options.max_distance;
     return field_.get();
+  }
+
+  // As CachedField, but a field solved further (a larger max_distance, all else the same) serves:
+  // its values up to the smaller limit are the same. Isolines drawn on render's whole field reuse
+  // it (and the pointer render holds stays valid).
+  absl::StatusOr<const DistanceField*> CachedFieldWithin(const std::vector<SurfacePoint>& sources,
+                                                         const GeodesicOptions& options) {
+    if (field_ != nullptr && field_max_distance_ >= options.max_distance &&
+        Key(sources, Unlimited(options)) == field_unlimited_key_) {
+      return field_.get();
+    }
+    return CachedField(sources, options);
+  }
+  static GeodesicOptions Unlimited(GeodesicOptions options) {
+    options.max_distance = std::numeric_limits<double>::infinity();
+    return options;
   }
 
   std::unique_ptr<LoadedMesh> loaded_;
   std::unique_ptr<SurfaceLocator> locator_;  // built on the first p:X:Y:Z point
   std::unique_ptr<DistanceField> field_;     // the last sources' field
   std::string field_key_;
+  std::string field_unlimited_key_;  // field_key_ with no max_distance
+  double field_max_distance_ = 0;
 };
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -90,12 +91,12 @@ absl::StatusOr<T> Flagged(
 // the mesh made here.
 bool DerivedHere(const std::string& mesh, const terrain::DemOptions& options) {
   return terrain::IsDemPath(mesh) || std::isfinite(options.barrier_below) ||
-         !options.barrier_file.empty() || !options.friction_file.empty();
+         !options.barrier_files.empty() || !options.friction_file.empty();
 }
 absl::StatusOr<MeshRef> UploadDerived(GeodexClient& client, const std::string& mesh,
                                       const terrain::DemOptions& options, const MeshData& data) {
   // By its content's id, uploaded only if the server lacks it.
-  if (terrain::IsGeoTiffPath(mesh) && options.barrier_file.empty() &&
+  if (terrain::IsGeoTiffPath(mesh) && options.barrier_files.empty() &&
       options.friction_file.empty()) {
     client::DemUploadOptions dem;
     dem.step = options.step;
@@ -118,7 +119,7 @@ class RemoteBackend final : public Backend {
     std::error_code ec;
     absl::StatusOr<MeshRef> ref;
     const bool barrier =
-        std::isfinite(dem_options.barrier_below) || !dem_options.barrier_file.empty();
+        std::isfinite(dem_options.barrier_below) || !dem_options.barrier_files.empty();
     const bool here =
         (std::filesystem::exists(mesh, ec) && !std::filesystem::is_directory(mesh, ec)) ||
         mesh.rfind("sample:", 0) == 0;
@@ -147,24 +148,33 @@ class RemoteBackend final : public Backend {
   absl::Status OpenDerivedOnServer(const std::string& mesh, const terrain::DemOptions& options) {
     absl::StatusOr<MeshRef> base = client_->ResolveMesh(mesh);
     if (!base.ok()) return base.status();
-    client::BarrierOptions barrier;
-    if (std::isfinite(options.barrier_below)) barrier.below = options.barrier_below;
-    if (!options.barrier_file.empty()) {
-      absl::StatusOr<std::string> text = ReadBarrierText(options.barrier_file);
-      if (!text.ok()) return text.status();
-      barrier.polygons_geojson = *std::move(text);
-      barrier.width = options.barrier_width;
-    }
-    absl::StatusOr<client::ServerMesh> derived = client_->DeriveMesh(base->name, barrier);
-    if (!derived.ok()) {
-      std::optional<FieldViolation> violation = FieldViolationOf(derived.status());
-      if (violation.has_value() && violation->field.rfind("barrier", 0) == 0) {
-        const bool polygons = violation->field == "barrier.polygons_geojson";
-        return absl::InvalidArgumentError(absl::StrCat(
-            polygons ? "--barrier " + options.barrier_file : std::string("--barrier-below"), ": ",
-            violation->description));
+    // One DeriveMesh per --barrier file, each cutting the mesh the one before made (the first
+    // also takes --barrier-below): every file's polygons end up cut out, as in local mode.
+    const size_t files = std::max<size_t>(1, options.barrier_files.size());
+    std::string from = base->name;
+    absl::StatusOr<client::ServerMesh> derived;
+    for (size_t k = 0; k < files; ++k) {
+      client::BarrierOptions barrier;
+      if (k == 0 && std::isfinite(options.barrier_below)) barrier.below = options.barrier_below;
+      const std::string file = k < options.barrier_files.size() ? options.barrier_files[k] : "";
+      if (!file.empty()) {
+        absl::StatusOr<std::string> text = ReadBarrierText(file);
+        if (!text.ok()) return text.status();
+        barrier.polygons_geojson = *std::move(text);
+        barrier.width = options.barrier_width;
       }
-      return derived.status();
+      derived = client_->DeriveMesh(from, barrier);
+      if (!derived.ok()) {
+        std::optional<FieldViolation> violation = FieldViolationOf(derived.status());
+        if (violation.has_value() && violation->field.rfind("barrier", 0) == 0) {
+          const bool polygons = violation->field == "barrier.polygons_geojson";
+          return absl::InvalidArgumentError(
+              absl::StrCat(polygons ? "--barrier " + file : std::string("--barrier-below"), ": ",
+                           violation->description));
+        }
+        return derived.status();
+      }
+      from = derived->name;
     }
     WarnIfBarrierSplits(options, derived->summary.report.components);
     mesh_.name = derived->name;

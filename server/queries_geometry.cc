@@ -40,8 +40,8 @@ absl::StatusOr<MessageStream<v1::ComputeIsolinesResponse>> RunComputeIsolines(
     const QueryEnv& env, const v1::ComputeIsolinesRequest& request) {
   absl::StatusOr<IsolineOptions> options = IsolineLevels(env, api::IsolineLevelsFromProto(request));
   if (!options.ok()) return options.status();
-  absl::StatusOr<SolvedField> solved =
-      SolveField(env, request.mesh(), request.sources(), request.options(), SnapsOf(request));
+  absl::StatusOr<SolvedField> solved = SolveField(env, request.mesh(), request.sources(),
+                                                  request.options(), SnapsOf(request), &*options);
   if (!solved.ok()) return solved.status();
   absl::StatusOr<Isolines> isolines =
       ExtractIsolines(*solved->mesh->mesh, *solved->field, *options);
@@ -58,7 +58,9 @@ absl::StatusOr<MessageStream<v1::ComputeVoronoiResponse>> RunComputeVoronoi(
   absl::StatusOr<SolvedField> solved =
       SolveField(env, request.mesh(), request.sources(), request.options(), SnapsOf(request));
   if (!solved.ok()) return solved.status();
-  absl::StatusOr<VoronoiDiagram> diagram = BuildVoronoi(*solved->mesh->mesh, *solved->field);
+  absl::StatusOr<VoronoiDiagram> diagram =
+      BuildVoronoi(*solved->mesh->mesh, *solved->field,
+                   solved->options.travel.has_value() ? &*solved->options.travel : nullptr);
   if (!diagram.ok()) return diagram.status();
 
   std::vector<v1::ComputeVoronoiResponse> messages = api::VoronoiToProto(

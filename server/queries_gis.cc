@@ -131,7 +131,9 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
       if (absl::IsNotFound(path.status()))
         return UnreachableError("points[0]: unreachable from sources[0]");
       if (!path.ok()) return NameSolveError(path.status(), "sources");
-      return geojson({terrain::PathFeature(path->path.points, path->distance)});
+      return geojson(
+          {terrain::PathFeature(path->path.points, path->path.length,
+                                solver->travel.has_value() ? path->distance : std::nan(""))});
     }
     absl::StatusOr<std::vector<SurfacePoint>> sources =
         ResolveSources(env, mesh, request.sources(), &*snaps);
@@ -160,7 +162,8 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
     if (!levels.ok()) return levels.status();
   }
   absl::StatusOr<SolvedField> solved =
-      SolveField(env, request.mesh(), request.sources(), request.options(), *snaps);
+      SolveField(env, request.mesh(), request.sources(), request.options(), *snaps,
+                 levels.ok() ? &*levels : nullptr);
   if (!solved.ok()) return solved.status();
   *snaps = solved->snaps;  // the sources' distances, for the file's first message
   travel_epsilon = solved->field->travel_epsilon;
@@ -181,7 +184,8 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
                                   options.travel.has_value() ? &*options.travel : nullptr));
     }
     case v1::GIS_PRODUCT_VORONOI: {
-      absl::StatusOr<VoronoiDiagram> diagram = BuildVoronoi(mesh, field);
+      absl::StatusOr<VoronoiDiagram> diagram = BuildVoronoi(
+          mesh, field, solved->options.travel.has_value() ? &*solved->options.travel : nullptr);
       if (!diagram.ok()) return diagram.status();
       return geojson_of(grid, terrain::VoronoiFeatures(grid.mesh(), *diagram));
     }

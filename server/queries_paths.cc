@@ -64,7 +64,7 @@ absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPath
       }
       if (!path.ok()) return path.status();
       std::reverse(path->points.begin(), path->points.end());  // traced from `to`
-      api::PathResultToProto(field->distance[to->vertex], path->points, response);
+      api::PathResultToProto(field->distance[to->vertex], path->length, path->points, response);
       if (request.want_stats()) FieldStatsToProto(*field, cached, response->mutable_stats());
       return CheckUnaryResponseSize(env, *response, "paths");
     }
@@ -86,7 +86,7 @@ absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPath
     }
     return NameSolveError(result.status(), "from/to");
   }
-  api::PathResultToProto(result->distance, result->path.points, response);
+  api::PathResultToProto(result->distance, result->path.length, result->path.points, response);
   if (request.want_stats()) StatsToProto(result->stats, response->mutable_stats());
   return CheckUnaryResponseSize(env, *response, "paths");
 }
@@ -152,7 +152,8 @@ absl::Status RunFindShortestPaths(const QueryEnv& env, const v1::FindShortestPat
     AddSolveStats(result->stats, &total);
     for (size_t k = 0; k < groups[g].size(); ++k) {
       v1::FindShortestPathResponse* out = response->mutable_paths(static_cast<int>(groups[g][k]));
-      api::PathResultToProto(result->distance[k], result->paths[k].points, out);
+      api::PathResultToProto(result->distance[k], result->paths[k].length, result->paths[k].points,
+                             out);
     }
   }
   response->set_solves(static_cast<uint32_t>(groups.size()));

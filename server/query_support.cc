@@ -18,6 +18,7 @@
 #include "geodex/distance_matrix.h"
 #include "geodex/friction.h"
 #include "geodex/geodesic_solver.h"
+#include "geodex/geometry_queries.h"
 #include "geodex/isolines.h"
 #include "geodex/mesh_id.h"
 #include "geodex/point_distance.h"
@@ -221,7 +222,8 @@ void FieldStatsToProto(const DistanceField& field, bool cached, v1::SolveStats* 
 
 absl::StatusOr<SolvedField> SolveField(const QueryEnv& env, const std::string& mesh_name,
                                        const PointList& sources, const v1::SolverOptions& options,
-                                       absl::StatusOr<PointSnaps> snaps) {
+                                       absl::StatusOr<PointSnaps> snaps,
+                                       const IsolineOptions* isolines) {
   if (!snaps.ok()) return snaps.status();
   SolvedField out;
   out.snaps = *std::move(snaps);
@@ -235,6 +237,7 @@ absl::StatusOr<SolvedField> SolveField(const QueryEnv& env, const std::string& m
   out.sources = *std::move(resolved);
   absl::StatusOr<GeodesicOptions> solver = Options(env, *out.mesh, options);
   if (!solver.ok()) return solver.status();
+  if (isolines != nullptr) *solver = IsolineFieldOptions(*out.mesh->mesh, *solver, *isolines);
   out.options = *solver;
   absl::StatusOr<std::shared_ptr<const DistanceField>> field =
       CachedField(env, *out.mesh, out.sources, *solver, &out.cached);

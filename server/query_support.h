@@ -99,8 +99,11 @@ struct SolvedField {
                             // for a travel cost)
 };
 // `snaps` is the request's rule (SnapsOf); the result's `snaps` carries the sources' distances.
+// `isolines`: the levels the field is drawn for (isolines, isochrones): solved with core's
+// IsolineFieldOptions, just past the top level.
 absl::StatusOr<SolvedField> SolveField(const QueryEnv& env, const std::string& mesh_name,
                                        const PointList& sources, const v1::SolverOptions& options,
-                                       absl::StatusOr<PointSnaps> snaps);
+                                       absl::StatusOr<PointSnaps> snaps,
+                                       const IsolineOptions* isolines = nullptr);
 
 }  // namespace geodex::server

@@ -56,15 +56,7 @@ std::shared_ptr<const SlopeCost> SlopeCostOf(const TravelCost& travel) {
   auto cost = std::make_shared<SlopeCost>();
   cost->per_metre.resize(kSamples);
   for (int i = 0; i < kSamples; ++i) {
-    const double sine = -1 + 2.0 * i / (kSamples - 1);
-    double kmh = 0;
-    if (travel.speed_model == SpeedModel::kTobler) {
-      const double cosine = std::sqrt(std::max(0.0, 1 - sine * sine));
-      kmh = cosine == 0 ? 0 : ToblerKmh(sine / cosine);
-    } else {
-      kmh = TableKmh(*travel.speed_table, std::asin(sine) * 180 / M_PI);
-    }
-    cost->per_metre[i] = kmh > 0 ? 3.6 / kmh : kInf;
+    cost->per_metre[i] = SecondsPerMetre(travel, -1 + 2.0 * i / (kSamples - 1), 1.0);
   }
   return cost;
 }
@@ -73,6 +65,19 @@ std::shared_ptr<const SlopeCost> SlopeCostOf(const TravelCost& travel) {
 
 double ToblerKmh(double rise_over_run) {
   return 6 * std::exp(-3.5 * std::abs(rise_over_run + 0.05));
+}
+
+double SecondsPerMetre(const TravelCost& travel, double rise, double length) {
+  if (travel.speed_model == SpeedModel::kConstant) return 3.6 / travel.speed_kmh;
+  const double sine = length > 0 ? std::clamp(rise / length, -1.0, 1.0) : 0.0;
+  double kmh = 0;
+  if (travel.speed_model == SpeedModel::kTobler) {
+    const double cosine = std::sqrt(std::max(0.0, 1 - sine * sine));
+    kmh = cosine == 0 ? 0 : ToblerKmh(sine / cosine);
+  } else if (travel.speed_table != nullptr) {
+    kmh = TableKmh(*travel.speed_table, std::asin(sine) * 180 / M_PI);
+  }
+  return kmh > 0 ? 3.6 / kmh : kInf;
 }
 
 absl::Status ValidateTravelCost(const TravelCost& travel) {

@@ -6,6 +6,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
+
+#include "geodex/travel_cost.h"
 
 namespace geodex {
 namespace {
@@ -42,12 +45,15 @@ struct BoundarySegment {
 
 class Builder {
  public:
-  Builder(const TriangleMesh& mesh, const DistanceField& field)
+  Builder(const TriangleMesh& mesh, const DistanceField& field, const TravelCost* travel)
       : mesh_(mesh),
         d_(field.internal_distance.data()),
         label_(field.internal_source.data()),
+        travel_(travel),
         edge_node_(3 * static_cast<size_t>(mesh.face_count()), kNoIndex),
-        cell_of_site_(field.sources.size(), kNoIndex) {}
+        cell_of_site_(field.sources.size(), kNoIndex) {
+    if (travel_ != nullptr && travel_->max_slope_deg > 0) slope_deg_ = FaceSlopesDeg(mesh);
+  }
 
   VoronoiDiagram Run() {
     // Cells for every site that labels a vertex, by ascending site.
@@ -89,9 +95,12 @@ class Builder {
     if (edge_node_[key] == kNoIndex) {
       const uint32_t a = mesh_.From(key), b = mesh_.To(key);
       const double len = mesh_.Length(key);
-      // d_a + s len = d_b + (1 - s) len; the exact field keeps |d_a - d_b| <= len, round-off and
-      // approximate fields may not, so s is clamped.
-      double s = len > 0 ? (len + d_[b] - d_[a]) / (2 * len) : 0.5;
+      // The edge's cost each way in the field's unit (metres, or seconds of travel).
+      double ab = len, ba = len;
+      TravelCosts(key, &ab, &ba);
+      // d_a + s ab = d_b + (1 - s) ba; the exact field keeps the difference within the edge's
+      // cost, round-off and approximate fields may not, so s is clamped.
+      double s = ab + ba > 0 ? (ba + d_[b] - d_[a]) / (ab + ba) : 0.5;
       s = std::min(1.0, std::max(0.0, s));
       const Vec3 pa = Local(a), pb = Local(b);
       Node n;
@@ -105,6 +114,29 @@ class Builder {
     const double s = nodes_[node].point.where.t;
     *s_local = key == h ? s : 1 - s;
     return node;
+  }
+
+  // With a travel cost, the edge of half-edge `key` walked each way in seconds: its length at the
+  // pace of its cheaper side (a walker along it may use either face) and of its slope. Left as
+  // metres where the edge cannot be walked (its ends are then unreachable or labelled alike).
+  void TravelCosts(uint32_t key, double* ab, double* ba) const {
+    if (travel_ == nullptr) return;
+    double weight = kUnreachable;
+    for (uint32_t h : {key, mesh_.Twin(key)}) {
+      if (h == kNoIndex) continue;
+      const uint32_t f = TriangleMesh::FaceOf(h);
+      double w = travel_->face_weight != nullptr && f < travel_->face_weight->size()
+                     ? (*travel_->face_weight)[f]
+                     : 1.0;
+      if (!slope_deg_.empty() && slope_deg_[f] > travel_->max_slope_deg) w = kUnreachable;
+      weight = std::min(weight, w);
+    }
+    const double len = mesh_.Length(key);
+    const double rise = Local(mesh_.To(key))[2] - Local(mesh_.From(key))[2];
+    double up = weight * len * SecondsPerMetre(*travel_, rise, len);
+    double down = weight * len * SecondsPerMetre(*travel_, -rise, len);
+    if (TimesInbound(*travel_)) std::swap(up, down);  // times to reach the sources: walked back
+    if (std::isfinite(up) && std::isfinite(down)) *ab = up, *ba = down;
   }
 
   void AddSegment(uint32_t u, uint32_t v, uint32_t s1, uint32_t s2) {
@@ -234,6 +266,8 @@ class Builder {
   const TriangleMesh& mesh_;
   const double* d_;
   const uint32_t* label_;
+  const TravelCost* travel_;         // null: the field is in metres
+  std::vector<double> slope_deg_;    // with a travel cost's max_slope_deg: each face's slope
   std::vector<uint32_t> edge_node_;  // per half-edge key
   std::vector<uint32_t> cell_of_site_;
   std::vector<Node> nodes_;
@@ -243,7 +277,8 @@ class Builder {
 
 }  // namespace
 
-absl::StatusOr<VoronoiDiagram> BuildVoronoi(const TriangleMesh& mesh, const DistanceField& field) {
+absl::StatusOr<VoronoiDiagram> BuildVoronoi(const TriangleMesh& mesh, const DistanceField& field,
+                                            const TravelCost* travel) {
   if (field.internal_distance.size() != mesh.vertex_count() ||
       field.internal_source.size() != mesh.vertex_count()) {
     return absl::InvalidArgumentError("the distance field was not computed on this mesh");
@@ -255,7 +290,11 @@ absl::StatusOr<VoronoiDiagram> BuildVoronoi(const TriangleMesh& mesh, const Dist
           "the distance field labels a vertex with an unknown source");
     }
   }
-  return Builder(mesh, field).Run();
+  if (field.travel_epsilon > 0 && travel == nullptr) {
+    return absl::InvalidArgumentError(
+        "a travel-time field's Voronoi diagram needs its travel cost (seconds, not metres)");
+  }
+  return Builder(mesh, field, field.travel_epsilon > 0 ? travel : nullptr).Run();
 }
 
 }  // namespace geodex

@@ -309,16 +309,20 @@ void MatrixQueryToProto(const MatrixQuery& query, v1::ComputeDistanceMatrixReque
   out->set_k_nearest(query.options.k_nearest);
 }
 
-void PathResultToProto(double distance, const std::vector<PathPoint>& points,
+void PathResultToProto(double distance, double length_m, const std::vector<PathPoint>& points,
                        v1::FindShortestPathResponse* out) {
   out->set_distance(distance);
+  out->set_length_m(length_m);
   for (const PathPoint& p : points) PathPointToProto(p, out->add_points());
 }
 
 PathQueryResult PathResultFromProto(const v1::FindShortestPathResponse& response) {
   PathQueryResult result;
   result.distance = response.distance();
-  result.path.length = response.distance();
+  // Metres along the surface (a server before length_m sent only `distance`: metres when exact).
+  result.path.length = response.length_m() > 0 || response.travel_epsilon() > 0
+                           ? response.length_m()
+                           : response.distance();
   for (const auto& p : response.points()) result.path.points.push_back(PathPointFromProto(p));
   if (response.has_stats()) result.stats = StatsFromProto(response.stats());
   return result;

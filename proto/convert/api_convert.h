@@ -89,7 +89,8 @@ void MatrixQueryToProto(const MatrixQuery& query, v1::ComputeDistanceMatrixReque
 // FindShortestPath's answer (and each of FindShortestPaths'), both directions: the length and the
 // points from `from` to `to` (none when unreachable in FindShortestPaths). Stats are the
 // caller's; FromProto reads them when present.
-void PathResultToProto(double distance, const std::vector<PathPoint>& points,
+// `distance`: the path's cost (metres, or seconds with a travel cost); `length_m`: metres.
+void PathResultToProto(double distance, double length_m, const std::vector<PathPoint>& points,
                        v1::FindShortestPathResponse* out);
 PathQueryResult PathResultFromProto(const v1::FindShortestPathResponse& response);
 

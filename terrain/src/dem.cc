@@ -229,6 +229,64 @@ struct FrictionRegion {
   double friction;
 };
 
+// Coordinates beyond this (in any unit a file may use) are a mistake, not a map: refused rather
+// than left to GEOS, where they overflow (a friction polygon at 1e308 once vanished in silence).
+constexpr double kMaxMapCoordinate = 1e12;
+
+// Why a friction polygon cannot be used as drawn ("" when it can): a coordinate not finite or
+// absurd, a ring with fewer than 3 distinct points; an invalid polygon is repaired as the cut
+// repairs it (areas kept, collapsed parts dropped) and refused when no area is left.
+std::string UnusableFrictionShape(std::unique_ptr<OGRGeometry>* shape) {
+  std::string why;
+  std::function<void(const OGRGeometry&)> check = [&](const OGRGeometry& g) {
+    if (!why.empty()) return;
+    if (const auto* collection = dynamic_cast<const OGRGeometryCollection*>(&g)) {
+      for (const OGRGeometry* part : *collection) check(*part);
+      return;
+    }
+    const auto* polygon = dynamic_cast<const OGRPolygon*>(&g);
+    if (polygon == nullptr) return;
+    for (const OGRLinearRing* ring : *polygon) {
+      std::set<std::pair<double, double>> distinct;
+      for (const OGRPoint& p : *ring) {
+        const double x = p.getX(), y = p.getY();
+        if (!std::isfinite(x) || !std::isfinite(y)) {
+          why = "a coordinate is not a finite number";
+          return;
+        }
+        if (std::abs(x) > kMaxMapCoordinate || std::abs(y) > kMaxMapCoordinate) {
+          why = absl::StrFormat("a coordinate (%g, %g) is beyond %g in size", x, y,
+                                kMaxMapCoordinate);
+          return;
+        }
+        distinct.insert({x, y});
+      }
+      if (distinct.size() < 3) {
+        why = absl::StrFormat("a ring has %d distinct points; a polygon's ring needs 3 or more",
+                              distinct.size());
+        return;
+      }
+    }
+  };
+  check(**shape);
+  if (!why.empty() || (*shape)->IsValid()) return why;
+  std::unique_ptr<OGRGeometry> valid((*shape)->MakeValid());
+  auto polygons = std::make_unique<OGRMultiPolygon>();
+  std::function<void(const OGRGeometry&)> keep = [&](const OGRGeometry& g) {
+    if (const auto* collection = dynamic_cast<const OGRGeometryCollection*>(&g)) {
+      for (const OGRGeometry* part : *collection) keep(*part);
+    } else if (dynamic_cast<const OGRPolygon*>(&g) != nullptr) {
+      polygons->addGeometry(&g);
+    }
+  };
+  if (valid != nullptr) keep(*valid);
+  if (polygons->IsEmpty() || polygons->get_Area() <= 0) {
+    return "the polygon is invalid and encloses no area once repaired";
+  }
+  *shape = std::move(polygons);
+  return "";
+}
+
 // The friction polygons of a vector dataset, checked (polygons only, each with a numeric
 // "friction" > 0) and projected to `crs` (null: as they are). Both uses start here: the faces'
 // values (FaceFrictionOf) and the outlines cut into a mesh (OutlinesOf).
@@ -263,6 +321,9 @@ absl::StatusOr<std::vector<FrictionRegion>> ReadFrictionRegions(GDALDataset& ds,
             absl::StrCat(which, " is a ", g->getGeometryName(), "; friction regions are polygons"));
       }
       std::unique_ptr<OGRGeometry> copy(g->clone());
+      if (std::string why = UnusableFrictionShape(&copy); !why.empty()) {
+        return bad(absl::StrCat(which, ": ", why));
+      }
       if (*to_dem != nullptr && copy->transform(to_dem->get()) != OGRERR_NONE) {
         return bad(absl::StrCat("cannot project ", which, " to the DEM's CRS (",
                                 QuietGdal::LastMessage(), ")"));
@@ -287,7 +348,26 @@ std::unique_ptr<OGRGeometry> OutlinesOf(const std::vector<FrictionRegion>& regio
   return all;
 }
 
+// Two collections of BarrierPolygonsOf as one (the second's members moved into the first).
+std::unique_ptr<OGRGeometry> JoinCollections(std::unique_ptr<OGRGeometry> a,
+                                             std::unique_ptr<OGRGeometry> b) {
+  auto* into = a->toGeometryCollection();
+  auto* from = b->toGeometryCollection();
+  while (!from->IsEmpty()) {
+    into->addGeometryDirectly(from->getGeometryRef(0)->clone());
+    from->removeGeometry(0);
+  }
+  return a;
+}
+
 }  // namespace
+
+std::string BarrierFilesName(const std::vector<std::string>& paths) {
+  std::string name;
+  for (const std::string& p : paths)
+    absl::StrAppend(&name, name.empty() ? "" : ", ", "--barrier ", p);
+  return name;
+}
 
 absl::Status CheckFrictionSnap(double friction_snap, bool has_outlines) {
   if (!(friction_snap >= 0 && friction_snap <= 0.25)) {
@@ -861,15 +941,32 @@ absl::StatusOr<MeshData> CutBarrierPolygons(const MeshData& mesh, const std::str
                                             const DemInfo* dem, double width,
                                             const std::string& name, CutStats* stats,
                                             uint64_t max_vertices) {
+  return CutBarrierPolygons(mesh, std::vector<NamedText>{{geojson, name}}, dem, width, stats,
+                            max_vertices);
+}
+
+absl::StatusOr<MeshData> CutBarrierPolygons(const MeshData& mesh,
+                                            const std::vector<NamedText>& geojsons,
+                                            const DemInfo* dem, double width, CutStats* stats,
+                                            uint64_t max_vertices) {
+  if (geojsons.empty()) return absl::InvalidArgumentError("no barrier polygons");
   QuietGdal quiet;
   OGRSpatialReference file_crs;
-  if (absl::Status s = ParseFileCrs(dem, name, &file_crs); !s.ok()) return s;
-  return WithGeoJsonText<MeshData>(geojson, name, [&](GDALDataset& ds) -> absl::StatusOr<MeshData> {
+  std::string all_names;
+  for (const NamedText& g : geojsons)
+    absl::StrAppend(&all_names, all_names.empty() ? "" : ", ", g.name);
+  if (absl::Status s = ParseFileCrs(dem, all_names, &file_crs); !s.ok()) return s;
+  std::unique_ptr<OGRGeometry> barrier;
+  for (const NamedText& g : geojsons) {
     absl::StatusOr<std::unique_ptr<OGRGeometry>> polygons =
-        BarrierPolygonsOf(&ds, name, dem != nullptr ? &file_crs : nullptr);
+        WithGeoJsonText<std::unique_ptr<OGRGeometry>>(g.text, g.name, [&](GDALDataset& ds) {
+          return BarrierPolygonsOf(&ds, g.name, dem != nullptr ? &file_crs : nullptr);
+        });
     if (!polygons.ok()) return polygons.status();
-    return CutBarrier(mesh, **polygons, dem, &file_crs, width, max_vertices, name, stats);
-  });
+    barrier = barrier == nullptr ? *std::move(polygons)
+                                 : JoinCollections(std::move(barrier), *std::move(polygons));
+  }
+  return CutBarrier(mesh, *barrier, dem, &file_crs, width, max_vertices, all_names, stats);
 }
 
 bool IsGeoTiffPath(const std::string& path) {
@@ -909,7 +1006,7 @@ absl::StatusOr<Dem> Dem::Read(const std::string& path, const DemOptions& options
 absl::StatusOr<Dem> Dem::ReadGeoTiffBytes(const std::string& bytes, const std::string& name,
                                           const DemOptions& options) {
   if (options.step < 1) return absl::InvalidArgumentError("the DEM step must be at least 1");
-  if (!options.barrier_file.empty()) {
+  if (!options.barrier_files.empty()) {
     return absl::InvalidArgumentError("a barrier file is read with the DEM's path, not its bytes");
   }
   if (!LooksLikeTiff(bytes)) {
@@ -1175,15 +1272,18 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
   }
 
   // A barrier drawn as polygons: one union in the file's CRS, cut out of the mesh once it is made.
+  // Several files add up: their features go into the one collection, as one file holding them all.
   std::unique_ptr<OGRGeometry> barrier;
-  const std::string barrier_name = absl::StrCat("--barrier ", options.barrier_file);
-  if (!options.barrier_file.empty()) {
-    absl::StatusOr<GDALDatasetUniquePtr> file = OpenBarrierFile(options.barrier_file, barrier_name);
+  const std::string barrier_name = BarrierFilesName(options.barrier_files);
+  for (const std::string& path : options.barrier_files) {
+    const std::string name = absl::StrCat("--barrier ", path);
+    absl::StatusOr<GDALDatasetUniquePtr> file = OpenBarrierFile(path, name);
     if (!file.ok()) return file.status();
     absl::StatusOr<std::unique_ptr<OGRGeometry>> polygons =
-        BarrierPolygonsOf(file->get(), barrier_name, &file_crs);
+        BarrierPolygonsOf(file->get(), name, &file_crs);
     if (!polygons.ok()) return polygons.status();
-    barrier = *std::move(polygons);
+    barrier = barrier == nullptr ? *std::move(polygons)
+                                 : JoinCollections(std::move(barrier), *std::move(polygons));
   }
   // Friction regions: their outlines cut in once the barrier is out (geodex/friction.h).
   std::vector<FrictionRegion> friction_regions;
@@ -1732,6 +1832,7 @@ absl::StatusOr<CellValues> SampleCells(const Dem& dem, const DistanceField& fiel
     return absl::InternalError("one value per vertex expected");
   }
   CellValues out;
+  out.travel_time = field.travel_epsilon > 0;
   out.distance.assign(cells, std::numeric_limits<double>::infinity());
   out.source.assign(cells, kNoVertex);
   out.hole.assign(cells, 0);
@@ -2053,14 +2154,16 @@ absl::Status Dem::WriteDistanceRaster(const std::string& path, const CellValues&
   if (cells.distance.size() != size_t{info_.grid_width} * info_.grid_height) {
     return absl::InternalError("one value per used cell expected");
   }
-  return WriteRaster(info_, path, GDT_Float32,
-                     cells.estimated ? "geodesic distance (section-4 estimate at cell centres)"
-                                     : "geodesic distance",
-                     "m", [&](size_t cell) {
-                       if (cells.hole[cell]) return kRasterNoSurface;
-                       const double d = cells.distance[cell];
-                       return std::isfinite(d) ? d : kRasterUnreachable;
-                     });
+  // The band says what its values are: travel time in seconds, or distance in metres.
+  const std::string what = cells.travel_time ? "travel time" : "geodesic distance";
+  return WriteRaster(
+      info_, path, GDT_Float32,
+      (cells.estimated ? what + " (section-4 estimate at cell centres)" : what).c_str(),
+      cells.travel_time ? "s" : "m", [&](size_t cell) {
+        if (cells.hole[cell]) return kRasterNoSurface;
+        const double d = cells.distance[cell];
+        return std::isfinite(d) ? d : kRasterUnreachable;
+      });
 }
 
 absl::Status Dem::WriteLabelRaster(const std::string& path, const CellValues& cells) const {
@@ -2285,6 +2388,39 @@ absl::StatusOr<MeshData> CutFrictionOutlines(const MeshData& mesh, const std::st
     if (!regions.ok()) return regions.status();
     return CutOutlines(mesh, *OutlinesOf(*regions), dem, &file_crs, max_vertices, name, stats);
   });
+}
+
+absl::StatusOr<std::vector<double>> ReadFrictionFiles(const MeshData& mesh,
+                                                      const std::vector<std::string>& paths,
+                                                      const DemInfo& dem) {
+  if (paths.size() == 1) return ReadFrictionFile(mesh, paths[0], dem, "--friction " + paths[0]);
+  QuietGdal quiet;
+  std::string names;
+  for (const std::string& path : paths) {
+    const std::string name = absl::StrCat("--friction ", path);
+    absl::StrAppend(&names, names.empty() ? "" : ", ", name);
+    const GisFormat* format = GisFormatOf(path);
+    if (format != nullptr && format->kind == GisFileKind::kRaster) {
+      return absl::InvalidArgumentError(absl::StrCat(
+          name,
+          ": a friction raster is given alone (it values every face); only polygon files "
+          "add up when --friction is repeated"));
+    }
+  }
+  OGRSpatialReference file_crs;
+  if (absl::Status s = ParseFileCrs(&dem, names, &file_crs); !s.ok()) return s;
+  // Every file's polygons in one list: as one file holding them all (overlaps take the largest).
+  std::vector<FrictionRegion> all;
+  for (const std::string& path : paths) {
+    const std::string name = absl::StrCat("--friction ", path);
+    absl::StatusOr<GDALDatasetUniquePtr> ds = OpenBarrierFile(path, name);
+    if (!ds.ok()) return ds.status();
+    absl::StatusOr<std::vector<FrictionRegion>> regions =
+        ReadFrictionRegions(**ds, &file_crs, name);
+    if (!regions.ok()) return regions.status();
+    for (FrictionRegion& r : *regions) all.push_back(std::move(r));
+  }
+  return FaceFrictionOf(std::move(all), mesh, &dem, names);
 }
 
 absl::StatusOr<std::vector<double>> ReadFrictionFile(const MeshData& mesh, const std::string& path,

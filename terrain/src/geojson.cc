@@ -338,11 +338,12 @@ std::vector<GeoFeature> DelaunayFeatures(const DelaunayTriangulation& delaunay) 
   return features;
 }
 
-GeoFeature PathFeature(const std::vector<PathPoint>& points, double length) {
+GeoFeature PathFeature(const std::vector<PathPoint>& points, double length_m, double time_s) {
   GeoFeature f;
   f.kind = GeoFeature::Kind::kLine;
   for (const PathPoint& q : points) f.points.push_back(q.position);
-  f.properties = {{"length", length}, {"units", std::string("m")}};
+  f.properties = {{"length_m", length_m}, {"length", length_m}, {"units", std::string("m")}};
+  if (!std::isnan(time_s)) f.properties.push_back({"time_s", time_s});
   return f;
 }
 

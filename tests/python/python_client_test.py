@@ -629,6 +629,17 @@ class ControlLoopTest(unittest.TestCase):
         self.assertEqual(exact.travel_epsilon, 0.0)
         self.assertGreaterEqual(path.length, exact.length * (1 - 1e-9))
         self.assertLessEqual(path.length, exact.length * 1.05)
+        # Metres and seconds, both: length_m is the route's length, time_s its time (length is
+        # the cost asked for); at 7.2 km/h (2 m/s) the time is length_m / 2 within the bound.
+        self.assertIsNone(exact.time_s)
+        self.assertAlmostEqual(exact.length_m, exact.length, delta=1e-12 * exact.length)
+        self.assertEqual(path.time_s, path.length)
+        self.assertGreaterEqual(path.length_m, exact.length * (1 - 1e-9))
+        fast = sync.shortest_path(mesh.name, vertex(0), vertex(440),
+                                  travel=geodex.Travel(7.2, epsilon=0.05))
+        self.assertGreaterEqual(fast.time_s, fast.length_m / 2 * (1 - 1e-9))
+        self.assertLessEqual(fast.time_s, exact.length_m / 2 * 1.05)
+        self.assertAlmostEqual(fast.length_m, path.length_m, delta=1e-9 * path.length_m)
         matrix = sync.distance_matrix(mesh.name, sources, targets, travel=walk)
         self.assertEqual(matrix.travel_epsilon, 0.05)
         self.assertEqual(sync.distance_matrix(mesh.name, sources, targets).travel_epsilon, 0.0)
@@ -641,6 +652,7 @@ class ControlLoopTest(unittest.TestCase):
         numpy.testing.assert_allclose(points.exact, matrix.min(axis=0), rtol=1e-12)
         paths = sync.shortest_paths(mesh.name, [(vertex(0), vertex(440))], travel=walk)
         self.assertEqual((paths[0].length, paths[0].travel_epsilon), (path.length, 0.05))
+        self.assertEqual((paths[0].length_m, paths[0].time_s), (path.length_m, path.time_s))
         isolines = sync.isolines(mesh.name, sources, count=4, travel=walk)
         self.assertEqual(isolines.travel_epsilon, 0.05)
         self.assertEqual(sync.voronoi(mesh.name, sources, travel=walk).travel_epsilon, 0.05)

@@ -348,10 +348,19 @@ TEST(ApiConvertTest, PathAndLocatedPointRoundTrip) {
   ASSERT_TRUE(path.ok());
   ASSERT_GT(path->path.points.size(), 3u);
   v1::FindShortestPathResponse response;
-  api::PathResultToProto(path->distance, path->path.points, &response);
+  api::PathResultToProto(path->distance, path->path.length, path->path.points, &response);
   api::StatsToProto(path->stats, response.mutable_stats());
   const PathQueryResult back = api::PathResultFromProto(response);
   EXPECT_EQ(back.distance, path->distance);
+  EXPECT_EQ(back.path.length, path->path.length);
+
+  // A travel-cost path: its cost is seconds, its length still metres, and both come back.
+  v1::FindShortestPathResponse timed;
+  api::PathResultToProto(2 * path->path.length, path->path.length, path->path.points, &timed);
+  timed.set_travel_epsilon(0.01);
+  const PathQueryResult timed_back = api::PathResultFromProto(timed);
+  EXPECT_EQ(timed_back.distance, 2 * path->path.length);
+  EXPECT_EQ(timed_back.path.length, path->path.length);
   EXPECT_EQ(Text(back.path.points), Text(path->path.points));
   EXPECT_EQ(back.stats.windows_processed, path->stats.windows_processed);
 

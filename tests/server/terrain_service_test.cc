@@ -386,7 +386,7 @@ TEST_F(TerrainServiceTest, DeriveMeshByABarrier) {
   const std::string wall_file = (dir_ / "in" / "wall.geojson").string();
   std::ofstream(wall_file) << geojson;
   terrain::DemOptions with_wall;
-  with_wall.barrier_file = wall_file;
+  with_wall.barrier_files = {wall_file};
   absl::StatusOr<terrain::Dem> local = terrain::Dem::Read(tif_, with_wall);
   ASSERT_TRUE(local.ok()) << local.status();
   // x 500052-500068 cuts block columns 4 and 6 and covers column 5, rows 0-19: a wall

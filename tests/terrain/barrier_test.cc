@@ -551,7 +551,7 @@ TEST(BarrierCutTest, DemHoleGivesTheTautString) {
       << R"({"type": "Polygon", "crs": {"type": "name", "properties": {"name": "EPSG:32633"}}, "coordinates": [[)"
       << ring << "]]}";
   DemOptions options;
-  options.barrier_file = hole_file;
+  options.barrier_files = {hole_file};
   absl::StatusOr<Dem> dem = Dem::Read(tif, options);
   ASSERT_TRUE(dem.ok()) << dem.status();
   EXPECT_GT(dem->info().barrier_faces, 0u);

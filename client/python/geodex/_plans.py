@@ -143,6 +143,13 @@ def _stacklevel() -> int:
     return level
 
 
+def _metres_and_seconds(path, travel_epsilon):
+    """(length_m, time_s) of a FindShortestPathResponse: metres always, seconds with a travel cost."""
+    travel = travel_epsilon > 0
+    return (path.length_m if (path.length_m > 0 or travel) else path.distance,
+            path.distance if travel else None)
+
+
 def _point_names(*groups) -> List[str]:
     """Request-order names of points: ("sources", 2), ("to", None) -> sources[0], sources[1], to."""
     names = []
@@ -388,7 +395,7 @@ class Plans:
         response = yield Rpc("FindShortestPath", request, pb.FindShortestPathResponse, mesh=mesh)
         path = Path(response.distance, _wire.path_points(response.points),
                     response.stats if response.HasField("stats") else None, _snaps(response),
-                    response.travel_epsilon)
+                    response.travel_epsilon, *_metres_and_seconds(response, response.travel_epsilon))
         yield from self._warn_far_snaps(mesh, path.snap_distances, ["start", "end"])
         return path
 
@@ -404,7 +411,8 @@ class Plans:
         response = yield Rpc("FindShortestPaths", request, pb.FindShortestPathsResponse,
                              mesh=mesh)
         paths = [Path(p.distance, _wire.path_points(p.points), None, _snaps(p),
-                      response.travel_epsilon) for p in response.paths]
+                      response.travel_epsilon, *_metres_and_seconds(p, response.travel_epsilon))
+                 for p in response.paths]
         names = ["pairs[%d].%s" % (i, end) for i in range(len(paths)) for end in ("from", "to")]
         all_snaps = (np.concatenate([p.snap_distances for p in paths]) if paths
                      else np.zeros(0))

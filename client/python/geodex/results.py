@@ -84,12 +84,16 @@ class PathPoint(_Unpacks):
 class Path(_Unpacks):
     """An exact shortest path: its length and its points (`length, points = path`); with
     want_stats, the solve's SolveStats in `stats` (solve_ms, windows_created, cached, ...);
-    `snap_distances` of (start, end) (not unpacked)."""
+    `snap_distances` of (start, end) (not unpacked). `length` is the path's cost: metres, or with
+    a travel cost seconds; `length_m` is always its length along the surface in metres and
+    `time_s` its travel time in seconds (None without a travel cost)."""
     length: float
     points: List[PathPoint]
     stats: Any = _extra()
     snap_distances: np.ndarray = _no_snaps()
     travel_epsilon: float = _exact()
+    length_m: float = _extra(float("nan"))
+    time_s: Optional[float] = _extra()
 
 
 @dataclasses.dataclass(eq=False)

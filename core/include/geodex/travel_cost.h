@@ -141,6 +141,12 @@ bool CostsUseSharedGraph(const TravelCost& travel);
 // Tobler's hiking function: km/h at s = rise / run along the direction of travel.
 double ToblerKmh(double rise_over_run);
 
+// Seconds per metre along a straight segment of 3D `length` rising `rise` (z up; < 0 downhill)
+// on a face of weight 1, as the engine times it: 3.6 / speed_kmh, or the slope-dependent speed at
+// the segment's slope; +inf where the model cannot walk it. What converts metres along an edge to
+// a field's seconds (the Voronoi boundary on an edge).
+double SecondsPerMetre(const TravelCost& travel, double rise, double length);
+
 // The slope of each face in degrees from the x-y plane (0 flat, 90 vertical; 0 for a degenerate
 // face): what max_slope_deg compares.
 std::vector<double> FaceSlopesDeg(const TriangleMesh& mesh);

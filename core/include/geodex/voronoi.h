@@ -61,7 +61,13 @@ struct VoronoiDiagram {
   double total_area = 0;
 };
 
-// Errors: InvalidArgument when the field does not belong to the mesh.
-absl::StatusOr<VoronoiDiagram> BuildVoronoi(const TriangleMesh& mesh, const DistanceField& field);
+// `travel`: the travel cost a travel-time field was solved with (its values are seconds): each
+// boundary point on an edge is placed where the two sites' times meet, the edge walked at its
+// pace, so that at a constant speed with equal weights the cells are the geodesic ones at any
+// speed. Errors: InvalidArgument when the field does not belong to the mesh, or is a travel-time
+// field given without its travel cost.
+struct TravelCost;
+absl::StatusOr<VoronoiDiagram> BuildVoronoi(const TriangleMesh& mesh, const DistanceField& field,
+                                            const TravelCost* travel = nullptr);
 
 }  // namespace geodex

@@ -21,8 +21,10 @@ namespace geodex::terrain {
 // the polygon containing its centroid (the largest where polygons overlap) and 1 elsewhere: on a
 // mesh cut along the polygons' outlines (CutFrictionOutlines, DemOptions::friction_file) region
 // boundaries are exact, on any other as fine as the mesh. InvalidArgument starting with `name` for
-// text that is not GeoJSON polygons, a feature without a positive numeric friction, or polygons
-// that do not project to the mesh's CRS.
+// text that is not GeoJSON polygons, a feature without a positive numeric friction, a polygon
+// that cannot be used as drawn (a coordinate not finite or beyond 1e12, a ring of fewer than 3
+// distinct points, or invalid and enclosing no area once repaired: it names the feature), or
+// polygons that do not project to the mesh's CRS. Nothing is dropped in silence.
 absl::StatusOr<std::vector<double>> FrictionFromGeoJson(const MeshData& mesh,
                                                         const std::string& geojson,
                                                         const DemInfo* dem,
@@ -43,5 +45,11 @@ absl::StatusOr<MeshData> CutFrictionOutlines(const MeshData& mesh, const std::st
 // raster in another CRS, one not covering every face's centroid, or a value <= 0 (the cell named).
 absl::StatusOr<std::vector<double>> ReadFrictionFile(const MeshData& mesh, const std::string& path,
                                                      const DemInfo& dem, const std::string& name);
+// Several --friction files: polygon files add up, read as one file holding every polygon (where
+// polygons overlap, the largest friction); a raster must come alone (InvalidArgument naming it).
+// One path is ReadFrictionFile's, named "--friction PATH".
+absl::StatusOr<std::vector<double>> ReadFrictionFiles(const MeshData& mesh,
+                                                      const std::vector<std::string>& paths,
+                                                      const DemInfo& dem);
 
 }  // namespace geodex::terrain

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <utility>
 #include <variant>
@@ -64,8 +65,11 @@ std::vector<GeoFeature> IsochroneFeatures(const MeshData& mesh, const std::vecto
 std::vector<GeoFeature> VoronoiFeatures(const MeshData& mesh, const VoronoiDiagram& diagram);
 // Delaunay edges: one 3D LineString per edge (`site_a`, `site_b`, `length`).
 std::vector<GeoFeature> DelaunayFeatures(const DelaunayTriangulation& delaunay);
-// A path: one 3D LineString (`length`, `units` "m").
-GeoFeature PathFeature(const std::vector<PathPoint>& points, double length);
+// A path: one 3D LineString with its length along the surface in metres (`length_m`; also as
+// `length` with `units` "m") and, for a travel-cost path (`time_s` finite), its time in seconds
+// (`time_s`): seconds are never labelled as metres.
+GeoFeature PathFeature(const std::vector<PathPoint>& points, double length_m,
+                       double time_s = std::numeric_limits<double>::quiet_NaN());
 // Points with their distance: `point` as the user wrote it, `surface_point` where it landed,
 // `distance` and `source` (both null where the point is unreachable).
 struct PointValue {

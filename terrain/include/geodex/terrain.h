@@ -45,12 +45,14 @@ struct DemOptions {
   // A barrier: cells lower than this (metres; the sea at 0) are left out like nodata, so paths
   // go around them. -inf: none.
   double barrier_below = -std::numeric_limits<double>::infinity();
-  // A barrier drawn as polygons (GeoJSON, Shapefile, GeoPackage or FlatGeobuf; its own CRS, WGS 84
-  // when it names none), cut exactly out of the surface (CutBarrierPolygons). "": none.
-  std::string barrier_file;
-  // The width (metres) of the lines and points in barrier_file; 0: lines are slits, points refused.
+  // Barriers drawn as polygons (GeoJSON, Shapefile, GeoPackage or FlatGeobuf; each its own CRS,
+  // WGS 84 when it names none), cut exactly out of the surface (CutBarrierPolygons). Several files
+  // add up: they cut what one file holding all their features cuts. Empty: none.
+  std::vector<std::string> barrier_files;
+  // The width (metres) of the lines and points in barrier_files; 0: lines are slits, points
+  // refused.
   double barrier_width = 0;
-  // Friction polygons (a vector file as barrier_file, each with a "friction" property): their
+  // Friction polygons (a vector file as barrier_files', each with a "friction" property): their
   // outlines are cut into the surface, nothing removed, so that each face lies in one region and
   // the friction read from the same file on this mesh (ReadFrictionFile) has exact region
   // boundaries (geodex/friction.h). "": none.
@@ -136,6 +138,18 @@ absl::StatusOr<MeshData> CutBarrierPolygons(const MeshData& mesh, const std::str
                                             const DemInfo* dem, double width,
                                             const std::string& name, CutStats* stats,
                                             uint64_t max_vertices = 0);
+// Several GeoJSON texts, each named in its own errors: cut as one text holding all their features
+// (the --barrier flag given several times). Errors about the cut itself name them all.
+struct NamedText {
+  std::string text;
+  std::string name;
+};
+absl::StatusOr<MeshData> CutBarrierPolygons(const MeshData& mesh,
+                                            const std::vector<NamedText>& geojsons,
+                                            const DemInfo* dem, double width, CutStats* stats,
+                                            uint64_t max_vertices = 0);
+// "--barrier a.geojson, --barrier b.gpkg": how errors name several barrier files together.
+std::string BarrierFilesName(const std::vector<std::string>& paths);
 
 // A point read from a file (--sources-file, --targets-file): its coordinates in the file's CRS
 // (crs_wkt; "" when the file names none: then in the DEM's CRS) and how messages name it.
@@ -164,7 +178,7 @@ class Dem {
   // triangle with data), NotFound when the file does not exist.
   static absl::StatusOr<Dem> Read(const std::string& path, const DemOptions& options = {});
   // The same from a GeoTIFF's bytes (an upload to geodexd; only GDAL's GTiff driver parses them,
-  // and options.barrier_file must be empty). `name` spells the raster in errors.
+  // and options.barrier_files must be empty). `name` spells the raster in errors.
   static absl::StatusOr<Dem> ReadGeoTiffBytes(const std::string& bytes, const std::string& name,
                                               const DemOptions& options = {});
   // A DEM mesh again from the mesh and its info, as stored by geodexd or fetched from it: each
@@ -282,8 +296,9 @@ struct CellValues {
   std::vector<double> distance;
   std::vector<uint32_t> source;
   std::vector<uint8_t> hole;
-  bool estimated = false;  // some value is the section-4 estimate (a TIN without `exact`)
-  SolveStats exact_stats;  // the targeted solve's, when there was one
+  bool estimated = false;    // some value is the section-4 estimate (a TIN without `exact`)
+  bool travel_time = false;  // the values are seconds (a travel-cost field), not metres
+  SolveStats exact_stats;    // the targeted solve's, when there was one
 };
 // `mesh`: the engine's mesh of dem.mesh() when the caller has one (a TIN's values need it; null:
 // built here, a TIN being small). The CLI and geodexd pass `exact` (the field's own options): a
