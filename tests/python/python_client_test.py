@@ -676,6 +676,16 @@ class ControlLoopTest(unittest.TestCase):
                                     travel=geodex.Travel(3.6, epsilon=0.05, friction_geojson=half))
         self.assertEqual(rough.travel_epsilon, 0.05)
         self.assertGreater(rough.distances.sum(), field.distances.sum())
+        # A friction polygon that cannot be used is refused naming the field, never dropped in
+        # silence (a coordinate beyond any map, a ring of two distinct points).
+        for ring in ([[-1, -1], [1e308, -1], [0.5, 2], [-1, -1]], [[-1, -1], [0.5, -1], [-1, -1]]):
+            bad = {"type": "FeatureCollection", "features": [{
+                "type": "Feature", "properties": {"friction": 2},
+                "geometry": {"type": "Polygon", "coordinates": [ring]}}]}
+            with self.assertRaises(geodex.InvalidArgumentError) as error:
+                sync.distance_field(mesh.name, sources,
+                                    travel=geodex.Travel(3.6, friction_geojson=bad))
+            self.assertEqual(error.exception.field, "options.travel.friction_geojson")
 
         async def run():
             async with AsyncGeodexClient("127.0.0.1:" + self.port, timeout=120) as client:
