@@ -131,14 +131,6 @@ assert sorted(areas) == [60, 120, 180], areas
 assert 0 < areas[60] < areas[120] < areas[180], areas"
 
 # Errors name the flag (exit 2).
-expect_error() {  # expect_error NAME TEXT ARGS...
-  local name="$1" text="$2"
-  shift 2
-  "$GEODEX" "$@" >/dev/null 2>"$tmp/err.txt"
-  local rc=$?
-  check "$name: exit 2 ($rc)" test "$rc" -eq 2
-  check "$name: says '$text'" grep -qF -- "$text" "$tmp/err.txt"
-}
 printf 'slope_deg,speed_kmh\n-10,4\nsteep,2\n' >"$tmp/bad_row.csv"
 printf '5,4\n10,3\n' >"$tmp/no_level.csv"
 printf -- '-10,4\n-10,5\n' >"$tmp/repeat.csv"

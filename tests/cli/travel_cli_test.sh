@@ -153,14 +153,6 @@ check "face weights 2 double the time ($t1, $t2)" $PY -c "assert $t2 == 2 * $t1 
 # Errors name the flag (exit 2): a cost flag without --speed, a bad speed, epsilon out of range,
 # friction in another CRS, friction on a plain mesh, weights of the wrong count, a time level
 # without --speed, directions with a travel cost.
-expect_error() {  # expect_error NAME TEXT ARGS...
-  local name="$1" text="$2"
-  shift 2
-  "$GEODEX" "$@" >/dev/null 2>"$tmp/err.txt"
-  local rc=$?
-  check "$name: exit 2 ($rc)" test "$rc" -eq 2
-  check "$name: says '$text'" grep -qF -- "$text" "$tmp/err.txt"
-}
 expect_error "no speed" "--max-slope: a travel cost needs --speed" distances "$F" --sources 0 --max-slope 30
 expect_error "bad speed" "--speed: must be > 0" distances "$F" --sources 0 --speed constant:0
 expect_error "speed syntax" "--speed: 'walking' is not constant:KMH" distances "$F" --sources 0 --speed walking

@@ -82,14 +82,6 @@ two, merged, b = (json.load(open('$tmp/fr_%s.json' % k))['points'] for k in ('tw
 assert [p['time_s'] for p in two] == [p['time_s'] for p in merged], (two, merged)
 assert two[0]['time_s'] > b[0]['time_s'] + 200, (two, b)"
 
-expect_error() {  # expect_error NAME TEXT ARGS...
-  local name="$1" text="$2"
-  shift 2
-  "$GEODEX" "$@" >/dev/null 2>"$tmp/err.txt"
-  local rc=$?
-  check "$name: exit 2 ($rc)" test "$rc" -eq 2
-  check "$name: says '$text'" grep -qF -- "$text" "$tmp/err.txt"
-}
 # A flag that takes one value, given twice, is refused naming it (it used to keep the last).
 expect_error "speed twice" "option --speed given twice" distances "$F" --sources $S --speed constant:3.6 --speed constant:7.2
 expect_error "output twice" "option --output given twice" distances "$F" --sources $S --output "$tmp/a.tif" --output "$tmp/b.tif"

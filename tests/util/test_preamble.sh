@@ -22,6 +22,17 @@ check() {
   fi
 }
 
+# expect_error NAME TEXT ARGS...: runs "$GEODEX" ARGS and checks a usage error: exit 2 and TEXT in
+# what it printed on stderr (kept in $tmp/err.txt).
+expect_error() {  # expect_error NAME TEXT ARGS...
+  local name="$1" text="$2"
+  shift 2
+  "$GEODEX" "$@" >/dev/null 2>"$tmp/err.txt"
+  local rc=$?
+  check "$name: exit 2 ($rc)" test "$rc" -eq 2
+  check "$name: says '$text'" grep -qF -- "$text" "$tmp/err.txt"
+}
+
 # finish LABEL: prints "LABEL: N passed, M failed"; its status (the script's last command) is 0
 # only if no check failed.
 finish() {
