@@ -618,6 +618,10 @@ std::string FormatDistances(const std::vector<double>& distances,
 std::string TravelTextHeader(const GeodesicOptions& options) {
   if (!options.travel.has_value()) return "";
   const TravelCost& t = *options.travel;
+  if (TravelIsExact(t)) {
+    return absl::StrFormat("# travel time in seconds at %g km/h on friction 1; exact\n",
+                           t.speed_kmh);
+  }
   if (!IsDirectional(t)) {
     return absl::StrFormat(
         "# travel time in seconds at %g km/h on friction 1; approximate: at most (1 + %g) x the "
@@ -633,11 +637,14 @@ std::string TravelTextHeader(const GeodesicOptions& options) {
 std::string TravelJsonMembers(const GeodesicOptions& options) {
   if (!options.travel.has_value()) return "";
   const TravelCost& t = *options.travel;
+  // Exact answers (a constant speed, one weight: the exact engine) say so, with epsilon 0.
+  const bool exact = TravelIsExact(t);
   return absl::StrFormat(
-      "\"unit\": \"s\", \"approximate\": true, \"epsilon\": %s, \"bound\": %s, \"speed\": "
-      "\"%s\", \"inbound\": %s, ",
-      JsonNumber(TravelEpsilon(t)), IsDirectional(t) ? "false" : "true",
-      SpeedModelName(t.speed_model), t.inbound ? "true" : "false");
+      "\"unit\": \"s\", \"approximate\": %s, \"exact\": %s, \"epsilon\": %s, \"bound\": %s, "
+      "\"speed\": \"%s\", \"inbound\": %s, ",
+      exact ? "false" : "true", exact ? "true" : "false", JsonNumber(StatedTravelEpsilon(t)),
+      IsDirectional(t) ? "false" : "true", SpeedModelName(t.speed_model),
+      t.inbound ? "true" : "false");
 }
 
 // `distances --at`: one line per point, "POINT<TAB>estimate D<TAB>exact D<TAB>source I" (I = -1

@@ -251,10 +251,13 @@ absl::StatusOr<std::shared_ptr<const WeightedSurface>> BuildTravelGraph(
   return std::make_shared<const WeightedSurface>(*std::move(surface));
 }
 
-bool CostsUseSharedGraph(const TravelCost& travel) {
+bool TravelIsExact(const TravelCost& travel) {
   return !IsDirectional(travel) &&
          (travel.face_weight == nullptr || OneFiniteWeight(*travel.face_weight));
 }
+
+// The exact engine's surface is what is shared: the same condition as exactness.
+bool CostsUseSharedGraph(const TravelCost& travel) { return TravelIsExact(travel); }
 
 absl::StatusOr<TravelPointSolver> TravelPointSolver::Create(
     const TriangleMesh& mesh, const GeodesicOptions& options,

@@ -291,10 +291,11 @@ std::vector<GeoFeature> IsochroneFeatures(const MeshData& mesh, const std::vecto
     f.exact_tiling = true;
     f.properties = {{"level", level}, {"units", std::string(travel != nullptr ? "s" : "m")}};
     if (travel != nullptr) {
-      f.properties.push_back({"epsilon", TravelEpsilon(*travel)});
+      f.properties.push_back({"epsilon", StatedTravelEpsilon(*travel)});
       f.properties.push_back({"bound", !IsDirectional(*travel)});
       f.properties.push_back({"speed", std::string(SpeedModelName(travel->speed_model))});
       f.properties.push_back({"inbound", TimesInbound(*travel)});
+      f.properties.push_back({"exact", TravelIsExact(*travel)});
     }
     features.push_back(std::move(f));
   }

@@ -74,13 +74,13 @@ assert json.load(open('$tmp/in.json'))['inbound'] is True"
 # Without --cost-epsilon: a slope speed's default spacing (0.125), a constant speed's bound (0.01).
 "$GEODEX" distances "$G" --sources $B --at $T --speed tobler --format json >"$tmp/up_default.json"
 "$GEODEX" distances "$G" --sources $B --at $T --speed constant:3.6 --format json >"$tmp/flat_default.json"
-check "default epsilon: 0.125 for Tobler (still within 1%), 0.01 for a constant speed" $PY -c "
+check "default epsilon: 0.125 for Tobler (still within 1%); a constant speed with one weight exact" $PY -c "
 $tobler
 import json
 up = json.load(open('$tmp/up_default.json')); flat = json.load(open('$tmp/flat_default.json'))
 assert up['epsilon'] == 0.125 and up['bound'] is False, up
 assert abs(up['points'][0]['time_s'] / (290 * math.hypot(1, 0.05) * per_metre(0.05)) - 1) < 0.01, up
-assert flat['epsilon'] == 0.01 and flat['bound'] is True, flat"
+assert flat['epsilon'] == 0 and flat['exact'] is True and flat['bound'] is True, flat"
 
 # Up the 45-degree slope: the switchbacks (the analytic minimum over symmetric zigzags) within
 # 2%, and far below straight up.

@@ -57,15 +57,17 @@ F="$tmp/flat.tif"
 check "at: exit 0" test $? -eq 0
 "$GEODEX" distances "$F" --sources g:500015:4999985 --at g:500315:4999876.81 \
   --speed constant:7.2 --cost-epsilon 0.003 --format json >"$tmp/at_fast.json"
-check "at: time = distance / speed within the bound; says seconds, approximate, epsilon" $PY -c "
+# One weight is the exact engine: the answer says exact (epsilon 0), not approximate.
+check "at: time = distance / speed; says seconds and exact" $PY -c "
 import json, math
 a = json.load(open('$tmp/at.json')); b = json.load(open('$tmp/at_fast.json'))
 d = math.hypot(300, 108.19)
-assert a['unit'] == 's' and a['approximate'] is True and a['epsilon'] == 0.01, a
+assert a['unit'] == 's' and a['approximate'] is False and a['exact'] is True, a
+assert a['epsilon'] == 0 and b['epsilon'] == 0, (a, b)
 t = a['points'][0]['time_s']
-assert d * (1 - 1e-9) <= t <= d * 1.01, (t, d)
+assert abs(t - d) <= 1e-9 * d, (t, d)  # exact: the straight line on the plane
 t2 = b['points'][0]['time_s']
-assert d / 2 * (1 - 1e-9) <= t2 <= d / 2 * 1.003, (t2, d / 2)"
+assert abs(t2 - d / 2) <= 1e-9 * d, (t2, d / 2)"
 
 # Friction: a 100 m band of friction 4 across the map costs 3 x 100 s more to cross at 1 m/s,
 # drawn as polygons or as a raster. Faces take the friction under their centroids, so the band's
@@ -116,7 +118,8 @@ areas = {}
 for x in f:
     g = ogr.CreateGeometryFromJson(json.dumps(x['geometry']))
     assert g.IsValid(), x['properties']
-    assert x['properties']['units'] == 's' and x['properties']['epsilon'] == 0.01, x['properties']
+    assert x['properties']['units'] == 's' and x['properties']['epsilon'] == 0, x['properties']
+    assert x['properties']['exact'] is True, x['properties']
     assert x['properties']['bound'] is True and x['properties']['speed'] == 'constant', x['properties']
     areas[x['properties']['level']] = areas.get(x['properties']['level'], 0) + g.GetArea()
 assert sorted(areas) == [60, 120], areas
@@ -142,6 +145,13 @@ assert abs(p['length'] - math.hypot(300, 108.19)) < 0.01 * p['length'], p['lengt
 "$GEODEX" matrix "$F" --sources g:500015:4999985,g:500315:4999876.81 \
   --targets g:500015:4999985,g:500315:4999876.81 --speed constant:3.6 >"$tmp/m.txt"
 check "matrix: a header saying seconds and the bound" grep -q "^# travel time in seconds" "$tmp/m.txt"
+
+# Several weights are answered within the bound, and say so: approximate, epsilon 0.01.
+"$GEODEX" distances "$F" --sources g:500015:4999985 --at g:500315:4999876.81 --speed constant:3.6 \
+  --friction "$tmp/friction.tif" --format json >"$tmp/at_fr.json"
+check "at with friction: says approximate with its bound" $PY -c "
+import json; a = json.load(open('$tmp/at_fr.json'))
+assert a['approximate'] is True and a['exact'] is False and a['epsilon'] == 0.01 and a['bound'] is True, a"
 
 # --face-weights on a plain mesh: one weight per face; 2 everywhere doubles the time.
 printf 'OFF\n4 2 0\n0 0 0\n10 0 0\n10 10 0\n0 10 0\n3 0 1 2\n3 0 2 3\n' >"$tmp/sq.off"

@@ -114,6 +114,18 @@ assert ga == gb, 'differ'"
 done
 expect_error "max-distance time without speed" "--max-distance: '2min' is a time" isolines "$F" --sources $S --levels 10,20 --max-distance 2min
 
+# A limit's message suggests only what applies: a travel solve over its window budget is not told
+# to use --lambda, which --speed refuses. (--max-windows is local; geodexd has its own flag.)
+if [ "${GEODEX_MODE:-local}" = local ]; then
+  "$GEODEX" distances "$F" --sources $S --speed constant:3.6 --max-windows 50 >/dev/null 2>"$tmp/err.txt"
+  rc=$?
+  check "travel window budget: exit 1 ($rc)" test "$rc" -eq 1
+  check "travel window budget: says so" grep -q "window budget exceeded" "$tmp/err.txt"
+  check "travel window budget: no --lambda suggested" bash -c "! grep -q lambda '$tmp/err.txt'"
+  "$GEODEX" distances "$F" --sources $S --max-windows 50 >/dev/null 2>"$tmp/err.txt"
+  check "plain window budget: lambda suggested" grep -q "lambda > 0" "$tmp/err.txt"
+fi
+
 # Metres and seconds, both, labelled: a 7.2 km/h (2 m/s) path's JSON and GeoJSON carry length_m
 # (metres along the surface) and time_s (within the bound of length_m / 2); a time raster's band
 # says travel time in seconds, a distance raster's geodesic distance in metres.

@@ -100,6 +100,16 @@ inline bool TimesInbound(const TravelCost& travel) {
   return travel.inbound && IsDirectional(travel);
 }
 
+// Whether answers under `travel` are exact: a constant speed with one finite weight (any
+// --max-slope) is answered by the exact engine on the passable faces, so its times are the least
+// times, not within a bound. Such answers say exact, with epsilon 0 (StatedTravelEpsilon).
+bool TravelIsExact(const TravelCost& travel);
+// The epsilon an answer states: 0 when exact, else TravelEpsilon (a constant speed's bound, a
+// slope speed's spacing).
+inline double StatedTravelEpsilon(const TravelCost& travel) {
+  return TravelIsExact(travel) ? 0 : TravelEpsilon(travel);
+}
+
 // The model's name in answers: "constant", "tobler" or "table".
 inline const char* SpeedModelName(SpeedModel model) {
   switch (model) {

@@ -543,12 +543,13 @@ absl::Status IchSolver::Run(const std::vector<ResolvedSource>& sources,
       }
     }
     if (options_.max_windows != 0 && stats_.windows_created > options_.max_windows) {
+      // lambda is suggested only where it applies: a travel solve (on regions) refuses it.
       status = LimitExceededError(
           Limit::kWindows,
           absl::StrFormat(
-              "window budget exceeded: %d windows created (limit %d); use a larger budget, a "
-              "max_distance, or lambda > 0",
-              stats_.windows_created, options_.max_windows));
+              "window budget exceeded: %d windows created (limit %d); use a larger budget%s",
+              stats_.windows_created, options_.max_windows,
+              regions_ != nullptr ? " or a max_distance" : ", a max_distance, or lambda > 0"));
       break;
     }
     if (is_point) {
