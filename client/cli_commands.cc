@@ -846,7 +846,10 @@ int RunDistances(Backend& backend, const Args& args) {
                           SurfacePointToString(at[i]), values->exact.distance[i],
                           source == kNoIndex ? -1 : int64_t{source}});
       }
-      if (int code = WriteVectorOutput(backend, args, terrain::PointFeatures(points));
+      if (int code = WriteVectorOutput(
+              backend, args,
+              terrain::PointFeatures(
+                  points, query.options.travel.has_value() ? &*query.options.travel : nullptr));
           code != kExitOk) {
         return code;
       }

@@ -152,7 +152,8 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
                         SurfacePointToString((*points)[i]), distance,
                         std::isfinite(distance) ? int64_t{label} : -1});
     }
-    return geojson(terrain::PointFeatures(values));
+    return geojson(
+        terrain::PointFeatures(values, solver->travel.has_value() ? &*solver->travel : nullptr));
   }
 
   // The rest is made from the field of `sources` (cached like any field).

@@ -348,19 +348,22 @@ GeoFeature PathFeature(const std::vector<PathPoint>& points, double length_m, do
   return f;
 }
 
-std::vector<GeoFeature> PointFeatures(const std::vector<PointValue>& points) {
+std::vector<GeoFeature> PointFeatures(const std::vector<PointValue>& points,
+                                      const TravelCost* travel) {
   std::vector<GeoFeature> features;
+  const std::string value = travel != nullptr ? "time_s" : "distance";
   for (const PointValue& p : points) {
     GeoFeature f;
     f.points = {p.position};
     f.properties = {{"point", p.point}, {"surface_point", p.surface_point}};
     if (std::isfinite(p.distance)) {
-      f.properties.push_back({"distance", p.distance});
+      f.properties.push_back({value, p.distance});
       f.properties.push_back({"source", p.source});
     } else {  // unreachable: null, as the proto and docs say (not left out)
-      f.properties.push_back({"distance", std::monostate()});
+      f.properties.push_back({value, std::monostate()});
       f.properties.push_back({"source", std::monostate()});
     }
+    f.properties.push_back({"units", std::string(travel != nullptr ? "s" : "m")});
     features.push_back(std::move(f));
   }
   return features;

@@ -145,6 +145,13 @@ assert abs(p['length_m'] - m['length_m']) < 1e-6 * line, (p, m)
 assert p['length_m'] / 2 * (1 - 1e-9) <= p['time_s'] <= p['length_m'] / 2 * 1.01, p
 assert abs(g['length_m'] - p['length_m']) < 1e-9 * line and g['time_s'] == p['time_s'], g
 assert g.get('units') != 'm' or g['length'] == g['length_m'], g"
+"$GEODEX" distances "$F" --sources $S --at $AT --speed constant:7.2 --output "$tmp/pts.geojson" --crs native
+check "points geojson: exit 0" test $? -eq 0
+check "points: seconds are time_s in units s, not a distance" $PY -c "
+import json
+for f in json.load(open('$tmp/pts.geojson'))['features']:
+    p = f['properties']
+    assert p['units'] == 's' and 'distance' not in p and p['time_s'] > 0, p"
 "$GEODEX" distances "$F" --sources $S --speed constant:7.2 --output "$tmp/t.tif"
 "$GEODEX" distances "$F" --sources $S --output "$tmp/d.tif"
 check "rasters: travel time in s, geodesic distance in m" $PY -c "

@@ -78,7 +78,10 @@ struct PointValue {
   double distance = 0;
   int64_t source = -1;
 };
-std::vector<GeoFeature> PointFeatures(const std::vector<PointValue>& points);
+// With `travel` (the values are travel times) each point's value is `time_s` with `units` "s",
+// else `distance` with `units` "m": a value always says what it is.
+std::vector<GeoFeature> PointFeatures(const std::vector<PointValue>& points,
+                                      const TravelCost* travel = nullptr);
 
 // The part of each face where the field, linear on the face between its vertices' values, is at
 // most `level`: a convex polygon per face (an edge to a vertex at +inf contributes only its finite
