@@ -136,6 +136,10 @@ std::string MeshToOffText(const MeshData& mesh) {
 GeodexClient::GeodexClient(ClientOptions options) : options_(std::move(options)) {
   grpc::ChannelArguments args;
   args.SetMaxReceiveMessageSize(4 << 20);  // gRPC's default, kept on purpose: the API streams
+  // Reconnect soon after a server comes back (gRPC waits 1 s, then 1.6 s, 2.6 s, ... by default).
+  args.SetInt(GRPC_ARG_INITIAL_RECONNECT_BACKOFF_MS, 100);
+  args.SetInt(GRPC_ARG_MIN_RECONNECT_BACKOFF_MS, 100);
+  args.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS, 1000);
   std::shared_ptr<grpc::ChannelCredentials> credentials = grpc::InsecureChannelCredentials();
   if (options_.tls) {
     grpc::SslCredentialsOptions ssl;
@@ -175,11 +179,18 @@ grpc::Status GeodexClient::Call(const std::string& mesh_id,
                                 const std::function<grpc::Status(grpc::ClientContext*)>& call) {
   double backoff = options_.initial_backoff_seconds;
   grpc::Status status;
-  for (int attempt = 0; attempt < std::max(1, options_.max_attempts); ++attempt) {
+  // UNAVAILABLE (a restart, a drain) is retried while the server may come back: each retry waits
+  // for the channel to connect, up to reconnect_wait_seconds from the first one; a full queue is
+  // retried max_attempts times.
+  using Clock = std::chrono::system_clock;
+  constexpr Clock::time_point kNotWaiting = Clock::time_point::max();
+  Clock::time_point reconnect_until = kNotWaiting;
+  for (int attempt = 0;; ++attempt) {
     if (attempt > 0) {
       ++retries_;
-      std::this_thread::sleep_for(std::chrono::duration<double>(backoff));
+      std::this_thread::sleep_for(std::chrono::duration<double>(std::min(backoff, 1.0)));
       backoff *= 2;
+      if (reconnect_until != kNotWaiting && !channel_->WaitForConnected(reconnect_until)) break;
     }
     grpc::ClientContext context;
     context.set_deadline(
@@ -195,8 +206,19 @@ grpc::Status GeodexClient::Call(const std::string& mesh_id,
     if (auto it = metadata.find("x-geodex-replica"); it != metadata.end()) {
       last_replica_.assign(it->second.data(), it->second.size());
     }
-    if (status.error_code() != grpc::StatusCode::UNAVAILABLE &&
-        !(options_.retry_queue_full && IsQueueFull(status))) {
+    if (status.error_code() == grpc::StatusCode::UNAVAILABLE) {
+      if (reconnect_until == kNotWaiting) {
+        reconnect_until =
+            Clock::now() +
+            std::chrono::microseconds(static_cast<int64_t>(
+                std::min(options_.reconnect_wait_seconds, options_.deadline_seconds) * 1e6));
+      }
+      if (Clock::now() < reconnect_until) continue;
+      break;
+    }
+    reconnect_until = kNotWaiting;
+    if (!(options_.retry_queue_full && IsQueueFull(status)) ||
+        attempt + 1 >= std::max(1, options_.max_attempts)) {
       break;
     }
   }

@@ -466,28 +466,66 @@ class ControlLoopTest(unittest.TestCase):
         self.assertEqual(again, before)
         self.assertEqual(client.reuploads, 1)
 
-    def test_retries_survive_a_restart(self):
-        client = self.client(timeout=60, retry=geodex.RetryPolicy(max_attempts=10,
-                                                                   initial_backoff=0.1))
-        mesh = client.upload(os.path.join(DATA, "kitten.off"))
-        before = client.shortest_path(mesh.name, vertex(0), vertex(1250))
-        stop_geodexd(self.server, self.log)  # down; back on the same port a moment later
-        self.server = None
-        restarted = {}
-
-        def restart():
-            time.sleep(0.5)
-            restarted["server"] = start_geodexd(self.tmp.name, "127.0.0.1:" + self.port, "again")
-        thread = threading.Thread(target=restart)
-        thread.start()
+    def _restart_during(self, call):
+        """Stops geodexd, starts it again on the same port 2 s later, and makes `call` while it
+        is down: returns its answer."""
+        thread = self._stop_for_restart()
         try:
-            again = client.shortest_path(mesh.name, vertex(0), vertex(1250))
+            return call()
         finally:
             thread.join(timeout=60)
-            if "server" in restarted:
-                self.server, _, self.log = restarted["server"]
+
+    def test_retries_survive_a_restart(self):
+        # The default policy: a call made while geodexd restarts on the same port succeeds (the
+        # channel is waited for, not given up on after 4 quick attempts).
+        client = self.client(timeout=60)
+        mesh = client.upload(os.path.join(DATA, "kitten.off"))
+        before = client.shortest_path(mesh.name, vertex(0), vertex(1250))
+        again = self._restart_during(
+            lambda: client.shortest_path(mesh.name, vertex(0), vertex(1250)))
         self.assertEqual(again, before)
         self.assertGreater(client.retries, 0)
+
+    def test_async_retries_survive_a_restart(self):
+        from geodex.aio import AsyncGeodexClient
+        mesh = self.client(timeout=60).upload(os.path.join(DATA, "kitten.off"))
+
+        async def run():
+            async with AsyncGeodexClient("127.0.0.1:" + self.port, timeout=60) as client:
+                before = await client.shortest_path(mesh.name, vertex(0), vertex(1250))
+                loop = asyncio.get_running_loop()
+                # The restart runs in a thread; the call is made on this loop while it is down.
+                stopped = await loop.run_in_executor(None, self._stop_for_restart)
+                try:
+                    again = await client.shortest_path(mesh.name, vertex(0), vertex(1250))
+                finally:
+                    await loop.run_in_executor(None, stopped.join, 60)
+                return before, again, client.retries
+        before, again, retries = asyncio.run(run())
+        self.assertEqual(again, before)
+        self.assertGreater(retries, 0)
+
+    def _stop_for_restart(self):
+        """Stops geodexd and returns a started thread that brings it back 2 s later (longer than
+        the 1.4 s the old policy's 4 attempts spanned)."""
+        stop_geodexd(self.server, self.log)
+        self.server = None
+
+        def restart():
+            time.sleep(2)
+            self.server, _, self.log = start_geodexd(self.tmp.name, "127.0.0.1:" + self.port,
+                                                     "again")
+        thread = threading.Thread(target=restart)
+        thread.start()
+        return thread
+
+    def test_a_server_that_stays_down_fails_within_the_reconnect_wait(self):
+        policy = geodex.RetryPolicy(reconnect_wait=1.0)
+        client = geodex.GeodexClient("127.0.0.1:1", timeout=30, retry=policy)
+        start = time.monotonic()
+        with self.assertRaises(geodex.UnavailableError):
+            client.health()
+        self.assertLess(time.monotonic() - start, 20)  # generous: the wait is 1 s, not 30
 
     def test_max_snap_refuses_far_points_and_answers_say_how_far(self):
         client = self.client(timeout=60)

@@ -103,8 +103,13 @@ std::optional<FieldViolation> FieldViolationOf(const absl::Status& status);
 struct ClientOptions {
   std::string target = "127.0.0.1:50051";  // HOST:PORT
   double deadline_seconds = 600;           // per call
-  int max_attempts = 4;                    // tries on UNAVAILABLE or a full queue
-  double initial_backoff_seconds = 0.2;    // doubled after each retry
+  int max_attempts = 4;                    // tries on a full queue (RESOURCE_EXHAUSTED QUEUE_FULL)
+  double initial_backoff_seconds = 0.2;    // doubled after each retry (at most 1 s between)
+  // UNAVAILABLE (the server restarting on the same address, draining, not yet listening) is
+  // retried for up to this long from the first one, each retry waiting for the channel to
+  // connect again (geodexd's shutdown grace, 10 s by default, plus its start); the channel tries
+  // to reconnect every 0.1 to 1 s. Then the call answers UNAVAILABLE.
+  double reconnect_wait_seconds = 30;
   // Wait for the server to come up (until the deadline) instead of failing an attempt at once
   // with UNAVAILABLE while the channel is not connected (gRPC's wait-for-ready).
   bool wait_for_ready = false;

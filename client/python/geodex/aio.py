@@ -37,8 +37,9 @@ class AsyncGeodexClient(Plans):
                  wait_for_ready: bool = False, max_snap: Optional[float] = None):
         super().__init__(timeout, retry, wait_for_ready, max_snap)
         secure = credentials(token, root_pem)
-        self.channel = (grpc.aio.insecure_channel(target) if secure is None
-                        else grpc.aio.secure_channel(target, secure))
+        options = _plans.CHANNEL_OPTIONS
+        self.channel = (grpc.aio.insecure_channel(target, options) if secure is None
+                        else grpc.aio.secure_channel(target, secure, options))
         self._callables: Dict[tuple, Any] = {}
 
     async def close(self):
@@ -75,6 +76,13 @@ class AsyncGeodexClient(Plans):
                     raise value from rpc_error
                 if action == "retry":
                     await asyncio.sleep(value)
+                elif action == "reconnect":  # the server restarting: wait for it to listen again
+                    await asyncio.sleep(value)
+                    try:
+                        await asyncio.wait_for(self.channel.channel_ready(),
+                                               timeout=policy.reconnect_left())
+                    except asyncio.TimeoutError:
+                        raise policy.last_error from rpc_error
                 else:
                     await self._run(self._reupload(value), policy)
                 if rpc.on_message is not None and hasattr(rpc.on_message, "restart"):

@@ -9,10 +9,14 @@ A control loop's policy, the same on every method:
 
 - `timeout=` (seconds) bounds the whole call, retries included (the client's `timeout` when not
   given). When it passes, DeadlineExceededError.
-- UNAVAILABLE (the server not listening yet, restarting, draining) and RESOURCE_EXHAUSTED with
-  reason QUEUE_FULL (every worker busy) are retried with exponential backoff (`RetryPolicy`:
-  4 attempts, 0.2 s doubled each time), while the deadline leaves room; a limit (reason LIMIT)
-  never is. With `wait_for_ready=True` an attempt waits for the server to come up instead.
+- UNAVAILABLE (the server not listening yet, restarting, draining) is retried while the server
+  may be restarting: each retry waits for the channel to connect again, for up to 30 s from the
+  first failure (`RetryPolicy.reconnect_wait`: geodexd's shutdown grace plus its start), within
+  the call's deadline, so a call made during a restart on the same address succeeds. The channel
+  tries to reconnect every 0.1 to 1 s. RESOURCE_EXHAUSTED with reason QUEUE_FULL (every worker
+  busy) is retried with exponential backoff (`RetryPolicy`: 4 attempts, 0.2 s doubled each
+  time); a limit (reason LIMIT) never is. With `wait_for_ready=True` every attempt waits for the
+  server to come up.
 - A mesh this client uploaded (from a path, bytes or arrays) that the server lost (NOT_FOUND,
   reason MESH_NOT_FOUND: a restarted replica) is uploaded again, once, and the call retried.
 - `max_snap=` (or the client's `max_snap`) on every method that takes points: the server refuses
@@ -57,8 +61,9 @@ class GeodexClient(Plans):
                  wait_for_ready: bool = False, max_snap: Optional[float] = None):
         super().__init__(timeout, retry, wait_for_ready, max_snap)
         secure = credentials(token, root_pem)
-        self.channel = (grpc.insecure_channel(target) if secure is None
-                        else grpc.secure_channel(target, secure))
+        options = _plans.CHANNEL_OPTIONS
+        self.channel = (grpc.insecure_channel(target, options) if secure is None
+                        else grpc.secure_channel(target, secure, options))
         self._callables: Dict[tuple, Any] = {}
 
     def close(self):
@@ -95,6 +100,13 @@ class GeodexClient(Plans):
                     raise value from rpc_error
                 if action == "retry":
                     time.sleep(value)
+                elif action == "reconnect":  # the server restarting: wait for it to listen again
+                    time.sleep(value)
+                    try:
+                        grpc.channel_ready_future(self.channel).result(
+                            timeout=policy.reconnect_left())
+                    except grpc.FutureTimeoutError:
+                        raise policy.last_error from rpc_error
                 else:
                     self._run(self._reupload(value), policy)
                 if rpc.on_message is not None and hasattr(rpc.on_message, "restart"):

@@ -228,8 +228,15 @@ class Mesh:
 @dataclasses.dataclass
 class RetryPolicy:
     """Which failures are tried again, how often and how far apart (see geodex.client).
-    Retries happen only while the call's deadline leaves room for the wait."""
+    Retries happen only while the call's deadline leaves room for the wait.
+
+    UNAVAILABLE (the server restarting, draining, not yet listening) is retried for up to
+    `reconnect_wait` seconds after it is first seen, each retry waiting for the channel to
+    connect again (a restart on the same address: geodexd's shutdown grace, 10 s by default, plus
+    its start), whatever `max_attempts` says; then UnavailableError. `max_attempts` bounds the
+    retries of a full queue (RESOURCE_EXHAUSTED, reason QUEUE_FULL)."""
     max_attempts: int = 4
     initial_backoff: float = 0.2
     multiplier: float = 2.0
     retry_queue_full: bool = True
+    reconnect_wait: float = 30.0
