@@ -172,6 +172,12 @@ void FieldCache::InsertLocked(const std::string& key, Entry entry) {
   entries_[key] = std::move(entry);
 }
 
+bool FieldCache::Contains(const std::string& key) const {
+  std::lock_guard<std::mutex> lock(mu_);
+  auto it = entries_.find(key);
+  return it != entries_.end() && it->second.field != nullptr;
+}
+
 bool FieldCache::NotePathSource(const std::string& key) {
   if (!enabled()) return false;
   std::lock_guard<std::mutex> lock(mu_);

@@ -56,8 +56,11 @@ class FieldCache {
   void InsertGraph(const std::string& key, std::shared_ptr<const WeightedSurface> graph,
                    uint64_t mesh_bytes);
   // Records that a path query started from `key`'s source; true when one did recently (the
-  // second query from a point pays for a full field that the following ones reuse).
+  // source is then offered for a background field, FieldPromoter).
   bool NotePathSource(const std::string& key);
+
+  // Whether `key` holds a field now (not counted as a hit or a miss).
+  bool Contains(const std::string& key) const;
 
   bool enabled() const { return budget_bytes_ > 0; }
   uint64_t budget_bytes() const { return budget_bytes_; }

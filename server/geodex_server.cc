@@ -149,6 +149,11 @@ absl::StatusOr<std::unique_ptr<GeodexServer>> GeodexServer::Start(const ServerOp
   if (!metrics.ok()) return metrics.status();
   s->metrics_ = *std::move(metrics);
 
+  if (options.background_solves && s->cache_->enabled()) {
+    s->promoter_ = std::make_unique<FieldPromoter>(
+        s->cache_.get(), &s->service_->mutable_counters(), options.limits.max_windows);
+    s->service_->set_promoter(s->promoter_.get());
+  }
   s->pool_->Publish();  // the service (and everything above) before any task runs
   if (s->quick_pool_) s->quick_pool_->Publish();
 
@@ -246,6 +251,7 @@ void GeodexServer::Shutdown(absl::Time deadline) {
   shut_down_ = true;
   health_->Shutdown();  // NOT_SERVING; Watch streams end now, not at the deadline
   server_->Shutdown(absl::ToChronoTime(deadline));
+  if (promoter_ != nullptr) promoter_->Stop();  // a background solve is cancelled, not awaited
 }
 
 void GeodexServer::Wait() { server_->Wait(); }

@@ -12,6 +12,7 @@
 #include "absl/status/statusor.h"
 #include "absl/time/time.h"
 #include "compute_pool.h"
+#include "field_promoter.h"
 #include "geodex_service.h"
 #include "grpcpp/server.h"
 #include "health_service.h"
@@ -44,6 +45,9 @@ struct ServerOptions {
   size_t queue_capacity = 64;
   int max_receive_message_bytes = 4 << 20;            // per message; uploads are chunked below this
   uint64_t result_cache_bytes = uint64_t{256} << 20;  // finished fields kept for reuse; 0 = off
+  // A path source asked again gets its whole field solved in the background (FieldPromoter: one
+  // thread, lowest priority, never on a caller's clock), so later paths from it are traces.
+  bool background_solves = true;
   std::string metrics_listen;  // HOST:PORT of the Prometheus /metrics endpoint; "" = none
   bool log_requests = false;   // one spdlog line per call (geodexd: on)
   std::string replica_name;    // sent as x-geodex-replica on every geodex.v1 call; "" = none
@@ -112,6 +116,7 @@ class GeodexServer {
   std::unique_ptr<HealthService> health_;
   std::unique_ptr<ComputePool> pool_;
   std::unique_ptr<ComputePool> quick_pool_;
+  std::unique_ptr<FieldPromoter> promoter_;  // stopped once the calls are done
   std::unique_ptr<grpc::Server> server_;
   int port_ = 0;
   bool tls_ = false, authenticated_ = false;

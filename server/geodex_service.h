@@ -43,7 +43,11 @@ class GeodexService final : public v1::Geodex::CallbackService {
   ComputePool* pool() const { return pool_; }
   const ServiceLimits& limits() const { return limits_; }
   const ServiceCounters& counters() const { return counters_; }
+  ServiceCounters& mutable_counters() { return counters_; }
   const ReactorEnv& env() const { return env_; }
+  // Where paths offer their hot sources for a background field (before calls arrive; it must
+  // outlive the calls).
+  void set_promoter(FieldPromoter* promoter) { env_.promoter = promoter; }
 
  private:
   MeshStore* store_;

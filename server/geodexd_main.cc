@@ -44,6 +44,10 @@ ABSL_FLAG(std::string, auth_token_file, "",
 ABSL_FLAG(bool, allow_plaintext_tokens, false,
           "Allow --auth_token_file without TLS (only behind a TLS-terminating proxy: tokens then "
           "cross the proxy's link in plaintext)");
+ABSL_FLAG(bool, background_solves, true,
+          "Solve the whole field of a path source asked again in the background (one thread, "
+          "lowest priority, bounded queue) so later paths from it are traces; never on a caller's "
+          "clock");
 ABSL_FLAG(bool, log_requests, true, "Log one line per call (method, mesh, sources, time, status)");
 ABSL_FLAG(uint32_t, pool_threads, 0, "Compute worker threads (0 = one per hardware thread)");
 ABSL_FLAG(uint32_t, quick_threads, 2,
@@ -130,6 +134,7 @@ int main(int argc, char** argv) {
   options.result_cache_bytes = absl::GetFlag(FLAGS_result_cache_bytes);
   options.metrics_listen = absl::GetFlag(FLAGS_metrics_listen);
   options.log_requests = absl::GetFlag(FLAGS_log_requests);
+  options.background_solves = absl::GetFlag(FLAGS_background_solves);
   options.replica_name = absl::GetFlag(FLAGS_replica_name);
   options.tls_cert_file = absl::GetFlag(FLAGS_tls_cert);
   options.tls_key_file = absl::GetFlag(FLAGS_tls_key);

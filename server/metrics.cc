@@ -84,6 +84,13 @@ class GaugeCollector final : public prometheus::Collectable {
         static_cast<double>(sources_.counters->solves.load(std::memory_order_relaxed)));
     add("geodex_windows_processed_total", "ICH windows propagated by all solves", T::Counter,
         static_cast<double>(sources_.counters->windows_processed.load(std::memory_order_relaxed)));
+    add("geodex_background_solves_total",
+        "Fields of hot path sources solved in the background (off every caller's clock)",
+        T::Counter,
+        static_cast<double>(sources_.counters->background_solves.load(std::memory_order_relaxed)));
+    add("geodex_background_dropped_total",
+        "Background field offers dropped because the queue was full", T::Counter,
+        static_cast<double>(sources_.counters->background_dropped.load(std::memory_order_relaxed)));
     return out;
   }
 

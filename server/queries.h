@@ -25,7 +25,13 @@ class FieldCache;
 struct ServiceCounters {
   std::atomic<uint64_t> solves{0};
   std::atomic<uint64_t> windows_processed{0};
+  // Fields of hot path sources solved in the background (FieldPromoter), and offers dropped
+  // because its queue was full.
+  std::atomic<uint64_t> background_solves{0};
+  std::atomic<uint64_t> background_dropped{0};
 };
+
+class FieldPromoter;
 
 // What every query needs besides its request.
 struct QueryEnv {
@@ -37,6 +43,8 @@ struct QueryEnv {
   // Where a matrix's rows get helpers (queued behind other calls' work: a fair share); null: the
   // calling worker solves every row.
   ComputePool* pool = nullptr;
+  // Where a path's hot source is offered for a background field solve; null: none.
+  FieldPromoter* promoter = nullptr;
   // On the quick lane (query_reactors.h): answer only what needs no solve and no disk load;
   // anything else returns SolveLaneNeeded() and the call moves to the compute pool.
   bool quick = false;

@@ -12,6 +12,7 @@
 
 #include "absl/strings/str_cat.h"
 #include "field_cache.h"
+#include "field_promoter.h"
 #include "geodex/distance_matrix.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/point_distance.h"
@@ -41,19 +42,20 @@ absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPath
   absl::StatusOr<GeodesicOptions> solver = Options(env, **mesh, request.options());
   if (!solver.ok()) return solver.status();
   response->set_travel_epsilon(TravelEpsilon(*solver));
-  // From a cached field of `from` a path to a vertex is a trace, not a solve; the second query
-  // from the same point solves (and caches) the full field so that the following ones reuse it.
-  // (A travel field has no origins to trace: a travel path is always its own solve.)
+  // From a cached field of `from` a path to a vertex is a trace, not a solve. Otherwise the path
+  // runs A* (the work it asked for); a source asked again is offered for its whole field in the
+  // background (FieldPromoter), never solved on this caller's clock, so that later paths from it
+  // become traces. (A travel field has no origins to trace: a travel path is always its own
+  // solve.)
   if (to->kind == SurfacePoint::Kind::kVertex && env.cache->enabled() && !solver->travel) {
     const std::string key = FieldCacheKey((*mesh)->id, {*from}, *solver);
     std::shared_ptr<const DistanceField> field = env.cache->Find(key);
-    bool cached = field != nullptr;
+    const bool cached = field != nullptr;
     if (field == nullptr && env.quick) return SolveLaneNeeded();
-    if (field == nullptr && env.cache->NotePathSource(key)) {
-      absl::StatusOr<std::shared_ptr<const DistanceField>> solved =
-          CachedField(env, **mesh, {*from}, *solver, &cached);
-      if (!solved.ok()) return NameSolveError(solved.status(), "from");
-      field = *std::move(solved);
+    if (field == nullptr && env.cache->NotePathSource(key) && env.promoter != nullptr) {
+      GeodesicOptions background = *solver;
+      background.cancel = nullptr;  // the promoter sets its own
+      env.promoter->Offer(*mesh, {*from}, background, key);
     }
     if (field != nullptr) {
       absl::StatusOr<GeodesicPath> path = TracePathFromVertex(*(*mesh)->mesh, *field, to->vertex);

@@ -77,7 +77,8 @@ struct ReactorEnv {
   FieldCache* cache;
   ServiceCounters* counters;
   const TokenAuthenticator* auth;
-  CallDescriptions* descriptions;  // may be null
+  CallDescriptions* descriptions;     // may be null
+  FieldPromoter* promoter = nullptr;  // background fields of hot path sources; may be null
 };
 
 // Where a method's work runs.
@@ -102,6 +103,7 @@ grpc::Status AdmitCall(const ReactorEnv& env, grpc::CallbackServerContext* conte
 
 inline QueryEnv MakeQueryEnv(const ReactorEnv& env, const CancelToken* cancel, bool quick) {
   QueryEnv q{env.store, env.limits, cancel, env.cache, env.counters, env.pool};
+  q.promoter = env.promoter;
   q.quick = quick;
   return q;
 }

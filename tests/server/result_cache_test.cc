@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
+#include "absl/time/clock.h"
 #include "geodex/shortest_path.h"
 #include "server_test_util.h"
 
@@ -71,19 +73,25 @@ TEST_F(ResultCacheTest, RepeatedFieldIsServedFromTheCache) {
 TEST_F(ResultCacheTest, PathsFromOneSourceReuseOneField) {
   StartServer();
   std::string off = GridOff(20, 20, true);
-  ASSERT_TRUE(Upload(*stub_, off, "hills").status.ok());
+  testing::UploadResult up = Upload(*stub_, off, "hills");
+  ASSERT_TRUE(up.status.ok());
+  const std::string mesh_id = up.mesh.name().substr(std::string("meshes/").size());
   TriangleMesh local = testing::BuildLocal(off);
-  // 1st query from vertex 5: A*; 2nd: solves and caches the full field; 3rd..: traced from it.
-  std::vector<uint32_t> goals = {440, 100, 230, 17, 399};
-  for (size_t i = 0; i < goals.size(); ++i) {
-    v1::FindShortestPathResponse path = Path(*stub_, 5, goals[i]);
+  // The whole field from vertex 5, for its size.
+  v1::ComputeDistanceFieldRequest whole = FieldRequest("meshes/hills", {5});
+  whole.set_want_stats(true);
+  const uint64_t field_windows = ReadField(*stub_, whole).stats.windows_created();
+  // From vertex 6 (no field cached): every path runs A* on its caller's clock, the second one
+  // included (it only offers the source for a background field); once that field is in the
+  // cache, paths are traced from it. Every answer is the exact path, however it was made.
+  auto check = [&](uint32_t from, uint32_t to, const v1::FindShortestPathResponse& path) {
     PathQueryResult expected =
-        *ComputeShortestPath(local, SurfacePoint::AtVertex(5), SurfacePoint::AtVertex(goals[i]));
-    EXPECT_NEAR(path.distance(), expected.distance, 1e-12 * expected.distance) << i;
+        *ComputeShortestPath(local, SurfacePoint::AtVertex(from), SurfacePoint::AtVertex(to));
+    EXPECT_NEAR(path.distance(), expected.distance, 1e-12 * expected.distance) << to;
     ASSERT_GE(path.points_size(), 2);
     // The path runs from `from` to `to` whichever way it was computed.
-    EXPECT_EQ(path.points(0).where().vertex(), 5u);
-    EXPECT_EQ(path.points(path.points_size() - 1).where().vertex(), goals[i]);
+    EXPECT_EQ(path.points(0).where().vertex(), from);
+    EXPECT_EQ(path.points(path.points_size() - 1).where().vertex(), to);
     double length = 0;
     for (int k = 1; k < path.points_size(); ++k) {
       const auto& a = path.points(k - 1).position();
@@ -91,10 +99,37 @@ TEST_F(ResultCacheTest, PathsFromOneSourceReuseOneField) {
       length += std::hypot(a.x() - b.x(), a.y() - b.y(), a.z() - b.z());
     }
     EXPECT_NEAR(length, path.distance(), 1e-9 * path.distance());
-    EXPECT_EQ(path.stats().cached(), i >= 2) << i;
+  };
+  for (uint32_t to : {27u, 48u}) {  // short goals: A* touches a small part of the field
+    v1::FindShortestPathResponse path = Path(*stub_, 6, to);
+    check(6, to, path);
+    EXPECT_FALSE(path.stats().cached()) << to;
+    EXPECT_LT(path.stats().windows_created(), field_windows / 2) << "not a whole field: " << to;
   }
-  EXPECT_EQ(server_->service().counters().solves.load(), 2u);  // one A*, one field
-  EXPECT_EQ(server_->cache().hits(), 3u);
+  // The background solve lands (a generous bound; it runs at the lowest priority).
+  const std::string key = FieldCacheKey(mesh_id, {SurfacePoint::AtVertex(6)}, GeodesicOptions{});
+  for (int i = 0; i < 600 && !server_->cache().Contains(key); ++i) {
+    absl::SleepFor(absl::Milliseconds(100));
+  }
+  ASSERT_TRUE(server_->cache().Contains(key));
+  EXPECT_EQ(server_->service().counters().background_solves.load(), 1u);
+  for (uint32_t to : {440u, 100u, 230u}) {
+    v1::FindShortestPathResponse path = Path(*stub_, 6, to);
+    check(6, to, path);
+    EXPECT_TRUE(path.stats().cached()) << to;
+  }
+}
+
+// With background solves off, a repeated path source keeps running A*: nothing is solved or
+// cached behind the caller's back.
+TEST_F(ResultCacheTest, WithoutBackgroundSolvesPathsStayAStar) {
+  ServerOptions options;
+  options.background_solves = false;
+  StartServer(options);
+  ASSERT_TRUE(Upload(*stub_, GridOff(20, 20, true), "hills").status.ok());
+  for (uint32_t to : {27u, 48u, 440u}) EXPECT_FALSE(Path(*stub_, 6, to).stats().cached());
+  EXPECT_EQ(server_->service().counters().background_solves.load(), 0u);
+  EXPECT_EQ(server_->cache().entries(), 0u);
 }
 
 TEST_F(ResultCacheTest, ZeroBudgetDisablesTheCache) {
