@@ -4,12 +4,13 @@
 # timeout, from 1, 4 and 16 concurrent clients. Prints a Markdown table (docs/performance.md,
 # "A planner's workload"). Bounded: the server is stopped by its PID at exit.
 # Usage: bench/planner_bench.sh [BUILD_DIR] [GRID_N]
+# Env: GEODEXD, another server binary to measure with this build's client (an older commit's).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build="${1:-build}"
 n="${2:-211}"
 tmp=$(mktemp -d)
-"$build/server/geodexd" --listen 127.0.0.1:0 --metrics_listen "" --data-dir "$tmp/data" \
+"${GEODEXD:-$build/server/geodexd}" --listen 127.0.0.1:0 --metrics_listen "" --data-dir "$tmp/data" \
   >"$tmp/server.log" 2>&1 &
 pid=$!
 trap 'kill "$pid" 2>/dev/null; wait "$pid" 2>/dev/null; rm -rf "$tmp"' EXIT
