@@ -5,6 +5,7 @@ geodex.errors. GEODEX_PROTO_DIR overrides where the protos are (default ../../pr
 import os
 import shutil
 import subprocess
+import tempfile
 
 from setuptools import setup
 from setuptools.command.build_py import build_py
@@ -32,4 +33,9 @@ class BuildWithStubs(build_py):
             "google/rpc/status.proto", "google/rpc/error_details.proto"])
 
 
-setup(cmdclass={"build_py": BuildWithStubs})
+# Build products (build/, geodex.egg-info) go to a directory of their own, never into the source
+# tree: `pip install ./client/python` leaves the checkout as it was.
+_OUT = tempfile.mkdtemp(prefix="geodex-build-")
+setup(cmdclass={"build_py": BuildWithStubs},
+      options={"build": {"build_base": os.path.join(_OUT, "build")},
+               "egg_info": {"egg_base": _OUT}})

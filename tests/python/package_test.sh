@@ -6,10 +6,17 @@
 set -euo pipefail
 # shellcheck source-path=SCRIPTDIR source=../util/test_preamble.sh
 source "$(dirname "${BASH_SOURCE[0]}")/../util/test_preamble.sh"
-cp -r "$SRC/client/python" "$tmp/src"  # pip builds in the tree it is given: keep ours clean
+# From the source tree itself, as a user runs it: pip must write nothing into it (its build
+# products go to a directory of their own, setup.py).
+before=$(cd "$SRC/client/python" && find . -not -path "*__pycache__*" | sort)
 /usr/bin/python3 -m venv --system-site-packages "$tmp/venv"
 GEODEX_PROTO_DIR="$SRC/proto" "$tmp/venv/bin/pip" install --quiet --no-index \
-  --no-build-isolation "$tmp/src"
+  --no-build-isolation "$SRC/client/python"
+after=$(cd "$SRC/client/python" && find . -not -path "*__pycache__*" | sort)
+if [ "$before" != "$after" ]; then
+  diff <(echo "$before") <(echo "$after") || true
+  die "pip install ./client/python wrote into the source tree"
+fi
 cd "$tmp"  # nothing of the source tree on the path
 unset PYTHONPATH
 "$tmp/venv/bin/python" -c "import geodex, sys; assert 'site-packages' in geodex.__file__, geodex.__file__"

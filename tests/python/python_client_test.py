@@ -456,6 +456,22 @@ class ControlLoopTest(unittest.TestCase):
         with self.assertRaises(geodex.InvalidArgumentError) as error:
             client.upload(b"OFF\n")
         self.assertEqual(error.exception.field, "file_name")
+        # Array shapes are checked here, naming the argument (not numpy's reshape error).
+        vertices, faces = read_off(kitten)
+        for bad, field in (((vertices, faces[:, :2]), "faces"), ((vertices[:, :2], faces), "vertices"),
+                           ((vertices, faces.astype(float)), "faces")):
+            with self.assertRaises(geodex.InvalidArgumentError) as error:
+                client.upload(bad)
+            self.assertEqual(error.exception.field, field)
+            self.assertIn("upload((vertices, faces))", str(error.exception))
+        # A mesh named bare, as the CLI takes it ("kitten-arrays"), is "meshes/kitten-arrays".
+        bare = client.shortest_path("kitten-arrays", vertex(0), vertex(5))
+        self.assertEqual(bare, client.shortest_path(from_file.name, vertex(0), vertex(5)))
+        self.assertEqual(client.get_mesh("kitten-arrays").name, from_file.name)
+        # help() and type checkers see what a call returns, not a generator.
+        import typing
+        self.assertIs(typing.get_type_hints(GeodexClient.shortest_path)["return"], geodex.Path)
+        self.assertIs(typing.get_type_hints(GeodexClient.get_mesh)["return"], geodex.Mesh)
 
     def test_the_mesh_is_uploaded_again_after_the_server_lost_it(self):
         client = self.client(timeout=60)

@@ -4,6 +4,7 @@ call as an `Rpc`, receives its answer and returns the result. `GeodexClient` run
 retries, re-upload), so the two clients cannot drift apart.
 """
 import dataclasses
+import functools
 import json
 import os
 import sys
@@ -28,6 +29,41 @@ SNAP_WARN_FRACTION = 0.01
 MeshSource = Union[str, "os.PathLike[str]", bytes, Tuple[Any, Any]]
 T = TypeVar("T")
 Plan = Generator["Rpc", Any, T]
+
+
+def mesh_name(mesh):
+    """A mesh as the API names it: "kitten" (an alias or an id, as the CLI takes it) is
+    "meshes/kitten"; "meshes/kitten" stays."""
+    if isinstance(mesh, str) and mesh and not mesh.startswith("meshes/"):
+        return "meshes/" + mesh
+    return mesh
+
+
+def _bare_mesh_names(plan_method):
+    """`plan_method` taking its `mesh` argument (the first) bare or as a resource name."""
+    if "mesh" not in plan_method.__code__.co_varnames[1:2]:
+        return plan_method
+
+    @functools.wraps(plan_method)
+    def named(self, *args, **kwargs):
+        if args:
+            args = (mesh_name(args[0]),) + args[1:]
+        elif "mesh" in kwargs:
+            kwargs["mesh"] = mesh_name(kwargs["mesh"])
+        return plan_method(self, *args, **kwargs)
+    return named
+
+
+def answered(plan_method, method):
+    """`method` (a client's wrapper of `plan_method`) annotated with what it returns: the plan's
+    result type (Path), not the generator a plan is (help() and type checkers read this)."""
+    annotations = dict(getattr(plan_method, "__annotations__", {}))
+    returned = annotations.get("return")
+    args = getattr(returned, "__args__", None)
+    if args and len(args) == 3:
+        annotations["return"] = args[2]
+    method.__annotations__ = annotations
+    return method
 
 
 class SnapWarning(UserWarning):
@@ -213,7 +249,7 @@ class Plans:
     @classmethod
     def _make_methods(cls, wrap):
         for name in cls._PLANS:
-            setattr(cls, name, wrap(getattr(Plans, name)))
+            setattr(cls, name, wrap(_bare_mesh_names(getattr(Plans, name))))
 
     def _policy(self, timeout: Optional[float]) -> Policy:
         return Policy(self.retry, time.monotonic() + (self.timeout if timeout is None else timeout),

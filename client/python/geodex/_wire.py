@@ -163,8 +163,19 @@ def reassemble(pieces, start):
 def off_text(vertices, faces) -> bytes:
     """A mesh from arrays as OFF text with coordinates that round-trip exactly (%.17g): the
     server computes the same mesh id as for a file with these float64 values."""
-    v = np.asarray(vertices, dtype=np.float64).reshape(-1, 3)
-    f = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces)
+    # Shapes checked here, naming the argument (a reshape would fail with numpy's own words, or
+    # silently regroup an (m, 2) array into triangles).
+    for array, what, field in ((v, "vertices", "vertices"), (f, "faces", "faces")):
+        if array.ndim != 2 or array.shape[1] != 3:
+            raise invalid("upload((vertices, faces)): %s has shape %s; expected (n, 3) (%s)" % (
+                what, array.shape, "x, y, z per vertex" if what == "vertices"
+                else "three vertex ids per triangle"), field)
+    if f.size and not np.issubdtype(f.dtype, np.integer):
+        raise invalid("upload((vertices, faces)): faces must be integer vertex ids, not %s" %
+                      f.dtype, "faces")
+    f = f.astype(np.int64)
     lines = ["OFF", "%d %d 0" % (len(v), len(f))]
     lines += ["%.17g %.17g %.17g" % tuple(row) for row in v.tolist()]
     lines += ["3 %d %d %d" % tuple(row) for row in f.tolist()]

@@ -25,7 +25,7 @@ def _awaitable(plan):
     @functools.wraps(plan)
     async def method(self, *args, **kwargs):
         return await self._drive(plan(self, *args, **kwargs), kwargs.get("timeout"))
-    return method
+    return _plans.answered(plan, method)
 
 
 class AsyncGeodexClient(Plans):

@@ -47,7 +47,7 @@ def _blocking(plan):
     @functools.wraps(plan)
     def method(self, *args, **kwargs):
         return self._drive(plan(self, *args, **kwargs), kwargs.get("timeout"))
-    return method
+    return _plans.answered(plan, method)
 
 
 class GeodexClient(Plans):
