@@ -458,8 +458,11 @@ class ControlLoopTest(unittest.TestCase):
         self.assertEqual(error.exception.field, "file_name")
         # Array shapes are checked here, naming the argument (not numpy's reshape error).
         vertices, faces = read_off(kitten)
+        out_of_range = faces.copy()
+        out_of_range[7, 1] = len(vertices)
         for bad, field in (((vertices, faces[:, :2]), "faces"), ((vertices[:, :2], faces), "vertices"),
-                           ((vertices, faces.astype(float)), "faces")):
+                           ((vertices, faces.astype(float)), "faces"), ((vertices, out_of_range), "faces"),
+                           ((vertices * numpy.nan, faces), "vertices")):
             with self.assertRaises(geodex.InvalidArgumentError) as error:
                 client.upload(bad)
             self.assertEqual(error.exception.field, field)

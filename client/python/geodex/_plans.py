@@ -324,7 +324,8 @@ class Plans:
         `z_tolerance` > 0 makes it an adaptive TIN within that height of every cell (the CLI's
         --z-tolerance; Mesh.terrain then reports max_vertical_deviation)."""
         if isinstance(source, tuple):
-            data, file_name = _wire.off_text(*source), file_name or "arrays.off"
+            # Named as what the user passed (server messages echo it), not a file they never wrote.
+            data, file_name = _wire.off_text(*source), file_name or "(vertices, faces).off"
         elif isinstance(source, (bytes, bytearray, memoryview)):
             if not file_name:
                 raise _wire.invalid("upload(bytes): give file_name (its extension names the "

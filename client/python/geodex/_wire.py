@@ -176,6 +176,15 @@ def off_text(vertices, faces) -> bytes:
         raise invalid("upload((vertices, faces)): faces must be integer vertex ids, not %s" %
                       f.dtype, "faces")
     f = f.astype(np.int64)
+    bad = np.argwhere((f < 0) | (f >= len(v)))
+    if len(bad):
+        i, k = (int(x) for x in bad[0])
+        raise invalid("upload((vertices, faces)): faces[%d, %d] is %d: no such vertex (vertices "
+                      "has %d rows)" % (i, k, f[i, k], len(v)), "faces")
+    bad = np.argwhere(~np.isfinite(v))
+    if len(bad):
+        raise invalid("upload((vertices, faces)): vertices[%d] is not finite" % int(bad[0][0]),
+                      "vertices")
     lines = ["OFF", "%d %d 0" % (len(v), len(f))]
     lines += ["%.17g %.17g %.17g" % tuple(row) for row in v.tolist()]
     lines += ["3 %d %d %d" % tuple(row) for row in f.tolist()]
