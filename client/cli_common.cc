@@ -23,6 +23,7 @@
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
 #include "geodex/geodesic_solver.h"
+#include "geodex/limits.h"
 #include "geodex/mesh_io.h"
 #include "geodex/samples.h"
 #include "output_file.h"
@@ -241,6 +242,8 @@ bool GetTravelFlags(const Args& args, GeodesicOptions* options, std::string* err
     if (!GetDouble(args, "cost-epsilon", &epsilon, error)) return false;
     travel.epsilon = epsilon;
   }
+  // A default budget, as geodexd's: a solve needing more points is refused before allocating.
+  travel.max_steiner_points = kDefaultMaxSteinerPoints;
   if (!GetDouble(args, "max-slope", &travel.max_slope_deg, error) ||
       !GetUint(args, "max-steiner-points", &travel.max_steiner_points, error)) {
     return false;

@@ -77,8 +77,9 @@ Travel time (distances, path, matrix, isolines, voronoi; docs/travel.md): --spee
       --face-weights FILE: one
       weight per face, a number a line (inf: impassable). --max-slope DEG: faces steeper than
       DEG (from the x-y plane, z up) are impassable. --max-steiner-points N bounds the engine's
-      memory (about 32 bytes a point). Answers say so: a '# travel time in seconds ...' first
-      line, or JSON "unit": "s", "approximate": true, "epsilon", and "time_s" for values.
+      memory (about 32 bytes a point; default 50000000, 0: none). Answers say so: a '# travel
+      time in seconds ...' first line, or JSON "unit": "s", "approximate" or "exact",
+      "epsilon", and "time_s" for values.
       Isoline levels may carry a unit: --levels 10min,20min (s, min, h). Not with --lambda,
       --directions or delaunay.
       --speed tobler (Tobler's hiking function of the slope along the way) or --speed

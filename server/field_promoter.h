@@ -61,7 +61,7 @@ class FieldPromoter {
   CancelToken cancel_;
   std::mutex mu_;
   std::condition_variable wake_;
-  std::deque<Job> queue_;                    // guarded by mu_
+  std::deque<Job> queue_;                     // guarded by mu_
   absl::flat_hash_set<std::string> pending_;  // queued or running keys; guarded by mu_
   bool stopped_ = false;                      // guarded by mu_
   std::thread thread_;

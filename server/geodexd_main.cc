@@ -15,6 +15,7 @@
 #include "absl/flags/parse.h"
 #include "absl/flags/usage.h"
 #include "absl/time/clock.h"
+#include "geodex/limits.h"
 #include "geodex_server.h"
 #include "spdlog/spdlog.h"
 
@@ -75,7 +76,7 @@ ABSL_FLAG(uint64_t, max_unary_response_bytes, 4 << 20,
           "Largest unary response (clients keep gRPC's default 4 MiB receive limit)");
 ABSL_FLAG(uint32_t, stream_chunk_bytes, 1 << 20, "Approximate size of one streamed result message");
 ABSL_FLAG(uint64_t, max_windows, 0, "Window budget per solve (0 = unlimited)");
-ABSL_FLAG(uint64_t, max_steiner_points, 50'000'000,
+ABSL_FLAG(uint64_t, max_steiner_points, geodex::kDefaultMaxSteinerPoints,
           "Most Steiner points of one travel-cost solve (SolverOptions.travel; about 32 bytes "
           "each; 0 = unlimited)");
 ABSL_FLAG(int32_t, max_receive_message_bytes, 4 << 20,
