@@ -20,14 +20,13 @@ from geodex import vertex
 
 
 def bumpy_grid(n):
+    # Vertex (i, j) is j * n + i; each cell split along its rising diagonal.
     x, y = numpy.meshgrid(numpy.linspace(0, 1, n), numpy.linspace(0, 1, n))
-    z = 0.05 * numpy.sin(9 * x) * numpy.cos(7 * y)
-    vertices = numpy.stack([x.ravel(), y.ravel(), z.ravel()], axis=1)
-    i = numpy.arange(n - 1)
-    a = (i[None, :] + n * i[:, None]).ravel()
-    faces = numpy.concatenate([numpy.stack([a, a + 1, a + n + 1], 1),
-                               numpy.stack([a, a + n + 1, a + n], 1)])
-    return vertices, faces
+    heights = 0.05 * numpy.sin(9 * x) * numpy.cos(7 * y)
+    corner = (numpy.arange(n - 1)[None, :] + n * numpy.arange(n - 1)[:, None]).ravel()
+    lower = numpy.stack([corner, corner + 1, corner + n + 1], 1)
+    upper = numpy.stack([corner, corner + n + 1, corner + n], 1)
+    return numpy.column_stack([x.ravel(), y.ravel(), heights.ravel()]), numpy.vstack([lower, upper])
 
 
 def main():
