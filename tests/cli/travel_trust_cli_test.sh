@@ -66,6 +66,50 @@ assert two == merged, (two, merged)
 assert all(p['exact'] is None for p in two), two
 assert all(p['exact'] is not None for p in one), one"
 
+# On a mesh kept by the server (named, not a local file), each --barrier file is one DeriveMesh
+# on the one before: the two walls cut it apart as the merged file does. (Remote mode only.)
+if [ "${GEODEX_MODE:-local}" = remote ]; then
+  $PY - "$tmp" <<'PY'
+import json, sys
+out = sys.argv[1]
+n = 21  # a 20 x 20 square of unit cells, vertex (i, j) = j * 21 + i
+with open(f"{out}/sq.off", "w") as f:
+    f.write("OFF\n%d %d 0\n" % (n * n, 2 * 20 * 20))
+    for j in range(n):
+        for i in range(n):
+            f.write("%d %d 0\n" % (i, j))
+    for j in range(20):
+        for i in range(20):
+            a = j * n + i
+            f.write("3 %d %d %d\n3 %d %d %d\n" % (a, a + 1, a + n + 1, a, a + n + 1, a + n))
+def walls(boxes):
+    return {"type": "FeatureCollection", "features": [
+        {"type": "Feature", "properties": {}, "geometry": {"type": "Polygon", "coordinates": [
+            [[x0, y0], [x1, y0], [x1, y1], [x0, y1], [x0, y0]]]}} for x0, y0, x1, y1 in boxes]}
+a, b = (9.5, 8, 10.5, 25), (9.5, -5, 10.5, 8.5)
+for name, boxes in (("sq_a", [a]), ("sq_b", [b]), ("sq_ab", [a, b])):
+    json.dump(walls(boxes), open(f"{out}/{name}.geojson", "w"))
+PY
+  "$GEODEX" mesh upload "$tmp/sq.off" --name trust-square >/dev/null
+  check "server mesh uploaded" test $? -eq 0
+  for k in two merged one; do
+    case $k in
+      two) b=(--barrier "$tmp/sq_a.geojson" --barrier "$tmp/sq_b.geojson") ;;
+      merged) b=(--barrier "$tmp/sq_ab.geojson") ;;
+      one) b=(--barrier "$tmp/sq_a.geojson") ;;
+    esac
+    "$GEODEX" distances trust-square --sources 0 --at 440,20 "${b[@]}" --format json \
+      >"$tmp/sq_$k.json" 2>/dev/null
+    check "server mesh, barriers $k: exit 0" test $? -eq 0
+  done
+  check "server mesh: two barrier files cut what the merged file cuts" $PY -c "
+import json
+two, merged, one = (json.load(open('$tmp/sq_%s.json' % k))['points'] for k in ('two', 'merged', 'one'))
+assert [p['exact'] for p in two] == [p['exact'] for p in merged], (two, merged)
+assert all(p['exact'] is None for p in two), two
+assert all(p['exact'] is not None for p in one), one"
+fi
+
 # --friction twice (polygon files) adds up: the same times as the file holding both bands.
 for k in two merged; do
   if [ $k = two ]; then fr=(--friction "$tmp/band_a.geojson" --friction "$tmp/band_b.geojson");
