@@ -53,9 +53,7 @@ absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPath
     const bool cached = field != nullptr;
     if (field == nullptr && env.quick) return SolveLaneNeeded();
     if (field == nullptr && env.cache->NotePathSource(key) && env.promoter != nullptr) {
-      GeodesicOptions background = *solver;
-      background.cancel = nullptr;  // the promoter sets its own
-      env.promoter->Offer(*mesh, {*from}, background, key);
+      env.promoter->Offer(*mesh, {*from}, *solver, key);  // with its own cancel token and budget
     }
     if (field != nullptr) {
       absl::StatusOr<GeodesicPath> path = TracePathFromVertex(*(*mesh)->mesh, *field, to->vertex);

@@ -19,6 +19,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
 #include "absl/strings/str_format.h"
+#include "absl/strings/str_join.h"
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
 #include "barrier_cut.h"
@@ -360,13 +361,18 @@ std::unique_ptr<OGRGeometry> JoinCollections(std::unique_ptr<OGRGeometry> a,
   return a;
 }
 
+// Several files of one flag as messages name them together: "--friction a.geojson, --friction
+// b.gpkg".
+std::string FlagFilesName(absl::string_view flag, const std::vector<std::string>& paths) {
+  return absl::StrJoin(paths, ", ", [&](std::string* out, const std::string& path) {
+    absl::StrAppend(out, "--", flag, " ", path);
+  });
+}
+
 }  // namespace
 
 std::string BarrierFilesName(const std::vector<std::string>& paths) {
-  std::string name;
-  for (const std::string& p : paths)
-    absl::StrAppend(&name, name.empty() ? "" : ", ", "--barrier ", p);
-  return name;
+  return FlagFilesName("barrier", paths);
 }
 
 absl::Status CheckFrictionSnap(double friction_snap, bool has_outlines) {
@@ -952,9 +958,8 @@ absl::StatusOr<MeshData> CutBarrierPolygons(const MeshData& mesh,
   if (geojsons.empty()) return absl::InvalidArgumentError("no barrier polygons");
   QuietGdal quiet;
   OGRSpatialReference file_crs;
-  std::string all_names;
-  for (const NamedText& g : geojsons)
-    absl::StrAppend(&all_names, all_names.empty() ? "" : ", ", g.name);
+  const std::string all_names = absl::StrJoin(
+      geojsons, ", ", [](std::string* out, const NamedText& g) { out->append(g.name); });
   if (absl::Status s = ParseFileCrs(dem, all_names, &file_crs); !s.ok()) return s;
   std::unique_ptr<OGRGeometry> barrier;
   for (const NamedText& g : geojsons) {
@@ -2395,10 +2400,9 @@ absl::StatusOr<std::vector<double>> ReadFrictionFiles(const MeshData& mesh,
                                                       const DemInfo& dem) {
   if (paths.size() == 1) return ReadFrictionFile(mesh, paths[0], dem, "--friction " + paths[0]);
   QuietGdal quiet;
-  std::string names;
+  const std::string names = FlagFilesName("friction", paths);
   for (const std::string& path : paths) {
     const std::string name = absl::StrCat("--friction ", path);
-    absl::StrAppend(&names, names.empty() ? "" : ", ", name);
     const GisFormat* format = GisFormatOf(path);
     if (format != nullptr && format->kind == GisFileKind::kRaster) {
       return absl::InvalidArgumentError(absl::StrCat(
