@@ -4,7 +4,7 @@
 // command is written once against this interface (cli_commands.cc, cli_geometry.cc,
 // cli_render.cc), so it takes the same options and prints the same output in both modes.
 // LocalBackend is in cli_local_backend.cc, RemoteBackend in cli_remote.cc; the shared point
-// resolution and exit codes in cli_commands.cc.
+// resolution, exit codes and mesh-reading options in cli_args.cc.
 
 #include <array>
 #include <cstdint>

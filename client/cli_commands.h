@@ -1,8 +1,9 @@
 #pragma once
 
-// The geodex command line: argument parsing and the query commands (info, distances, path,
-// matrix, locate here; isolines, voronoi, delaunay, render in cli_geometry.cc and cli_render.cc),
-// each written once against a Backend (local or remote), with its help and formats beside it.
+// The geodex command line: argument parsing (cli_args.cc) and the query commands (info,
+// distances, path, matrix, locate in cli_commands.cc; isolines, voronoi, delaunay, render in
+// cli_geometry.cc and cli_render.cc), each written once against a Backend (local or remote), with
+// its help and formats beside it.
 
 #include <map>
 #include <string>
