@@ -2,8 +2,6 @@
 // point SPECs resolved against a backend (map points dropped onto a DEM, snaps checked and said),
 // query errors in the user's words and exit codes, travel weights from files, GIS output, and
 // how MESH is read (cli_backend.h, cli_commands.h declare them).
-#include "cli_commands.h"
-
 #include <unistd.h>
 
 #include <algorithm>
@@ -29,6 +27,7 @@
 #include "absl/strings/str_split.h"
 #include "absl/strings/strip.h"
 #include "cli_backend.h"
+#include "cli_commands.h"
 #include "cli_common.h"
 #include "geodex/distance_matrix.h"
 #include "geodex/friction.h"
@@ -253,7 +252,6 @@ absl::Status ResolveOption(Backend& backend, const Args& args, const std::string
   *points = *std::move(p);
   return absl::OkStatus();
 }
-
 
 int QueryExitCode(const absl::Status& status) {
   switch (status.code()) {
