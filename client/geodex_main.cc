@@ -138,7 +138,7 @@ int main(int argc, char** argv) {
     return argc < 2 ? kExitUsage : kExitOk;
   }
   if (!std::strcmp(argv[1], "--version")) {
-    std::puts("geodex 0.1.0");
+    std::puts("geodex " GEODEX_VERSION);  // CMake's project version
     return kExitOk;
   }
   // Global options before the command: --server HOST:PORT (else GEODEX_SERVER), --tls, --ca FILE,

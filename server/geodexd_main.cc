@@ -14,6 +14,7 @@
 #include "absl/flags/flag.h"
 #include "absl/flags/parse.h"
 #include "absl/flags/usage.h"
+#include "absl/flags/usage_config.h"
 #include "absl/time/clock.h"
 #include "geodex/limits.h"
 #include "geodex_server.h"
@@ -99,6 +100,10 @@ int main(int argc, char** argv) {
   absl::SetProgramUsageMessage(
       "geodexd --listen HOST:PORT --data-dir DIR [flags]: the geodex gRPC server "
       "(geodex.v1.Geodex, grpc.health.v1.Health, server reflection)");
+  // --version prints CMake's project version (absl's default says which build type it was).
+  absl::FlagsUsageConfig usage;
+  usage.version_string = [] { return std::string("geodexd " GEODEX_VERSION "\n"); };
+  absl::SetFlagsUsageConfig(usage);
   // Accept --data-dir as well as --data_dir, for every flag (absl flags use underscores; the
   // command-line contract in docs/service.md uses dashes).
   std::vector<std::string> args(argv, argv + argc);

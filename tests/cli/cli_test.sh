@@ -13,6 +13,11 @@ expect_usage() {  # NAME PATTERN ARGS...: exit 2, one line naming PATTERN
   expect_code "$name" 2 "$pattern" "$@"
 }
 
+# --version: CMake's project version (VERSION, given by ctest; the remote rerun leaves it out).
+if [ -n "${VERSION:-}" ]; then
+  check "--version prints CMake's project version" test "$("$GEODEX" --version)" = "geodex $VERSION"
+fi
+
 # info: key: value lines with the documented keys; json parses; exit 0.
 "$GEODEX" info "$DATA/kitten.off" >"$tmp/info.txt"
 check "info exits 0" test $? -eq 0

@@ -2,10 +2,11 @@
 # The geodexd binary as an operator runs it: starts on 127.0.0.1 (a port it picks), reports
 # where it listens (flags spelled with dashes or underscores), and on SIGTERM drains and exits 0;
 # settings that cannot work make it exit 1 naming the flag. Bounded: gives up after 30 s.
-# Env: GEODEXD (the binary).
+# Env: GEODEXD (the binary), VERSION (CMake's project version).
 set -u
 # shellcheck source-path=SCRIPTDIR source=../util/test_preamble.sh
 source "$(dirname "${BASH_SOURCE[0]}")/../util/test_preamble.sh"
+check "--version prints CMake's project version" test "$("$GEODEXD" --version)" = "geodexd ${VERSION:-?}"
 # Every socket on a port of its own (port 0): a quickstart server may hold the default ports.
 # start_geodexd adds --listen 127.0.0.1:0 and waits up to 30 s for the listening line.
 start_geodexd "$tmp/log" --metrics_listen 127.0.0.1:0 --data-dir "$tmp/data" \

@@ -25,7 +25,9 @@ from ._plans import SnapWarning  # noqa: E402
 from .results import (Delaunay, DistanceMatrix, Field, GisFile, Isolines, Located,  # noqa: E402
                       Mesh, Path, PathPoint, PointDistances, RetryPolicy, Travel, Voronoi)
 
-__version__ = "0.4.0"
+# Written at build time from CMakeLists.txt's project version (setup.py for pip, CMake for
+# build/python): one version for geodex, geodexd and this package.
+from ._version import __version__  # noqa: E402
 __all__ = [
     "GeodexClient", "RetryPolicy", "Travel", "Mesh", "vertex", "edge_point", "face_point",
     "position", "map_point", "lon_lat", "Field", "Path", "PathPoint", "Located", "PointDistances",
