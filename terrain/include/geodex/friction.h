@@ -2,8 +2,8 @@
 
 // Friction for travel cost (geodex/travel_cost.h): one multiplicative weight per face of a mesh,
 // from what GIS users draw or already have. Read under the same rules as barriers (no file or URL a
-// file names is opened; GeoJSON names its CRS only by an identifier); defined in dem.cc beside
-// the barrier reader whose helpers they share.
+// file names is opened; GeoJSON names its CRS only by an identifier); defined in friction.cc,
+// sharing the barrier reader's helpers (dem_internal.h).
 
 #include <string>
 #include <vector>
