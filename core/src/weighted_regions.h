@@ -73,7 +73,7 @@ class RegionSurface {
 };
 
 // The bounded placement's points on the edges between faces of different (finite) weights, with
-// the graph refined around `anchors` (weighted_field.cc): per such edge, the half-edge its
+// the graph refined around `anchors` (weighted/steiner_graph.cc): per such edge, the half-edge its
 // parameters run along and its points. Errors: the Steiner-point limit, a bad anchor.
 struct RegionBoundaryPoints {
   std::vector<uint32_t> half_edge;  // per chain

@@ -46,7 +46,7 @@
 // Sources and targets strictly inside faces or edges have neither long pieces nor a vicinity ball
 // of their own (AMS make them vertices): two such points a hair from an edge, facing each other
 // across it, would cost the detour through the nearest Steiner point, unboundedly more than their
-// distance. So the graph is refined around them (weighted_field.cc, AddAnchorPoints: each
+// distance. So the graph is refined around them (weighted/steiner_graph.cc, AddAnchorPoints: each
 // crossing near the point gets a node within sqrt(epsilon / 8) x its distance from the point, and
 // the vertices of the point's faces continue their progressions down to (epsilon / 8) x the
 // point's distance from them), which restores both steps for them; it adds some hundreds of
@@ -238,7 +238,7 @@ class WeightedSurface {
   uint64_t bytes() const;  // what it holds: the Steiner points, the graph's arrays, the weights
   const TriangleMesh& mesh() const;  // the mesh it was built on
 
-  struct Impl;  // the graph and cost model (weighted_field.cc); every solve builds one
+  struct Impl;  // the graph and cost model (weighted/surface.cc); every solve builds one
 
  private:
   explicit WeightedSurface(std::unique_ptr<Impl> impl);
