@@ -104,7 +104,7 @@ absl::StatusOr<MeshRef> UploadDerived(GeodexClient& client, const std::string& m
     dem.z_tolerance = options.z_tolerance;
     return client.ResolveDem(mesh, data, dem);
   }
-  return client.ResolveMeshData(std::filesystem::path(mesh).stem().string() + ".off", data);
+  return client.UploadMeshData(std::filesystem::path(mesh).stem().string() + ".off", data);
 }
 
 // Queries on a geodexd: MESH resolves to the server's copy (uploaded once, by content hash),

@@ -52,7 +52,32 @@ ServerMesh ServerMeshFromProto(const v1::Mesh& m) {
   out.pinned = m.pinned();
   out.create_time_seconds = m.create_time().seconds();
   out.has_terrain = m.has_terrain();
-  if (out.has_terrain) out.terrain = m.terrain().SerializeAsString();
+  if (out.has_terrain) {
+    out.terrain = m.terrain().SerializeAsString();
+    const v1::Terrain& t = m.terrain();
+    ServerTerrain& map = out.map.emplace();
+    map.driver = t.driver();
+    map.raster_width = t.raster_width();
+    map.raster_height = t.raster_height();
+    map.step = t.step();
+    map.grid_width = t.grid_width();
+    map.grid_height = t.grid_height();
+    map.nodata_cells = t.nodata_cells();
+    map.barrier_cells = t.barrier_cells();
+    map.barrier_faces = t.barrier_faces();
+    map.crs_name = t.crs_name();
+    map.crs_wkt = t.crs_wkt();
+    map.reprojected = t.reprojected();
+    map.mesh_crs_name = t.mesh_crs_name();
+    map.mesh_crs_wkt = t.mesh_crs_wkt();
+    map.horizontal_scale = t.horizontal_scale();
+    map.vertical_unit = t.vertical_unit();
+    map.vertical_scale = t.vertical_scale();
+    for (int i = 0; i < t.geotransform_size() && i < 6; ++i) map.geotransform[i] = t.geotransform(i);
+    map.z_tolerance = t.z_tolerance();
+    map.max_vertical_deviation = t.max_vertical_deviation();
+    map.rms_vertical_deviation = t.rms_vertical_deviation();
+  }
   return out;
 }
 
@@ -133,7 +158,32 @@ std::string MeshToOffText(const MeshData& mesh) {
   return out;
 }
 
-GeodexClient::GeodexClient(ClientOptions options) : options_(std::move(options)) {
+void Cancellation::Cancel() {
+  std::lock_guard<std::mutex> lock(mu_);
+  cancelled_ = true;
+  for (grpc::ClientContext* context : in_flight_) context->TryCancel();
+}
+
+bool Cancellation::cancelled() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return cancelled_;
+}
+
+bool Cancellation::Register(grpc::ClientContext* context) {
+  std::lock_guard<std::mutex> lock(mu_);
+  if (cancelled_) return false;
+  in_flight_.push_back(context);
+  return true;
+}
+
+void Cancellation::Unregister(grpc::ClientContext* context) {
+  std::lock_guard<std::mutex> lock(mu_);
+  in_flight_.erase(std::remove(in_flight_.begin(), in_flight_.end(), context), in_flight_.end());
+}
+
+GeodexClient::GeodexClient(ClientOptions options)
+    : options_(std::move(options)), state_(std::make_unique<State>()) {
+  state_->deadline_seconds = options_.deadline_seconds;
   grpc::ChannelArguments args;
   args.SetMaxReceiveMessageSize(4 << 20);  // gRPC's default, kept on purpose: the API streams
   // Reconnect soon after a server comes back (gRPC waits 1 s, then 1.6 s, 2.6 s, ... by default).
@@ -175,9 +225,26 @@ bool IsQueueFull(const grpc::Status& status) {
 }
 }  // namespace
 
+namespace {
+grpc::Status CancelledByCaller() {
+  return grpc::Status(grpc::StatusCode::CANCELLED, "cancelled by the caller");
+}
+
+// Sleeps `seconds`, or less when `cancel` is cancelled meanwhile.
+void SleepUnlessCancelled(double seconds, const Cancellation* cancel) {
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (std::chrono::steady_clock::now() < until && !(cancel && cancel->cancelled())) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
+}  // namespace
+
 grpc::Status GeodexClient::Call(const std::string& mesh_id,
-                                const std::function<grpc::Status(grpc::ClientContext*)>& call) {
+                                const std::function<grpc::Status(grpc::ClientContext*)>& call,
+                                const CallOptions& options) {
   double backoff = options_.initial_backoff_seconds;
+  const double deadline_seconds = options.deadline_seconds.value_or(state_->deadline_seconds);
+  Cancellation* cancel = options.cancel.get();
   grpc::Status status;
   // UNAVAILABLE (a restart, a drain) is retried while the server may come back: each retry waits
   // for the channel to connect, up to reconnect_wait_seconds from the first one; a full queue is
@@ -187,31 +254,42 @@ grpc::Status GeodexClient::Call(const std::string& mesh_id,
   Clock::time_point reconnect_until = kNotWaiting;
   for (int attempt = 0;; ++attempt) {
     if (attempt > 0) {
-      ++retries_;
-      std::this_thread::sleep_for(std::chrono::duration<double>(std::min(backoff, 1.0)));
+      ++state_->retries;
+      SleepUnlessCancelled(std::min(backoff, 1.0), cancel);
       backoff *= 2;
-      if (reconnect_until != kNotWaiting && !channel_->WaitForConnected(reconnect_until)) break;
+      // Waits for the channel in short steps, so that a cancel is seen.
+      bool connected = reconnect_until == kNotWaiting;
+      while (!connected && !(cancel && cancel->cancelled()) && Clock::now() < reconnect_until) {
+        connected = channel_->WaitForConnected(
+            std::min(reconnect_until, Clock::now() + std::chrono::milliseconds(100)));
+      }
+      if (cancel && cancel->cancelled()) return CancelledByCaller();
+      if (!connected) break;
     }
     grpc::ClientContext context;
-    context.set_deadline(
-        std::chrono::system_clock::now() +
-        std::chrono::microseconds(static_cast<int64_t>(options_.deadline_seconds * 1e6)));
+    context.set_deadline(std::chrono::system_clock::now() +
+                         std::chrono::microseconds(static_cast<int64_t>(deadline_seconds * 1e6)));
     if (options_.wait_for_ready) context.set_wait_for_ready(true);
     if (!mesh_id.empty()) context.AddMetadata("x-mesh-id", mesh_id);
     if (!options_.token.empty()) context.AddMetadata("authorization", "Bearer " + options_.token);
-    ++calls_;
+    if (cancel && !cancel->Register(&context)) return CancelledByCaller();
+    ++state_->calls;
     status = call(&context);
-    last_replica_.clear();
-    const auto& metadata = context.GetServerInitialMetadata();
-    if (auto it = metadata.find("x-geodex-replica"); it != metadata.end()) {
-      last_replica_.assign(it->second.data(), it->second.size());
+    if (cancel) cancel->Unregister(&context);
+    if (cancel && cancel->cancelled()) return CancelledByCaller();
+    {
+      const auto& metadata = context.GetServerInitialMetadata();
+      auto it = metadata.find("x-geodex-replica");
+      std::lock_guard<std::mutex> lock(state_->mu);
+      state_->last_replica =
+          it == metadata.end() ? "" : std::string(it->second.data(), it->second.size());
     }
     if (status.error_code() == grpc::StatusCode::UNAVAILABLE) {
       if (reconnect_until == kNotWaiting) {
         reconnect_until =
             Clock::now() +
             std::chrono::microseconds(static_cast<int64_t>(
-                std::min(options_.reconnect_wait_seconds, options_.deadline_seconds) * 1e6));
+                std::min(options_.reconnect_wait_seconds, deadline_seconds) * 1e6));
       }
       if (Clock::now() < reconnect_until) continue;
       break;
@@ -226,8 +304,9 @@ grpc::Status GeodexClient::Call(const std::string& mesh_id,
 }
 
 grpc::Status GeodexClient::MeshCall(MeshRef& mesh,
-                                    const std::function<grpc::Status(grpc::ClientContext*)>& call) {
-  grpc::Status status = Call(mesh.id, call);
+                                    const std::function<grpc::Status(grpc::ClientContext*)>& call,
+                                    const CallOptions& options) {
+  grpc::Status status = Call(mesh.id, call, options);
   if (status.error_code() == grpc::StatusCode::NOT_FOUND && !mesh.file_bytes.empty() &&
       ErrorReason(status) == "MESH_NOT_FOUND") {
     // The server lost (or never had) the mesh: upload it again and retry once.
@@ -237,8 +316,8 @@ grpc::Status GeodexClient::MeshCall(MeshRef& mesh,
       return grpc::Status(static_cast<grpc::StatusCode>(uploaded.status().code()),
                           std::string(uploaded.status().message()));
     }
-    ++reuploads_;
-    status = Call(mesh.id, call);
+    ++state_->reuploads;
+    status = Call(mesh.id, call, options);
   }
   return status;
 }
@@ -372,8 +451,8 @@ absl::StatusOr<MeshRef> GeodexClient::UploadIfAbsent(MeshRef ref) {
   return ref;
 }
 
-absl::StatusOr<MeshRef> GeodexClient::ResolveMeshData(const std::string& file_name,
-                                                      const MeshData& data) {
+absl::StatusOr<MeshRef> GeodexClient::UploadMeshData(const std::string& file_name,
+                                                     const MeshData& data) {
   MeshRef ref;
   ref.id = ComputeMeshId(data);
   ref.name = absl::StrCat("meshes/", ref.id);
@@ -407,7 +486,7 @@ absl::StatusOr<MeshRef> GeodexClient::ResolveMesh(const std::string& mesh) {
   if (mesh.rfind("sample:", 0) == 0) {
     absl::StatusOr<MeshData> data = MakeSampleMesh(mesh);
     if (!data.ok()) return data.status();
-    return ResolveMeshData(mesh.substr(7) + ".off", *data);
+    return UploadMeshData(mesh.substr(7) + ".off", *data);
   }
   // A directory is a mesh name the server may know (a "terrain" directory beside "terrain" the
   // sample); if it does not, it fails as in local mode ("is a directory").
@@ -446,8 +525,10 @@ absl::StatusOr<MeshRef> GeodexClient::ResolveMesh(const std::string& mesh) {
 
 template <typename Assembler, typename Start, typename OnMessage>
 absl::Status GeodexClient::ReadStream(MeshRef& mesh, Start start, Assembler* out,
-                                      OnMessage on_message) {
-  grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
+                                      OnMessage on_message, const CallOptions& options) {
+  grpc::Status status = MeshCall(
+      mesh,
+      [&](grpc::ClientContext* context) {
     *out = Assembler();
     auto reader = start(context);
     typename Assembler::Message message;
@@ -456,7 +537,8 @@ absl::Status GeodexClient::ReadStream(MeshRef& mesh, Start start, Assembler* out
       on_message(*out);
     }
     return reader->Finish();
-  });
+      },
+      options);
   return status.ok() ? absl::OkStatus() : ToAbsl(status);
 }
 
@@ -465,17 +547,17 @@ constexpr auto kNothing = [](const auto&) {};
 }  // namespace
 
 absl::StatusOr<DistanceField> GeodexClient::Field(MeshRef& mesh, const FieldQuery& query,
-                                                  bool* cached) {
+                                                  bool* cached, const CallOptions& call) {
   v1::ComputeDistanceFieldRequest request;
   request.set_mesh(mesh.name);
   api::FieldQueryToProto(query, &request);
-  SetMaxSnap(options_.max_snap, &request);
+  SetMaxSnap(MaxSnap(call), &request);
   request.set_want_stats(true);
   api::FieldAssembler field;
   if (absl::Status s = ReadStream(
           mesh,
           [&](grpc::ClientContext* c) { return stub_->rpc->ComputeDistanceField(c, request); },
-          &field, kNothing);
+          &field, kNothing, call);
       !s.ok()) {
     return s;
   }
@@ -489,32 +571,37 @@ absl::StatusOr<MeshData> GeodexClient::GetMeshGeometry(MeshRef& mesh) {
   api::MeshGeometryAssembler out;
   if (absl::Status s = ReadStream(
           mesh, [&](grpc::ClientContext* c) { return stub_->rpc->GetMeshGeometry(c, request); },
-          &out, kNothing);
+          &out, kNothing, CallOptions{});
       !s.ok()) {
     return s;
   }
   return std::move(out.result());
 }
 
-absl::StatusOr<PathQueryResult> GeodexClient::ShortestPath(MeshRef& mesh, const PathQuery& query) {
+absl::StatusOr<PathQueryResult> GeodexClient::ShortestPath(MeshRef& mesh, const PathQuery& query,
+                                                           const CallOptions& call) {
   v1::FindShortestPathRequest request;
   request.set_mesh(mesh.name);
   api::PathQueryToProto(query, &request);
-  SetMaxSnap(options_.max_snap, &request);
+  SetMaxSnap(MaxSnap(call), &request);
   request.set_want_stats(true);
   v1::FindShortestPathResponse response;
-  grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
-    return stub_->rpc->FindShortestPath(context, request, &response);
-  });
+  grpc::Status status = MeshCall(
+      mesh,
+      [&](grpc::ClientContext* context) {
+        return stub_->rpc->FindShortestPath(context, request, &response);
+      },
+      call);
   if (!status.ok()) return ToAbsl(status);
   return api::PathResultFromProto(response);
 }
 
-absl::StatusOr<DistanceMatrix> GeodexClient::Matrix(MeshRef& mesh, const MatrixQuery& query) {
+absl::StatusOr<DistanceMatrix> GeodexClient::Matrix(MeshRef& mesh, const MatrixQuery& query,
+                                                    const CallOptions& call) {
   v1::ComputeDistanceMatrixRequest request;
   request.set_mesh(mesh.name);
   api::MatrixQueryToProto(query, &request);
-  SetMaxSnap(options_.max_snap, &request);
+  SetMaxSnap(MaxSnap(call), &request);
   request.set_want_stats(true);
   api::MatrixAssembler matrix;
   if (absl::Status s = ReadStream(
@@ -525,7 +612,8 @@ absl::StatusOr<DistanceMatrix> GeodexClient::Matrix(MeshRef& mesh, const MatrixQ
             if (query.options.on_row && m.result().cols > 0) {
               query.options.on_row(m.rows_done(), m.result().rows);
             }
-          });
+          },
+          call);
       !s.ok()) {
     return s;
   }
@@ -534,48 +622,58 @@ absl::StatusOr<DistanceMatrix> GeodexClient::Matrix(MeshRef& mesh, const MatrixQ
 
 absl::StatusOr<PointDistances> GeodexClient::DistancesAtPoints(MeshRef& mesh,
                                                                const PointQuery& query,
-                                                               PointDistanceMode mode) {
+                                                               PointDistanceMode mode,
+                                                               const CallOptions& call) {
   v1::EstimateDistancesRequest request;
   request.set_mesh(mesh.name);
   api::PointQueryToProto(query, &request);
-  SetMaxSnap(options_.max_snap, &request);
+  SetMaxSnap(MaxSnap(call), &request);
   request.set_mode(ModeToProto(mode));
   v1::EstimateDistancesResponse response;
-  grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
-    return stub_->rpc->EstimateDistances(context, request, &response);
-  });
+  grpc::Status status = MeshCall(
+      mesh,
+      [&](grpc::ClientContext* context) {
+        return stub_->rpc->EstimateDistances(context, request, &response);
+      },
+      call);
   if (!status.ok()) return ToAbsl(status);
   PointDistances out;
   out.estimates = api::PointEstimatesFromProto(response);
   out.exact = api::PointValuesFromProto(response);
+  out.snap_distances.assign(response.snap_distances().begin(), response.snap_distances().end());
   return out;
 }
 
 absl::StatusOr<std::vector<LocatedPoint>> GeodexClient::Locate(
-    MeshRef& mesh, const std::vector<std::array<double, 3>>& xyz, double max_snap) {
+    MeshRef& mesh, const std::vector<std::array<double, 3>>& xyz, double max_snap,
+    const CallOptions& call) {
   v1::LocatePointsRequest request;
   request.set_mesh(mesh.name);
   for (const auto& q : xyz) api::PositionToProto(q, request.add_positions());
-  SetMaxSnap(std::min(max_snap, options_.max_snap), &request);
+  SetMaxSnap(std::min(max_snap, MaxSnap(call)), &request);
   v1::LocatePointsResponse response;
-  grpc::Status status = MeshCall(mesh, [&](grpc::ClientContext* context) {
-    return stub_->rpc->LocatePoints(context, request, &response);
-  });
+  grpc::Status status = MeshCall(
+      mesh,
+      [&](grpc::ClientContext* context) {
+        return stub_->rpc->LocatePoints(context, request, &response);
+      },
+      call);
   if (!status.ok()) return ToAbsl(status);
   std::vector<LocatedPoint> out;
   for (const auto& p : response.points()) out.push_back(api::LocatedPointFromProto(p));
   return out;
 }
 
-absl::StatusOr<Isolines> GeodexClient::ComputeIsolines(MeshRef& mesh, const IsolineQuery& query) {
+absl::StatusOr<Isolines> GeodexClient::ComputeIsolines(MeshRef& mesh, const IsolineQuery& query,
+    const CallOptions& call) {
   v1::ComputeIsolinesRequest request;
   request.set_mesh(mesh.name);
   api::IsolineQueryToProto(query, &request);
-  SetMaxSnap(options_.max_snap, &request);
+  SetMaxSnap(MaxSnap(call), &request);
   api::IsolinesAssembler out;
   if (absl::Status s = ReadStream(
           mesh, [&](grpc::ClientContext* c) { return stub_->rpc->ComputeIsolines(c, request); },
-          &out, kNothing);
+          &out, kNothing, call);
       !s.ok()) {
     return s;
   }
@@ -583,15 +681,16 @@ absl::StatusOr<Isolines> GeodexClient::ComputeIsolines(MeshRef& mesh, const Isol
 }
 
 absl::StatusOr<VoronoiDiagram> GeodexClient::ComputeVoronoi(MeshRef& mesh,
-                                                            const VoronoiQuery& query) {
+                                                            const VoronoiQuery& query,
+    const CallOptions& call) {
   v1::ComputeVoronoiRequest request;
   request.set_mesh(mesh.name);
   api::VoronoiQueryToProto(query, &request);
-  SetMaxSnap(options_.max_snap, &request);
+  SetMaxSnap(MaxSnap(call), &request);
   api::VoronoiAssembler out;
   if (absl::Status s = ReadStream(
           mesh, [&](grpc::ClientContext* c) { return stub_->rpc->ComputeVoronoi(c, request); },
-          &out, kNothing);
+          &out, kNothing, call);
       !s.ok()) {
     return s;
   }
@@ -599,19 +698,56 @@ absl::StatusOr<VoronoiDiagram> GeodexClient::ComputeVoronoi(MeshRef& mesh,
 }
 
 absl::StatusOr<DelaunayTriangulation> GeodexClient::ComputeDelaunay(MeshRef& mesh,
-                                                                    const DelaunayQuery& query) {
+                                                                    const DelaunayQuery& query,
+    const CallOptions& call) {
   v1::ComputeDelaunayRequest request;
   request.set_mesh(mesh.name);
   api::DelaunayQueryToProto(query, &request);
-  SetMaxSnap(options_.max_snap, &request);
+  SetMaxSnap(MaxSnap(call), &request);
   api::DelaunayAssembler out;
   if (absl::Status s = ReadStream(
           mesh, [&](grpc::ClientContext* c) { return stub_->rpc->ComputeDelaunay(c, request); },
-          &out, kNothing);
+          &out, kNothing, call);
       !s.ok()) {
     return s;
   }
   return std::move(out.result());
+}
+
+AsyncCall<PathQueryResult> GeodexClient::ShortestPathAsync(MeshRef mesh, PathQuery query,
+                                                           CallOptions call) {
+  return Async<PathQueryResult>(
+      std::move(mesh), std::move(query), std::move(call),
+      [](GeodexClient& client, MeshRef& m, const PathQuery& q, const CallOptions& c) {
+        return client.ShortestPath(m, q, c);
+      });
+}
+
+AsyncCall<DistanceField> GeodexClient::FieldAsync(MeshRef mesh, FieldQuery query, CallOptions call) {
+  return Async<DistanceField>(
+      std::move(mesh), std::move(query), std::move(call),
+      [](GeodexClient& client, MeshRef& m, const FieldQuery& q, const CallOptions& c) {
+        return client.Field(m, q, nullptr, c);
+      });
+}
+
+AsyncCall<PointDistances> GeodexClient::DistancesAtPointsAsync(MeshRef mesh, PointQuery query,
+                                                               PointDistanceMode mode,
+                                                               CallOptions call) {
+  return Async<PointDistances>(
+      std::move(mesh), std::move(query), std::move(call),
+      [mode](GeodexClient& client, MeshRef& m, const PointQuery& q, const CallOptions& c) {
+        return client.DistancesAtPoints(m, q, mode, c);
+      });
+}
+
+AsyncCall<DistanceMatrix> GeodexClient::MatrixAsync(MeshRef mesh, MatrixQuery query,
+                                                    CallOptions call) {
+  return Async<DistanceMatrix>(
+      std::move(mesh), std::move(query), std::move(call),
+      [](GeodexClient& client, MeshRef& m, const MatrixQuery& q, const CallOptions& c) {
+        return client.Matrix(m, q, c);
+      });
 }
 
 }  // namespace geodex::client

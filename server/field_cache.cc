@@ -1,14 +1,17 @@
 #include "field_cache.h"
 
+#include <algorithm>
 #include <array>
 #include <cstring>
+#include <tuple>
 
 #include "geodex/mesh_id.h"
 
 namespace geodex::server {
 namespace {
 
-constexpr size_t kMaxPathSources = 4096;
+// Keys whose asks are remembered: a planner's starts, with room (each is about 100 bytes).
+constexpr size_t kMaxAskHistory = 4096;
 
 template <typename T>
 void Append(std::string* out, const T& value) {
@@ -112,21 +115,26 @@ uint64_t FieldBytes(const DistanceField& field) {
 template <typename T, typename Usable>
 std::shared_ptr<const T> FieldCache::Lookup(const std::string& key,
                                             std::shared_ptr<const T> Entry::*slot, uint64_t* hits,
-                                            uint64_t* misses, Usable usable) {
+                                            uint64_t* misses, Usable usable, bool count_miss) {
   if (!enabled()) return nullptr;
   std::lock_guard<std::mutex> lock(mu_);
   auto it = entries_.find(key);
   if (it == entries_.end() || it->second.*slot == nullptr || !usable(*(it->second.*slot))) {
-    ++*misses;
+    if (count_miss) {
+      NoteAskLocked(key);
+      ++*misses;
+    }
     return nullptr;
   }
+  NoteAskLocked(key);
   ++*hits;
   lru_.splice(lru_.begin(), lru_, it->second.lru);
   return it->second.*slot;
 }
 
-std::shared_ptr<const DistanceField> FieldCache::Find(const std::string& key) {
-  return Lookup(key, &Entry::field, &hits_, &misses_, [](const DistanceField&) { return true; });
+std::shared_ptr<const DistanceField> FieldCache::Find(const std::string& key, bool count_miss) {
+  return Lookup(
+      key, &Entry::field, &hits_, &misses_, [](const DistanceField&) { return true; }, count_miss);
 }
 
 void FieldCache::Insert(const std::string& key, std::shared_ptr<const DistanceField> field) {
@@ -160,16 +168,59 @@ void FieldCache::InsertGraph(const std::string& key, std::shared_ptr<const Weigh
 
 void FieldCache::InsertLocked(const std::string& key, Entry entry) {
   if (entries_.contains(key)) return;
-  while (bytes_ + entry.bytes > budget_bytes_ && !lru_.empty()) {
-    auto victim = entries_.find(lru_.back());
-    bytes_ -= victim->second.bytes;
-    entries_.erase(victim);
-    lru_.pop_back();
+  if (bytes_ + entry.bytes > budget_bytes_) {
+    // Room is made from the least-asked entries, least recently used first among equals (lru_ is
+    // most recent first); none is evicted for a key asked less often than it.
+    std::vector<std::tuple<uint32_t, size_t, const std::string*>> order;
+    order.reserve(lru_.size());
+    size_t age = 0;
+    for (auto it = lru_.rbegin(); it != lru_.rend(); ++it)
+      order.emplace_back(AsksLocked(*it), age++, &*it);
+    std::sort(order.begin(), order.end());
+    const uint32_t asks = AsksLocked(key);
+    uint64_t freed = 0;
+    size_t victims = 0;
+    while (bytes_ - freed + entry.bytes > budget_bytes_ && victims < order.size()) {
+      if (std::get<0>(order[victims]) > asks) {
+        ++declined_;
+        return;
+      }
+      freed += entries_.find(*std::get<2>(order[victims]))->second.bytes;
+      ++victims;
+    }
+    std::vector<std::string> evicted;
+    for (size_t i = 0; i < victims; ++i) evicted.push_back(*std::get<2>(order[i]));
+    for (const std::string& victim_key : evicted) {
+      auto victim = entries_.find(victim_key);
+      bytes_ -= victim->second.bytes;
+      lru_.erase(victim->second.lru);
+      entries_.erase(victim);
+    }
   }
   lru_.push_front(key);
   entry.lru = lru_.begin();
   bytes_ += entry.bytes;
   entries_[key] = std::move(entry);
+}
+
+void FieldCache::NoteAskLocked(const std::string& key) {
+  if (!asks_.contains(key) && asks_.size() >= kMaxAskHistory) {
+    // Recent demand counts: halve every count and forget the keys that reach 0.
+    for (auto it = asks_.begin(); it != asks_.end();) {
+      it->second /= 2;
+      if (it->second == 0) {
+        asks_.erase(it++);
+      } else {
+        ++it;
+      }
+    }
+  }
+  if (asks_.size() < kMaxAskHistory || asks_.contains(key)) ++asks_[key];
+}
+
+uint32_t FieldCache::AsksLocked(const std::string& key) const {
+  auto it = asks_.find(key);
+  return it == asks_.end() ? 0 : it->second;
 }
 
 bool FieldCache::Contains(const std::string& key) const {
@@ -181,14 +232,17 @@ bool FieldCache::Contains(const std::string& key) const {
 bool FieldCache::NotePathSource(const std::string& key) {
   if (!enabled()) return false;
   std::lock_guard<std::mutex> lock(mu_);
-  if (path_sources_.contains(key)) return true;
-  path_sources_[key] = 1;
-  path_source_order_.push_back(key);
-  if (path_source_order_.size() > kMaxPathSources) {
-    path_sources_.erase(path_source_order_.front());
-    path_source_order_.pop_front();
-  }
-  return false;
+  return AsksLocked(key) >= 2;  // the Find that missed counted this ask
+}
+
+uint32_t FieldCache::asks(const std::string& key) const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return AsksLocked(key);
+}
+
+uint64_t FieldCache::declined() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return declined_;
 }
 
 uint64_t FieldCache::bytes() const {

@@ -1,9 +1,14 @@
 #pragma once
 
-// The result cache: finished distance fields under a byte budget with LRU eviction, keyed by mesh
-// id, the resolved sources and the solver options. Many queries from one source position (a robot
-// asking for paths to many goals, isolines then Voronoi of the same sites) reuse one solve. Fields
-// are immutable and shared (shared_ptr), so eviction never disturbs a reader. Thread-safe.
+// The result cache: finished distance fields under a byte budget, keyed by mesh id, the resolved
+// sources and the solver options. What it keeps is chosen by what is asked repeatedly: every
+// look-up counts an ask of its key (hit or miss; the counts are halved when the history is full,
+// so they measure recent demand), a full cache evicts its least-asked entries first (least
+// recently used among equals), and declines a new entry rather than evict one asked more often
+// (a one-off solve never pushes out a field a planner keeps asking for). Many queries from one
+// source position (a robot asking for paths to many goals, isolines then Voronoi of the same sites)
+// reuse one solve. Fields are immutable and shared (shared_ptr), so eviction never disturbs a
+// reader. Thread-safe.
 //
 // The same budget holds travel graphs (the weighted engine's Steiner points for one mesh and one
 // constant-speed travel cost, core's BuildTravelGraph), keyed by TravelGraphKey: the travel paths,
@@ -42,8 +47,11 @@ class FieldCache {
   // budget_bytes = 0 disables the cache (Find always misses, Insert keeps nothing).
   explicit FieldCache(uint64_t budget_bytes) : budget_bytes_(budget_bytes) {}
 
-  std::shared_ptr<const DistanceField> Find(const std::string& key);
-  // Keeps `field` unless it alone exceeds the budget; evicts least recently used fields.
+  // `count_miss` false: a miss is not counted as an ask (a quick-lane look-up whose request goes
+  // on to the solve lane, which asks again: one request, one ask).
+  std::shared_ptr<const DistanceField> Find(const std::string& key, bool count_miss = true);
+  // Keeps `field` unless it alone exceeds the budget or making room would evict an entry asked
+  // for more often than `key`; evicts the least-asked entries (least recently used first).
   void Insert(const std::string& key, std::shared_ptr<const DistanceField> field);
   // A travel graph. Its owner keeps the mesh it refers to alive, so the entry counts that mesh's
   // `mesh_bytes` too (the mesh store may evict or delete the mesh meanwhile: the budget still
@@ -55,9 +63,13 @@ class FieldCache {
                                                    bool any_point = false);
   void InsertGraph(const std::string& key, std::shared_ptr<const WeightedSurface> graph,
                    uint64_t mesh_bytes);
-  // Records that a path query started from `key`'s source; true when one did recently (the
-  // source is then offered for a background field, FieldPromoter).
+  // After a missed Find(key) by a path query: true when `key` was asked for before (the source
+  // is then offered for a background field, FieldPromoter).
   bool NotePathSource(const std::string& key);
+  // How often `key` was asked for recently (Find and FindGraph, hit or miss).
+  uint32_t asks(const std::string& key) const;
+  // Entries not kept because making room would have evicted more-asked ones.
+  uint64_t declined() const;
 
   // Whether `key` holds a field now (not counted as a hit or a miss).
   bool Contains(const std::string& key) const;
@@ -88,15 +100,18 @@ class FieldCache {
   uint64_t misses_ = 0;
   uint64_t graph_hits_ = 0;
   uint64_t graph_misses_ = 0;
+  uint64_t declined_ = 0;
   void InsertLocked(const std::string& key, Entry entry);
+  void NoteAskLocked(const std::string& key);
+  uint32_t AsksLocked(const std::string& key) const;
   // The look-up both kinds share: `key`'s entry of one kind (`slot`), when `usable` accepts it,
   // moved to the front and counted in `*hits`; else nullptr, counted in `*misses`.
   template <typename T, typename Usable>
   std::shared_ptr<const T> Lookup(const std::string& key, std::shared_ptr<const T> Entry::*slot,
-                                  uint64_t* hits, uint64_t* misses, Usable usable);
-  // Recent path sources (bounded FIFO of keys).
-  absl::flat_hash_map<std::string, uint64_t> path_sources_;
-  std::list<std::string> path_source_order_;
+                                  uint64_t* hits, uint64_t* misses, Usable usable,
+                                  bool count_miss = true);
+  // Asks per key, bounded: at kMaxAskHistory keys every count is halved and the zeros dropped.
+  absl::flat_hash_map<std::string, uint32_t> asks_;
 };
 
 }  // namespace geodex::server

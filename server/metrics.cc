@@ -78,6 +78,9 @@ class GaugeCollector final : public prometheus::Collectable {
     add("geodex_travel_graph_hits_total",
         "Travel paths, point times and matrices that reused a cached travel graph", T::Counter,
         static_cast<double>(cache.graph_hits()));
+    add("geodex_result_cache_declined_total",
+        "Fields and graphs not kept: room would have evicted ones asked for more often", T::Counter,
+        static_cast<double>(cache.declined()));
     add("geodex_travel_graph_misses_total", "Travel graph look-ups that built one", T::Counter,
         static_cast<double>(cache.graph_misses()));
     add("geodex_solves_total", "Geodesic solves run", T::Counter,

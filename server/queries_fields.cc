@@ -246,7 +246,7 @@ absl::StatusOr<MessageStream<v1::ComputeDistanceMatrixResponse>> RunComputeDista
   const std::string targets_key = FieldCacheKey("", *targets, *solver);
   std::string matrix_key =
       absl::StrCat(sources_key, "|matrix|", targets_key, "|k", request.k_nearest());
-  std::shared_ptr<const DistanceField> cached_matrix = env.cache->Find(matrix_key);
+  std::shared_ptr<const DistanceField> cached_matrix = env.cache->Find(matrix_key, !env.quick);
   if (cached_matrix == nullptr && env.quick) return SolveLaneNeeded();
 
   auto state = std::make_shared<MatrixStreamState>();

@@ -49,7 +49,7 @@ absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPath
   // solve.)
   if (to->kind == SurfacePoint::Kind::kVertex && env.cache->enabled() && !solver->travel) {
     const std::string key = FieldCacheKey((*mesh)->id, {*from}, *solver);
-    std::shared_ptr<const DistanceField> field = env.cache->Find(key);
+    std::shared_ptr<const DistanceField> field = env.cache->Find(key, !env.quick);
     const bool cached = field != nullptr;
     if (field == nullptr && env.quick) return SolveLaneNeeded();
     if (field == nullptr && env.cache->NotePathSource(key) && env.promoter != nullptr) {

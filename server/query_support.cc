@@ -80,7 +80,7 @@ absl::StatusOr<std::shared_ptr<const std::vector<double>>> TravelWeights(
   // `distance`, like a matrix's values): a repeated request, and its cached field, need no
   // reading. Otherwise every face's centroid goes against the polygons: solve-lane work.
   const std::string key = absl::StrCat(mesh.id, "|friction|", Sha256Hex(travel.friction_geojson()));
-  if (std::shared_ptr<const DistanceField> hit = env.cache->Find(key)) {
+  if (std::shared_ptr<const DistanceField> hit = env.cache->Find(key, !env.quick)) {
     return std::shared_ptr<const std::vector<double>>(hit, &hit->distance);
   }
   if (env.quick) return SolveLaneNeeded();
@@ -199,7 +199,7 @@ absl::StatusOr<std::shared_ptr<const DistanceField>> CachedField(
     const QueryEnv& env, const StoredMesh& mesh, const std::vector<SurfacePoint>& sources,
     const GeodesicOptions& options, bool* cached) {
   const std::string key = FieldCacheKey(mesh.id, sources, options);
-  if (std::shared_ptr<const DistanceField> hit = env.cache->Find(key)) {
+  if (std::shared_ptr<const DistanceField> hit = env.cache->Find(key, !env.quick)) {
     *cached = true;
     return hit;
   }

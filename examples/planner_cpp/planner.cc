@@ -72,19 +72,34 @@ int RunPlanner(const std::string& target, const std::string& mesh_file, uint32_t
     std::printf("\n");
   }
 
-  // 4. A call whose deadline is too short: DEADLINE_EXCEEDED, and the client answers the next.
-  client.set_deadline_seconds(1e-6);
-  // (A max_distance of its own: the server caches fields, and a cached one could be back within
-  // any deadline; this one is solved.)
+  // 4. A call's own deadline (CallOptions): too short, DEADLINE_EXCEEDED; the client's own 60 s
+  // still apply to the next call. (A max_distance of its own: the server caches fields, and a
+  // cached one could be back within any deadline; this one is solved.)
   geodex::FieldQuery field_query;
   field_query.sources = {path_query.from};
   field_query.options.max_distance = 1e9 + static_cast<double>(getpid());
-  absl::StatusOr<geodex::DistanceField> field = client.Field(*mesh, field_query);
+  geodex::client::CallOptions hurried;
+  hurried.deadline_seconds = 1e-6;
+  absl::StatusOr<geodex::DistanceField> field = client.Field(*mesh, field_query, nullptr, hurried);
   std::printf("deadline 1 us: %s\n", field.ok() ? "answered" : field.status().ToString().c_str());
   if (field.ok() || !absl::IsDeadlineExceeded(field.status())) return 1;
-  client.set_deadline_seconds(60);
   field = client.Field(*mesh, field_query);
   if (!field.ok()) return Fail("field after the short deadline", field.status());
   std::printf("deadline 60 s: %zu distances\n", field->distance.size());
+
+  // 5. Asynchronous: the path computed while this thread does other work, then taken; and a
+  // call cancelled while it runs (or before it is sent): CANCELLED.
+  geodex::client::AsyncCall<geodex::PathQueryResult> pending =
+      client.ShortestPathAsync(*mesh, path_query);
+  absl::StatusOr<geodex::PathQueryResult> later = pending.Get();
+  if (!later.ok()) return Fail("async path", later.status());
+  std::printf("async path: %s\n", later->distance == path->distance ? "the same length" : "differs");
+  field_query.options.max_distance = 2e9 + static_cast<double>(getpid());  // solved, not cached
+  geodex::client::AsyncCall<geodex::DistanceField> cancelled = client.FieldAsync(*mesh, field_query);
+  cancelled.Cancel();
+  absl::StatusOr<geodex::DistanceField> gone = cancelled.Get();
+  // (A field this small may finish before the cancel reaches it: then it answers.)
+  std::printf("cancelled: %s\n", gone.ok() ? "answered first" : gone.status().ToString().c_str());
+  if (!gone.ok() && !absl::IsCancelled(gone.status())) return Fail("cancel", gone.status());
   return 0;
 }

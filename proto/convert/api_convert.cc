@@ -275,6 +275,7 @@ void FieldChunkToProto(const DistanceField& field, const DistanceField& products
 void FieldAssembler::Add(const v1::ComputeDistanceFieldResponse& message) {
   if (message.offset() == 0) {
     field_.travel_epsilon = message.travel_epsilon();
+    field_.snap_distances.assign(message.snap_distances().begin(), message.snap_distances().end());
     field_.distance.reserve(message.vertex_count());
     field_.source.reserve(message.vertex_count());
     for (const auto& p : message.resolved_sources()) {
@@ -325,6 +326,7 @@ PathQueryResult PathResultFromProto(const v1::FindShortestPathResponse& response
                            : response.distance();
   for (const auto& p : response.points()) result.path.points.push_back(PathPointFromProto(p));
   if (response.has_stats()) result.stats = StatsFromProto(response.stats());
+  result.snap_distances.assign(response.snap_distances().begin(), response.snap_distances().end());
   return result;
 }
 
@@ -354,6 +356,10 @@ void MatrixChunkToProto(size_t rows, size_t cols, const std::vector<double>& val
 void MatrixAssembler::Add(const v1::ComputeDistanceMatrixResponse& message) {
   matrix_.rows = message.rows();
   matrix_.cols = message.cols();
+  if (message.snap_distances_size() > 0) {  // the first message's
+    matrix_.snap_distances.assign(message.snap_distances().begin(),
+                                  message.snap_distances().end());
+  }
   matrix_.values.insert(matrix_.values.end(), message.values_f64().begin(),
                         message.values_f64().end());
   matrix_.values.insert(matrix_.values.end(), message.values_f32().begin(),

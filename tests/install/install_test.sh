@@ -18,6 +18,9 @@ check "installs geodex.pc" test -f "$prefix/lib/pkgconfig/geodex.pc"
 check "no CLI internals or generated API among the headers" \
   bash -c "! find '$prefix/include' -name 'cli_*' -o -name '*.pb.h' | grep -q ."
 check "the installed headers name no generated type" bash -c "! grep -rq 'v1::' '$prefix/include'"
+missing=$(grep -rhoE '#include "geodex/[^"]+"' "$prefix/include" | sed -E 's/#include "(.*)"/\1/' | sort -u |
+  while read -r h; do test -f "$prefix/include/$h" || echo "$h"; done)
+check "every geodex header the installed headers include is installed${missing:+ (missing: $missing)}" test -z "$missing"
 
 # The example, copied away from the tree: only the prefix can satisfy find_package(geodex).
 cp -r "$SRC/examples/planner_cpp" "$tmp/planner_src"
@@ -28,10 +31,12 @@ cmake --build "$tmp/planner_build" -j 2 >"$tmp/build.log" 2>&1 || die "build exa
 check "the planner library is a shared object" test -f "$tmp/planner_build/libplanner.so"
 check "the planner links no GDAL" bash -c "! ldd '$tmp/planner_build/libplanner.so' | grep -qiE 'gdal|libproj|geos'"
 
-# pkg-config: the same sources, one compiler command.
+# pkg-config: the same sources, one compiler command, as C++17 (the headers need no more, and
+# geodex.pc forces no -std on its users).
 export PKG_CONFIG_PATH="$prefix/lib/pkgconfig"
+check "geodex.pc sets no -std" bash -c "! pkg-config --cflags geodex | grep -q -- -std="
 # shellcheck disable=SC2046
-g++ -O1 -o "$tmp/planner_pc" "$tmp/planner_src/main.cc" "$tmp/planner_src/planner.cc" \
+g++ -std=c++17 -O1 -o "$tmp/planner_pc" "$tmp/planner_src/main.cc" "$tmp/planner_src/planner.cc" \
   $(pkg-config --cflags --libs geodex) >"$tmp/pc.log" 2>&1
 check "builds with pkg-config --cflags --libs geodex" test $? -eq 0
 
@@ -50,5 +55,7 @@ for planner in "$tmp/planner_build/planner_cpp" "$tmp/planner_pc"; do
     bash -c "grep -q '^path: ' '$tmp/$name.out' && grep -q '^matrix 3 x 3' '$tmp/$name.out' && grep -q '^2 nearest' '$tmp/$name.out'"
   check "$name: a too-short deadline is DEADLINE_EXCEEDED, the next call answers" \
     bash -c "grep -q 'DEADLINE_EXCEEDED' '$tmp/$name.out' && grep -q '^deadline 60 s: 2500 distances' '$tmp/$name.out'"
+  check "$name: the async path has the same length; the cancelled call answers" \
+    bash -c "grep -q '^async path: the same length' '$tmp/$name.out' && grep -qE '^cancelled: (CANCELLED|answered first)' '$tmp/$name.out'"
 done
 finish "install"

@@ -9,6 +9,7 @@
 
 #include "absl/time/clock.h"
 #include "geodex/geodesic_solver.h"
+#include "geodex/shortest_path.h"
 #include "geodex/geodex_client.h"
 #include "geodex/mesh_id.h"
 #include "geodex/samples.h"
@@ -177,6 +178,144 @@ TEST_F(ClientTest, QueueFullIsRetriedWithBackoffButALimitIsNot) {
                            MatrixOptions{}});
   EXPECT_EQ(matrix.status().code(), absl::StatusCode::kResourceExhausted) << matrix.status();
   EXPECT_EQ(client.retries(), retries_mid);
+}
+
+// A call's own CallOptions (deadline, max_snap) apply to that call alone.
+TEST_F(ClientTest, PerCallOptionsApplyToThatCallAlone) {
+  StartServer();
+  GeodexClient client = Client();  // deadline 60 s, any snap
+  MeshRef mesh = *client.ResolveMesh(WriteFile("client-per-call.off", GridOff(8, 8, true)));
+  PathQuery far_path;
+  far_path.from = SurfacePoint::AtVertex(0);
+  far_path.to = SurfacePoint::AtPosition(2, 2, 50);
+  client::CallOptions strict;
+  strict.max_snap = 1;
+  absl::StatusOr<PathQueryResult> refused = client.ShortestPath(mesh, far_path, strict);
+  ASSERT_TRUE(absl::IsInvalidArgument(refused.status())) << refused.status();
+  EXPECT_EQ(client::FieldViolationOf(refused.status())->field, "to.position");
+  ASSERT_TRUE(client.ShortestPath(mesh, far_path).ok());  // the client's own: any snap
+
+  // A field no cache holds (its own max_distance) with a 1 us deadline: DEADLINE_EXCEEDED; the
+  // next call has the client's 60 s.
+  FieldQuery query{{SurfacePoint::AtVertex(5)}, {}, false};
+  query.options.max_distance = 1e9 + 17;
+  client::CallOptions hurried;
+  hurried.deadline_seconds = 1e-6;
+  EXPECT_TRUE(absl::IsDeadlineExceeded(client.Field(mesh, query, nullptr, hurried).status()));
+  EXPECT_EQ(client.deadline_seconds(), 60);
+  EXPECT_TRUE(client.Field(mesh, query).ok());
+}
+
+// Every result of a query that took 3D positions says how far each moved onto the surface, as
+// LocatePoints does (0 for a point given on the surface).
+TEST_F(ClientTest, ResultsCarryTheSnapDistances) {
+  StartServer();
+  GeodexClient client = Client();
+  MeshRef mesh = *client.ResolveMesh(WriteFile("client-snaps.off", GridOff(8, 8, true)));
+  const SurfacePoint above = SurfacePoint::AtPosition(2.5, 3.5, 20);
+  absl::StatusOr<std::vector<LocatedPoint>> located = client.Locate(mesh, {above.position});
+  ASSERT_TRUE(located.ok()) << located.status();
+  const double snap = (*located)[0].distance;
+  ASSERT_GT(snap, 10);
+
+  PathQuery path_query;
+  path_query.from = SurfacePoint::AtVertex(0);
+  path_query.to = above;
+  absl::StatusOr<PathQueryResult> path = client.ShortestPath(mesh, path_query);
+  ASSERT_TRUE(path.ok()) << path.status();
+  EXPECT_EQ(path->snap_distances, (std::vector<double>{0, snap}));
+
+  absl::StatusOr<DistanceField> field = client.Field(mesh, FieldQuery{{above}, {}, false});
+  ASSERT_TRUE(field.ok()) << field.status();
+  EXPECT_EQ(field->snap_distances, std::vector<double>{snap});
+
+  MatrixQuery matrix_query;
+  matrix_query.sources = {above, SurfacePoint::AtVertex(3)};
+  matrix_query.targets = {SurfacePoint::AtVertex(9)};
+  absl::StatusOr<DistanceMatrix> matrix = client.Matrix(mesh, matrix_query);
+  ASSERT_TRUE(matrix.ok()) << matrix.status();
+  EXPECT_EQ(matrix->snap_distances, (std::vector<double>{snap, 0, 0}));
+
+  PointQuery point_query;
+  point_query.sources = {SurfacePoint::AtVertex(0)};
+  point_query.points = {above};
+  absl::StatusOr<client::PointDistances> at =
+      client.DistancesAtPoints(mesh, point_query, client::PointDistanceMode::kExact);
+  ASSERT_TRUE(at.ok()) << at.status();
+  EXPECT_EQ(at->snap_distances, (std::vector<double>{0, snap}));
+}
+
+// The asynchronous form answers what the blocking one does, and a call waiting for a worker is
+// cancelled at once (the worker is held by the test until after the cancel has answered).
+TEST_F(ClientTest, AnAsyncCallAnswersAsTheBlockingOneAndCanBeCancelled) {
+  ServerOptions options;
+  options.pool_threads = 1;
+  options.queue_capacity = 4;
+  StartServer(options);
+  GeodexClient client = Client();
+  const std::string off = GridOff(8, 8, true);
+  MeshRef mesh = *client.ResolveMesh(WriteFile("client-async.off", off));
+  PathQuery path_query;
+  path_query.from = SurfacePoint::AtVertex(0);
+  path_query.to = SurfacePoint::AtVertex(80);
+  absl::StatusOr<PathQueryResult> blocking = client.ShortestPath(mesh, path_query);
+  ASSERT_TRUE(blocking.ok()) << blocking.status();
+  client::AsyncCall<PathQueryResult> async = client.ShortestPathAsync(mesh, path_query);
+  absl::StatusOr<PathQueryResult> answered = async.Get();
+  ASSERT_TRUE(answered.ok()) << answered.status();
+  EXPECT_EQ(answered->distance, blocking->distance);
+  EXPECT_EQ(answered->path.points.size(), blocking->path.points.size());
+
+  // The only worker held: a field (not cached: its own max_distance) waits in the queue.
+  testing::Notification release;
+  ASSERT_TRUE(server_->pool().TrySubmit([&release] { release.WaitForNotification(); }));
+  for (int i = 0; i < 6000 && server_->pool().busy() == 0; ++i)
+    absl::SleepFor(absl::Milliseconds(5));
+  FieldQuery query{{SurfacePoint::AtVertex(7)}, {}, false};
+  query.options.max_distance = 1e9 + 23;
+  client::AsyncCall<DistanceField> waiting = client.FieldAsync(mesh, query);
+  EXPECT_FALSE(waiting.Ready(0.3));  // still queued behind the held worker
+  waiting.Cancel();
+  ASSERT_TRUE(waiting.Ready(30)) << "the cancelled call did not answer";
+  EXPECT_TRUE(absl::IsCancelled(waiting.Get().status()));
+  release.Notify();
+
+  // A Cancellation cancelled before the call: nothing is sent.
+  auto cancelled = std::make_shared<client::Cancellation>();
+  cancelled->Cancel();
+  const int calls_before = client.calls();
+  client::CallOptions call;
+  call.cancel = cancelled;
+  EXPECT_TRUE(absl::IsCancelled(client.ShortestPath(mesh, path_query, call).status()));
+  EXPECT_EQ(client.calls(), calls_before);
+}
+
+// One client shared by threads calling at once: every answer is core's.
+TEST_F(ClientTest, OneClientServesManyThreadsAtOnce) {
+  StartServer();
+  GeodexClient client = Client();
+  const std::string off = GridOff(9, 9, true);
+  const MeshRef mesh = *client.ResolveMesh(WriteFile("client-threads.off", off));
+  const TriangleMesh local = testing::BuildLocal(off);
+  constexpr int kThreads = 4, kCalls = 8;
+  std::vector<std::thread> threads;
+  std::vector<int> wrong(kThreads, 0);
+  for (int t = 0; t < kThreads; ++t) {
+    threads.emplace_back([&, t] {
+      MeshRef own = mesh;  // a MeshRef per thread (a re-upload may update it)
+      for (int i = 0; i < kCalls; ++i) {
+        PathQuery q;
+        q.from = SurfacePoint::AtVertex(static_cast<uint32_t>(t));
+        q.to = SurfacePoint::AtVertex(static_cast<uint32_t>(40 + 3 * i));
+        absl::StatusOr<PathQueryResult> got = client.ShortestPath(own, q);
+        absl::StatusOr<PathQueryResult> expected = ComputeShortestPath(local, q.from, q.to);
+        if (!got.ok() || !expected.ok() || got->distance != expected->distance) ++wrong[t];
+      }
+    });
+  }
+  for (std::thread& thread : threads) thread.join();
+  EXPECT_EQ(wrong, std::vector<int>(kThreads, 0));
+  EXPECT_GE(client.calls(), kThreads * kCalls);
 }
 
 TEST(ClientRetryTest, UnavailableIsRetriedWithBackoffThenReported) {

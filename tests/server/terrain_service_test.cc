@@ -195,6 +195,20 @@ TEST_F(TerrainServiceTest, GeoTiffUploadKeepsItsMapAndTakesMapPoints) {
   EXPECT_EQ(t.driver(), "GTiff");
   ASSERT_EQ(t.geotransform_size(), 6);
   EXPECT_EQ(t.geotransform(1), 10);
+  // The C++ client gives the same map as plain values (ServerMesh::map: its header names no
+  // generated or uninstalled type).
+  client::ClientOptions client_options;
+  client_options.target = absl::StrCat("127.0.0.1:", server_->port());
+  client::GeodexClient client(client_options);
+  absl::StatusOr<client::ServerMesh> got = client.GetMesh(up.mesh.name());
+  ASSERT_TRUE(got.ok()) << got.status();
+  ASSERT_TRUE(got->map.has_value());
+  EXPECT_EQ(got->map->crs_name, t.crs_name());
+  EXPECT_EQ(got->map->crs_wkt, t.crs_wkt());
+  EXPECT_EQ(got->map->grid_width, 30u);
+  EXPECT_EQ(got->map->nodata_cells, 50u);
+  EXPECT_EQ(got->map->driver, "GTiff");
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(got->map->geotransform[i], t.geotransform(i)) << i;
 
   // A map point in the raster's CRS, and a longitude/latitude: the server drops them where the
   // CLI does, and the fields are the same to the bit.

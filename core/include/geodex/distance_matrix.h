@@ -21,6 +21,10 @@ struct DistanceMatrix {
   size_t rows = 0, cols = 0;
   std::vector<double> values;
   SolveStats stats;  // summed over the solves (solve_ms: total)
+  // geodexd's answers only (the client library): how far each point given as a 3D position
+  // (SurfacePoint::kPosition) moved onto the surface, the sources' then the targets'; 0 for a point given on the
+  // surface. Core's own queries take surface points and leave it empty.
+  std::vector<double> snap_distances;
 };
 
 // The k_nearest rule of a matrix row: the k smallest of `row[0..n)` keep their values (ties: the

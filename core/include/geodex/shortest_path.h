@@ -83,6 +83,10 @@ struct PathQueryResult {
   double distance = kUnreachable;
   GeodesicPath path;  // from `from` to `to`
   SolveStats stats;
+  // geodexd's answers only (the client library): how far each point given as a 3D position
+  // (SurfacePoint::kPosition) moved onto the surface, `from`'s then `to`'s; 0 for a point given on the
+  // surface. Core's own queries take surface points and leave it empty.
+  std::vector<double> snap_distances;
 };
 
 // The exact shortest path between two surface points, with its length.
