@@ -73,7 +73,8 @@ ServerMesh ServerMeshFromProto(const v1::Mesh& m) {
     map.horizontal_scale = t.horizontal_scale();
     map.vertical_unit = t.vertical_unit();
     map.vertical_scale = t.vertical_scale();
-    for (int i = 0; i < t.geotransform_size() && i < 6; ++i) map.geotransform[i] = t.geotransform(i);
+    for (int i = 0; i < t.geotransform_size() && i < 6; ++i)
+      map.geotransform[i] = t.geotransform(i);
     map.z_tolerance = t.z_tolerance();
     map.max_vertical_deviation = t.max_vertical_deviation();
     map.rms_vertical_deviation = t.rms_vertical_deviation();
@@ -287,9 +288,8 @@ grpc::Status GeodexClient::Call(const std::string& mesh_id,
     if (status.error_code() == grpc::StatusCode::UNAVAILABLE) {
       if (reconnect_until == kNotWaiting) {
         reconnect_until =
-            Clock::now() +
-            std::chrono::microseconds(static_cast<int64_t>(
-                std::min(options_.reconnect_wait_seconds, deadline_seconds) * 1e6));
+            Clock::now() + std::chrono::microseconds(static_cast<int64_t>(
+                               std::min(options_.reconnect_wait_seconds, deadline_seconds) * 1e6));
       }
       if (Clock::now() < reconnect_until) continue;
       break;
@@ -529,14 +529,14 @@ absl::Status GeodexClient::ReadStream(MeshRef& mesh, Start start, Assembler* out
   grpc::Status status = MeshCall(
       mesh,
       [&](grpc::ClientContext* context) {
-    *out = Assembler();
-    auto reader = start(context);
-    typename Assembler::Message message;
-    while (reader->Read(&message)) {
-      out->Add(message);
-      on_message(*out);
-    }
-    return reader->Finish();
+        *out = Assembler();
+        auto reader = start(context);
+        typename Assembler::Message message;
+        while (reader->Read(&message)) {
+          out->Add(message);
+          on_message(*out);
+        }
+        return reader->Finish();
       },
       options);
   return status.ok() ? absl::OkStatus() : ToAbsl(status);
@@ -665,7 +665,7 @@ absl::StatusOr<std::vector<LocatedPoint>> GeodexClient::Locate(
 }
 
 absl::StatusOr<Isolines> GeodexClient::ComputeIsolines(MeshRef& mesh, const IsolineQuery& query,
-    const CallOptions& call) {
+                                                       const CallOptions& call) {
   v1::ComputeIsolinesRequest request;
   request.set_mesh(mesh.name);
   api::IsolineQueryToProto(query, &request);
@@ -682,7 +682,7 @@ absl::StatusOr<Isolines> GeodexClient::ComputeIsolines(MeshRef& mesh, const Isol
 
 absl::StatusOr<VoronoiDiagram> GeodexClient::ComputeVoronoi(MeshRef& mesh,
                                                             const VoronoiQuery& query,
-    const CallOptions& call) {
+                                                            const CallOptions& call) {
   v1::ComputeVoronoiRequest request;
   request.set_mesh(mesh.name);
   api::VoronoiQueryToProto(query, &request);
@@ -699,7 +699,7 @@ absl::StatusOr<VoronoiDiagram> GeodexClient::ComputeVoronoi(MeshRef& mesh,
 
 absl::StatusOr<DelaunayTriangulation> GeodexClient::ComputeDelaunay(MeshRef& mesh,
                                                                     const DelaunayQuery& query,
-    const CallOptions& call) {
+                                                                    const CallOptions& call) {
   v1::ComputeDelaunayRequest request;
   request.set_mesh(mesh.name);
   api::DelaunayQueryToProto(query, &request);
@@ -716,19 +716,16 @@ absl::StatusOr<DelaunayTriangulation> GeodexClient::ComputeDelaunay(MeshRef& mes
 
 AsyncCall<PathQueryResult> GeodexClient::ShortestPathAsync(MeshRef mesh, PathQuery query,
                                                            CallOptions call) {
-  return Async<PathQueryResult>(
-      std::move(mesh), std::move(query), std::move(call),
-      [](GeodexClient& client, MeshRef& m, const PathQuery& q, const CallOptions& c) {
-        return client.ShortestPath(m, q, c);
-      });
+  return Async<PathQueryResult>(std::move(mesh), std::move(query), std::move(call),
+                                [](GeodexClient& client, MeshRef& m, const PathQuery& q,
+                                   const CallOptions& c) { return client.ShortestPath(m, q, c); });
 }
 
-AsyncCall<DistanceField> GeodexClient::FieldAsync(MeshRef mesh, FieldQuery query, CallOptions call) {
-  return Async<DistanceField>(
-      std::move(mesh), std::move(query), std::move(call),
-      [](GeodexClient& client, MeshRef& m, const FieldQuery& q, const CallOptions& c) {
-        return client.Field(m, q, nullptr, c);
-      });
+AsyncCall<DistanceField> GeodexClient::FieldAsync(MeshRef mesh, FieldQuery query,
+                                                  CallOptions call) {
+  return Async<DistanceField>(std::move(mesh), std::move(query), std::move(call),
+                              [](GeodexClient& client, MeshRef& m, const FieldQuery& q,
+                                 const CallOptions& c) { return client.Field(m, q, nullptr, c); });
 }
 
 AsyncCall<PointDistances> GeodexClient::DistancesAtPointsAsync(MeshRef mesh, PointQuery query,
@@ -743,11 +740,9 @@ AsyncCall<PointDistances> GeodexClient::DistancesAtPointsAsync(MeshRef mesh, Poi
 
 AsyncCall<DistanceMatrix> GeodexClient::MatrixAsync(MeshRef mesh, MatrixQuery query,
                                                     CallOptions call) {
-  return Async<DistanceMatrix>(
-      std::move(mesh), std::move(query), std::move(call),
-      [](GeodexClient& client, MeshRef& m, const MatrixQuery& q, const CallOptions& c) {
-        return client.Matrix(m, q, c);
-      });
+  return Async<DistanceMatrix>(std::move(mesh), std::move(query), std::move(call),
+                               [](GeodexClient& client, MeshRef& m, const MatrixQuery& q,
+                                  const CallOptions& c) { return client.Matrix(m, q, c); });
 }
 
 }  // namespace geodex::client

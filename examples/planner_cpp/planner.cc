@@ -93,9 +93,11 @@ int RunPlanner(const std::string& target, const std::string& mesh_file, uint32_t
       client.ShortestPathAsync(*mesh, path_query);
   absl::StatusOr<geodex::PathQueryResult> later = pending.Get();
   if (!later.ok()) return Fail("async path", later.status());
-  std::printf("async path: %s\n", later->distance == path->distance ? "the same length" : "differs");
+  std::printf("async path: %s\n",
+              later->distance == path->distance ? "the same length" : "differs");
   field_query.options.max_distance = 2e9 + static_cast<double>(getpid());  // solved, not cached
-  geodex::client::AsyncCall<geodex::DistanceField> cancelled = client.FieldAsync(*mesh, field_query);
+  geodex::client::AsyncCall<geodex::DistanceField> cancelled =
+      client.FieldAsync(*mesh, field_query);
   cancelled.Cancel();
   absl::StatusOr<geodex::DistanceField> gone = cancelled.Get();
   // (A field this small may finish before the cancel reaches it: then it answers.)

@@ -357,8 +357,7 @@ void MatrixAssembler::Add(const v1::ComputeDistanceMatrixResponse& message) {
   matrix_.rows = message.rows();
   matrix_.cols = message.cols();
   if (message.snap_distances_size() > 0) {  // the first message's
-    matrix_.snap_distances.assign(message.snap_distances().begin(),
-                                  message.snap_distances().end());
+    matrix_.snap_distances.assign(message.snap_distances().begin(), message.snap_distances().end());
   }
   matrix_.values.insert(matrix_.values.end(), message.values_f64().begin(),
                         message.values_f64().end());

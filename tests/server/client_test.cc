@@ -9,10 +9,10 @@
 
 #include "absl/time/clock.h"
 #include "geodex/geodesic_solver.h"
-#include "geodex/shortest_path.h"
 #include "geodex/geodex_client.h"
 #include "geodex/mesh_id.h"
 #include "geodex/samples.h"
+#include "geodex/shortest_path.h"
 #include "server_test_util.h"
 
 namespace geodex::server {
@@ -182,7 +182,10 @@ TEST_F(ClientTest, QueueFullIsRetriedWithBackoffButALimitIsNot) {
 
 // A call's own CallOptions (deadline, max_snap) apply to that call alone.
 TEST_F(ClientTest, PerCallOptionsApplyToThatCallAlone) {
-  StartServer();
+  ServerOptions options;
+  options.pool_threads = 1;
+  options.queue_capacity = 4;
+  StartServer(options);
   GeodexClient client = Client();  // deadline 60 s, any snap
   MeshRef mesh = *client.ResolveMesh(WriteFile("client-per-call.off", GridOff(8, 8, true)));
   PathQuery far_path;
@@ -195,15 +198,22 @@ TEST_F(ClientTest, PerCallOptionsApplyToThatCallAlone) {
   EXPECT_EQ(client::FieldViolationOf(refused.status())->field, "to.position");
   ASSERT_TRUE(client.ShortestPath(mesh, far_path).ok());  // the client's own: any snap
 
-  // A field no cache holds (its own max_distance) with a 1 us deadline: DEADLINE_EXCEEDED; the
-  // next call has the client's 60 s.
+  // The only worker held by the test: a field waits in the queue, and a call with a 0.2 s
+  // deadline of its own is DEADLINE_EXCEEDED; once the worker is free, the next call (the
+  // client's 60 s) answers.
+  testing::Notification release;
+  ASSERT_TRUE(server_->pool().TrySubmit([&release] { release.WaitForNotification(); }));
+  for (int i = 0; i < 6000 && server_->pool().busy() == 0; ++i)
+    absl::SleepFor(absl::Milliseconds(5));
   FieldQuery query{{SurfacePoint::AtVertex(5)}, {}, false};
-  query.options.max_distance = 1e9 + 17;
   client::CallOptions hurried;
-  hurried.deadline_seconds = 1e-6;
-  EXPECT_TRUE(absl::IsDeadlineExceeded(client.Field(mesh, query, nullptr, hurried).status()));
+  hurried.deadline_seconds = 0.2;
+  absl::Status hurried_status = client.Field(mesh, query, nullptr, hurried).status();
+  EXPECT_TRUE(absl::IsDeadlineExceeded(hurried_status)) << hurried_status;
+  release.Notify();
   EXPECT_EQ(client.deadline_seconds(), 60);
-  EXPECT_TRUE(client.Field(mesh, query).ok());
+  absl::StatusOr<DistanceField> field = client.Field(mesh, query);
+  EXPECT_TRUE(field.ok()) << field.status();
 }
 
 // Every result of a query that took 3D positions says how far each moved onto the surface, as

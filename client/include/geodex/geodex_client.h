@@ -65,10 +65,10 @@ namespace geodex::client {
 // A DEM's map as geodexd keeps it with the mesh (geodex.v1.Terrain, in the client's terms; plain
 // values: reading the CRS is the caller's, e.g. with GDAL/PROJ from `crs_wkt`).
 struct ServerTerrain {
-  std::string driver;                       // GDAL's driver of the raster ("GTiff")
+  std::string driver;                            // GDAL's driver of the raster ("GTiff")
   uint32_t raster_width = 0, raster_height = 0;  // the raster's size in cells
-  uint32_t step = 1;                        // every step-th cell was used
-  uint32_t grid_width = 0, grid_height = 0;  // the used cells
+  uint32_t step = 1;                             // every step-th cell was used
+  uint32_t grid_width = 0, grid_height = 0;      // the used cells
   uint64_t nodata_cells = 0, barrier_cells = 0, barrier_faces = 0;
   std::string crs_name, crs_wkt;            // the raster's CRS (map points are in it)
   bool reprojected = false;                 // geographic raster: the mesh is in mesh_crs (UTM)
@@ -375,12 +375,11 @@ template <typename T, typename Query, typename Run>
 AsyncCall<T> GeodexClient::Async(MeshRef mesh, Query query, CallOptions call, Run run) {
   if (call.cancel == nullptr) call.cancel = std::make_shared<Cancellation>();
   std::shared_ptr<Cancellation> cancel = call.cancel;
-  return AsyncCall<T>(std::async(std::launch::async,
-                                 [this, mesh = std::move(mesh), query = std::move(query),
-                                  call = std::move(call), run]() mutable -> absl::StatusOr<T> {
-                                   return run(*this, mesh, query, call);
-                                 }),
-                      std::move(cancel));
+  return AsyncCall<T>(
+      std::async(std::launch::async,
+                 [this, mesh = std::move(mesh), query = std::move(query), call = std::move(call),
+                  run]() mutable -> absl::StatusOr<T> { return run(*this, mesh, query, call); }),
+      std::move(cancel));
 }
 
 }  // namespace geodex::client

@@ -22,8 +22,8 @@ struct DistanceMatrix {
   std::vector<double> values;
   SolveStats stats;  // summed over the solves (solve_ms: total)
   // geodexd's answers only (the client library): how far each point given as a 3D position
-  // (SurfacePoint::kPosition) moved onto the surface, the sources' then the targets'; 0 for a point given on the
-  // surface. Core's own queries take surface points and leave it empty.
+  // (SurfacePoint::kPosition) moved onto the surface, the sources' then the targets'; 0 for a point
+  // given on the surface. Core's own queries take surface points and leave it empty.
   std::vector<double> snap_distances;
 };
 

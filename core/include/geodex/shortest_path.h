@@ -84,8 +84,8 @@ struct PathQueryResult {
   GeodesicPath path;  // from `from` to `to`
   SolveStats stats;
   // geodexd's answers only (the client library): how far each point given as a 3D position
-  // (SurfacePoint::kPosition) moved onto the surface, `from`'s then `to`'s; 0 for a point given on the
-  // surface. Core's own queries take surface points and leave it empty.
+  // (SurfacePoint::kPosition) moved onto the surface, `from`'s then `to`'s; 0 for a point given on
+  // the surface. Core's own queries take surface points and leave it empty.
   std::vector<double> snap_distances;
 };
 
