@@ -13,30 +13,15 @@
 #include "cli_backend.h"
 #include "geodex/locate.h"
 #include "geodex/point_distance.h"
+#include "geodex/solve_key.h"
 #include "geodex/triangle_mesh.h"
 
 namespace geodex::cli {
 namespace {
 
+// The answer a field cache may reuse: core's SolveKey, the rule geodexd's result cache keeps.
 std::string Key(const std::vector<SurfacePoint>& sources, const GeodesicOptions& o) {
-  std::string key = absl::StrFormat("%d|%.17g|%d|%.17g|%d|%d|%d|", static_cast<int>(o.method),
-                                    o.lambda, static_cast<int>(o.lambda_scale), o.max_distance,
-                                    o.max_windows, o.use_filter, o.use_one_angle_one_split);
-  if (o.travel.has_value()) {  // a travel field is another field; weights and table by content
-    const TravelCost& t = *o.travel;
-    absl::StrAppend(
-        &key, absl::StrFormat("travel %d|%.17g|%.17g|%.17g|%d|%d|", static_cast<int>(t.speed_model),
-                              t.speed_kmh, TravelEpsilon(t), t.max_slope_deg, t.max_steiner_points,
-                              t.inbound));
-    auto bytes = [](const auto* v) {
-      return v == nullptr ? std::string("-")
-                          : std::string(reinterpret_cast<const char*>(v->data()),
-                                        v->size() * sizeof((*v)[0]));
-    };
-    absl::StrAppend(&key, bytes(t.face_weight.get()), "|", bytes(t.speed_table.get()), "|");
-  }
-  for (const SurfacePoint& p : sources) absl::StrAppend(&key, SurfacePointToString(p), ",");
-  return key;
+  return SolveKey(sources, o);
 }
 
 // Core says NOT_FOUND for a target no source reaches; as geodexd does, the CLI treats that as a

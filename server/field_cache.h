@@ -30,9 +30,8 @@
 
 namespace geodex::server {
 
-// The key of a field: mesh id, every source bit for bit, lambda, its scale, max_distance and the
-// travel cost (none, or its speed, epsilon, slope limit and the SHA-256 of its face weights): a
-// travel field is never served for a plain request, nor for another travel cost.
+// The key of a field: the mesh id and core's SolveKey (geodex/solve_key.h: every source and every
+// option that changes the answer, the travel cost included), the rule the CLI's cache keeps too.
 std::string FieldCacheKey(const std::string& mesh_id, const std::vector<SurfacePoint>& sources,
                           const GeodesicOptions& options);
 

@@ -12,6 +12,7 @@
 
 #include "absl/strings/cord.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "absl/strings/strip.h"
 #include "field_cache.h"
 #include "geodex/delaunay.h"
@@ -65,6 +66,18 @@ absl::StatusOr<std::vector<SurfacePoint>> ResolveSources(const QueryEnv& env,
 
 namespace {
 
+// What reading GeoJSON on a mesh depends on beyond the mesh itself: its map (the CRS it projects
+// polygons into, the grid's geotransform and units), or none.
+std::string MapContextKey(const std::optional<terrain::DemInfo>& map) {
+  if (!map.has_value()) return "no map";
+  std::string key = absl::StrCat(map->file_crs_wkt, "|", map->mesh_crs_wkt, "|", map->reprojected,
+                                 "|", map->step, "|", map->grid_width, "x", map->grid_height);
+  for (double g : map->geotransform) absl::StrAppend(&key, absl::StrFormat("|%.17g", g));
+  absl::StrAppend(&key,
+                  absl::StrFormat("|%.17g|%.17g", map->horizontal_scale, map->vertical_scale));
+  return Sha256Hex(key);
+}
+
 // A travel cost's face weights on `mesh`: null (every face 1), the request's face_weights, or the
 // friction of its GeoJSON polygons.
 absl::StatusOr<std::shared_ptr<const std::vector<double>>> TravelWeights(
@@ -76,10 +89,13 @@ absl::StatusOr<std::shared_ptr<const std::vector<double>>> TravelWeights(
                                                        travel.face_weights().end());
   }
   if (travel.friction_geojson().empty()) return nullptr;
-  // Friction read before from the same text on this mesh is in the result cache (as a field's
-  // `distance`, like a matrix's values): a repeated request, and its cached field, need no
-  // reading. Otherwise every face's centroid goes against the polygons: solve-lane work.
-  const std::string key = absl::StrCat(mesh.id, "|friction|", Sha256Hex(travel.friction_geojson()));
+  // Friction read before from the same text on this mesh in the same map is in the result cache
+  // (as a field's `distance`, like a matrix's values): a repeated request, and its cached field,
+  // need no reading. Otherwise every face's centroid goes against the polygons: solve-lane work.
+  // The map is part of the key: a mesh uploaded as a file gains one when its GeoTIFF is uploaded
+  // (the same id), and the same GeoJSON then lands elsewhere (projected from its CRS).
+  const std::string key = absl::StrCat(mesh.id, "|friction|", MapContextKey(mesh.terrain), "|",
+                                       Sha256Hex(travel.friction_geojson()));
   if (std::shared_ptr<const DistanceField> hit = env.cache->Find(key, !env.quick)) {
     return std::shared_ptr<const std::vector<double>>(hit, &hit->distance);
   }

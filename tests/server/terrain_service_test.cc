@@ -8,6 +8,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <chrono>
@@ -847,6 +848,58 @@ TEST_F(TerrainServiceTest, TravelWithFrictionInTheDemsMap) {
     EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
     EXPECT_EQ(BadField(status), "options.travel") << status.error_message();
   }
+}
+
+// Friction read on a mesh is cached with the map it was read in: a mesh uploaded as a file has
+// none (the GeoJSON's coordinates are its own x and y), and when the same mesh's GeoTIFF is
+// uploaded (the same id) it gains one, and the same request must read the polygons in it (issue
+// 55: it used to answer from the weights read without the map).
+TEST_F(TerrainServiceTest, FrictionReadBeforeTheMeshGainedItsMapIsNotReused) {
+  StartServer();
+  absl::StatusOr<terrain::Dem> local = terrain::Dem::Read(tif_);
+  ASSERT_TRUE(local.ok()) << local.status();
+  const std::string off = (dir_ / "in" / "gain.off").string();
+  ASSERT_TRUE(WriteMeshOff(off, local->mesh()).ok());
+  std::ifstream in(off, std::ios::binary);
+  const std::string off_bytes((std::istreambuf_iterator<char>(in)),
+                              std::istreambuf_iterator<char>());
+  ASSERT_TRUE(testing::Upload(*stub_, off_bytes, "gain").status.ok());
+  // Friction 3 west of about x = 500100 in longitude/latitude (RFC 7946): in the DEM's map the
+  // western third; as the file mesh's own x and y (metres from 500000), far off the mesh.
+  const std::string friction_text = R"({"type": "FeatureCollection", "features": [
+      {"type": "Feature", "properties": {"friction": 3}, "geometry": {"type": "Polygon",
+       "coordinates": [[[14.99, 45.0], [15.0012, 45.0], [15.0012, 45.3], [14.99, 45.3],
+                        [14.99, 45.0]]]}}]})";
+  v1::ComputeDistanceFieldRequest request;
+  request.set_mesh("meshes/gain");
+  request.add_sources()->set_vertex(0);
+  request.mutable_options()->mutable_travel()->set_speed_kmh(5);
+  request.mutable_options()->mutable_travel()->set_epsilon(0.1);
+  request.mutable_options()->mutable_travel()->set_friction_geojson(friction_text);
+  testing::FieldResult without_map = testing::ReadField(*stub_, request);
+  ASSERT_TRUE(without_map.status.ok()) << without_map.status.error_message();
+
+  ASSERT_TRUE(UploadDem(bytes_, "").status.ok());  // the same mesh gains its map
+  testing::FieldResult with_map = testing::ReadField(*stub_, request);
+  ASSERT_TRUE(with_map.status.ok()) << with_map.status.error_message();
+
+  // What a server that only ever had the GeoTIFF answers: the friction read in the map.
+  absl::StatusOr<std::vector<double>> weights =
+      terrain::FrictionFromGeoJson(local->mesh(), friction_text, &local->info(), "friction");
+  ASSERT_TRUE(weights.ok()) << weights.status();
+  ASSERT_GT(*std::max_element(weights->begin(), weights->end()), 1);  // the polygon is on the DEM
+  absl::StatusOr<TriangleMesh> built = TriangleMesh::Build(local->mesh());
+  ASSERT_TRUE(built.ok());
+  GeodesicOptions options;
+  options.travel = TravelCost{};
+  options.travel->speed_kmh = 5;
+  options.travel->epsilon = 0.1;
+  options.travel->face_weight = std::make_shared<const std::vector<double>>(*weights);
+  absl::StatusOr<DistanceField> want =
+      ComputeDistanceField(*built, {SurfacePoint::AtVertex(0)}, options);
+  ASSERT_TRUE(want.ok()) << want.status();
+  EXPECT_EQ(with_map.distances, want->distance);
+  EXPECT_NE(without_map.distances, want->distance);  // the two readings differ: the test can fail
 }
 
 // ExportGis: the files the CLI writes, made by geodexd from a stored DEM's mesh.
