@@ -46,6 +46,9 @@ namespace geodex::cli {
 
 bool ParseArgs(int argc, char** argv, int first, const std::vector<std::string>& boolean_flags,
                Args* out, std::string* error) {
+  out->command_line = "geodex";
+  for (int i = std::max(first - 1, 1); i < argc; ++i)
+    absl::StrAppend(&out->command_line, " ", argv[i]);
   const std::set<std::string> booleans(boolean_flags.begin(), boolean_flags.end());
   const std::set<std::string> repeatable(std::begin(kRepeatableFlags), std::end(kRepeatableFlags));
   auto add = [&](const std::string& key, const std::string& value) {
@@ -327,7 +330,8 @@ bool IsVectorPath(const Args& args) {
 }
 
 int WriteVectorOutput(const Backend& backend, const Args& args,
-                      const std::vector<terrain::GeoFeature>& features) {
+                      const std::vector<terrain::GeoFeature>& features,
+                      const GeodesicOptions* options) {
   const std::string& path = args.options.at("output");
   const terrain::Dem* dem = backend.Terrain();
   if (dem == nullptr) {
@@ -336,7 +340,8 @@ int WriteVectorOutput(const Backend& backend, const Args& args,
   }
   // --crs was checked with the mesh's other reading options (OpenMesh).
   const bool native = args.options.count("crs") && args.options.at("crs") == "native";
-  absl::Status written = terrain::WriteVectorFile(dem->info(), features, path, native);
+  const terrain::Provenance provenance = terrain::MakeProvenance(args.command_line, options);
+  absl::Status written = terrain::WriteVectorFile(dem->info(), features, path, native, &provenance);
   if (!written.ok()) return Fail(kExitUsage, std::string(written.message()));
   return kExitOk;
 }

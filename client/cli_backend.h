@@ -126,8 +126,11 @@ int FailQuery(const absl::Status& status);
 // `features` (mesh coordinates of the backend's DEM), GeoJSON as RFC 7946 unless --crs native, the
 // others in the DEM's CRS. Exit 2 without a DEM, or when FILE cannot be written (the reason given).
 bool IsVectorPath(const Args& args);
+// The file records what made it (terrain::Provenance: the command line, and what `options`, when
+// given, make of the values).
 int WriteVectorOutput(const Backend& backend, const Args& args,
-                      const std::vector<terrain::GeoFeature>& features);
+                      const std::vector<terrain::GeoFeature>& features,
+                      const GeodesicOptions* options = nullptr);
 // How MESH is read (--dem-step, --barrier-below, --barrier) and GeoJSON written (--crs), checked:
 // InvalidArgument naming the flag.
 absl::StatusOr<terrain::DemOptions> MeshReadOptions(const Args& args, const std::string& mesh);

@@ -451,7 +451,8 @@ int RunDistances(Backend& backend, const Args& args) {
       if (int code = WriteVectorOutput(
               backend, args,
               terrain::PointFeatures(
-                  points, query.options.travel.has_value() ? &*query.options.travel : nullptr));
+                  points, query.options.travel.has_value() ? &*query.options.travel : nullptr),
+              &query.options);
           code != kExitOk) {
         return code;
       }
@@ -468,6 +469,7 @@ int RunDistances(Backend& backend, const Args& args) {
       absl::StatusOr<terrain::CellValues> cells =
           terrain::SampleCells(*dem, **field, nullptr, &query.options);
       if (!cells.ok()) return FailQuery(cells.status());
+      cells->provenance = terrain::MakeProvenance(args.command_line, &query.options);
       if (raster) written = dem->WriteDistanceRaster(output, *cells);
       if (written.ok() && !labels_output.empty()) {
         written = dem->WriteLabelRaster(labels_output, *cells);
@@ -603,7 +605,8 @@ int RunPath(Backend& backend, const Args& args) {
             backend, args,
             {terrain::PathFeature(
                 result->path.points, result->path.length,
-                options.solver.travel.has_value() ? result->distance : std::nan(""))});
+                options.solver.travel.has_value() ? result->distance : std::nan(""))},
+            &options.solver);
         code != kExitOk) {
       return code;
     }

@@ -28,6 +28,9 @@ struct Args {
   // first value here, and to all of them, in order, in `lists`.
   std::map<std::string, std::string> options;
   std::map<std::string, std::vector<std::string>> lists;
+  // "geodex COMMAND ARGS..." as given (from the command on: no global option, no token), recorded
+  // in the GIS files the command writes (terrain::Provenance).
+  std::string command_line;
   // Every value of `key`: lists' when repeatable, else the one value (none when absent).
   std::vector<std::string> All(const std::string& key) const;
 };

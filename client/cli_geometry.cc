@@ -290,7 +290,8 @@ int RunIsolines(Backend& backend, const Args& args) {
         backend, args,
         terrain::IsochroneFeatures(
             *s.data, (*field)->distance, iso->levels,
-            query.options.travel.has_value() ? &*query.options.travel : nullptr));
+            query.options.travel.has_value() ? &*query.options.travel : nullptr),
+        &query.options);
   }
   if (format == Format::kObj) return WriteOutput(args, Obj("isolines", lines));
   if (format == Format::kSvg)
@@ -363,7 +364,7 @@ int RunVoronoi(Backend& backend, const Args& args) {
   json += "]}\n";
   if (format == Format::kGeoJson) {
     // One (Multi)Polygon per site: its whole faces and its fragments, unioned.
-    return WriteVectorOutput(backend, args, terrain::VoronoiFeatures(*s.data, *vd));
+    return WriteVectorOutput(backend, args, terrain::VoronoiFeatures(*s.data, *vd), &query.options);
   }
   if (format == Format::kObj) return WriteOutput(args, Obj("voronoi", lines));
   if (format == Format::kSvg)
@@ -448,7 +449,7 @@ int RunDelaunay(Backend& backend, const Args& args) {
   json += "]}\n";
   if (format == Format::kGeoJson) {
     // One 3D LineString per Delaunay edge: the geodesic between its two sites.
-    return WriteVectorOutput(backend, args, terrain::DelaunayFeatures(*dt));
+    return WriteVectorOutput(backend, args, terrain::DelaunayFeatures(*dt), &query.options);
   }
   if (format == Format::kObj) return WriteOutput(args, Obj("delaunay", lines));
   if (format == Format::kSvg)

@@ -97,11 +97,16 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
   const uint32_t chunk = env.limits->stream_chunk_bytes;
   const char* kGeoJson = "application/geo+json";
   double travel_epsilon = 0;  // set once the options are resolved
+  // What made the file, recorded in it (terrain::Provenance): the request, and its options once
+  // they are resolved.
+  const std::string made_by =
+      absl::StrCat("geodexd ExportGis ", v1::GisProduct_Name(product), " ", request.mesh());
+  terrain::Provenance provenance = terrain::MakeProvenance(made_by, nullptr);
   auto geojson_of = [&](const terrain::Dem& on, const std::vector<terrain::GeoFeature>& features)
       -> absl::StatusOr<MessageStream<v1::ExportGisResponse>> {
     if (env.cancel->IsCancelled()) return absl::CancelledError("export cancelled");
     absl::StatusOr<std::string> text =
-        terrain::GeoJsonText(on.info(), features, request.native_crs());
+        terrain::GeoJsonText(on.info(), features, request.native_crs(), &provenance);
     if (!text.ok()) return text.status();
     return FileStream(*text, kGeoJson, chunk, env.limits->max_output_values, *snaps,
                       travel_epsilon);
@@ -115,6 +120,7 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
     absl::StatusOr<GeodesicOptions> solver = Options(env, mesh, request.options());
     if (!solver.ok()) return solver.status();
     travel_epsilon = TravelEpsilon(*solver);
+    provenance = terrain::MakeProvenance(made_by, &*solver);
     if (product == v1::GIS_PRODUCT_PATH) {
       if (request.sources_size() != 1 || request.points_size() != 1) {
         return FieldError(request.sources_size() != 1 ? "sources" : "points",
@@ -168,6 +174,7 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
   if (!solved.ok()) return solved.status();
   *snaps = solved->snaps;  // the sources' distances, for the file's first message
   travel_epsilon = solved->field->travel_epsilon;
+  provenance = terrain::MakeProvenance(made_by, &solved->options);
   const TriangleMesh& mesh = *solved->mesh->mesh;
   const DistanceField& field = *solved->field;
   // The mesh the field was solved on (the name was looked up again: it may name another mesh now).
@@ -201,6 +208,7 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
       absl::StatusOr<terrain::CellValues> cells =
           terrain::SampleCells(grid, field, &mesh, &solved->options);
       if (!cells.ok()) return NameSolveError(cells.status(), "sources");
+      cells->provenance = provenance;
       absl::StatusOr<std::string> tiff = product == v1::GIS_PRODUCT_DISTANCE_RASTER
                                              ? grid.DistanceRasterBytes(*cells)
                                              : grid.LabelRasterBytes(*cells);

@@ -6,6 +6,7 @@
 #include <map>
 #include <memory>
 
+#include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "cpl_error.h"
 #include "gdal_priv.h"
@@ -155,7 +156,8 @@ std::vector<Polygon2> SublevelPieces(const MeshData& mesh, const std::vector<dou
 }
 
 absl::Status WriteVectorFile(const DemInfo& dem, const std::vector<GeoFeature>& features,
-                             const std::string& path, bool native_crs) {
+                             const std::string& path, bool native_crs,
+                             const Provenance* provenance) {
   QuietGdal quiet;
   auto failed = [&](const std::string& why) {
     return absl::PermissionDeniedError(absl::StrCat("cannot write ", path, ": ", why));
@@ -183,12 +185,25 @@ absl::Status WriteVectorFile(const DemInfo& dem, const std::vector<GeoFeature>& 
   built.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
   file.importFromWkt(dem.file_crs_wkt.c_str());
   file.SetAxisMappingStrategy(OAMS_TRADITIONAL_GIS_ORDER);
-  const char* rfc[] = {"RFC7946=YES", "WRITE_NAME=NO", nullptr};
-  const char* native[] = {"WRITE_NAME=NO", nullptr};
-  OGRLayer* layer =
-      ds->CreateLayer("geodex", native_crs ? &file : &built, wkbUnknown,
-                      geojson ? const_cast<char**>(native_crs ? native : rfc) : nullptr);
+  CPLStringList layer_options;
+  if (geojson) {
+    if (!native_crs) layer_options.AddString("RFC7946=YES");
+    layer_options.AddString("WRITE_NAME=NO");
+    if (provenance != nullptr) {  // a foreign member of the FeatureCollection: "geodex": {...}
+      layer_options.SetNameValue(
+          "NATIVE_DATA", absl::StrCat("{\"geodex\": ", ProvenanceJson(*provenance), "}").c_str());
+      layer_options.SetNameValue("NATIVE_MEDIA_TYPE", "application/vnd.geo+json");
+    }
+  }
+  OGRLayer* layer = ds->CreateLayer("geodex", native_crs ? &file : &built, wkbUnknown,
+                                    geojson ? layer_options.List() : nullptr);
   if (layer == nullptr) return failed(QuietGdal::LastMessage());
+  if (provenance != nullptr && !geojson) {
+    for (const auto& [key, value] : provenance->items) {
+      layer->SetMetadataItem(absl::StrCat("GEODEX_", absl::AsciiStrToUpper(key)).c_str(),
+                             value.c_str());
+    }
+  }
   std::unique_ptr<OGRCoordinateTransformation, decltype(&OGRCoordinateTransformation::DestroyCT)>
       to_file(nullptr, &OGRCoordinateTransformation::DestroyCT);
   if (native_crs && dem.reprojected) {
@@ -271,9 +286,9 @@ absl::Status WriteVectorFile(const DemInfo& dem, const std::vector<GeoFeature>& 
 }
 
 absl::StatusOr<std::string> GeoJsonText(const DemInfo& dem, const std::vector<GeoFeature>& features,
-                                        bool native_crs) {
+                                        bool native_crs, const Provenance* provenance) {
   MemFile file(".geojson");
-  if (absl::Status written = WriteVectorFile(dem, features, file.path(), native_crs);
+  if (absl::Status written = WriteVectorFile(dem, features, file.path(), native_crs, provenance);
       !written.ok()) {
     return absl::InternalError(written.message());
   }

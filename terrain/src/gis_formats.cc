@@ -5,9 +5,11 @@
 #include "absl/strings/ascii.h"
 #include "absl/strings/match.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
 #include "gdal_priv.h"
 #include "gdal_quiet.h"
+#include "geodex/travel_cost.h"
 
 namespace geodex::terrain {
 namespace {
@@ -72,6 +74,59 @@ std::string GisExtensions(GisFileKind kind) {
     if (f.kind == kind) absl::StrAppend(&out, out.empty() ? "" : ", ", f.extension);
   }
   return out;
+}
+
+Provenance MakeProvenance(const std::string& made_by, const GeodesicOptions* options) {
+  Provenance out;
+  out.items.push_back({"software", "geodex " GEODEX_VERSION});
+  if (!made_by.empty()) out.items.push_back({"made_by", made_by});
+  if (options == nullptr) return out;
+  const bool travel = options->travel.has_value();
+  out.items.push_back({"values", travel ? "travel time" : "geodesic distance"});
+  out.items.push_back({"units", travel ? "s" : "m"});
+  if (travel) {
+    const TravelCost& t = *options->travel;
+    out.items.push_back({"speed", t.speed_model == SpeedModel::kConstant
+                                      ? absl::StrFormat("constant %g km/h", t.speed_kmh)
+                                      : std::string(SpeedModelName(t.speed_model))});
+    const bool exact = TravelIsExact(t);
+    out.items.push_back({"exact", exact ? "true" : "false"});
+    out.items.push_back({"epsilon", absl::StrFormat("%g", StatedTravelEpsilon(t))});
+    // Within (1 + epsilon) of the least time: proved at a constant speed, not for slope speeds.
+    out.items.push_back({"bound", exact || !IsDirectional(t) ? "true" : "false"});
+    if (t.face_weight != nullptr) out.items.push_back({"friction", "per face"});
+    if (t.max_slope_deg > 0 && t.max_slope_deg < 90) {
+      out.items.push_back({"max_slope_deg", absl::StrFormat("%g", t.max_slope_deg)});
+    }
+  } else {
+    out.items.push_back({"exact", options->lambda > 0 ? "false" : "true"});
+    if (options->lambda > 0)
+      out.items.push_back({"lambda", absl::StrFormat("%g", options->lambda)});
+  }
+  return out;
+}
+
+std::string ProvenanceJson(const Provenance& provenance) {
+  auto quoted = [](const std::string& text) {
+    std::string out = "\"";
+    for (unsigned char c : text) {
+      if (c == '"' || c == '\\') {
+        out += '\\';
+        out += static_cast<char>(c);
+      } else if (c < 0x20) {
+        out += absl::StrFormat("\\u%04x", c);
+      } else {
+        out += static_cast<char>(c);
+      }
+    }
+    return out + "\"";
+  };
+  std::string out = "{";
+  for (size_t i = 0; i < provenance.items.size(); ++i) {
+    absl::StrAppend(&out, i ? ", " : "", quoted(provenance.items[i].first), ": ",
+                    quoted(provenance.items[i].second));
+  }
+  return out + "}";
 }
 
 }  // namespace geodex::terrain

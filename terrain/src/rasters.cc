@@ -14,6 +14,7 @@
 
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
+#include "absl/strings/ascii.h"
 #include "absl/strings/str_cat.h"
 #include "cpl_error.h"
 #include "cpl_string.h"
@@ -114,7 +115,8 @@ namespace {
 // (the band's nodata) where there is no surface.
 absl::Status WriteRaster(const DemInfo& info, const std::string& path, GDALDataType type,
                          const char* description, const char* unit,
-                         const std::function<double(size_t)>& value_of_cell) {
+                         const std::function<double(size_t)>& value_of_cell,
+                         const Provenance* provenance = nullptr) {
   QuietGdal quiet;
   const GisFormat* format = GisFormatOf(path);
   if (format == nullptr || format->kind != GisFileKind::kRaster) {
@@ -141,6 +143,13 @@ absl::Status WriteRaster(const DemInfo& info, const std::string& path, GDALDataT
   OGRSpatialReference crs;
   crs.importFromWkt(info.file_crs_wkt.c_str());
   ds->SetSpatialRef(&crs);
+  if (provenance != nullptr) {  // what made the file (gdalinfo lists the items)
+    for (const auto& [key, value] : provenance->items) {
+      ds->SetMetadataItem(absl::StrCat("GEODEX_", absl::AsciiStrToUpper(key)).c_str(),
+                          value.c_str());
+      if (key == "software") ds->SetMetadataItem("TIFFTAG_SOFTWARE", value.c_str());
+    }
+  }
   GDALRasterBand* band = ds->GetRasterBand(1);
   band->SetNoDataValue(kRasterNoSurface);
   band->SetDescription(description);
@@ -209,22 +218,27 @@ absl::Status Dem::WriteDistanceRaster(const std::string& path, const CellValues&
   return WriteRaster(
       info_, path, GDT_Float32,
       (cells.estimated ? what + " (section-4 estimate at cell centres)" : what).c_str(),
-      cells.travel_time ? "s" : "m", [&](size_t cell) {
+      cells.travel_time ? "s" : "m",
+      [&](size_t cell) {
         if (cells.hole[cell]) return kRasterNoSurface;
         const double d = cells.distance[cell];
         return std::isfinite(d) ? d : kRasterUnreachable;
-      });
+      },
+      &cells.provenance);
 }
 
 absl::Status Dem::WriteLabelRaster(const std::string& path, const CellValues& cells) const {
   if (cells.source.size() != size_t{info_.grid_width} * info_.grid_height) {
     return absl::InternalError("one value per used cell expected");
   }
-  return WriteRaster(info_, path, GDT_Int32, "nearest source", nullptr, [&](size_t cell) {
-    if (cells.hole[cell]) return kRasterNoSurface;
-    const uint32_t s = cells.source[cell];
-    return s >= 0x80000000u ? kRasterUnreachable : static_cast<double>(s);
-  });
+  return WriteRaster(
+      info_, path, GDT_Int32, "nearest source", nullptr,
+      [&](size_t cell) {
+        if (cells.hole[cell]) return kRasterNoSurface;
+        const uint32_t s = cells.source[cell];
+        return s >= 0x80000000u ? kRasterUnreachable : static_cast<double>(s);
+      },
+      &cells.provenance);
 }
 
 namespace {

@@ -205,4 +205,21 @@ t, d = ts.GetRasterBand(1), ds.GetRasterBand(1)
 assert t.GetDescription() == 'travel time' and t.GetUnitType() == 's', (t.GetDescription(), t.GetUnitType())
 assert d.GetDescription() == 'geodesic distance' and d.GetUnitType() == 'm', (d.GetDescription(), d.GetUnitType())"
 
+# Every GIS file records what made it: the software, the command line, what the values are and,
+# for times, the speed and the bound (a raster's GEODEX_* metadata, a GeoJSON's "geodex" member).
+check "rasters record what made them" $PY -c "
+from osgeo import gdal
+t, d = gdal.Open('$tmp/t.tif').GetMetadata(), gdal.Open('$tmp/d.tif').GetMetadata()
+assert t['GEODEX_SOFTWARE'].startswith('geodex ') and t['TIFFTAG_SOFTWARE'] == t['GEODEX_SOFTWARE'], t
+assert t['GEODEX_MADE_BY'].startswith('geodex distances ') and '--speed constant:7.2' in t['GEODEX_MADE_BY'], t
+assert (t['GEODEX_VALUES'], t['GEODEX_UNITS'], t['GEODEX_SPEED']) == ('travel time', 's', 'constant 7.2 km/h'), t
+assert (t['GEODEX_EXACT'], t['GEODEX_EPSILON'], t['GEODEX_BOUND']) == ('true', '0', 'true'), t
+assert (d['GEODEX_VALUES'], d['GEODEX_UNITS'], d['GEODEX_EXACT']) == ('geodesic distance', 'm', 'true'), d
+assert 'GEODEX_SPEED' not in d, d"
+check "GeoJSON records what made it" $PY -c "
+import json
+g = json.load(open('$tmp/p.geojson'))['geodex']
+assert g['software'].startswith('geodex ') and g['made_by'].startswith('geodex path '), g
+assert (g['values'], g['units'], g['speed'], g['exact']) == ('travel time', 's', 'constant 7.2 km/h', 'true'), g"
+
 finish "travel_trust_cli"

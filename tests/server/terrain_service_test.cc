@@ -961,6 +961,12 @@ TEST_F(TerrainServiceTest, ExportGisMakesTheCliFiles) {
   double gt[6];
   ds->GetGeoTransform(gt);
   EXPECT_EQ(gt[0], 500000);
+  // What made it: geodexd's request and what the values are (terrain::Provenance).
+  const char* made_by = ds->GetMetadataItem("GEODEX_MADE_BY");
+  ASSERT_NE(made_by, nullptr);
+  EXPECT_EQ(std::string(made_by), "geodexd ExportGis GIS_PRODUCT_DISTANCE_RASTER meshes/slot");
+  ASSERT_NE(ds->GetMetadataItem("GEODEX_VALUES"), nullptr);
+  EXPECT_EQ(std::string(ds->GetMetadataItem("GEODEX_VALUES")), "geodesic distance");
   GDALClose(ds);
   VSIUnlink(path.c_str());
   EXPECT_EQ(cells[15 * 30 + 14], -1);  // the slot
@@ -975,6 +981,9 @@ TEST_F(TerrainServiceTest, ExportGisMakesTheCliFiles) {
   EXPECT_TRUE(Contains(geojson, "\"level\": 120")) << geojson.substr(0, 300);
   EXPECT_TRUE(Contains(geojson, "MultiPolygon") || Contains(geojson, "\"Polygon\""));
   EXPECT_TRUE(Contains(geojson, "[ 15.")) << geojson.substr(0, 400);  // longitudes near 15 E
+  EXPECT_TRUE(
+      Contains(geojson, R"("made_by": "geodexd ExportGis GIS_PRODUCT_ISOCHRONES meshes\/slot")"))
+      << geojson.substr(0, 400);
 
   // Points name themselves as written and where they landed.
   request.set_product(v1::GIS_PRODUCT_POINTS);

@@ -16,6 +16,7 @@
 #include "absl/status/status.h"
 #include "absl/status/statusor.h"
 #include "geodex/delaunay.h"
+#include "geodex/gis_formats.h"
 #include "geodex/mesh_data.h"
 #include "geodex/shortest_path.h"
 #include "geodex/terrain.h"
@@ -46,11 +47,14 @@ struct GeoFeature {
 // .geojson, .gpkg, .shp, .fgb). GeoJSON is RFC 7946 (WGS 84) unless `native_crs`; every other
 // format is in the DEM's CRS. Errors name the path (with GDAL's reason); an extension that is not a
 // vector format's is InvalidArgument listing them.
+// `provenance` (gis_formats.h), when given, is recorded: GeoJSON's "geodex" member, other formats'
+// layer metadata.
 absl::Status WriteVectorFile(const DemInfo& dem, const std::vector<GeoFeature>& features,
-                             const std::string& path, bool native_crs);
+                             const std::string& path, bool native_crs,
+                             const Provenance* provenance = nullptr);
 // The same file's text (what geodexd's ExportGis sends).
 absl::StatusOr<std::string> GeoJsonText(const DemInfo& dem, const std::vector<GeoFeature>& features,
-                                        bool native_crs);
+                                        bool native_crs, const Provenance* provenance = nullptr);
 
 // The features of each product, as the CLI and geodexd write them; x y z in the DEM's mesh.
 // Isochrones: per level, the area within that distance (`level`, `units` "m"), from the field's

@@ -5,8 +5,25 @@
 // in WGS 84 for GeoJSON (RFC 7946) and in the DEM's own CRS otherwise.
 
 #include <string>
+#include <utility>
+#include <vector>
+
+#include "geodex/geodesic_solver.h"
 
 namespace geodex::terrain {
+
+// What made a GIS file, recorded in it (docs/gis-files.md): a raster's metadata items GEODEX_KEY
+// (gdalinfo lists them; the software also as TIFFTAG_SOFTWARE), a GeoJSON's "geodex" member, the
+// layer metadata GEODEX_KEY of other vector formats. Never a clock time: the same inputs make the
+// same bytes.
+struct Provenance {
+  std::vector<std::pair<std::string, std::string>> items;  // (key, value), in order
+};
+// software ("geodex VERSION"), made_by (the command line, or the request), then what the values
+// are with `options` (values, units; a travel cost's speed, epsilon, exact and bound; lambda).
+Provenance MakeProvenance(const std::string& made_by, const GeodesicOptions* options);
+// The items as a JSON object's text (the GeoJSON member).
+std::string ProvenanceJson(const Provenance& provenance);
 
 enum class GisFileKind { kRaster, kVector };
 

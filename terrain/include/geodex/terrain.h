@@ -31,6 +31,7 @@
 #include "absl/status/statusor.h"
 #include "geodex/distance_field.h"
 #include "geodex/geodesic_solver.h"
+#include "geodex/gis_formats.h"
 #include "geodex/mesh_data.h"
 #include "geodex/surface_point.h"
 #include "geodex/triangle_mesh.h"
@@ -299,6 +300,7 @@ struct CellValues {
   bool estimated = false;    // some value is the section-4 estimate (a TIN without `exact`)
   bool travel_time = false;  // the values are seconds (a travel-cost field), not metres
   SolveStats exact_stats;    // the targeted solve's, when there was one
+  Provenance provenance;     // what made the values, recorded in the rasters (the caller's)
 };
 // `mesh`: the engine's mesh of dem.mesh() when the caller has one (a TIN's values need it; null:
 // built here, a TIN being small). The CLI and geodexd pass `exact` (the field's own options): a
