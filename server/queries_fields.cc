@@ -177,6 +177,7 @@ struct MatrixStreamState {
   bool cached = false;
   std::vector<double> snap_distances;      // sent in the first message
   double travel_epsilon = 0;               // sent in the first message
+  bool travel_exact = false;               // sent in the first message
   size_t next = 0;                         // the next value to send
   bool sent = false;                       // a message went out (an empty matrix still gets one)
   double progress = 0, progress_sent = 0;  // fraction of the solves done; the last one sent
@@ -200,6 +201,7 @@ Produced NextMatrixMessage(MatrixStreamState& state, bool f32, bool want_stats, 
   if (!state.sent) {
     out->mutable_snap_distances()->Add(state.snap_distances.begin(), state.snap_distances.end());
     out->set_travel_epsilon(state.travel_epsilon);
+    out->set_travel_exact(state.travel_exact);
   }
   state.progress_sent = progress;
   if (end == n && want_stats) {
@@ -254,6 +256,7 @@ absl::StatusOr<MessageStream<v1::ComputeDistanceMatrixResponse>> RunComputeDista
   state->cols = targets->size();
   state->snap_distances = std::move(snaps->distances);
   state->travel_epsilon = TravelEpsilon(*solver);
+  state->travel_exact = TravelExact(*solver);
   const bool f32 = request.value_type() == v1::VALUE_TYPE_FLOAT32;
   const bool want_stats = request.want_stats();
   const size_t chunk = std::max<size_t>(1, env.limits->stream_chunk_bytes / (f32 ? 4 : 8));

@@ -50,6 +50,7 @@ absl::StatusOr<MessageStream<v1::ComputeIsolinesResponse>> RunComputeIsolines(
   std::vector<v1::ComputeIsolinesResponse> messages =
       api::IsolinesToProto(*isolines, env.limits->stream_chunk_bytes);
   messages.front().set_travel_epsilon(solved->field->travel_epsilon);
+  messages.front().set_travel_exact(solved->field->travel_exact);
   return Streamed(std::move(messages), *solved, request.want_stats());
 }
 
@@ -66,6 +67,7 @@ absl::StatusOr<MessageStream<v1::ComputeVoronoiResponse>> RunComputeVoronoi(
   std::vector<v1::ComputeVoronoiResponse> messages = api::VoronoiToProto(
       *diagram, solved->sources, request.omit_cell_faces(), env.limits->stream_chunk_bytes);
   messages.front().set_travel_epsilon(solved->field->travel_epsilon);
+  messages.front().set_travel_exact(solved->field->travel_exact);
   return Streamed(std::move(messages), *solved, request.want_stats());
 }
 

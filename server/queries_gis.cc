@@ -55,7 +55,7 @@ std::string SpecOf(const v1::SurfacePoint& p) {
 // --max_output_values is refused.
 absl::StatusOr<MessageStream<v1::ExportGisResponse>> FileStream(
     const std::string& bytes, const char* media_type, uint32_t chunk_bytes,
-    uint64_t max_output_values, const PointSnaps& snaps, double travel_epsilon) {
+    uint64_t max_output_values, const PointSnaps& snaps, double travel_epsilon, bool travel_exact) {
   if (bytes.size() / 8 > max_output_values) {
     return ServerLimitError(
         "max_output_values",
@@ -69,6 +69,7 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> FileStream(
       m.set_media_type(media_type);
       SnapsToProto(snaps, &m);
       m.set_travel_epsilon(travel_epsilon);
+      m.set_travel_exact(travel_exact);
     }
     m.set_data(bytes.substr(offset, chunk_bytes));
   }
@@ -97,6 +98,7 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
   const uint32_t chunk = env.limits->stream_chunk_bytes;
   const char* kGeoJson = "application/geo+json";
   double travel_epsilon = 0;  // set once the options are resolved
+  bool travel_exact = false;
   // What made the file, recorded in it (terrain::Provenance): the request, and its options once
   // they are resolved.
   const std::string made_by =
@@ -108,8 +110,8 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
     absl::StatusOr<std::string> text =
         terrain::GeoJsonText(on.info(), features, request.native_crs(), &provenance);
     if (!text.ok()) return text.status();
-    return FileStream(*text, kGeoJson, chunk, env.limits->max_output_values, *snaps,
-                      travel_epsilon);
+    return FileStream(*text, kGeoJson, chunk, env.limits->max_output_values, *snaps, travel_epsilon,
+                      travel_exact);
   };
   auto geojson = [&](const std::vector<terrain::GeoFeature>& features) {
     return geojson_of(dem, features);
@@ -120,6 +122,7 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
     absl::StatusOr<GeodesicOptions> solver = Options(env, mesh, request.options());
     if (!solver.ok()) return solver.status();
     travel_epsilon = TravelEpsilon(*solver);
+    travel_exact = TravelExact(*solver);
     provenance = terrain::MakeProvenance(made_by, &*solver);
     if (product == v1::GIS_PRODUCT_PATH) {
       if (request.sources_size() != 1 || request.points_size() != 1) {
@@ -174,6 +177,7 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
   if (!solved.ok()) return solved.status();
   *snaps = solved->snaps;  // the sources' distances, for the file's first message
   travel_epsilon = solved->field->travel_epsilon;
+  travel_exact = solved->field->travel_exact;
   provenance = terrain::MakeProvenance(made_by, &solved->options);
   const TriangleMesh& mesh = *solved->mesh->mesh;
   const DistanceField& field = *solved->field;
@@ -214,7 +218,7 @@ absl::StatusOr<MessageStream<v1::ExportGisResponse>> RunExportGis(
                                              : grid.LabelRasterBytes(*cells);
       if (!tiff.ok()) return tiff.status();
       return FileStream(*tiff, "image/tiff", chunk, env.limits->max_output_values, *snaps,
-                        travel_epsilon);
+                        travel_epsilon, travel_exact);
     }
     default:
       break;

@@ -42,6 +42,7 @@ absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPath
   absl::StatusOr<GeodesicOptions> solver = Options(env, **mesh, request.options());
   if (!solver.ok()) return solver.status();
   response->set_travel_epsilon(TravelEpsilon(*solver));
+  response->set_travel_exact(TravelExact(*solver));
   // From a cached field of `from` a path to a vertex is a trace, not a solve. Otherwise the path
   // runs A* (the work it asked for); a source asked again is offered for its whole field in the
   // background (FieldPromoter), never solved on this caller's clock, so that later paths from it
@@ -107,6 +108,7 @@ absl::Status RunFindShortestPaths(const QueryEnv& env, const v1::FindShortestPat
   absl::StatusOr<GeodesicOptions> solver = Options(env, **mesh, request.options());
   if (!solver.ok()) return solver.status();
   response->set_travel_epsilon(TravelEpsilon(*solver));
+  response->set_travel_exact(TravelExact(*solver));
   absl::StatusOr<PointSnaps> rule = SnapsOf(request);
   if (!rule.ok()) return rule.status();
   // Group the pairs by their source point (bit for bit), in order of first appearance.
@@ -133,6 +135,7 @@ absl::Status RunFindShortestPaths(const QueryEnv& env, const v1::FindShortestPat
     v1::FindShortestPathResponse* path = response->add_paths();
     SnapsToProto(snaps, path);
     path->set_travel_epsilon(response->travel_epsilon());
+    path->set_travel_exact(response->travel_exact());
   }
   PathQueryOptions options;
   options.solver = *solver;
@@ -195,6 +198,7 @@ absl::Status RunEstimateDistances(const QueryEnv& env, const v1::EstimateDistanc
   absl::StatusOr<GeodesicOptions> solver = Options(env, **mesh, request.options());
   if (!solver.ok()) return solver.status();
   response->set_travel_epsilon(TravelEpsilon(*solver));
+  response->set_travel_exact(TravelExact(*solver));
   if (estimate) {
     bool cached = false;
     absl::StatusOr<std::shared_ptr<const DistanceField>> field =

@@ -65,6 +65,10 @@ void ShareTravelGraph(const QueryEnv& env, const StoredMesh& mesh,
 inline double TravelEpsilon(const GeodesicOptions& options) {
   return options.travel ? TravelEpsilon(*options.travel) : 0;
 }
+// The response field travel_exact: the times are exact (TravelIsExact).
+inline bool TravelExact(const GeodesicOptions& options) {
+  return options.travel && TravelIsExact(*options.travel);
+}
 // INVALID_ARGUMENT naming options.travel for a product a travel cost cannot give, before any
 // solve (`why`: what the product needs, "the geodesic Delaunay triangulation is traced through the
 // exact engine's origins"); OK without a travel cost.

@@ -215,6 +215,7 @@ absl::StatusOr<DistanceField> ComputeTravelField(const TriangleMesh& mesh,
   }
   field.stats = StatsOf(w->stats);
   field.travel_epsilon = TravelEpsilon(*options.travel);
+  field.travel_exact = TravelIsExact(*options.travel);
   return field;
 }
 

@@ -251,6 +251,7 @@ void FieldChunkToProto(const DistanceField& field, const DistanceField& products
   if (begin == 0) {
     for (const SurfacePoint& p : field.sources) SurfacePointToProto(p, out->add_resolved_sources());
     out->set_travel_epsilon(field.travel_epsilon);
+    out->set_travel_exact(field.travel_exact);
   }
   if (encoding.f32) {
     auto* values = out->mutable_distances_f32();
@@ -275,6 +276,7 @@ void FieldChunkToProto(const DistanceField& field, const DistanceField& products
 void FieldAssembler::Add(const v1::ComputeDistanceFieldResponse& message) {
   if (message.offset() == 0) {
     field_.travel_epsilon = message.travel_epsilon();
+    field_.travel_exact = message.travel_exact();
     field_.snap_distances.assign(message.snap_distances().begin(), message.snap_distances().end());
     field_.distance.reserve(message.vertex_count());
     field_.source.reserve(message.vertex_count());

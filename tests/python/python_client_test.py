@@ -684,6 +684,10 @@ class ControlLoopTest(unittest.TestCase):
         numpy.testing.assert_allclose(faster.distances, field.distances / 2, rtol=1e-12)
         weighted = sync.distance_field(mesh.name, sources, travel=heavy)
         self.assertGreater(weighted.distances.sum(), field.distances.sum())
+        # One weight at a constant speed is the exact engine's answer, and says so; two weights
+        # are within the bound; metres are not travel times.
+        self.assertEqual((field.travel_exact, weighted.travel_exact, plain.travel_exact),
+                         (True, False, False))
         # A path, a matrix and exact point values in seconds, consistent with the field.
         path = sync.shortest_path(mesh.name, vertex(0), vertex(440), travel=walk)
         self.assertEqual(path.travel_epsilon, 0.05)
@@ -713,12 +717,19 @@ class ControlLoopTest(unittest.TestCase):
         self.assertEqual(points.travel_epsilon, 0.05)
         self.assertEqual(len(points.estimates), 0)  # the unfolding estimate is of metres
         numpy.testing.assert_allclose(points.exact, matrix.min(axis=0), rtol=1e-12)
+        self.assertTrue(path.travel_exact and matrix.travel_exact and points.travel_exact)
         paths = sync.shortest_paths(mesh.name, [(vertex(0), vertex(440))], travel=walk)
+        self.assertTrue(paths[0].travel_exact)
         self.assertEqual((paths[0].length, paths[0].travel_epsilon), (path.length, 0.05))
         self.assertEqual((paths[0].length_m, paths[0].time_s), (path.length_m, path.time_s))
         isolines = sync.isolines(mesh.name, sources, count=4, travel=walk)
         self.assertEqual(isolines.travel_epsilon, 0.05)
-        self.assertEqual(sync.voronoi(mesh.name, sources, travel=walk).travel_epsilon, 0.05)
+        self.assertTrue(isolines.travel_exact)
+        voronoi = sync.voronoi(mesh.name, sources, travel=walk)
+        self.assertEqual((voronoi.travel_epsilon, voronoi.travel_exact), (0.05, True))
+        self.assertFalse(sync.voronoi(mesh.name, sources, travel=heavy).travel_exact)
+        gis_free = sync.shortest_path(mesh.name, vertex(0), vertex(440), travel=heavy)
+        self.assertFalse(gis_free.travel_exact)
         # What a travel cost cannot do, and a bad value, name the field.
         with self.assertRaises(geodex.InvalidArgumentError) as error:
             sync.delaunay(mesh.name, sources, travel=walk)

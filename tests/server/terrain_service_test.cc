@@ -794,6 +794,7 @@ TEST_F(TerrainServiceTest, TravelWithFrictionInTheDemsMap) {
   *request.mutable_options()->mutable_travel() = travel;
   std::vector<double> got;
   double travel_epsilon = -1;
+  bool travel_exact = true;
   {
     grpc::ClientContext context;
     context.set_deadline(testing::In(120));
@@ -801,12 +802,14 @@ TEST_F(TerrainServiceTest, TravelWithFrictionInTheDemsMap) {
     v1::ComputeDistanceFieldResponse message;
     while (reader->Read(&message)) {
       if (message.offset() == 0) travel_epsilon = message.travel_epsilon();
+      if (message.offset() == 0) travel_exact = message.travel_exact();
       got.insert(got.end(), message.distances_f64().begin(), message.distances_f64().end());
     }
     grpc::Status status = reader->Finish();
     ASSERT_TRUE(status.ok()) << status.error_message();
   }
   EXPECT_EQ(travel_epsilon, 0.1);
+  EXPECT_FALSE(travel_exact);  // two weights: within the bound, not exact
   EXPECT_EQ(got, want->distance);
 
   // ExportGis: isochrones of the travel times carry the bound; Delaunay is refused.

@@ -124,6 +124,7 @@ class TravelServiceTest : public testing::ServerFixture {
     grpc::Status status;
     std::vector<double> distances;
     double travel_epsilon = -1;
+    bool travel_exact = false;
     bool cached = false;
   };
   Field ReadField(const v1::ComputeDistanceFieldRequest& request) {
@@ -134,6 +135,7 @@ class TravelServiceTest : public testing::ServerFixture {
         request, &messages);
     for (const auto& m : messages) {
       if (m.offset() == 0) out.travel_epsilon = m.travel_epsilon();
+      if (m.offset() == 0) out.travel_exact = m.travel_exact();
       out.distances.insert(out.distances.end(), m.distances_f64().begin(), m.distances_f64().end());
       if (m.has_stats()) out.cached = m.stats().cached();
     }
@@ -178,6 +180,7 @@ TEST_F(TravelServiceTest, SolverOptionsRoundTrip) {
   field.distance = {0, 1.5};
   field.source = {0, 0};
   field.travel_epsilon = 0.05;
+  field.travel_exact = true;
   v1::ComputeDistanceFieldResponse first, second;
   api::FieldChunkToProto(field, DistanceField(), 0, 1, {}, &first);
   api::FieldChunkToProto(field, DistanceField(), 1, 2, {}, &second);
@@ -187,6 +190,8 @@ TEST_F(TravelServiceTest, SolverOptionsRoundTrip) {
   assembler.Add(first);
   assembler.Add(second);
   EXPECT_EQ(assembler.result().travel_epsilon, 0.05);
+  EXPECT_TRUE(first.travel_exact());
+  EXPECT_TRUE(assembler.result().travel_exact);
   EXPECT_EQ(assembler.result().distance, field.distance);
   // The slope-dependent speed round-trips: model, table rows, inbound.
   GeodesicOptions table = SlopeTravel(/*inbound=*/true, WalkerTable());
@@ -236,6 +241,8 @@ TEST_F(TravelServiceTest, FieldPathMatrixAndIsolinesEqualCore) {
   Field got = ReadField(FieldRequestOf(options));
   ASSERT_TRUE(got.status.ok()) << got.status.error_message();
   EXPECT_EQ(got.travel_epsilon, 0.05);
+  EXPECT_EQ(got.travel_exact, TravelIsExact(*options.travel));  // the answer says which it is
+  EXPECT_EQ(got.travel_exact, want->travel_exact);
   ASSERT_EQ(got.distances.size(), want->distance.size());
   size_t finite = 0;
   for (size_t v = 0; v < got.distances.size(); ++v) {
@@ -256,6 +263,7 @@ TEST_F(TravelServiceTest, FieldPathMatrixAndIsolinesEqualCore) {
     ASSERT_TRUE(status.ok()) << status.error_message();
     EXPECT_TRUE(BitEqual(response.distance(), want_path->distance));
     EXPECT_EQ(response.travel_epsilon(), 0.05);
+    EXPECT_EQ(response.travel_exact(), TravelIsExact(*options.travel));
     ASSERT_EQ(response.points_size(), static_cast<int>(want_path->path.points.size()));
     for (int i = 0; i < response.points_size(); ++i) {
       EXPECT_TRUE(

@@ -410,6 +410,7 @@ class Plans:
         out.media_type = messages[0].media_type if messages else ""
         out.snap_distances = _snaps(messages[0]) if messages else np.zeros(0)
         out.travel_epsilon = messages[0].travel_epsilon if messages else 0.0
+        out.travel_exact = messages[0].travel_exact if messages else False
         yield from self._warn_far_snaps(mesh, out.snap_distances,
                                         _point_names(("sources", len(sources)),
                                                      ("points", len(points))))
@@ -429,7 +430,7 @@ class Plans:
             want_stats=want_stats, want_directions=want_directions), max_snap)
         raws = yield Rpc("ComputeDistanceField", request, None, stream=True, mesh=mesh)
         distances, labels, directions, stats, snaps = [], [], [], None, np.zeros(0)
-        travel_epsilon = 0.0
+        travel_epsilon, travel_exact = 0.0, False
         for k, raw in enumerate(raws):
             arrays, rest = _wire.split_packed(raw, {3: "<f8", 5: "<u4", 8: "<f8", 9: "<f8"})
             head = pb.ComputeDistanceFieldResponse.FromString(rest)
@@ -440,14 +441,14 @@ class Plans:
             directions.append(arrays[8])
             if k == 0:
                 snaps = arrays[9]
-                travel_epsilon = head.travel_epsilon
+                travel_epsilon, travel_exact = head.travel_epsilon, head.travel_exact
             if head.HasField("stats"):
                 stats = head.stats
         yield from self._warn_far_snaps(mesh, snaps, _point_names(("sources", len(sources))))
         return Field(np.concatenate(distances) if distances else np.zeros(0),
                      np.concatenate(labels) if labels else np.zeros(0, "<u4"), stats,
                      (np.concatenate(directions) if directions else np.zeros(0)).reshape(-1, 3),
-                     snaps, travel_epsilon)
+                     snaps, travel_epsilon, travel_exact)
 
     def shortest_path(self, mesh: str, start, end, want_stats: bool = False,
                       max_snap: Optional[float] = None, timeout: Optional[float] = None,
@@ -461,7 +462,8 @@ class Plans:
         response = yield Rpc("FindShortestPath", request, pb.FindShortestPathResponse, mesh=mesh)
         path = Path(response.distance, _wire.path_points(response.points),
                     response.stats if response.HasField("stats") else None, _snaps(response),
-                    response.travel_epsilon, *_metres_and_seconds(response, response.travel_epsilon))
+                    response.travel_epsilon, *_metres_and_seconds(response, response.travel_epsilon),
+                    response.travel_exact)
         yield from self._warn_far_snaps(mesh, path.snap_distances, ["start", "end"])
         return path
 
@@ -477,7 +479,8 @@ class Plans:
         response = yield Rpc("FindShortestPaths", request, pb.FindShortestPathsResponse,
                              mesh=mesh)
         paths = [Path(p.distance, _wire.path_points(p.points), None, _snaps(p),
-                      response.travel_epsilon, *_metres_and_seconds(p, response.travel_epsilon))
+                      response.travel_epsilon, *_metres_and_seconds(p, response.travel_epsilon),
+                      response.travel_exact)
                  for p in response.paths]
         names = ["pairs[%d].%s" % (i, end) for i in range(len(paths)) for end in ("from", "to")]
         all_snaps = (np.concatenate([p.snap_distances for p in paths]) if paths
@@ -499,7 +502,7 @@ class Plans:
             mesh=mesh, sources=sources, targets=targets, k_nearest=k_nearest,
             options=_wire.solver_options(options, travel)), max_snap)
         state = {"values": [], "rows": 0, "cols": 0, "received": 0, "snaps": np.zeros(0),
-                 "travel_epsilon": 0.0}
+                 "travel_epsilon": 0.0, "travel_exact": False}
 
         def on_message(raw):
             arrays, rest = _wire.split_packed(raw, {4: "<f8", 8: "<f8"})
@@ -507,6 +510,7 @@ class Plans:
             if head.offset == 0 and not state["values"]:
                 state["snaps"] = arrays[8]
                 state["travel_epsilon"] = head.travel_epsilon
+                state["travel_exact"] = head.travel_exact
             if head.offset != state["received"]:
                 raise _wire.invalid("the matrix's rows arrived out of order", "")
             state["rows"], state["cols"] = head.rows, head.cols
@@ -524,6 +528,7 @@ class Plans:
         matrix = flat.reshape(state["rows"], state["cols"]).view(DistanceMatrix)
         matrix.snap_distances = state["snaps"]
         matrix.travel_epsilon = state["travel_epsilon"]
+        matrix.travel_exact = state["travel_exact"]
         yield from self._warn_far_snaps(mesh, matrix.snap_distances,
                                         _point_names(("sources", len(sources)),
                                                      ("targets", len(targets))))
@@ -549,7 +554,7 @@ class Plans:
                              np.array(r.exact, dtype=np.float64),
                              np.array(r.exact_labels, dtype=np.uint32),
                              np.array(r.exact_directions, dtype=np.float64).reshape(-1, 3),
-                             _snaps(r), r.travel_epsilon)
+                             _snaps(r), r.travel_epsilon, r.travel_exact)
         yield from self._warn_far_snaps(mesh, out.snap_distances,
                                         _point_names(("sources", len(sources)),
                                                      ("points", len(points))))
@@ -585,7 +590,8 @@ class Plans:
         snaps = _snaps(messages[0]) if messages else np.zeros(0)
         yield from self._warn_far_snaps(mesh, snaps, _point_names(("sources", len(sources))))
         return Isolines(all_levels, _wire.reassemble(pieces, lambda p: (p.level, p.closed, [])),
-                        snaps, messages[0].travel_epsilon if messages else 0.0)
+                        snaps, messages[0].travel_epsilon if messages else 0.0,
+                        messages[0].travel_exact if messages else False)
 
     def voronoi(self, mesh: str, sites: Sequence, max_snap: Optional[float] = None,
                 timeout: Optional[float] = None, travel: Optional[Travel] = None,
@@ -606,7 +612,8 @@ class Plans:
         snaps = _snaps(messages[0]) if messages else np.zeros(0)
         yield from self._warn_far_snaps(mesh, snaps, _point_names(("sites", len(sites))))
         return Voronoi(areas, _wire.reassemble(pieces, lambda p: (p.site_a, p.site_b, [])),
-                       adjacency, snaps, messages[0].travel_epsilon if messages else 0.0)
+                       adjacency, snaps, messages[0].travel_epsilon if messages else 0.0,
+                       messages[0].travel_exact if messages else False)
 
     def delaunay(self, mesh: str, sites: Sequence, max_snap: Optional[float] = None,
                  timeout: Optional[float] = None, travel: Optional[Travel] = None,

@@ -5,7 +5,8 @@ Every answer to a request that takes points carries `snap_distances`: how far ea
 moved onto the surface, in request order (numpy float64; 0 for vertices, edge and face points and
 map points). Every answer with distances carries `travel_epsilon`: 0.0 when they are exact metres,
 > 0 when the request's `travel=` made them travel times in seconds, each within
-(1 + travel_epsilon) of the least time. The fields marked "not unpacked" are left out of tuple
+(1 + travel_epsilon) of the least time (`travel_exact` True: exact times, one weight at a constant
+speed). The fields marked "not unpacked" are left out of tuple
 unpacking.
 """
 import dataclasses
@@ -94,6 +95,7 @@ class Path(_Unpacks):
     travel_epsilon: float = _exact()
     length_m: float = _extra(float("nan"))
     time_s: Optional[float] = _extra()
+    travel_exact: bool = _extra(False)
 
 
 @dataclasses.dataclass(eq=False)
@@ -109,6 +111,7 @@ class Field(_Unpacks):
     directions: np.ndarray
     snap_distances: np.ndarray = _no_snaps()
     travel_epsilon: float = _exact()
+    travel_exact: bool = _extra(False)
 
 
 class DistanceMatrix(np.ndarray):
@@ -118,10 +121,12 @@ class DistanceMatrix(np.ndarray):
 
     snap_distances: np.ndarray
     travel_epsilon: float
+    travel_exact: bool
 
     def __array_finalize__(self, obj):
         self.snap_distances = getattr(obj, "snap_distances", np.zeros(0))
         self.travel_epsilon = getattr(obj, "travel_epsilon", 0.0)
+        self.travel_exact = getattr(obj, "travel_exact", False)
 
 
 @dataclasses.dataclass
@@ -146,6 +151,7 @@ class PointDistances(_Unpacks):
     directions: np.ndarray
     snap_distances: np.ndarray = _no_snaps()
     travel_epsilon: float = _exact()
+    travel_exact: bool = _extra(False)
 
 
 @dataclasses.dataclass
@@ -156,6 +162,7 @@ class Isolines(_Unpacks):
     lines: list
     snap_distances: np.ndarray = _no_snaps()
     travel_epsilon: float = _exact()
+    travel_exact: bool = _extra(False)
 
 
 @dataclasses.dataclass
@@ -167,6 +174,7 @@ class Voronoi(_Unpacks):
     adjacency: List[Tuple[int, int]]
     snap_distances: np.ndarray = _no_snaps()
     travel_epsilon: float = _exact()
+    travel_exact: bool = _extra(False)
 
 
 @dataclasses.dataclass
@@ -186,6 +194,7 @@ class GisFile(bytes):
     media_type: str
     snap_distances: np.ndarray
     travel_epsilon: float = 0.0
+    travel_exact: bool = False
 
 
 @dataclasses.dataclass

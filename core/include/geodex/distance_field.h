@@ -60,6 +60,8 @@ struct DistanceField {
   // > 0: a travel-cost field (geodex/travel_cost.h): `distance` holds seconds from the weighted
   // engine, within (1 + travel_epsilon) of the least times, and there are no origins to trace.
   double travel_epsilon = 0;
+  // A travel field whose times are exact (TravelIsExact: one weight at a constant speed).
+  bool travel_exact = false;
   // geodexd's answers only (the client library): how far each point given as a 3D position
   // (SurfacePoint::kPosition) moved onto the surface, one per source; 0 for a point given on the
   // surface. Core's own queries take surface points and leave it empty.
