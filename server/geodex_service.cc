@@ -235,6 +235,7 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
       options.barrier_below = metadata_.dem().barrier_below();
     options.z_tolerance = metadata_.dem().z_tolerance();
     options.max_cells = env_.limits->max_dem_cells;
+    options.cancel = &cancel_;  // the call's: a cancelled upload stops its TIN build
     options.max_vertices = env_.limits->max_vertices;
     options.max_faces = env_.limits->max_faces;
     absl::StatusOr<terrain::Dem> dem = terrain::Dem::ReadGeoTiffBytes(bytes_, file_name, options);

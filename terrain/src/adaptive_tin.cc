@@ -118,7 +118,7 @@ class TinBuilder {
     work_ += work;
     if (work_ < next_poll_) return false;
     next_poll_ = work_ + kPollEvery;
-    return options_.cancel != nullptr && options_.cancel->load(std::memory_order_relaxed);
+    return options_.cancel != nullptr && options_.cancel->IsCancelled();
   }
   double CornerHeight(uint32_t row, uint32_t col) const;
   void AddVertex(uint64_t cell, double height);
@@ -368,7 +368,7 @@ absl::StatusOr<AdaptiveTin> BuildAdaptiveTin(const double* heights, uint32_t row
         absl::StrCat("rows x cols is too large for an adaptive TIN: ", rows, " x ", cols));
   }
   if (heights == nullptr) return absl::InvalidArgumentError("heights is null");
-  if (options.cancel != nullptr && options.cancel->load(std::memory_order_relaxed)) {
+  if (options.cancel != nullptr && options.cancel->IsCancelled()) {
     return absl::CancelledError("adaptive TIN: cancelled");
   }
   for (uint64_t cell = 0; cell < uint64_t{rows} * cols; ++cell) {

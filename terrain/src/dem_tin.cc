@@ -44,6 +44,7 @@ absl::StatusOr<MeshData> Dem::BuildTin(const Dem& grid, const DemOptions& option
   AdaptiveTinOptions tin_options;
   tin_options.z_tolerance = options.z_tolerance * grid.info_.vertical_scale;
   tin_options.max_vertices = options.max_vertices;
+  tin_options.cancel = options.cancel;
   absl::StatusOr<AdaptiveTin> tin =
       BuildAdaptiveTin(heights.data(), H, W, holes ? valid.data() : nullptr, tin_options);
   if (!tin.ok()) {

@@ -332,14 +332,16 @@ TEST(AdaptiveTinTest, MaxVertices) {
 
 TEST(AdaptiveTinTest, Cancelled) {
   const Raster raster = GaussianHills(50, 60, 8);
-  std::atomic<bool> cancel{true};
+  CancelToken cancel;
+  cancel.Cancel();
   AdaptiveTinOptions options;
   options.z_tolerance = 0.1;
   options.cancel = &cancel;
   const auto tin =
       BuildAdaptiveTin(raster.heights.data(), raster.rows, raster.cols, nullptr, options);
   EXPECT_EQ(tin.status().code(), absl::StatusCode::kCancelled);
-  cancel = false;
+  CancelToken fresh;
+  options.cancel = &fresh;
   EXPECT_TRUE(
       BuildAdaptiveTin(raster.heights.data(), raster.rows, raster.cols, nullptr, options).ok());
 }
@@ -351,13 +353,13 @@ TEST(AdaptiveTinTest, CancelledWhileInserting) {
   std::mt19937_64 random(9);
   std::uniform_real_distribution<double> noise(0, 1);
   for (double& h : raster.heights) h = noise(random);
-  std::atomic<bool> cancel{false};
+  CancelToken cancel;
   AdaptiveTinOptions options;
   options.z_tolerance = 1e-12;
   options.cancel = &cancel;
   std::thread canceller([&] {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    cancel = true;
+    cancel.Cancel();
   });
   const auto start = std::chrono::steady_clock::now();
   const auto tin =

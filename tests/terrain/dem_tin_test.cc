@@ -32,6 +32,21 @@ double Hills(double x, double y) {
   return 40 * std::sin(u / 9.0) * std::cos(v / 7.0) + 0.3 * u + 15 * std::sin(v / 23.0);
 }
 
+// The TIN build takes the solves' cancel token (DemOptions::cancel): cancelled, the read answers
+// Cancelled (geodexd cancels an upload's build with its call); without one it builds.
+TEST_F(DemTest, ATinBuildStopsWhenCancelled) {
+  Grid g;
+  g.height_at = [](double x, double y, int, int) { return Hills(x, y); };
+  const std::string path = Write("cancel.tif", g);
+  CancelToken cancel;
+  cancel.Cancel();
+  DemOptions options = Tin(0.01);
+  options.cancel = &cancel;
+  EXPECT_EQ(Dem::Read(path, options).status().code(), absl::StatusCode::kCancelled);
+  options.cancel = nullptr;
+  EXPECT_TRUE(Dem::Read(path, options).ok());
+}
+
 TEST_F(DemTest, TinOfAPlaneIsTwoTrianglesAndItsRasterIsExact) {
   Grid g;
   g.height_at = [](double x, double y, int, int) {

@@ -39,6 +39,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "geodex/cancel.h"
 
 namespace geodex::terrain {
 
@@ -49,8 +50,9 @@ struct AdaptiveTinOptions {
   // The most vertices the TIN may have: a LimitExceededError (geodex/limits.h kVertices) when Z
   // needs more. 0: no bound (at most every cell becomes a vertex).
   uint64_t max_vertices = 0;
-  // Polled every few million cells scanned; when it reads true the build returns Cancelled.
-  const std::atomic<bool>* cancel = nullptr;
+  // Polled every few million cells scanned; once cancelled the build returns Cancelled (the
+  // solves' CancelToken: geodexd cancels an upload's TIN build with its call).
+  const CancelToken* cancel = nullptr;
 };
 
 struct AdaptiveTin {

@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "absl/status/statusor.h"
+#include "geodex/cancel.h"
 #include "geodex/distance_field.h"
 #include "geodex/geodesic_solver.h"
 #include "geodex/gis_formats.h"
@@ -69,6 +70,8 @@ struct DemOptions {
   // server sets before GDAL reads untrusted bytes: checked before any row is read, a
   // LimitExceededError (geodex/limits.h: kDemCells, kVertices, kFaces) above it.
   uint64_t max_cells = 0;
+  // Stops an adaptive TIN's build (Cancelled) once cancelled; null: not cancellable.
+  const CancelToken* cancel = nullptr;
   uint64_t max_vertices = 0;
   uint64_t max_faces = 0;
   // > 0: the mesh is an adaptive TIN whose surface is within this many of the band's height units
