@@ -106,25 +106,26 @@ Provenance MakeProvenance(const std::string& made_by, const GeodesicOptions* opt
   return out;
 }
 
-std::string ProvenanceJson(const Provenance& provenance) {
-  auto quoted = [](const std::string& text) {
-    std::string out = "\"";
-    for (unsigned char c : text) {
-      if (c == '"' || c == '\\') {
-        out += '\\';
-        out += static_cast<char>(c);
-      } else if (c < 0x20) {
-        out += absl::StrFormat("\\u%04x", c);
-      } else {
-        out += static_cast<char>(c);
-      }
+std::string JsonQuoted(const std::string& text) {
+  std::string out = "\"";
+  for (unsigned char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += static_cast<char>(c);
+    } else if (c < 0x20) {
+      out += absl::StrFormat("\\u%04x", c);
+    } else {
+      out += static_cast<char>(c);
     }
-    return out + "\"";
-  };
+  }
+  return out + "\"";
+}
+
+std::string ProvenanceJson(const Provenance& provenance) {
   std::string out = "{";
   for (size_t i = 0; i < provenance.items.size(); ++i) {
-    absl::StrAppend(&out, i ? ", " : "", quoted(provenance.items[i].first), ": ",
-                    quoted(provenance.items[i].second));
+    absl::StrAppend(&out, i ? ", " : "", JsonQuoted(provenance.items[i].first), ": ",
+                    JsonQuoted(provenance.items[i].second));
   }
   return out + "}";
 }

@@ -24,6 +24,9 @@ struct Provenance {
 Provenance MakeProvenance(const std::string& made_by, const GeodesicOptions* options);
 // The items as a JSON object's text (the GeoJSON member).
 std::string ProvenanceJson(const Provenance& provenance);
+// `text` as a JSON string literal (RFC 8259 escapes): the one quoting of geodex's JSON, the CLI's
+// included.
+std::string JsonQuoted(const std::string& text);
 
 enum class GisFileKind { kRaster, kVector };
 
