@@ -274,8 +274,10 @@ int FailQuery(const absl::Status& status) {
   const std::string option = InvalidOptionOf(status);
   const std::string flag = option.empty() ? "" : FlagOfOption(option) + ": ";
   // A core limit the CLI set from a flag: name it (geodexd names its own server flags).
-  const std::string limit =
-      ExceededLimit(status) == Limit::kSteinerPoints ? " (--max-steiner-points)" : "";
+  const std::optional<Limit> exceeded = ExceededLimit(status);
+  const std::string limit = exceeded == Limit::kSteinerPoints ? " (--max-steiner-points)"
+                            : exceeded == Limit::kWindows     ? " (--max-windows)"
+                                                              : "";
   return Fail(QueryExitCode(status), flag + InWrittenTerms(std::string(status.message())) + limit);
 }
 

@@ -285,6 +285,7 @@ bool GetSolverFlags(const Args& args, GeodesicOptions* options, std::string* err
                    error)) {
     return false;
   }
+  options->max_windows = kDefaultMaxWindows;  // the work budget (geodex/limits.h); 0: none
   if (!GetDouble(args, "lambda", &options->lambda, error) ||
       !GetUint(args, "max-windows", &options->max_windows, error) ||
       !GetTravelFlags(args, options, error)) {

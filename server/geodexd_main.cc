@@ -76,10 +76,12 @@ ABSL_FLAG(uint64_t, max_output_values, 100'000'000,
 ABSL_FLAG(uint64_t, max_unary_response_bytes, 4 << 20,
           "Largest unary response (clients keep gRPC's default 4 MiB receive limit)");
 ABSL_FLAG(uint32_t, stream_chunk_bytes, 1 << 20, "Approximate size of one streamed result message");
-ABSL_FLAG(uint64_t, max_windows, 0, "Window budget per solve (0 = unlimited)");
+ABSL_FLAG(uint64_t, max_windows, geodex::kServerDefaultMaxWindows,
+          "Work budget per solve: windows made, or a travel graph's links relaxed (32 a window); "
+          "0 = unlimited");
 ABSL_FLAG(uint64_t, max_steiner_points, geodex::kDefaultMaxSteinerPoints,
           "Most Steiner points of one travel-cost solve (SolverOptions.travel; about 32 bytes "
-          "each; 0 = unlimited)");
+          "each, refused before they are allocated; 0 = unlimited)");
 ABSL_FLAG(int32_t, max_receive_message_bytes, 4 << 20,
           "Largest single request message (uploads are chunked below this)");
 ABSL_FLAG(double, shutdown_grace_seconds, 10,

@@ -20,10 +20,12 @@ struct ServiceLimits {
   uint32_t max_targets = 50'000;                  // --max_targets (matrix columns, points)
   uint32_t max_levels = 1'000;                    // --max_levels (isolines)
   uint64_t max_output_values = 100'000'000;       // --max_output_values
-  uint64_t max_windows = 0;                       // --max_windows (per solve; 0 = unlimited)
-  // Steiner points of one travel-cost solve (the weighted engine, about 32 bytes each: 50M is
-  // about 1.6 GB); 0 = unlimited. --max_steiner_points
-  uint64_t max_steiner_points = 50'000'000;
+  // The work budget per solve (windows, or a travel graph's links relaxed; geodex/limits.h);
+  // 0 = unlimited. --max_windows
+  uint64_t max_windows = kServerDefaultMaxWindows;
+  // Steiner points of one travel-cost solve (the weighted engine, about 32 bytes each: 32M is
+  // about 1 GiB); 0 = unlimited. --max_steiner_points
+  uint64_t max_steiner_points = kDefaultMaxSteinerPoints;
   // Largest unary response (LocatePoints, EstimateDistances, FindShortestPath): clients keep
   // gRPC's default 4 MiB receive limit. --max_unary_response_bytes
   uint64_t max_unary_response_bytes = 4 << 20;

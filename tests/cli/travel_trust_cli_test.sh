@@ -46,6 +46,12 @@ json.dump(collection([feature({"friction": 4}, [[[500100, 4999000], [500200, 499
           open(f"{out}/two_points.geojson", "w"))
 json.dump(collection([feature({"friction": 4}, box(500100, 4999000, 1e308, 5001000))]),
           open(f"{out}/far.geojson", "w"))
+# A 2000-vertex circle of friction 3: cut into the grid exactly it leaves slivers, and a path's
+# travel graph there needs ~60M Steiner points (the blow-up, on a smaller map).
+import math
+ring = [[500200 + 100 * math.cos(2 * math.pi * i / 2000), 4999850 + 100 * math.sin(2 * math.pi * i / 2000)]
+        for i in range(2000)]
+json.dump(collection([feature({"friction": 3}, [ring + [ring[0]]])]), open(f"{out}/circle.geojson", "w"))
 PY
 check "fixtures made" test -s "$tmp/flat.tif"
 F="$tmp/flat.tif"
@@ -168,6 +174,30 @@ if [ "${GEODEX_MODE:-local}" = local ]; then
   check "travel window budget: no --lambda suggested" bash -c "! grep -q lambda '$tmp/err.txt'"
   "$GEODEX" distances "$F" --sources $S --max-windows 50 >/dev/null 2>"$tmp/err.txt"
   check "plain window budget: lambda suggested" grep -q "lambda > 0" "$tmp/err.txt"
+fi
+
+# Default work budgets (CLI and geodexd alike): a path whose travel graph blows up on the slivers
+# of an exactly cut 2000-vertex circle is refused up front by the Steiner-point limit, naming the
+# flag that sets it; and a graph search over its work budget is refused naming it too (it was
+# unlimited there). Both bounded by the test's own timeout, never minutes of work.
+CIRCLE=(path "$F" --from $S --to g:500315:4999725 --speed constant:3.6
+  --friction "$tmp/circle.geojson" --friction-boundaries exact)
+timeout 60 "$GEODEX" "${CIRCLE[@]}" >/dev/null 2>"$tmp/err.txt"
+rc=$?
+check "sliver blow-up: refused, exit 1 ($rc)" test "$rc" -eq 1
+if [ "${GEODEX_MODE:-local}" = local ]; then
+  check "sliver blow-up: names --max-steiner-points" grep -q -- "--max-steiner-points" "$tmp/err.txt"
+  timeout 60 "$GEODEX" "${CIRCLE[@]}" --max-steiner-points 0 --max-windows 100000 \
+    >/dev/null 2>"$tmp/err.txt"
+  rc=$?
+  check "graph work budget: exit 1 ($rc)" test "$rc" -eq 1
+  check "graph work budget: says so, naming --max-windows" \
+    grep -q "work budget exceeded.*(--max-windows)" "$tmp/err.txt"
+  "$GEODEX" path "$F" --from $S --to g:500315:4999725 --speed constant:3.6 \
+    --friction "$tmp/bands.geojson" --max-windows 10 >/dev/null 2>"$tmp/err.txt"
+  check "graph work budget (friction bands): names --max-windows" grep -q -- "--max-windows" "$tmp/err.txt"
+else
+  check "sliver blow-up: names geodexd's --max_steiner_points" grep -q "max_steiner_points" "$tmp/err.txt"
 fi
 
 # Metres and seconds, both, labelled: a 7.2 km/h (2 m/s) path's JSON and GeoJSON carry length_m

@@ -662,5 +662,48 @@ TEST(WeightedFieldTest, PathsHeadForTheirTargets) {
   }
 }
 
+// The work budget (max_windows) bounds the graph's searches too, in links relaxed
+// (kGraphLinksPerWindow a window): a field, a path and costs on a shared surface over it are
+// refused naming Limit::kWindows, and one at its size answers as without a budget (bit for bit).
+// Friction and a slope cost. Before the budget reached the graph it was ignored there.
+TEST(WeightedFieldTest, WorkBudgetBoundsTheGraphsSearches) {
+  const MeshData data = JitteredGrid(20);
+  const TriangleMesh mesh = BuildMesh(data);
+  std::vector<double> weights;
+  for (uint32_t f = 0; f < data.face_count(); ++f) {
+    weights.push_back(1 + 3 * (FaceCentroid(data, f)[0] > 0.4));
+  }
+  const SurfacePoint from = SurfacePoint::AtVertex(21 * 10 + 1);
+  const SurfacePoint to = SurfacePoint::AtVertex(21 * 10 + 19);
+  for (WeightedOptions options : WithAndWithoutSlope(weights)) {
+    const int variant = options.slope_cost != nullptr;
+    absl::StatusOr<WeightedField> full = ComputeWeightedField(mesh, {from}, options);
+    absl::StatusOr<WeightedPath> path = ComputeWeightedPath(mesh, from, to, options);
+    ASSERT_TRUE(full.ok() && path.ok()) << variant;
+    const uint64_t links = full->stats.edge_relaxations;
+    ASSERT_GT(links, 100 * kGraphLinksPerWindow) << variant;
+    // A budget the whole search fits in: the same answers.
+    options.max_windows = links / kGraphLinksPerWindow + 1;
+    absl::StatusOr<WeightedField> within = ComputeWeightedField(mesh, {from}, options);
+    ASSERT_TRUE(within.ok()) << within.status();
+    EXPECT_EQ(within->cost, full->cost) << variant;
+    // A tenth of it: refused, naming the budget.
+    options.max_windows = links / kGraphLinksPerWindow / 10;
+    absl::StatusOr<WeightedField> over = ComputeWeightedField(mesh, {from}, options);
+    EXPECT_EQ(over.status().code(), absl::StatusCode::kResourceExhausted) << variant;
+    EXPECT_EQ(ExceededLimit(over.status()), Limit::kWindows) << variant;
+    EXPECT_NE(over.status().message().find("work budget exceeded"), absl::string_view::npos);
+    options.max_windows = path->stats.edge_relaxations / kGraphLinksPerWindow / 10;
+    absl::StatusOr<WeightedPath> over_path = ComputeWeightedPath(mesh, from, to, options);
+    EXPECT_EQ(ExceededLimit(over_path.status()), Limit::kWindows) << variant;
+    // On a surface shared between queries, the budget it was built under bounds each query.
+    absl::StatusOr<WeightedSurface> surface = WeightedSurface::Build(mesh, options, {from}, {to});
+    ASSERT_TRUE(surface.ok()) << surface.status();
+    EXPECT_EQ(ExceededLimit(surface->CostsAt({from}, {to}, /*whole=*/true).status()),
+              Limit::kWindows)
+        << variant;
+  }
+}
+
 }  // namespace
 }  // namespace geodex

@@ -424,6 +424,30 @@ TEST_F(TravelServiceTest, OneWeightSurfaceIsSharedAsAGraphIs) {
   EXPECT_EQ(surface->steiner_points(), 0u);
 }
 
+// geodexd's work budget (--max_windows, on by default) bounds a travel graph's search too: a path
+// with several weights (the graph) on a server whose budget is too small is RESOURCE_EXHAUSTED
+// naming the flag, and the default budget answers it. Before, the graph ignored the budget.
+TEST_F(TravelServiceTest, WorkBudgetBoundsTravelGraphSearches) {
+  EXPECT_EQ(ServiceLimits().max_windows, kServerDefaultMaxWindows);
+  EXPECT_EQ(ServiceLimits().max_steiner_points, kDefaultMaxSteinerPoints);
+  PathQuery query{Sites()[0], SurfacePoint::AtVertex(420), {}};
+  query.options.solver = Travel();
+  v1::FindShortestPathResponse response;
+  ASSERT_TRUE(PathOverService(query, &response).ok());  // the default budget
+  server_->Shutdown(absl::Now());
+  ServerOptions options;
+  options.limits.max_windows = 2;
+  StartServer(options);
+  ASSERT_TRUE(Upload(*stub_, off_, "hills").status.ok());
+  grpc::Status status = PathOverService(query, &response);
+  ASSERT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << status.error_message();
+  EXPECT_NE(status.error_message().find("work budget exceeded"), std::string::npos)
+      << status.error_message();
+  EXPECT_NE(status.error_message().find("--max_windows"), std::string::npos)
+      << status.error_message();
+  EXPECT_EQ(Info(status).metadata().at("flag"), "max_windows");
+}
+
 // Travel graphs in the result cache: one per mesh and travel cost (another epsilon is another
 // graph; a slope-dependent speed has none), counted in its bytes, and what a graph's answers are
 // does not depend on whether it came from the cache.

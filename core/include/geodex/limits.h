@@ -22,9 +22,20 @@ enum class Limit {
 };
 
 // The default Steiner-point limit of a travel solve, the CLI's (--max-steiner-points) and
-// geodexd's (--max_steiner_points) alike: about 1.6 GiB of the engine's per-point state (25 to 33
+// geodexd's (--max_steiner_points) alike: about 1 GiB of the engine's per-point state (25 to 33
 // bytes a point), refused up front before it is allocated, never an out-of-memory kill.
-inline constexpr uint64_t kDefaultMaxSteinerPoints = 50'000'000;
+inline constexpr uint64_t kDefaultMaxSteinerPoints = 32'000'000;
+
+// The default work budget of one solve (GeodesicOptions::max_windows): the CLI's (--max-windows),
+// about 5 to 10 minutes of one core, and geodexd's (--max_windows), 1 to 3 minutes of one worker.
+// Core's own default stays 0 (unlimited): the budget is the caller's.
+inline constexpr uint64_t kDefaultMaxWindows = 4'000'000'000;
+inline constexpr uint64_t kServerDefaultMaxWindows = 1'000'000'000;
+
+// A travel graph's search (several weights, or a slope speed) makes no windows: it spends the same
+// budget in links relaxed, this many to a window, about their ratio in time (a window costs
+// 100-200 ns to make and propagate, a link 3-6 ns to relax; docs/travel.md, "Limits and memory").
+inline constexpr uint64_t kGraphLinksPerWindow = 32;
 
 absl::Status LimitExceededError(Limit limit, absl::string_view message);
 

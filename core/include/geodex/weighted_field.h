@@ -108,9 +108,10 @@ struct WeightedOptions {
   // 0 = unlimited; otherwise a solve needing more Steiner points fails with
   // LimitExceededError(Limit::kSteinerPoints) before allocating them.
   uint64_t max_steiner_points = 0;
-  // 0 = unlimited; otherwise, where the exact engine answers (one weight: weighted_regions.h), a
-  // solve creating more windows fails as GeodesicOptions::max_windows says (Limit::kWindows).
-  // The graph has no windows: max_steiner_points bounds it.
+  // The work budget, 0 = unlimited; otherwise, where the exact engine answers (the regions:
+  // weighted_regions.h), a solve creating more windows fails as GeodesicOptions::max_windows says
+  // (Limit::kWindows), and a graph's search relaxing more than kGraphLinksPerWindow links a
+  // window (geodex/limits.h) fails the same way, so every solve's time is bounded.
   uint64_t max_windows = 0;
   const CancelToken* cancel = nullptr;  // polled every few thousand settled nodes
   // Null: direction-independent (cost = length x weight, the bound above holds). Shared, so

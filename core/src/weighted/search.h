@@ -13,6 +13,7 @@
 
 #include "absl/status/status.h"
 #include "absl/strings/str_format.h"
+#include "geodex/limits.h"
 #include "geodex/triangle_mesh.h"
 #include "geodex/weighted_field.h"
 #include "weighted/cost_models.h"
@@ -246,12 +247,26 @@ class Search {
         if (options.cancel != nullptr && options.cancel->IsCancelled()) {
           return absl::CancelledError("weighted solve cancelled");
         }
+        if (absl::Status s = CheckBudget(options.max_windows); !s.ok()) return s;
       }
       Settle(u, bucket, d);
       settled(u);
     }
     peak_heap_ = std::max<uint64_t>(peak_heap_, heap_.capacity());
     return absl::OkStatus();
+  }
+
+  // The work budget (WeightedOptions::max_windows, 0: none), spent in links relaxed.
+  absl::Status CheckBudget(uint64_t max_windows) const {
+    if (max_windows == 0 || relaxations_ / kGraphLinksPerWindow <= max_windows) {
+      return absl::OkStatus();
+    }
+    return LimitExceededError(
+        Limit::kWindows,
+        absl::StrFormat("work budget exceeded: the travel graph's search relaxed %d links, more "
+                        "than the budget of %d windows allows (%d links a window); use a larger "
+                        "budget, a larger epsilon or a max_distance",
+                        relaxations_, max_windows, kGraphLinksPerWindow));
   }
 
   // Checks the search's result: no link from a settled node lowers any node's cost. Run after

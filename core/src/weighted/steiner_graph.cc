@@ -211,7 +211,8 @@ absl::Status SteinerGraph::Build(double epsilon, uint64_t max_points, Placement 
   if (max_points != 0 && total > max_points) {
     return LimitExceededError(
         Limit::kSteinerPoints,
-        absl::StrFormat("epsilon %g needs %d Steiner points on this mesh, more than the %d allowed",
+        absl::StrFormat("epsilon %g needs %d Steiner points on this mesh, more than the %d "
+                        "allowed; use a larger epsilon or allow more points",
                         epsilon, total, max_points));
   }
   if (total > kMaxNodes - nv_) {

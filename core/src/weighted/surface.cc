@@ -271,6 +271,7 @@ WeightedOptions SearchOptions(const WeightedOptions& built, const WeightedSurfac
   out.epsilon = built.epsilon;
   out.max_distance = limits.max_distance;
   out.cancel = limits.cancel;
+  out.max_windows = built.max_windows;  // the work budget the surface was built under
   out.check_optimality = built.check_optimality;
   return out;
 }
