@@ -182,62 +182,12 @@ absl::StatusOr<GeodesicOptions> SolverOptionsFromProto(const v1::SolverOptions& 
                                                        uint64_t max_windows,
                                                        uint64_t max_steiner_points,
                                                        const std::string& field) {
-  GeodesicOptions out;
-  out.lambda = options.lambda();
-  switch (options.lambda_scale()) {
-    case v1::LAMBDA_SCALE_UNSPECIFIED:
-    case v1::LAMBDA_SCALE_MAX_EDGE:
-      out.lambda_scale = LambdaScale::kMaxEdge;
-      break;
-    case v1::LAMBDA_SCALE_MEAN_EDGE:
-      out.lambda_scale = LambdaScale::kMeanEdge;
-      break;
-    default:
-      return FieldError(absl::StrCat(field, ".lambda_scale"),
-                        absl::StrCat("unknown value ", options.lambda_scale()));
-  }
-  if (options.has_max_distance()) out.max_distance = options.max_distance();
-  if (options.has_travel()) {
-    const v1::TravelCost& t = options.travel();
-    TravelCost travel;
-    travel.speed_kmh = t.speed_kmh();
-    if (t.has_epsilon()) travel.epsilon = t.epsilon();
-    travel.max_slope_deg = t.max_slope_deg();
-    switch (t.speed_model()) {
-      case v1::SPEED_MODEL_UNSPECIFIED:
-      case v1::SPEED_MODEL_CONSTANT:
-        travel.speed_model = SpeedModel::kConstant;
-        break;
-      case v1::SPEED_MODEL_TOBLER:
-        travel.speed_model = SpeedModel::kTobler;
-        break;
-      case v1::SPEED_MODEL_TABLE:
-        travel.speed_model = SpeedModel::kTable;
-        break;
-      default:
-        return FieldError(absl::StrCat(field, ".travel.speed_model"),
-                          absl::StrCat("unknown value ", t.speed_model()));
-    }
-    if (!t.speed_table().empty()) {  // core checks the rows (and that the model reads them)
-      auto table = std::make_shared<std::vector<std::array<double, 2>>>();
-      table->reserve(t.speed_table_size());
-      for (const v1::SpeedTableRow& row : t.speed_table()) {
-        table->push_back({row.slope_deg(), row.speed_kmh()});
-      }
-      travel.speed_table = std::move(table);
-    }
-    travel.inbound = t.inbound();
-    travel.max_steiner_points = max_steiner_points;
-    out.travel = std::move(travel);
-    if (!t.face_weights().empty() && !t.friction_geojson().empty()) {
-      return FieldError(absl::StrCat(field, ".travel.friction_geojson"),
-                        "give at most one of face_weights and friction_geojson");
-    }
-  }
-  if (absl::Status s = ValidateGeodesicOptions(out); !s.ok()) {  // core's one check
-    return FieldError(OptionFieldName(InvalidOptionOf(s), field), s.message());
-  }
-  out.max_windows = max_windows;
+  absl::StatusOr<GeodesicOptions> out = api::SolverOptionsFromProto(options);
+  if (!out.ok())
+    return FieldError(OptionFieldName(InvalidOptionOf(out.status()), field),
+                      out.status().message());
+  out->max_windows = max_windows;
+  if (out->travel) out->travel->max_steiner_points = max_steiner_points;
   return out;
 }
 

@@ -64,12 +64,11 @@ using api::SurfacePointToProto;
 // "options.travel.speed_table".
 std::string OptionFieldName(const std::string& option, const std::string& field = "options");
 
-// Solver options (lambda, lambda_scale, max_distance, and the travel cost's own values: speed
-// model, speed, table, inbound, epsilon, slope limit), checked by core's ValidateGeodesicOptions,
-// errors naming the field ("options.travel.speed_kmh"; an unknown speed model is
-// "options.travel.speed_model" here). `max_windows` and `max_steiner_points` come from the server's
-// limits. The travel cost's face weights need the mesh: query_support.h's Options resolves them
-// (face_weights, friction_geojson); here only "at most one of them" is checked.
+// A request's solver options as the server runs them: their wire mapping and core's check
+// (api::SolverOptionsFromProto), errors naming the field ("options.travel.speed_kmh"; an unknown
+// speed model is "options.travel.speed_model"), with the server's budgets (`max_windows`,
+// `max_steiner_points`). Face weights given as friction_geojson need the mesh: query_support.h's
+// Options reads them.
 absl::StatusOr<GeodesicOptions> SolverOptionsFromProto(const v1::SolverOptions& options,
                                                        uint64_t max_windows,
                                                        uint64_t max_steiner_points,

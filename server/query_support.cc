@@ -78,17 +78,10 @@ std::string MapContextKey(const std::optional<terrain::DemInfo>& map) {
   return Sha256Hex(key);
 }
 
-// A travel cost's face weights on `mesh`: null (every face 1), the request's face_weights, or the
-// friction of its GeoJSON polygons.
-absl::StatusOr<std::shared_ptr<const std::vector<double>>> TravelWeights(
+// The weights of a travel cost's friction_geojson on `mesh` (its face_weights came with the
+// options: api::SolverOptionsFromProto).
+absl::StatusOr<std::shared_ptr<const std::vector<double>>> FrictionWeights(
     const QueryEnv& env, const StoredMesh& mesh, const v1::TravelCost& travel) {
-  if (!travel.face_weights().empty()) {
-    // (their count and values are the engine's to check: its errors name face_weight[i], which
-    // OptionFieldName maps to options.travel.face_weights[i])
-    return std::make_shared<const std::vector<double>>(travel.face_weights().begin(),
-                                                       travel.face_weights().end());
-  }
-  if (travel.friction_geojson().empty()) return nullptr;
   // Friction read before from the same text on this mesh in the same map is in the result cache
   // (as a field's `distance`, like a matrix's values): a repeated request, and its cached field,
   // need no reading. Otherwise every face's centroid goes against the polygons: solve-lane work.
@@ -130,9 +123,9 @@ absl::StatusOr<GeodesicOptions> Options(const QueryEnv& env, const StoredMesh& m
       options, env.limits->max_windows, env.limits->max_steiner_points, "options");
   if (!out.ok()) return out;
   out->cancel = env.cancel;
-  if (out->travel) {
+  if (out->travel && !options.travel().friction_geojson().empty()) {
     absl::StatusOr<std::shared_ptr<const std::vector<double>>> weights =
-        TravelWeights(env, mesh, options.travel());
+        FrictionWeights(env, mesh, options.travel());
     if (!weights.ok()) return weights.status();
     out->travel->face_weight = *std::move(weights);
   }

@@ -3,6 +3,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include "absl/strings/str_cat.h"
 
 namespace geodex::api {
 
@@ -189,6 +194,65 @@ void SolverOptionsToProto(const GeodesicOptions& options, v1::SolverOptions* out
     t->set_inbound(travel.inbound);
     // max_steiner_points is the server's (--max_steiner_points), not the request's.
   }
+}
+
+absl::StatusOr<GeodesicOptions> SolverOptionsFromProto(const v1::SolverOptions& options) {
+  GeodesicOptions out;
+  out.lambda = options.lambda();
+  switch (options.lambda_scale()) {
+    case v1::LAMBDA_SCALE_UNSPECIFIED:
+    case v1::LAMBDA_SCALE_MAX_EDGE:
+      out.lambda_scale = LambdaScale::kMaxEdge;
+      break;
+    case v1::LAMBDA_SCALE_MEAN_EDGE:
+      out.lambda_scale = LambdaScale::kMeanEdge;
+      break;
+    default:
+      return OptionError("lambda_scale", absl::StrCat("unknown value ", options.lambda_scale()));
+  }
+  if (options.has_max_distance()) out.max_distance = options.max_distance();
+  if (options.has_travel()) {
+    const v1::TravelCost& t = options.travel();
+    TravelCost travel;
+    travel.speed_kmh = t.speed_kmh();
+    if (t.has_epsilon()) travel.epsilon = t.epsilon();
+    travel.max_slope_deg = t.max_slope_deg();
+    switch (t.speed_model()) {
+      case v1::SPEED_MODEL_UNSPECIFIED:
+      case v1::SPEED_MODEL_CONSTANT:
+        travel.speed_model = SpeedModel::kConstant;
+        break;
+      case v1::SPEED_MODEL_TOBLER:
+        travel.speed_model = SpeedModel::kTobler;
+        break;
+      case v1::SPEED_MODEL_TABLE:
+        travel.speed_model = SpeedModel::kTable;
+        break;
+      default:
+        return OptionError("travel.speed_model", absl::StrCat("unknown value ", t.speed_model()));
+    }
+    if (!t.speed_table().empty()) {  // core checks the rows (and that the model reads them)
+      auto table = std::make_shared<std::vector<std::array<double, 2>>>();
+      table->reserve(t.speed_table_size());
+      for (const v1::SpeedTableRow& row : t.speed_table()) {
+        table->push_back({row.slope_deg(), row.speed_kmh()});
+      }
+      travel.speed_table = std::move(table);
+    }
+    travel.inbound = t.inbound();
+    if (!t.face_weights().empty() && !t.friction_geojson().empty()) {
+      return OptionError("travel.friction_geojson",
+                         "give at most one of face_weights and friction_geojson");
+    }
+    // (their count and values are the engine's to check against the mesh: "face_weight[i]")
+    if (!t.face_weights().empty()) {
+      travel.face_weight = std::make_shared<const std::vector<double>>(t.face_weights().begin(),
+                                                                       t.face_weights().end());
+    }
+    out.travel = std::move(travel);
+  }
+  if (absl::Status s = ValidateGeodesicOptions(out); !s.ok()) return s;  // core's one check
+  return out;
 }
 
 void PointQueryToProto(const PointQuery& query, v1::EstimateDistancesRequest* out) {

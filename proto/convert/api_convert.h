@@ -1,11 +1,13 @@
 #pragma once
 
 // Plain conversions between geodex.v1 messages and core types, used by both sides of the API (the
-// server's validating conversions are in server/proto_convert.h). No validation here: a proto
-// point with nothing set (or a map point, which only a DEM can place) becomes a vertex 0.
+// server's validating conversions are in server/proto_convert.h). No validation here but the
+// solver options' (core's own check): a proto point with nothing set (or a map point, which only a
+// DEM can place) becomes a vertex 0.
 
 #include <array>
 
+#include "absl/status/statusor.h"
 #include "geodex/distance_field.h"
 #include "geodex/distance_matrix.h"
 #include "geodex/geodesic_solver.h"
@@ -36,11 +38,17 @@ SolveStats StatsFromProto(const v1::SolveStats& stats);
 void MeshSummaryToProto(const MeshSummary& summary, v1::Mesh* out);
 MeshSummary MeshSummaryFromProto(const v1::Mesh& mesh);
 
-// The request's solver options: lambda, its scale, max_distance and the travel cost (its face
-// weights as face_weights; the Steiner-point limit is the server's flag). The server's conversion
-// back, with validation, its limits and the mesh's friction, is server/proto_convert.h's
-// SolverOptionsFromProto with query_support.h's Options.
+// The request's solver options, both ways, the one place of their wire mapping: lambda, its
+// scale, max_distance and the travel cost (speed model, speed, table, inbound, epsilon, slope
+// limit, face weights as face_weights). Not on the wire: the budgets (max_windows,
+// max_steiner_points: the server's flags), the cancel token, and friction_geojson's weights, which
+// need the mesh (geodexd reads them: query_support.h's Options).
 void SolverOptionsToProto(const GeodesicOptions& options, v1::SolverOptions* out);
+// Back, checked by core's ValidateGeodesicOptions. Errors are InvalidArgument naming the option
+// as core's do (InvalidOptionOf: "lambda_scale", "travel.speed_model", "travel.speed_kmh",
+// "travel.friction_geojson" when face weights are given too), for the caller to put in its words
+// (geodexd: server/proto_convert.h's OptionFieldName).
+absl::StatusOr<GeodesicOptions> SolverOptionsFromProto(const v1::SolverOptions& options);
 
 // EstimateDistances' exact part, carried whole: the query into the request (its sources, points
 // and options; the mode is the caller's), and the answer into the response and back. The server

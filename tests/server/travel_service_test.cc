@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "absl/strings/match.h"
 #include "field_cache.h"
 #include "geodex/distance_matrix.h"
 #include "geodex/friction.h"
@@ -169,7 +170,17 @@ TEST_F(TravelServiceTest, SolverOptionsRoundTrip) {
   EXPECT_EQ(back->travel->epsilon, 0.05);
   EXPECT_EQ(back->travel->max_slope_deg, 40);
   EXPECT_EQ(back->travel->max_steiner_points, 77u);
-  EXPECT_EQ(back->travel->face_weight, nullptr);  // the mesh's business (query_support Options)
+  // The whole mapping comes back, face weights included (one place: proto/convert).
+  ASSERT_NE(back->travel->face_weight, nullptr);
+  EXPECT_EQ(*back->travel->face_weight, *Travel().travel->face_weight);
+  EXPECT_EQ(back->max_windows, 0u);
+  // Both ways of giving weights at once: refused naming the field, as the server words it.
+  proto.mutable_travel()->set_friction_geojson("{}");
+  absl::StatusOr<GeodesicOptions> both = SolverOptionsFromProto(proto, 0, 77, "pairs[1].options");
+  EXPECT_EQ(both.status().code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_TRUE(
+      absl::StartsWith(both.status().message(), "pairs[1].options.travel.friction_geojson: "))
+      << both.status();
   // Without a travel cost none comes back; an unset epsilon is core's default.
   v1::SolverOptions plain;
   EXPECT_FALSE(SolverOptionsFromProto(plain, 0, 0, "options")->travel.has_value());
