@@ -65,12 +65,9 @@ void FieldCache::Insert(const std::string& key, std::shared_ptr<const DistanceFi
 }
 
 std::shared_ptr<const WeightedSurface> FieldCache::FindGraph(const std::string& key,
-                                                             const TriangleMesh& mesh,
-                                                             bool any_point) {
+                                                             const TriangleMesh& mesh) {
   return Lookup(key, &Entry::graph, &graph_hits_, &graph_misses_,
-                [&mesh, any_point](const WeightedSurface& graph) {
-                  return &graph.mesh() == &mesh && (!any_point || graph.ServesAnyPoint());
-                });
+                [&mesh](const WeightedSurface& graph) { return &graph.mesh() == &mesh; });
 }
 
 void FieldCache::InsertGraph(const std::string& key, std::shared_ptr<const WeightedSurface> graph,

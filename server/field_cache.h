@@ -56,10 +56,8 @@ class FieldCache {
   // `mesh_bytes` too (the mesh store may evict or delete the mesh meanwhile: the budget still
   // bounds what the cache holds). FindGraph answers only a graph built on `mesh` itself: a graph
   // of a mesh since reloaded as another object counts as a miss, and InsertGraph replaces it.
-  // With `any_point` only a surface that answers points inside faces and edges as it is
-  // (WeightedSurface::ServesAnyPoint, the one-weight surface) counts; a graph is a miss.
-  std::shared_ptr<const WeightedSurface> FindGraph(const std::string& key, const TriangleMesh& mesh,
-                                                   bool any_point = false);
+  std::shared_ptr<const WeightedSurface> FindGraph(const std::string& key,
+                                                   const TriangleMesh& mesh);
   void InsertGraph(const std::string& key, std::shared_ptr<const WeightedSurface> graph,
                    uint64_t mesh_bytes);
   // After a missed Find(key) by a path query: true when `key` was asked for before (the source

@@ -73,7 +73,7 @@ absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPath
   if (env.quick) return SolveLaneNeeded();
   PathQueryOptions options;
   options.solver = *solver;
-  ShareTravelGraph(env, **mesh, {*from, *to}, SharedUse::kPaths, &options.solver);
+  ShareTravelGraph(env, **mesh, &options.solver);
   absl::StatusOr<PathQueryResult> result = ComputeShortestPath(*(*mesh)->mesh, *from, *to, options);
   if (result.ok()) {
     env.counters->solves.fetch_add(1, std::memory_order_relaxed);
@@ -139,9 +139,7 @@ absl::Status RunFindShortestPaths(const QueryEnv& env, const v1::FindShortestPat
   }
   PathQueryOptions options;
   options.solver = *solver;
-  std::vector<SurfacePoint> points = froms;
-  points.insert(points.end(), tos.begin(), tos.end());
-  ShareTravelGraph(env, **mesh, points, SharedUse::kPaths, &options.solver);
+  ShareTravelGraph(env, **mesh, &options.solver);
   SolveStats total;
   for (size_t g = 0; g < groups.size(); ++g) {
     std::vector<SurfacePoint> targets;
@@ -214,11 +212,7 @@ absl::Status RunEstimateDistances(const QueryEnv& env, const v1::EstimateDistanc
     }
   }
   if (exact) {
-    if (!request.want_directions()) {
-      std::vector<SurfacePoint> all = *sources;
-      all.insert(all.end(), points->begin(), points->end());
-      ShareTravelGraph(env, **mesh, all, SharedUse::kCosts, &*solver);
-    }
+    if (!request.want_directions()) ShareTravelGraph(env, **mesh, &*solver);
     PointQuery query{*std::move(sources), *std::move(points), *solver, request.want_directions()};
     absl::StatusOr<PointValues> values = ComputePointValues(tm, query);
     if (!values.ok()) return NameSolveError(values.status(), "points");

@@ -132,23 +132,16 @@ absl::StatusOr<GeodesicOptions> Options(const QueryEnv& env, const StoredMesh& m
   return out;
 }
 
-void ShareTravelGraph(const QueryEnv& env, const StoredMesh& mesh,
-                      const std::vector<SurfacePoint>& points, SharedUse use,
-                      GeodesicOptions* options) {
+void ShareTravelGraph(const QueryEnv& env, const StoredMesh& mesh, GeodesicOptions* options) {
   if (!options->travel.has_value() || IsDirectional(*options->travel) || !env.cache->enabled()) {
     return;
   }
-  if (use == SharedUse::kCosts && !CostsUseSharedGraph(*options->travel)) return;
-  // A point inside a face or an edge: a graph is refined around it per query, so only the
-  // one-weight surface (which takes any point) is worth sharing.
-  const bool vertices = std::all_of(points.begin(), points.end(), [](const SurfacePoint& p) {
-    return p.kind == SurfacePoint::Kind::kVertex;
-  });
+  if (!SharesTravelSurface(*options->travel)) return;
   const std::string key = TravelGraphKey(mesh.id, *options);
-  std::shared_ptr<const WeightedSurface> graph = env.cache->FindGraph(key, *mesh.mesh, !vertices);
+  std::shared_ptr<const WeightedSurface> graph = env.cache->FindGraph(key, *mesh.mesh);
   if (graph == nullptr) {
-    absl::StatusOr<std::shared_ptr<const WeightedSurface>> built = BuildTravelGraph(
-        *mesh.mesh, *options, vertices ? SharedPoints::kVertices : SharedPoints::kAny);
+    absl::StatusOr<std::shared_ptr<const WeightedSurface>> built =
+        BuildTravelGraph(*mesh.mesh, *options);
     if (!built.ok() || *built == nullptr) return;
     // The graph refers to the mesh: its owner keeps the mesh alive as long as the graph lives.
     struct Held {

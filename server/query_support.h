@@ -44,22 +44,14 @@ void SnapsToProto(const PointSnaps& snaps, Response* out) {
 // (terrain's FrictionFromGeoJson: in the DEM's map on a DEM's mesh, else in the mesh's x y).
 absl::StatusOr<GeodesicOptions> Options(const QueryEnv& env, const StoredMesh& mesh,
                                         const v1::SolverOptions& options);
-// A constant-speed travel cost's graph from the result cache (TravelGraphKey), or built and
-// cached, set in options->travel->graph: the travel paths, times at points and matrices on one
-// mesh with one cost layer then share it. Nothing without a travel cost, for a slope-dependent
-// speed (its graph follows each query's sources), with the cache off, or when any of the query's
-// `points` (its sources and targets) lies strictly inside a face or an edge and the cost has
-// several weights: the bound needs a graph refined around such a point (WeightedSurface::Build's
-// anchors), which the query builds. With one weight the exact engine's surface takes any point.
-// A graph that cannot be built is left to the query, whose solve names the error. Solve-lane
-// work (it may build).
-// `use`: what the query reads from it. Times at points and matrices with several weights run on
-// regions built for their points (core's CostsUseSharedGraph), so nothing is shared or built
-// for them.
-enum class SharedUse { kPaths, kCosts };
-void ShareTravelGraph(const QueryEnv& env, const StoredMesh& mesh,
-                      const std::vector<SurfacePoint>& points, SharedUse use,
-                      GeodesicOptions* options);
+// A constant-speed, one-weight travel cost's surface (the exact engine's on the passable faces,
+// core's BuildTravelGraph) from the result cache (TravelGraphKey), or built and cached, set in
+// options->travel->graph: the travel paths, times at points and matrices on one mesh with one
+// cost layer then share it; it takes any point. Nothing without a travel cost, with the cache off,
+// or where core shares nothing (SharesTravelSurface): several weights run on regions built around
+// each query's points, a slope-dependent speed on its own graph. A surface that cannot be built is
+// left to the query, whose solve names the error. Solve-lane work (it may build).
+void ShareTravelGraph(const QueryEnv& env, const StoredMesh& mesh, GeodesicOptions* options);
 // What an answer's travel_epsilon says: 0 for exact metres, else the epsilon the solve uses
 // (set, or the speed model's default).
 inline double TravelEpsilon(const GeodesicOptions& options) {

@@ -9,14 +9,19 @@
 #include "geodex/shortest_path.h"
 #include "geodex/triangle_mesh.h"
 #include "ich/ich_solver.h"
+#include "ich/region_links.h"
 
 namespace geodex {
 
 // What a backtrace reads per internal vertex: a DistanceField's arrays, or a targeted solve's
-// still in its workspace.
+// still in its workspace. On the union of a weighted surface's regions (weighted_regions.h) also
+// the boundary points' origins and the links that place them: a path then runs on through the
+// points (ich/region_links.h's kBoundaryPointTag) to its source.
 struct VertexPaths {
   const double* distance;
   const VertexOrigin* origin;
+  const VertexOrigin* point_origin = nullptr;
+  const ich::RegionLinks* links = nullptr;
 };
 
 // The path from the target (`where` names it in file terms) to its nearest source.

@@ -1,5 +1,6 @@
 #include "geodex/shortest_path.h"
 
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -91,24 +92,80 @@ class Tracer {
   }
 
  private:
-  absl::Status Chain(uint32_t v) {
-    // Every leg ends at a pseudo-source; a chain is at most as long as the vertex count.
-    for (uint32_t legs = 0; legs <= mesh_.vertex_count(); ++legs) {
+  // On along the origins from `node` (a vertex, or a boundary point tagged kBoundaryPointTag) to
+  // the source.
+  absl::Status Chain(uint32_t node) {
+    // Every leg ends at a pseudo-source or a boundary point: a chain is at most as long as those.
+    const uint64_t most = uint64_t{mesh_.vertex_count()} +
+                          (field_.links != nullptr ? field_.links->point_count() : 0) + 1;
+    for (uint64_t legs = 0; legs <= most; ++legs) {
+      if (ich::IsBoundaryPoint(node)) {
+        absl::StatusOr<uint32_t> next = FromPoint(node & ~ich::kBoundaryPointTag);
+        if (!next.ok()) return next.status();
+        if (*next == kNoIndex) return absl::OkStatus();
+        node = *next;
+        continue;
+      }
+      const uint32_t v = node;
       const VertexOrigin& o = field_.origin[v];
       if (field_.distance[v] == 0 && o.half_edge == kNoIndex) return absl::OkStatus();
       if (o.half_edge == kNoIndex) {
         // Along an edge from a neighbour (edge relaxation), or v is a source vertex.
         if (o.pseudo_source == kNoIndex || o.pseudo_source == v) return absl::OkStatus();
-        v = o.pseudo_source;
-        AddVertex(v);
+        node = o.pseudo_source;
+        AddVertex(node);
         continue;
       }
       absl::StatusOr<uint32_t> next = Leg(v, o);
       if (!next.ok()) return next.status();
       if (*next == kNoIndex) return absl::OkStatus();  // reached the source point itself
-      v = *next;
+      node = *next;
     }
     return absl::InternalError("path backtrace did not terminate");
+  }
+
+  // One step back from boundary point p: straight across the face its window ran in to that
+  // window's image, or along its chain to the vertex or point whose cost it took. Returns the
+  // vertex or (tagged) point reached, kNoIndex at a source point.
+  absl::StatusOr<uint32_t> FromPoint(uint32_t p) {
+    if (field_.links == nullptr || field_.point_origin == nullptr) {
+      return absl::InternalError("path backtrace reached a boundary point without the links");
+    }
+    const VertexOrigin& o = field_.point_origin[p];
+    if (o.half_edge == kNoIndex) {
+      const uint32_t from = o.pseudo_source;
+      if (from == kNoIndex) return absl::InternalError("path backtrace: a boundary point unset");
+      if (ich::IsBoundaryPoint(from)) {
+        AddBoundaryPoint(from & ~ich::kBoundaryPointTag);
+      } else {
+        AddVertex(from);
+      }
+      return from;
+    }
+    // Across the face of boundary half-edge e, from p on e towards the image.
+    const uint32_t e = o.half_edge;
+    const double len = mesh_.Length(e);
+    const Vec2 xp{PointOnHalfEdge(p, e), 0};
+    const Vec2 ip{o.ix, o.iy};
+    const Vec2 c{mesh_.OppX(e), mesh_.OppY(e)};
+    if (InsideTriangle(ip, len, c)) return Arrive(e, ip, o.pseudo_source);
+    const double side = (ip.x - xp.x) * (c.y - xp.y) - (ip.y - xp.y) * (c.x - xp.x);
+    const uint32_t exit = side > 0 ? TriangleMesh::Next(e) : TriangleMesh::Prev(e);
+    return Walk(exit, ToSiblingFrame(mesh_, e, exit, xp), ToSiblingFrame(mesh_, e, exit, ip),
+                o.pseudo_source);
+  }
+
+  // Where boundary point p lies along half-edge e (one of its chain's), from e's start.
+  double PointOnHalfEdge(uint32_t p, uint32_t e) const {
+    const double t = field_.links->point_param[p];
+    return mesh_.Length(e) * (field_.links->chain_reversed[e] ? 1 - t : t);
+  }
+
+  void AddBoundaryPoint(uint32_t p) {
+    const std::array<uint32_t, 2>& halves =
+        field_.links->chain_halves[field_.links->point_chain[p]];
+    const uint32_t e = halves[0] != kNoIndex ? halves[0] : halves[1];
+    AddEdgePoint(e, PointOnHalfEdge(p, e));
   }
 
   // Walks from vertex v straight towards the image in o's frame, face by face, until the image
@@ -123,15 +180,18 @@ class Tracer {
 
   // The same from a point p given in the frame of o.half_edge (inside its face or on its border).
   absl::StatusOr<uint32_t> LegFrom(Vec2 p, const VertexOrigin& o) {
-    uint32_t g = o.half_edge;
-    Vec2 image{o.ix, o.iy};
+    return Walk(o.half_edge, p, {o.ix, o.iy}, o.pseudo_source);
+  }
+
+  // From p (in the frame of g, in face(g) or on its border) straight to `image`, face by face.
+  absl::StatusOr<uint32_t> Walk(uint32_t g, Vec2 p, Vec2 image, uint32_t pseudo_source) {
     const uint32_t max_steps = 2 * mesh_.face_count() + 8;
     for (uint32_t step = 0; step < max_steps; ++step) {
       const double len = mesh_.Length(g);
       const double tol = 1e-12 * (len + std::abs(image.y));
       if (image.y >= -tol) {
         // The image is in this face (or on its border): the leg ends at it.
-        return Arrive(g, image, o.pseudo_source);
+        return Arrive(g, image, pseudo_source);
       }
       // Cross edge g where the segment p -> image meets it.
       const double s = p.y / (p.y - image.y);
@@ -149,7 +209,7 @@ class Tracer {
       const double side = (ip.x - xp.x) * (c.y - xp.y) - (ip.y - xp.y) * (c.x - xp.x);
       // If the image is inside face(t), the leg ends here.
       if (InsideTriangle(ip, len, c)) {
-        return Arrive(t, ip, o.pseudo_source);
+        return Arrive(t, ip, pseudo_source);
       }
       const uint32_t exit = side > 0 ? TriangleMesh::Next(t) : TriangleMesh::Prev(t);
       p = ToSiblingFrame(mesh_, t, exit, xp);
@@ -169,6 +229,11 @@ class Tracer {
   }
 
   absl::StatusOr<uint32_t> Arrive(uint32_t g, Vec2 image, uint32_t pseudo_source) {
+    if (ich::IsBoundaryPoint(pseudo_source)) {
+      // A boundary point on this face's border: the path goes on from it (Chain).
+      AddBoundaryPoint(pseudo_source & ~ich::kBoundaryPointTag);
+      return pseudo_source;
+    }
     if (pseudo_source != kNoIndex) {
       AddVertex(pseudo_source);
       return pseudo_source;

@@ -232,24 +232,18 @@ std::shared_ptr<const WeightedSurface> SharedGraph(const TriangleMesh& mesh,
 }  // namespace
 
 absl::StatusOr<std::shared_ptr<const WeightedSurface>> BuildTravelGraph(
-    const TriangleMesh& mesh, const GeodesicOptions& options, SharedPoints points) {
+    const TriangleMesh& mesh, const GeodesicOptions& options) {
   absl::StatusOr<WeightedOptions> weighted = WeightedOptionsFor(mesh, options);
   if (!weighted.ok()) return weighted.status();
-  // A slope cost builds its own per query.
-  if (weighted->slope_cost != nullptr) return nullptr;
-  weighted->cancel = nullptr;     // the graph outlives the call that builds it
-  if (RegionsServe(*weighted)) {  // one weight: the exact engine's surface, shared the same way
-    absl::StatusOr<std::shared_ptr<const RegionSurface>> regions =
-        RegionSurface::Build(mesh, *weighted);
-    if (!regions.ok()) return regions.status();
-    return std::make_shared<const WeightedSurface>(
-        WeightedSurface::OnRegions(mesh, *std::move(weighted), *std::move(regions)));
-  }
-  if (points == SharedPoints::kAny)
-    return nullptr;  // a graph: refined around such points per query
-  absl::StatusOr<WeightedSurface> surface = WeightedSurface::Build(mesh, *weighted);
-  if (!surface.ok()) return surface.status();
-  return std::make_shared<const WeightedSurface>(*std::move(surface));
+  // Several weights: regions per query (built around its points); a slope speed: a graph per
+  // query. Neither is shared.
+  if (!RegionsServe(*weighted)) return nullptr;
+  weighted->cancel = nullptr;  // the surface outlives the call that builds it
+  absl::StatusOr<std::shared_ptr<const RegionSurface>> regions =
+      RegionSurface::Build(mesh, *weighted);
+  if (!regions.ok()) return regions.status();
+  return std::make_shared<const WeightedSurface>(
+      WeightedSurface::OnRegions(mesh, *std::move(weighted), *std::move(regions)));
 }
 
 bool TravelIsExact(const TravelCost& travel) {
@@ -258,7 +252,7 @@ bool TravelIsExact(const TravelCost& travel) {
 }
 
 // The exact engine's surface is what is shared: the same condition as exactness.
-bool CostsUseSharedGraph(const TravelCost& travel) { return TravelIsExact(travel); }
+bool SharesTravelSurface(const TravelCost& travel) { return TravelIsExact(travel); }
 
 absl::StatusOr<TravelPointSolver> TravelPointSolver::Create(
     const TriangleMesh& mesh, const GeodesicOptions& options,
@@ -267,7 +261,7 @@ absl::StatusOr<TravelPointSolver> TravelPointSolver::Create(
   if (!weighted.ok()) return weighted.status();
   const WeightedSurface::Limits limits{weighted->max_distance, weighted->cancel};
   // Several weights: regions built for these points, not a shared graph (the exact engine inside
-  // each region answers a matrix in a fraction of the graph's search; CostsUseSharedGraph).
+  // each region answers a matrix in a fraction of the graph's search; SharesTravelSurface).
   const bool several = RegionsServeFields(*weighted) && !RegionsServe(*weighted);
   if (!several) {
     if (std::shared_ptr<const WeightedSurface> shared = SharedGraph(mesh, options, *weighted)) {
@@ -331,9 +325,15 @@ absl::StatusOr<PathsQueryResult> ComputeTravelPaths(const TriangleMesh& mesh,
   if (!weighted.ok()) return weighted.status();
   const WeightedSurface::Limits limits{weighted->max_distance, weighted->cancel};
   absl::StatusOr<std::vector<WeightedPath>> paths;
-  if (const std::shared_ptr<const WeightedSurface> shared = SharedGraph(mesh, options, *weighted)) {
+  // A constant speed: the regions, as for fields, so a path's time is the field's at its end
+  // (one weight: the exact engine's surface, shared when the caller has it; several: the regions
+  // built around the path's ends). A slope speed: the graph.
+  const bool several = RegionsServeFields(*weighted) && !RegionsServe(*weighted);
+  const std::shared_ptr<const WeightedSurface> shared =
+      several ? nullptr : SharedGraph(mesh, options, *weighted);
+  if (shared != nullptr) {
     paths = shared->Paths(from, tos, limits);
-  } else if (RegionsServe(*weighted)) {
+  } else if (RegionsServeFields(*weighted)) {
     std::vector<SurfacePoint> anchors = tos;
     anchors.push_back(from);
     absl::StatusOr<std::shared_ptr<const RegionSurface>> regions =

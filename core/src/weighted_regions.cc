@@ -550,12 +550,6 @@ absl::StatusOr<std::vector<WeightedPath>> RegionSurface::Paths(
     const SurfacePoint& from, const std::vector<SurfacePoint>& tos,
     const WeightedSurface::Limits& limits) const {
   const auto start = std::chrono::steady_clock::now();
-  // Windows leaving a boundary point record no vertex to trace back through, so paths are
-  // traced only where there are none (one weight: every product that serves paths this way).
-  if (impl_->boundary_points() > 0) {
-    return absl::FailedPreconditionError(
-        "paths across region boundaries are not traced by the regions (the graph serves them)");
-  }
   absl::StatusOr<UnionSourceSet> src = UnionSources(*impl_, {from});
   if (!src.ok()) return src.status();
   std::vector<ich::ResolvedTarget> resolved;
@@ -581,7 +575,10 @@ absl::StatusOr<std::vector<WeightedPath>> RegionSurface::Paths(
       !s.ok()) {
     return s;
   }
-  const VertexPaths paths{solver->distances().data(), solver->origins().data()};
+  // Traced back through the boundary points where they cross regions: the path's cost is the
+  // solve's, the field's at its end.
+  const VertexPaths paths{solver->distances().data(), solver->origins().data(),
+                          solver->point_origins().data(), &impl_->links()};
   for (size_t i = 0; i < tos.size(); ++i) {
     if (!std::isfinite(results[i].distance) || out[i].cost == 0) continue;
     absl::StatusOr<GeodesicPath> traced =

@@ -170,20 +170,28 @@ void ExpectSamePaths(const TriangleMesh& mesh, const SurfacePoint& from,
   }
 }
 
-// A graph built once (BuildTravelGraph) and handed to queries in TravelCost::graph gives every
-// path, point value and matrix entry bit for bit what a query building its own gives, under the
-// query's own limits (max_distance, cancel). A graph of other weights, another epsilon or another
-// mesh object is not used (the answers stay those of the query's own options), and a
-// slope-dependent speed has none.
+// Several weights share nothing (BuildTravelGraph gives null: paths, point values and matrices
+// run on regions built around their own points, the fields' engine). A Steiner graph of the
+// same cost handed to queries in TravelCost::graph anyway is not read: every path, point value and
+// matrix entry is bit for bit what a query building its own gives, under the query's own limits
+// (max_distance, cancel); the graph would serve them by its own test (Serves), and a graph of
+// other weights, another epsilon or another mesh object would not. A slope-dependent speed shares
+// nothing either.
 TEST(TravelCostTest, ASharedGraphAnswersAsEachQuerysOwn) {
   const TriangleMesh mesh = SquarePlane(8, 80, 0.2);
   auto weights = std::make_shared<std::vector<double>>(mesh.face_count(), 1.0);
   for (uint32_t f = 0; f < mesh.face_count(); f += 3) (*weights)[f] = 2.5;
   GeodesicOptions own = Travel(3.6, 0.05);
   own.travel->face_weight = weights;
-  absl::StatusOr<std::shared_ptr<const WeightedSurface>> graph = BuildTravelGraph(mesh, own);
-  ASSERT_TRUE(graph.ok()) << graph.status();
-  ASSERT_NE(*graph, nullptr);
+  absl::StatusOr<std::shared_ptr<const WeightedSurface>> nothing = BuildTravelGraph(mesh, own);
+  ASSERT_TRUE(nothing.ok()) << nothing.status();
+  EXPECT_EQ(*nothing, nullptr);
+  absl::StatusOr<WeightedOptions> weighted = WeightedOptionsFor(mesh, own);
+  ASSERT_TRUE(weighted.ok()) << weighted.status();
+  absl::StatusOr<WeightedSurface> built = WeightedSurface::Build(mesh, *weighted);
+  ASSERT_TRUE(built.ok()) << built.status();
+  const absl::StatusOr<std::shared_ptr<const WeightedSurface>> graph =
+      std::make_shared<const WeightedSurface>(*std::move(built));
   GeodesicOptions shared = own;
   shared.travel->graph = *graph;
   // What decides whether a query uses it.

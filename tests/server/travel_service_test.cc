@@ -394,13 +394,12 @@ TEST_F(TravelServiceTest, FieldPathMatrixAndIsolinesEqualCore) {
       EXPECT_TRUE(BitEqual(response.exact(i), values->distance[i])) << i;
     }
   }
-  // The paths above between vertices searched one graph: the first path built it (a miss), the
-  // two repeats and the batch reused it. The matrix and the point times (several weights) run on
-  // regions built for their points (CostsUseSharedGraph): they neither look the graph up nor add
-  // one. All equal core's own.
-  EXPECT_EQ(server_->cache().graph_misses(), 1u);
-  EXPECT_EQ(server_->cache().graph_hits(), 3u);
-  EXPECT_EQ(server_->cache().entries(), 3u);  // the field, the matrix and the one graph
+  // Several weights: the paths, the matrix and the point times run on regions built for their
+  // points (SharesTravelSurface is false), as the field does: nothing is looked up or shared, and
+  // a path's time is the field's at its end. All equal core's own.
+  EXPECT_EQ(server_->cache().graph_misses(), 0u);
+  EXPECT_EQ(server_->cache().graph_hits(), 0u);
+  EXPECT_EQ(server_->cache().entries(), 2u);  // the field and the matrix
 }
 
 // One weight (no friction, steep faces impassable): the exact engine's surface, no Steiner graph,
@@ -435,34 +434,45 @@ TEST_F(TravelServiceTest, OneWeightSurfaceIsSharedAsAGraphIs) {
   EXPECT_EQ(surface->steiner_points(), 0u);
 }
 
-// geodexd's work budget (--max_windows, on by default) bounds a travel graph's search too: a path
-// with several weights (the graph) on a server whose budget is too small is RESOURCE_EXHAUSTED
-// naming the flag, and the default budget answers it. Before, the graph ignored the budget.
+// geodexd's work budget (--max_windows, on by default) bounds every travel solve: a path with
+// several weights (the regions: windows) and one at Tobler's speed (the graph: links relaxed, 32
+// a window) on a server whose budget is too small are RESOURCE_EXHAUSTED naming the flag, and
+// the default budget answers both. Before, the graph ignored the budget.
 TEST_F(TravelServiceTest, WorkBudgetBoundsTravelGraphSearches) {
   EXPECT_EQ(ServiceLimits().max_windows, kServerDefaultMaxWindows);
   EXPECT_EQ(ServiceLimits().max_steiner_points, kDefaultMaxSteinerPoints);
-  PathQuery query{Sites()[0], SurfacePoint::AtVertex(420), {}};
-  query.options.solver = Travel();
+  PathQuery friction{Sites()[0], SurfacePoint::AtVertex(420), {}};
+  friction.options.solver = Travel();
+  PathQuery tobler = friction;
+  tobler.options.solver = SlopeTravel();
   v1::FindShortestPathResponse response;
-  ASSERT_TRUE(PathOverService(query, &response).ok());  // the default budget
+  ASSERT_TRUE(PathOverService(friction, &response).ok());  // the default budget
+  ASSERT_TRUE(PathOverService(tobler, &response).ok());
   server_->Shutdown(absl::Now());
   ServerOptions options;
   options.limits.max_windows = 2;
   StartServer(options);
   ASSERT_TRUE(Upload(*stub_, off_, "hills").status.ok());
-  grpc::Status status = PathOverService(query, &response);
-  ASSERT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << status.error_message();
-  EXPECT_NE(status.error_message().find("work budget exceeded"), std::string::npos)
+  for (const PathQuery& query : {friction, tobler}) {
+    grpc::Status status = PathOverService(query, &response);
+    ASSERT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << status.error_message();
+    EXPECT_NE(status.error_message().find("--max_windows"), std::string::npos)
+        << status.error_message();
+    EXPECT_EQ(Info(status).metadata().at("flag"), "max_windows");
+  }
+  grpc::Status status = PathOverService(tobler, &response);
+  EXPECT_NE(status.error_message().find("work budget exceeded: the travel graph's search"),
+            std::string::npos)
       << status.error_message();
-  EXPECT_NE(status.error_message().find("--max_windows"), std::string::npos)
-      << status.error_message();
-  EXPECT_EQ(Info(status).metadata().at("flag"), "max_windows");
 }
 
-// Travel graphs in the result cache: one per mesh and travel cost (another epsilon is another
-// graph; a slope-dependent speed has none), counted in its bytes, and what a graph's answers are
-// does not depend on whether it came from the cache.
+// Shared travel surfaces in the result cache (one weight: the exact engine's on the passable
+// faces; several weights and slope speeds share nothing): one per mesh and travel cost (another
+// epsilon is another), counted in its bytes, serving any point, and what its answers are does not
+// depend on whether it came from the cache.
 TEST_F(TravelServiceTest, TravelQueriesShareOneGraphPerCost) {
+  GeodesicOptions one = Travel();
+  one.travel->face_weight = nullptr;
   auto path = [&](const GeodesicOptions& options, uint32_t to) {
     PathQuery query{Sites()[0], SurfacePoint::AtVertex(to), {}};
     query.options.solver = options;
@@ -477,43 +487,43 @@ TEST_F(TravelServiceTest, TravelQueriesShareOneGraphPerCost) {
     }
   };
   const uint64_t empty = server_->cache().bytes();
-  path(Travel(), 420);
+  path(one, 420);
   EXPECT_EQ(server_->cache().graph_misses(), 1u);
-  EXPECT_EQ(server_->cache().entries(), 1u);               // the graph
-  EXPECT_GT(server_->cache().bytes(), empty + 8 * 10000);  // (its Steiner points' positions)
-  path(Travel(), 300);
-  path(Travel(), 12);
+  EXPECT_EQ(server_->cache().entries(), 1u);  // the surface
+  EXPECT_GT(server_->cache().bytes(), empty);
+  path(one, 300);
+  path(one, 12);
   EXPECT_EQ(server_->cache().graph_hits(), 2u);
-  GeodesicOptions finer = Travel();
+  GeodesicOptions finer = one;
   finer.travel->epsilon = 0.03;
   path(finer, 420);
   path(finer, 300);
   EXPECT_EQ(server_->cache().graph_misses(), 2u);
   EXPECT_EQ(server_->cache().graph_hits(), 3u);
   EXPECT_EQ(server_->cache().entries(), 2u);
-  path(SlopeTravel(), 420);  // its points follow each query's sources: no graph to share
+  path(SlopeTravel(), 420);  // its points follow each query's sources: nothing to share
+  path(Travel(), 420);       // several weights: regions around its ends, nothing shared
   EXPECT_EQ(server_->cache().graph_misses(), 2u);
   EXPECT_EQ(server_->cache().graph_hits(), 3u);
   {
-    // A point inside a face needs a graph refined around it: the query builds its own (and
-    // answers as core does); the cached graph does not serve it (a miss) and nothing is added.
+    // A point inside a face: the surface takes it as it is (a hit), answering as core does.
     PathQuery query{Sites()[2], SurfacePoint::AtVertex(420), {}};
-    query.options.solver = Travel();
+    query.options.solver = one;
     v1::FindShortestPathResponse response;
     ASSERT_TRUE(PathOverService(query, &response).ok());
     absl::StatusOr<PathQueryResult> want =
         ComputeShortestPath(*local_, query.from, query.to, query.options);
     ASSERT_TRUE(want.ok()) << want.status();
     EXPECT_TRUE(BitEqual(response.distance(), want->distance));
-    EXPECT_EQ(server_->cache().graph_misses(), 3u);
-    EXPECT_EQ(server_->cache().graph_hits(), 3u);
+    EXPECT_EQ(server_->cache().graph_misses(), 2u);
+    EXPECT_EQ(server_->cache().graph_hits(), 4u);
     EXPECT_EQ(server_->cache().entries(), 2u);
   }
 
   // A graph keeps its mesh alive, so its entry counts the mesh's memory as well as its own.
   absl::StatusOr<std::shared_ptr<const StoredMesh>> stored = server_->store().Get("hills");
   ASSERT_TRUE(stored.ok()) << stored.status();
-  const std::string key = TravelGraphKey((*stored)->id, Travel());
+  const std::string key = TravelGraphKey((*stored)->id, one);
   std::shared_ptr<const WeightedSurface> graph = server_->cache().FindGraph(key, *(*stored)->mesh);
   ASSERT_NE(graph, nullptr);
   EXPECT_EQ(&graph->mesh(), (*stored)->mesh.get());
@@ -533,7 +543,7 @@ TEST_F(TravelServiceTest, TravelQueriesShareOneGraphPerCost) {
   ASSERT_TRUE(Upload(*stub_, off_, "hills").status.ok());
   const uint64_t hits = server_->cache().graph_hits();
   const uint64_t misses = server_->cache().graph_misses();
-  path(Travel(), 420);
+  path(one, 420);
   EXPECT_EQ(server_->cache().graph_misses(), misses + 1);
   EXPECT_EQ(server_->cache().graph_hits(), hits);
   absl::StatusOr<std::shared_ptr<const StoredMesh>> again = server_->store().Get("hills");

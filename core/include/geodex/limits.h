@@ -32,7 +32,7 @@ inline constexpr uint64_t kDefaultMaxSteinerPoints = 32'000'000;
 inline constexpr uint64_t kDefaultMaxWindows = 4'000'000'000;
 inline constexpr uint64_t kServerDefaultMaxWindows = 1'000'000'000;
 
-// A travel graph's search (several weights, or a slope speed) makes no windows: it spends the same
+// A travel graph's search (a slope-dependent speed) makes no windows: it spends the same
 // budget in links relaxed, this many to a window, about their ratio in time (a window costs
 // 100-200 ns to make and propagate, a link 3-6 ns to relax; docs/travel.md, "Limits and memory").
 inline constexpr uint64_t kGraphLinksPerWindow = 32;

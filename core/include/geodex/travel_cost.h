@@ -123,30 +123,23 @@ inline const char* SpeedModelName(SpeedModel model) {
   return "constant";
 }
 
-// The graph a constant-speed travel cost's paths, times at points and matrices on `mesh` search,
-// to be shared through TravelCost::graph (geodexd keeps them in its result cache). `mesh` must
-// outlive it. Null for a slope-dependent speed: its points follow each query's sources. Where
-// every passable face weighs the same it holds the exact engine's surface instead of a graph
-// (WeightedSurface::OnRegions, no Steiner points), shared the same way. `points`: what the
-// queries sharing it search from and to; for kAny the result is null unless it serves any point
-// (the one-weight surface: a graph is refined around each point inside a face or an edge, so a
-// query with such a point builds its own). Errors: as the queries' (the options, the
-// Steiner-point limit).
-enum class SharedPoints {
-  kVertices,  // vertices only: every surface serves them
-  kAny,       // also points inside faces and edges (map points): the one-weight surface only
-};
+// The surface a constant-speed travel cost with one weight (every passable face the same) answers
+// paths, times at points and matrices on `mesh` from, to be shared through TravelCost::graph
+// (geodexd keeps them in its result cache): the exact engine's surface of the passable faces
+// (WeightedSurface::OnRegions, no Steiner points), which takes any point. `mesh` must outlive it.
+// Null where nothing is shared (SharesTravelSurface): several weights run on regions built around
+// each query's points, a slope-dependent speed on a graph that follows each query's sources.
+// Errors: as the queries' (the options).
 absl::StatusOr<std::shared_ptr<const WeightedSurface>> BuildTravelGraph(
-    const TriangleMesh& mesh, const GeodesicOptions& options,
-    SharedPoints points = SharedPoints::kVertices);
+    const TriangleMesh& mesh, const GeodesicOptions& options);
 
-// Whether times at points and matrices under `travel` read a graph shared through
-// TravelCost::graph: a constant speed with one weight (the exact engine's surface). With several
-// weights they run on regions built for their own points (docs/engine.md "Several weights by
-// regions"), far faster than a search of the shared graph, which then serves paths only; a
-// slope-dependent speed builds its own per query. Reads the face weights only (a --max-slope
-// leaving one weight is still counted as several: that only forgoes sharing).
-bool CostsUseSharedGraph(const TravelCost& travel);
+// Whether paths, times at points and matrices under `travel` read a surface shared through
+// TravelCost::graph: a constant speed with one weight (the exact engine's surface, which takes any
+// point). With several weights they run on regions built for their own points (docs/engine.md
+// "Several weights by regions"), the fields' engine, so a path's time is the field's at its end; a
+// slope-dependent speed builds its own graph per query. Reads the face weights only (a
+// --max-slope leaving one weight is still counted as several: that only forgoes sharing).
+bool SharesTravelSurface(const TravelCost& travel);
 
 // Tobler's hiking function: km/h at s = rise / run along the direction of travel.
 double ToblerKmh(double rise_over_run);

@@ -231,10 +231,7 @@ class WeightedSurface {
   // sources), and for a surface OnRegions the same window budget (max_windows). Costs the
   // comparison of the weights.
   bool Serves(const TriangleMesh& mesh, const WeightedOptions& options) const;
-  // Whether CostsAt and Paths answer points strictly inside faces and edges on this very surface:
-  // true OnRegions (the exact engine takes any point as it comes); a graph answers them on one
-  // refined around them for the call, so sharing it saves nothing there.
-  bool ServesAnyPoint() const;
+
   uint64_t steiner_points() const;
   uint64_t bytes() const;  // what it holds: the Steiner points, the graph's arrays, the weights
   const TriangleMesh& mesh() const;  // the mesh it was built on

@@ -107,7 +107,9 @@ void IchSolver::EmitFromPointInFace(uint32_t parent, uint32_t frame_edge, double
     UpdateVertex(mesh_.From(h), sigma + Hypot(qx, qy), parent, h, qx, qy);
     const uint32_t t = mesh_.Twin(h);
     if (t == kNoIndex) {
-      if (regions_ != nullptr) ReachBoundary(h, 0, len, len - qx, -qy, sigma, source);
+      if (regions_ != nullptr) {
+        ReachBoundary(h, 0, len, len - qx, -qy, sigma, source, pseudo_source);
+      }
       continue;
     }
     // In the twin's frame the point lies behind the edge: (len - x, -y).
@@ -302,7 +304,7 @@ double IchSolver::IntervalKey(double b0, double b1, double ix, double iy, double
       MakeInterval(id, t, t0 * el, t1 * el, nix, niy, WindowSide::kLeft, w.pseudo_source, w.sigma,
                    w.source);
     } else if (regions_ != nullptr) {
-      ReachBoundary(e, t0 * el, t1 * el, nix, niy, w.sigma, w.source);
+      ReachBoundary(e, t0 * el, t1 * el, nix, niy, w.sigma, w.source, w.pseudo_source);
     }
   }
 }
@@ -332,7 +334,7 @@ double IchSolver::IntervalKey(double b0, double b1, double ix, double iy, double
       MakeInterval(id, t, t0 * el, t1 * el, nix, niy, WindowSide::kRight, w.pseudo_source, w.sigma,
                    w.source);
     } else if (regions_ != nullptr) {
-      ReachBoundary(e, t0 * el, t1 * el, nix, niy, w.sigma, w.source);
+      ReachBoundary(e, t0 * el, t1 * el, nix, niy, w.sigma, w.source, w.pseudo_source);
     }
   }
 }
@@ -483,7 +485,7 @@ absl::Status IchSolver::Run(const std::vector<ResolvedSource>& sources,
                           regions_->point_count(), kPointEntry - 1));
     }
     point_cost_.assign(regions_->point_count(), kUnreachable);
-    point_from_.assign(regions_->point_count(), kNoIndex);
+    point_origin_.assign(regions_->point_count(), VertexOrigin{});
     point_source_.assign(regions_->point_count(), kNoIndex);
     point_slot_.assign(regions_->point_count(), kNoSlot);
     point_seq_.assign(regions_->point_count(), 0);

@@ -90,6 +90,9 @@ class IchSolver {
   // solver; the solver then uses no A* key (costs in different regions are not comparable by
   // position) and the paper's tree is not supported (Method::kExact only).
   void set_regions(const RegionLinks* links) { regions_ = links; }
+  // Per boundary point of the last solve on regions: where its cost came from (ReachPoint), for
+  // tracing paths back through the points.
+  const std::vector<VertexOrigin>& point_origins() const { return point_origin_; }
 
   // The last solve's per-vertex arrays (internal ids), for backtracing paths.
   const std::vector<double>& distances() const { return dist_; }
@@ -180,10 +183,14 @@ class IchSolver {
   // --- regions (region_links.h) ---
   // A window's rays meeting the boundary half-edge e over [x0, x1] (measured from e's end, the
   // image at (ix, iy) as MakeInterval takes it on e's twin): the chain's points there get costs.
+  // `pseudo_source`: the window's (what a path from these points bends at next).
   void ReachBoundary(uint32_t e, double x0, double x1, double ix, double iy, double sigma,
-                     uint32_t source);
-  // Lowers boundary point p's cost to d (reached from half-edge `from`, kNoIndex: along its chain).
-  void ReachPoint(uint32_t p, double d, uint32_t source, uint32_t from);
+                     uint32_t source, uint32_t pseudo_source);
+  // Lowers boundary point p's cost to d; `origin` says from where: a window across the face of
+  // boundary half-edge `origin.half_edge` (its image in that half-edge's frame, its
+  // pseudo-source), or (half_edge kNoIndex) along the chain from the vertex or the (tagged) point
+  // `origin.pseudo_source`.
+  void ReachPoint(uint32_t p, double d, uint32_t source, const VertexOrigin& origin);
   void ProcessBoundaryPoint(uint32_t p);
   // A copy of v got cost d: its other copies get it too, and spawn their own windows.
   void ShareWithCopies(uint32_t v, double d, uint32_t source);
@@ -258,9 +265,9 @@ class IchSolver {
   SolveStats stats_;
 
   const RegionLinks* regions_ = nullptr;
-  std::vector<double> point_cost_;      // per boundary point
-  std::vector<uint32_t> point_from_;    // the half-edge whose window set it (kNoIndex: its chain)
-  std::vector<uint32_t> point_source_;  // the label of its cost
+  std::vector<double> point_cost_;          // per boundary point
+  std::vector<VertexOrigin> point_origin_;  // where its cost came from (ReachPoint)
+  std::vector<uint32_t> point_source_;      // the label of its cost
   // A boundary point is queued as itself, not as a window (queue entries name it as
   // kPointEntry | p): at most one live entry per point, the one numbered point_seq_[p], in queue
   // slot point_slot_[p] (kNoSlot: none). A cost that drops within that slot needs no new entry,

@@ -66,7 +66,7 @@ void IchSolver::ProcessPseudoSource(uint32_t id) {
       if (t == kNoIndex) {
         if (regions_ != nullptr) {
           ReachBoundary(opposite, 0, len, len - mesh_.OppX(opposite), -mesh_.OppY(opposite),
-                        w.sigma, w.source);
+                        w.sigma, w.source, v);
         }
         continue;
       }
@@ -119,7 +119,7 @@ void IchSolver::SpawnShadowWindows(uint32_t id, uint32_t v, double sigma, uint32
       const double x1 = s1 >= span ? len : hit(s1);
       // In the twin's frame positions run the other way.
       if (t == kNoIndex) {
-        ReachBoundary(opposite, len - x1, len - x0, len - px, -py, sigma, source);
+        ReachBoundary(opposite, len - x1, len - x0, len - px, -py, sigma, source, v);
       } else {
         MakeInterval(id, t, len - x1, len - x0, len - px, -py, WindowSide::kInitial, v, sigma,
                      source);

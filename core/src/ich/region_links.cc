@@ -10,7 +10,7 @@
 namespace geodex::ich {
 
 void IchSolver::ReachBoundary(uint32_t e, double x0, double x1, double ix, double iy, double sigma,
-                              uint32_t source) {
+                              uint32_t source, uint32_t pseudo_source) {
   const uint32_t c = regions_->chain_of_half[e];
   if (c == kNoIndex) return;  // a true boundary, or an impassable face beyond
   const double len = mesh_.Length(e);
@@ -40,11 +40,15 @@ void IchSolver::ReachBoundary(uint32_t e, double x0, double x1, double ix, doubl
       i = run_end;
       continue;
     }
-    for (; i < run_end; ++i) ReachPoint(i, sigma + Hypot(x_of(i) - ix, iy), source, e);
+    for (; i < run_end; ++i) {
+      // (the image in e's own frame: the twin's (ix, iy) mirrored)
+      ReachPoint(i, sigma + Hypot(x_of(i) - ix, iy), source,
+                 VertexOrigin{e, pseudo_source, len - ix, -iy});
+    }
   }
 }
 
-void IchSolver::ReachPoint(uint32_t p, double d, uint32_t source, uint32_t from) {
+void IchSolver::ReachPoint(uint32_t p, double d, uint32_t source, const VertexOrigin& origin) {
   if (!(d < point_cost_[p]) || d > key_cap_) return;
   const double old = point_cost_[p];
   point_cost_[p] = d;
@@ -56,7 +60,7 @@ void IchSolver::ReachPoint(uint32_t p, double d, uint32_t source, uint32_t from)
         std::min<uint32_t>(first + kPointBlock, static_cast<uint32_t>(point_cost_.size()));
     run_max = *std::max_element(point_cost_.begin() + first, point_cost_.begin() + last);
   }
-  point_from_[p] = from;
+  point_origin_[p] = origin;
   point_source_[p] = source;
   // Its queued entry, if it pops in this slot anyway, serves: the point is processed at the cost
   // it has then.
@@ -70,8 +74,8 @@ void IchSolver::ReachPoint(uint32_t p, double d, uint32_t source, uint32_t from)
 void IchSolver::ProcessBoundaryPoint(uint32_t p) {
   point_slot_[p] = kNoSlot;
   // Its window exists only while it emits (the parent of what it makes).
-  const uint32_t id =
-      NewPointWindow(WindowKind::kBoundaryPoint, p, kNoIndex, point_cost_[p], point_source_[p], 0);
+  const uint32_t id = NewPointWindow(WindowKind::kBoundaryPoint, p, kBoundaryPointTag | p,
+                                     point_cost_[p], point_source_[p], 0);
   const Window w = pool_[id];
   pool_.MarkProcessed(id);
   const uint32_t c = regions_->point_chain[p];
@@ -97,19 +101,21 @@ void IchSolver::ProcessBoundaryPoint(uint32_t p) {
   };
   for (int side = 0; side < 2; ++side) {
     const uint32_t e = regions_->chain_halves[c][side];
-    if (e == kNoIndex || e == point_from_[p]) continue;
+    if (e == kNoIndex || e == point_origin_[p].half_edge) continue;
     if (covered_by_neighbour(regions_->side_cost[c][side])) continue;
     const double len = mesh_.Length(e);
     EmitFromPointInFace(id, e, len * (regions_->chain_reversed[e] ? 1 - t : t), 0, w.sigma,
-                        kNoIndex, w.source);
+                        kBoundaryPointTag | p, w.source);
   }
   // Along the edge, to its neighbours (the ends are the edge's vertices, reached straight above).
   const double cost = regions_->chain_cost[c];
   if (p > first) {
-    ReachPoint(p - 1, w.sigma + cost * (t - regions_->point_param[p - 1]), w.source, kNoIndex);
+    ReachPoint(p - 1, w.sigma + cost * (t - regions_->point_param[p - 1]), w.source,
+               VertexOrigin{kNoIndex, kBoundaryPointTag | p, 0, 0});
   }
   if (p + 1 < end) {
-    ReachPoint(p + 1, w.sigma + cost * (regions_->point_param[p + 1] - t), w.source, kNoIndex);
+    ReachPoint(p + 1, w.sigma + cost * (regions_->point_param[p + 1] - t), w.source,
+               VertexOrigin{kNoIndex, kBoundaryPointTag | p, 0, 0});
   }
   ReleaseIfDone(id);
 }
@@ -138,7 +144,8 @@ void IchSolver::RelaxChainEnds(uint32_t v, double d, uint32_t source) {
       const bool v_at_chain_start = (e == *corner) != (regions_->chain_reversed[e] != 0);
       const uint32_t p = v_at_chain_start ? first : last - 1;
       const double t = regions_->point_param[p];
-      ReachPoint(p, d + regions_->chain_cost[c] * (v_at_chain_start ? t : 1 - t), source, kNoIndex);
+      ReachPoint(p, d + regions_->chain_cost[c] * (v_at_chain_start ? t : 1 - t), source,
+                 VertexOrigin{kNoIndex, v, 0, 0});
     }
   }
 }

@@ -11,6 +11,15 @@
 
 namespace geodex::ich {
 
+// A path's origin at a boundary point rather than a vertex (VertexOrigin::pseudo_source |
+// kBoundaryPointTag = the point's index): what a window emitted by a boundary point carries as its
+// pseudo-source, so that a path traced back through the union continues from that point
+// (IchSolver::point_origins(), path_trace.h).
+inline constexpr uint32_t kBoundaryPointTag = 1u << 31;
+inline bool IsBoundaryPoint(uint32_t pseudo_source) {
+  return pseudo_source != 0xffffffffu && (pseudo_source & kBoundaryPointTag) != 0;
+}
+
 struct RegionLinks {
   // Per half-edge of the union mesh: the chain of boundary points on it (kNoIndex: none), and
   // whether the chain runs from the half-edge's end to its start.

@@ -57,7 +57,7 @@ void IchSolver::OfferPointToTargets(uint32_t f, double px, double py, double d, 
     const auto [t, placement] = face_target_entry_[e];
     const ResolvedTarget::Placement& at = (*targets_)[t].placements[placement];
     const double dd = d + Hypot(at.px - px, at.py - py);
-    if (via_vertex != kNoIndex) {
+    if (via_vertex != kNoIndex && !IsBoundaryPoint(via_vertex)) {
       Offer(t, placement, dd, label, VertexOrigin{kNoIndex, via_vertex, 0, 0}, 0, 0);
     } else {
       Offer(t, placement, dd, label, VertexOrigin{frame_edge, kNoIndex, fx, fy}, at.px, at.py);

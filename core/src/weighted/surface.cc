@@ -260,8 +260,6 @@ bool WeightedSurface::Serves(const TriangleMesh& mesh, const WeightedOptions& op
          (impl_->regions == nullptr || options.max_windows == built.max_windows);
 }
 
-bool WeightedSurface::ServesAnyPoint() const { return impl_->regions != nullptr; }
-
 namespace {
 
 // What a search on a shared surface reads of its options: the query's limits (the surface holds
