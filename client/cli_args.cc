@@ -353,33 +353,19 @@ absl::StatusOr<terrain::DemOptions> MeshReadOptions(const Args& args, const std:
   uint64_t step = 1;
   std::string error;
   if (!GetUint(args, "dem-step", &step, &error)) return absl::InvalidArgumentError(error);
-  if (step < 1 || step > 1000000) {
-    return absl::InvalidArgumentError("--dem-step must be in [1, 1000000]");
-  }
-  dem.step = static_cast<uint32_t>(step);
+  dem.step = static_cast<uint32_t>(std::min<uint64_t>(step, uint64_t{1} << 31));  // (checked below)
   if (!GetDouble(args, "barrier-below", &dem.barrier_below, &error)) {
     return absl::InvalidArgumentError(error);
-  }
-  if (std::isnan(dem.barrier_below)) {
-    return absl::InvalidArgumentError("--barrier-below must be a number");
   }
   dem.barrier_files = args.All("barrier");
   if (!GetDouble(args, "barrier-width", &dem.barrier_width, &error))
     return absl::InvalidArgumentError(error);
-  if (!(dem.barrier_width >= 0) || !std::isfinite(dem.barrier_width)) {
-    return absl::InvalidArgumentError(
-        "--barrier-width must be a finite number of metres, 0 or more");
-  }
   if (args.options.count("barrier-width") && dem.barrier_files.empty()) {
     return absl::InvalidArgumentError(
         "--barrier-width goes with --barrier (the width of its lines and points)");
   }
   if (!GetDouble(args, "z-tolerance", &dem.z_tolerance, &error)) {
     return absl::InvalidArgumentError(error);
-  }
-  if (!(dem.z_tolerance >= 0) || !std::isfinite(dem.z_tolerance)) {
-    return absl::InvalidArgumentError(
-        "--z-tolerance must be a finite height (the DEM's vertical unit), > 0 for a TIN");
   }
   if (args.options.count("z-tolerance") && !terrain::IsDemPath(mesh)) {
     return absl::InvalidArgumentError(
@@ -420,13 +406,14 @@ absl::StatusOr<terrain::DemOptions> MeshReadOptions(const Args& args, const std:
     if (how == "exact") dem.friction_file = path;
   }
   // --friction-snap F: those outlines snapped onto the vertices within F x the shortest edge at
-  // the vertex (terrain's CheckFrictionSnap holds its rules).
+  // the vertex.
   if (!GetDouble(args, "friction-snap", &dem.friction_snap, &error)) {
     return absl::InvalidArgumentError(error);
   }
-  if (absl::Status s = terrain::CheckFrictionSnap(dem.friction_snap, !dem.friction_file.empty());
-      !s.ok()) {
-    return s;
+  // The values' rules are terrain's (one check); their errors name the flag here.
+  if (absl::Status s = terrain::ValidateDemOptions(dem); !s.ok()) {
+    return absl::InvalidArgumentError(
+        absl::StrCat(FlagOfOption(InvalidOptionOf(s)), ": ", s.message()));
   }
   return dem;
 }
@@ -444,8 +431,12 @@ int OpenMesh(Backend& backend, const Args& args, const std::string& mesh,
     case absl::StatusCode::kResourceExhausted:
     case absl::StatusCode::kCancelled:
       return Fail(kExitSolveFailed, std::string(s.message()));
-    default:
-      return Fail(kExitInput, std::string(s.message()));
+    default: {
+      // A DEM option terrain refused while reading (a TIN's z_tolerance): name its flag.
+      const std::string option = InvalidOptionOf(s);
+      const std::string flag = option.empty() ? "" : FlagOfOption(option) + ": ";
+      return Fail(kExitInput, flag + std::string(s.message()));
+    }
   }
 }
 

@@ -160,6 +160,7 @@ std::string FlagOfOption(const std::string& option) {
     return "--face-weights";  // or --friction's values
   }
   if (option == "travel.friction_geojson") return "--friction";
+  if (option == "step") return "--dem-step";  // terrain's DemOptions (ValidateDemOptions)
   std::string flag = option;
   std::replace(flag.begin(), flag.end(), '_', '-');
   return "--" + flag;

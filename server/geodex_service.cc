@@ -135,9 +135,9 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
             !std::isfinite(metadata_.dem().barrier_below())) {
           return FieldError("metadata.dem.barrier_below", "must be finite");
         }
-        if (!(metadata_.dem().z_tolerance() >= 0) ||
-            !std::isfinite(metadata_.dem().z_tolerance())) {
-          return FieldError("metadata.dem.z_tolerance", "must be finite and >= 0 (0: the grid)");
+        // Terrain's one check of the values, before any byte is received.
+        if (absl::Status s = terrain::ValidateDemOptions(DemOptionsOf(metadata_.dem())); !s.ok()) {
+          return FieldError(absl::StrCat("metadata.dem.", InvalidOptionOf(s)), s.message());
         }
       }
       if (!metadata_.expected_mesh_id().empty() && !IsMeshId(metadata_.expected_mesh_id())) {
@@ -227,19 +227,27 @@ class CreateMeshReactor final : public grpc::ServerReadReactor<grpc::ByteBuffer>
     Finish(ToGrpcStatus(status));
   }
 
+  // The DEM options an upload's metadata asks for (step 0: every cell).
+  static terrain::DemOptions DemOptionsOf(const v1::DemOptions& dem) {
+    terrain::DemOptions options;
+    options.step = std::max<uint32_t>(1, dem.step());
+    if (dem.has_barrier_below()) options.barrier_below = dem.barrier_below();
+    options.z_tolerance = dem.z_tolerance();
+    return options;
+  }
+
   // A GeoTIFF upload's mesh, through GDAL's GTiff driver only, at most --max_dem_cells cells.
   absl::StatusOr<terrain::Dem> ReadDem(const std::string& file_name) const {
-    terrain::DemOptions options;
-    options.step = std::max<uint32_t>(1, metadata_.dem().step());
-    if (metadata_.dem().has_barrier_below())
-      options.barrier_below = metadata_.dem().barrier_below();
-    options.z_tolerance = metadata_.dem().z_tolerance();
+    terrain::DemOptions options = DemOptionsOf(metadata_.dem());
     options.max_cells = env_.limits->max_dem_cells;
     options.cancel = &cancel_;  // the call's: a cancelled upload stops its TIN build
     options.max_vertices = env_.limits->max_vertices;
     options.max_faces = env_.limits->max_faces;
     absl::StatusOr<terrain::Dem> dem = terrain::Dem::ReadGeoTiffBytes(bytes_, file_name, options);
     if (ExceededLimit(dem.status())) return dem.status();  // names its flag on the way out
+    if (const std::string option = InvalidOptionOf(dem.status()); !option.empty()) {
+      return FieldError(absl::StrCat("metadata.dem.", option), dem.status().message());
+    }
     if (!dem.ok()) return FieldError("chunk", dem.status().message());
     // What is stored must load again: the grid is rebuilt from the stored mesh then.
     if (absl::Status back = terrain::Dem::FromMesh(dem->mesh(), dem->info()).status(); !back.ok()) {

@@ -28,6 +28,7 @@
 #include "dem_internal.h"
 #include "gdal_priv.h"
 #include "gdal_quiet.h"
+#include "geodex/geodesic_solver.h"
 #include "geodex/limits.h"
 #include "geodex/terrain.h"
 #include "mem_file.h"
@@ -113,8 +114,36 @@ bool LooksLikeTiff(const std::string& bytes) {
                                 (bytes[3] == 42 || bytes[3] == 43)));
 }
 
+absl::Status ValidateDemOptions(const DemOptions& options) {
+  if (options.step < 1 || options.step > 1000000) {
+    return OptionError("step", absl::StrCat("must be in [1, 1000000], got ", options.step));
+  }
+  if (std::isnan(options.barrier_below)) return OptionError("barrier_below", "must be a number");
+  if (!(options.barrier_width >= 0) || !std::isfinite(options.barrier_width)) {
+    return OptionError("barrier_width", "must be a finite number of metres, 0 or more");
+  }
+  if (!(options.z_tolerance >= 0) || !std::isfinite(options.z_tolerance)) {
+    return OptionError("z_tolerance",
+                       absl::StrCat("must be a finite height (the DEM's vertical unit), >= 0 (0: "
+                                    "the full grid; > 0: a TIN), got ",
+                                    options.z_tolerance));
+  }
+  if (!(options.friction_snap >= 0 && options.friction_snap <= 0.25)) {
+    return OptionError("friction_snap",
+                       absl::StrCat("must be in [0, 0.25] (a fraction of the shortest edge at a "
+                                    "vertex; 0: exact), got ",
+                                    options.friction_snap));
+  }
+  if (options.friction_snap > 0 && options.friction_file.empty()) {
+    return OptionError("friction_snap",
+                       "snaps friction outlines cut into the mesh (--friction-boundaries exact "
+                       "with friction polygons); there are none");
+  }
+  return absl::OkStatus();
+}
+
 absl::StatusOr<Dem> Dem::Read(const std::string& path, const DemOptions& options) {
-  if (options.step < 1) return absl::InvalidArgumentError("--dem-step must be at least 1");
+  if (absl::Status s = ValidateDemOptions(options); !s.ok()) return s;
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) {
     return absl::NotFoundError(absl::StrCat(path, ": cannot open: No such file or directory"));
@@ -137,7 +166,7 @@ absl::StatusOr<Dem> Dem::Read(const std::string& path, const DemOptions& options
 
 absl::StatusOr<Dem> Dem::ReadGeoTiffBytes(const std::string& bytes, const std::string& name,
                                           const DemOptions& options) {
-  if (options.step < 1) return absl::InvalidArgumentError("the DEM step must be at least 1");
+  if (absl::Status s = ValidateDemOptions(options); !s.ok()) return s;
   if (!options.barrier_files.empty()) {
     return absl::InvalidArgumentError("a barrier file is read with the DEM's path, not its bytes");
   }
@@ -216,14 +245,6 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
         Limit::kDemCells,
         absl::StrFormat("%s: %ux%u cells, more than the %u a DEM may have here", path,
                         info.raster_width, info.raster_height, options.max_cells));
-  }
-  if (!(options.z_tolerance >= 0) || !std::isfinite(options.z_tolerance)) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "--z-tolerance: must be finite and >= 0 (0: the full grid), got ", options.z_tolerance));
-  }
-  if (absl::Status s = CheckFrictionSnap(options.friction_snap, !options.friction_file.empty());
-      !s.ok()) {
-    return s;
   }
   info.step = options.step;
   info.grid_width = (info.raster_width + options.step - 1) / options.step;

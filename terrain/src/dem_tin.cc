@@ -17,6 +17,7 @@
 #include "absl/strings/str_format.h"
 #include "dem_internal.h"
 #include "geodex/adaptive_tin.h"
+#include "geodex/geodesic_solver.h"
 #include "geodex/limits.h"
 #include "geodex/terrain.h"
 #include "ogr_geometry.h"
@@ -49,8 +50,7 @@ absl::StatusOr<MeshData> Dem::BuildTin(const Dem& grid, const DemOptions& option
       BuildAdaptiveTin(heights.data(), H, W, holes ? valid.data() : nullptr, tin_options);
   if (!tin.ok()) {
     if (absl::IsInvalidArgument(tin.status())) {
-      return absl::InvalidArgumentError(
-          absl::StrCat("--z-tolerance: ", name, ": ", tin.status().message()));
+      return OptionError("z_tolerance", absl::StrCat(name, ": ", tin.status().message()));
     }
     return tin.status();
   }

@@ -533,21 +533,6 @@ absl::StatusOr<std::vector<double>> FaceFrictionOf(std::vector<FrictionRegion> r
 
 }  // namespace dem_internal
 
-absl::Status CheckFrictionSnap(double friction_snap, bool has_outlines) {
-  if (!(friction_snap >= 0 && friction_snap <= 0.25)) {
-    return absl::InvalidArgumentError(
-        absl::StrCat("--friction-snap: must be in [0, 0.25] (a fraction of the shortest edge at a "
-                     "vertex; 0: exact), got ",
-                     friction_snap));
-  }
-  if (friction_snap > 0 && !has_outlines) {
-    return absl::InvalidArgumentError(
-        "--friction-snap: snaps friction outlines cut into the mesh (--friction-boundaries exact "
-        "with friction polygons); there are none");
-  }
-  return absl::OkStatus();
-}
-
 absl::StatusOr<std::vector<double>> FrictionFromGeoJson(const MeshData& mesh,
                                                         const std::string& geojson,
                                                         const DemInfo* dem,

@@ -247,6 +247,9 @@ TEST_F(DemTest, TinRastersAgreeWithTheGridsAndAStoredTinLoadsTheSame) {
   EXPECT_GT(dropped, 200);
 }
 
+// Terrain's one check of DemOptions (ValidateDemOptions, which Dem::Read runs) names the option as
+// data, in no caller's words: the CLI says --z-tolerance, geodexd metadata.dem.z_tolerance
+// (tests/cli, tests/server).
 TEST_F(DemTest, BadZToleranceIsRefusedNamingTheFlag) {
   Grid g;
   g.height_at = [](double, double, int, int) { return 1.0; };
@@ -255,8 +258,16 @@ TEST_F(DemTest, BadZToleranceIsRefusedNamingTheFlag) {
        {-1.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
     absl::StatusOr<Dem> dem = Dem::Read(path, Tin(z));
     EXPECT_EQ(dem.status().code(), absl::StatusCode::kInvalidArgument) << z;
-    EXPECT_NE(dem.status().message().find("--z-tolerance"), std::string::npos) << dem.status();
+    EXPECT_EQ(InvalidOptionOf(dem.status()), "z_tolerance") << dem.status();
+    EXPECT_EQ(dem.status().message().find("--"), std::string::npos) << dem.status();
   }
+  DemOptions step;
+  step.step = 0;
+  EXPECT_EQ(InvalidOptionOf(ValidateDemOptions(step)), "step");
+  DemOptions width;
+  width.barrier_width = -1;
+  EXPECT_EQ(InvalidOptionOf(ValidateDemOptions(width)), "barrier_width");
+  EXPECT_TRUE(ValidateDemOptions(DemOptions{}).ok());
 }
 
 }  // namespace

@@ -85,10 +85,13 @@ struct DemOptions {
 MeshData RemoveFacesBelow(const MeshData& mesh, double z);
 
 // What a DEM mesh knows about its map.
-// DemOptions::friction_snap's rules: in [0, 0.25], and above 0 only with friction outlines to
-// snap (`has_outlines`: DemOptions::friction_file given). InvalidArgument naming --friction-snap
-// otherwise. Dem::Read checks them; the CLI checks them first, as the flag's usage.
-absl::Status CheckFrictionSnap(double friction_snap, bool has_outlines);
+// The one check of DemOptions' values (step in [1, 1000000], barrier_below not NaN, barrier_width
+// finite and >= 0, z_tolerance finite and >= 0, friction_snap in [0, 0.25] and above 0 only with a
+// friction_file to snap). InvalidArgument naming the option as core's errors do (InvalidOptionOf:
+// "step", "barrier_below", "barrier_width", "z_tolerance", "friction_snap"), for the caller to
+// put in its words: the CLI its flag (--dem-step, --z-tolerance, ...), geodexd its field
+// (metadata.dem.z_tolerance). Dem::Read and ReadGeoTiffBytes check them too.
+absl::Status ValidateDemOptions(const DemOptions& options);
 
 struct DemInfo {
   std::string driver;                            // GDAL's short name ("GTiff")
