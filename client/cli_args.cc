@@ -270,15 +270,13 @@ int QueryExitCode(const absl::Status& status) {
 }
 
 int FailQuery(const absl::Status& status) {
-  // A core option error names its option as data: say the flag.
-  const std::string option = InvalidOptionOf(status);
-  const std::string flag = option.empty() ? "" : FlagOfOption(option) + ": ";
   // A core limit the CLI set from a flag: name it (geodexd names its own server flags).
   const std::optional<Limit> exceeded = ExceededLimit(status);
   const std::string limit = exceeded == Limit::kSteinerPoints ? " (--max-steiner-points)"
                             : exceeded == Limit::kWindows     ? " (--max-windows)"
                                                               : "";
-  return Fail(QueryExitCode(status), flag + InWrittenTerms(std::string(status.message())) + limit);
+  // A core option error names its option as data: say the flag.
+  return Fail(QueryExitCode(status), InWrittenTerms(InFlagTerms(status)) + limit);
 }
 
 int ResolveTravelWeights(Backend& backend, const Args& args, GeodesicOptions* options) {
@@ -412,8 +410,7 @@ absl::StatusOr<terrain::DemOptions> MeshReadOptions(const Args& args, const std:
   }
   // The values' rules are terrain's (one check); their errors name the flag here.
   if (absl::Status s = terrain::ValidateDemOptions(dem); !s.ok()) {
-    return absl::InvalidArgumentError(
-        absl::StrCat(FlagOfOption(InvalidOptionOf(s)), ": ", s.message()));
+    return absl::InvalidArgumentError(InFlagTerms(s));
   }
   return dem;
 }
@@ -431,12 +428,8 @@ int OpenMesh(Backend& backend, const Args& args, const std::string& mesh,
     case absl::StatusCode::kResourceExhausted:
     case absl::StatusCode::kCancelled:
       return Fail(kExitSolveFailed, std::string(s.message()));
-    default: {
-      // A DEM option terrain refused while reading (a TIN's z_tolerance): name its flag.
-      const std::string option = InvalidOptionOf(s);
-      const std::string flag = option.empty() ? "" : FlagOfOption(option) + ": ";
-      return Fail(kExitInput, flag + std::string(s.message()));
-    }
+    default:  // (a DEM option terrain refused while reading, a TIN's z_tolerance: its flag)
+      return Fail(kExitInput, InFlagTerms(s));
   }
 }
 

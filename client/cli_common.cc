@@ -166,6 +166,12 @@ std::string FlagOfOption(const std::string& option) {
   return "--" + flag;
 }
 
+std::string InFlagTerms(const absl::Status& status) {
+  const std::string option = InvalidOptionOf(status);
+  const std::string message(status.message());
+  return option.empty() ? message : absl::StrCat(FlagOfOption(option), ": ", message);
+}
+
 namespace {
 
 // A speed table file: "slope_deg,speed_kmh" rows (a header line, blank lines and # comments are
@@ -293,7 +299,7 @@ bool GetSolverFlags(const Args& args, GeodesicOptions* options, std::string* err
     return false;
   }
   if (absl::Status s = ValidateGeodesicOptions(*options); !s.ok()) {  // core's one check
-    *error = absl::StrFormat("%s: %s", FlagOfOption(InvalidOptionOf(s)), s.message());
+    *error = InFlagTerms(s);
     return false;
   }
   if (args.options.count("lambda-scale")) {

@@ -70,6 +70,9 @@ inline const std::set<std::string> kTravelFlags = {
 // "face_weight[3]"; or geodexd's request field under "options.", "travel.face_weights[3]"), as the
 // user typed it: "--lambda", "--cost-epsilon", "--face-weights".
 std::string FlagOfOption(const std::string& option);
+// The message of an option error (core's, terrain's) in the CLI's words: "--flag: message" when
+// it names an option (InvalidOptionOf), the message alone otherwise.
+std::string InFlagTerms(const absl::Status& status);
 // False with *error naming the first option neither in `known` nor in kMeshReadingFlags (nor, for
 // a command that takes --lambda, kTravelFlags).
 bool CheckKnown(const Args& args, const std::set<std::string>& known, std::string* error);

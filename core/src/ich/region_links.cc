@@ -28,6 +28,9 @@ void IchSolver::ReachBoundary(uint32_t e, double x0, double x1, double ix, doubl
   auto i = static_cast<uint32_t>(std::lower_bound(begin, end, t_lo) - param);
   const auto stop = static_cast<uint32_t>(std::upper_bound(param + i, end, t_hi) - param);
   auto x_of = [&](uint32_t p) { return len * (reversed ? param[p] : 1 - param[p]); };
+  // Where each point reached here took its cost from: this window, its image in e's own frame
+  // (the twin's (ix, iy) mirrored).
+  const VertexOrigin origin{e, pseudo_source, len - ix, -iy};
   while (i < stop) {
     const uint32_t b = i / kPointBlock;
     const uint32_t run_end = std::min(stop, (b + 1) * kPointBlock);
@@ -40,11 +43,7 @@ void IchSolver::ReachBoundary(uint32_t e, double x0, double x1, double ix, doubl
       i = run_end;
       continue;
     }
-    for (; i < run_end; ++i) {
-      // (the image in e's own frame: the twin's (ix, iy) mirrored)
-      ReachPoint(i, sigma + Hypot(x_of(i) - ix, iy), source,
-                 VertexOrigin{e, pseudo_source, len - ix, -iy});
-    }
+    for (; i < run_end; ++i) ReachPoint(i, sigma + Hypot(x_of(i) - ix, iy), source, origin);
   }
 }
 
