@@ -11,7 +11,7 @@ cd "$(dirname "$0")/.."
 seconds=${1:-60}
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(mesh_reader_fuzzer request_fuzzer stored_mesh_fuzzer dem_fuzzer)
+[ ${#targets[@]} -gt 0 ] || targets=(mesh_reader_fuzzer request_fuzzer stored_mesh_fuzzer dem_fuzzer http_fuzzer)
 
 # -g1: line tables are all a report needs, and full debug info doubles the compile time.
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \

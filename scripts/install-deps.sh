@@ -37,6 +37,8 @@ packages=(
   python3-yaml
   # the mesh-affine gateway (deploy/gateway) and its end-to-end test
   nginx-light
+  # the quickstart's and the HTTP tests' HTTP/JSON calls
+  curl
   # TLS tests make a self-signed certificate
   openssl
 )

@@ -73,6 +73,7 @@ absl::Status ValidateServerOptions(const ServerOptions& options) {
        }) {
     if (!status.ok()) return status;
   }
+  if (absl::Status http = ValidateHttpEdgeOptions(options.http); !http.ok()) return http;
   if (stream_chunk > kMaxStreamChunkBytes) {
     return absl::InvalidArgumentError(
         absl::StrCat("--stream_chunk_bytes=", stream_chunk, ": at most ", kMaxStreamChunkBytes,
@@ -178,6 +179,19 @@ absl::StatusOr<std::unique_ptr<GeodexServer>> GeodexServer::Start(const ServerOp
     }
     return absl::UnavailableError(absl::StrCat("--listen=", options.listen, ": cannot listen"));
   }
+  if (!options.http.listen.empty()) {
+    HttpEdgeOptions http = options.http;
+    http.max_body_bytes = static_cast<uint64_t>(options.max_receive_message_bytes);
+    http.tokens = s->authenticated_;
+    http.tls_cert_file = options.tls_cert_file;
+    http.tls_key_file = options.tls_key_file;
+    grpc::ChannelArguments arguments;
+    arguments.SetMaxReceiveMessageSize(-1);  // answers are bounded by the server's own limits
+    absl::StatusOr<std::unique_ptr<HttpEdge>> edge =
+        HttpEdge::Start(http, s->server_->InProcessChannel(arguments));
+    if (!edge.ok()) return edge.status();
+    s->http_ = *std::move(edge);
+  }
   s->health_->SetServing("", true);
   s->health_->SetServing(v1::Geodex::service_full_name(), true);
   return s;
@@ -251,6 +265,7 @@ void GeodexServer::Shutdown(absl::Time deadline) {
   shut_down_ = true;
   health_->Shutdown();  // NOT_SERVING; Watch streams end now, not at the deadline
   server_->Shutdown(absl::ToChronoTime(deadline));
+  if (http_ != nullptr) http_->Stop();  // its calls are over: the server's are
   if (promoter_ != nullptr) promoter_->Stop();  // a background solve is cancelled, not awaited
 }
 

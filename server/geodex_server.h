@@ -16,6 +16,7 @@
 #include "geodex_service.h"
 #include "grpcpp/server.h"
 #include "health_service.h"
+#include "http_edge.h"
 #include "mesh_store.h"
 #include "metrics.h"
 
@@ -58,6 +59,9 @@ struct ServerOptions {
   std::string auth_token_file;
   bool allow_plaintext_tokens = false;
   ServiceLimits limits;
+  // The HTTP/JSON port (http_edge.h); off unless http.listen is given. Its JSON body limit is
+  // max_receive_message_bytes, and it serves TLS and checks tokens as the gRPC port does.
+  HttpEdgeOptions http;
 };
 
 // Parses nothing: builds `data` and stores it under `alias` (may be empty) unless a mesh with the
@@ -90,6 +94,8 @@ class GeodexServer {
   bool authenticated() const { return authenticated_; }
   // The port actually bound (useful with port 0).
   int port() const { return port_; }
+  // The HTTP/JSON port bound (0 when off).
+  int http_port() const { return http_ != nullptr ? http_->port() : 0; }
   // Health NOT_SERVING, then grpc::Server::Shutdown(deadline): calls still running at the deadline
   // are cancelled (their workers stop at the next cancel-token poll and finish them).
   void Shutdown(absl::Time deadline);
@@ -118,6 +124,7 @@ class GeodexServer {
   std::unique_ptr<ComputePool> quick_pool_;
   std::unique_ptr<FieldPromoter> promoter_;  // stopped once the calls are done
   std::unique_ptr<grpc::Server> server_;
+  std::unique_ptr<HttpEdge> http_;  // calls server_ in-process: stopped before it goes
   int port_ = 0;
   bool tls_ = false, authenticated_ = false;
   StartupReport report_;

@@ -35,6 +35,16 @@ ABSL_FLAG(uint64_t, result_cache_bytes, uint64_t{256} << 20,
           "and options (0 = off)");
 ABSL_FLAG(std::string, metrics_listen, "127.0.0.1:9464",
           "HOST:PORT of the Prometheus /metrics HTTP endpoint (empty = off)");
+ABSL_FLAG(std::string, http_listen, "",
+          "HOST:PORT of the HTTP/JSON API (docs/service.md, \"HTTP/JSON\"; empty = off)");
+ABSL_FLAG(uint32_t, http_threads, 4, "HTTP requests served at once (each waits for its call)");
+ABSL_FLAG(uint64_t, http_max_response_bytes, uint64_t{64} << 20,
+          "Largest answer the HTTP port assembles from a stream (NDJSON answers are not bounded)");
+ABSL_FLAG(std::vector<std::string>, http_allowed_hosts, {},
+          "Host names the HTTP port answers besides localhost, 127.0.0.1 and [::1], when no "
+          "bearer tokens are on (comma-separated; * = any: only behind a proxy that checks Host)");
+ABSL_FLAG(std::string, http_cors_origin, "",
+          "Origin allowed to call the HTTP port from a browser (CORS; * = any; empty = none)");
 ABSL_FLAG(std::string, replica_name, "",
           "Name sent to clients as x-geodex-replica metadata (default: the host name)");
 ABSL_FLAG(std::string, tls_cert, "",
@@ -148,6 +158,11 @@ int main(int argc, char** argv) {
   options.tls_key_file = absl::GetFlag(FLAGS_tls_key);
   options.auth_token_file = absl::GetFlag(FLAGS_auth_token_file);
   options.allow_plaintext_tokens = absl::GetFlag(FLAGS_allow_plaintext_tokens);
+  options.http.listen = absl::GetFlag(FLAGS_http_listen);
+  options.http.threads = absl::GetFlag(FLAGS_http_threads);
+  options.http.max_response_bytes = absl::GetFlag(FLAGS_http_max_response_bytes);
+  options.http.allowed_hosts = absl::GetFlag(FLAGS_http_allowed_hosts);
+  options.http.cors_origin = absl::GetFlag(FLAGS_http_cors_origin);
   if (options.replica_name.empty()) {
     char host[256] = {};
     if (gethostname(host, sizeof host - 1) == 0) options.replica_name = host;
@@ -213,6 +228,11 @@ int main(int argc, char** argv) {
     const std::string& listen = options.metrics_listen;
     spdlog::info("metrics on http://{}:{}/metrics", listen.substr(0, listen.rfind(':')),
                  (*server)->metrics().port());
+  }
+  if ((*server)->http_port() != 0) {
+    const std::string& listen = options.http.listen;
+    spdlog::info("HTTP/JSON API on {}://{}:{}/v1/meshes", (*server)->tls() ? "https" : "http",
+                 listen.substr(0, listen.rfind(':')), (*server)->http_port());
   }
   if ((*server)->authenticated() && !(*server)->tls()) {
     spdlog::warn(
