@@ -55,10 +55,12 @@ size=$(docker image inspect "$tag" --format '{{.Size}}')
 echo "image $tag: $((size / 1024 / 1024)) MiB"
 
 port=$(/usr/bin/python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
-step "docker run on the host network, 127.0.0.1:$port"
+http_port=$(/usr/bin/python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
+step "docker run on the host network, 127.0.0.1:$port (HTTP/JSON on $http_port)"
 container=$(docker run -d --network host \
   --health-cmd "geodex --server 127.0.0.1:$port health" --health-interval 1s --health-start-period 30s \
-  "$tag" --listen="127.0.0.1:$port" --metrics_listen= --shutdown_grace_seconds=5)
+  "$tag" --listen="127.0.0.1:$port" --http_listen="127.0.0.1:$http_port" --metrics_listen= \
+  --shutdown_grace_seconds=5)
 health=""
 for _ in $(seq 1 120); do
   health=$(docker inspect "$container" --format '{{.State.Health.Status}}')
@@ -80,6 +82,12 @@ if [ -n "$local_answer" ]; then
   [ "$answer" = "$local_answer" ] || { echo "differs from local mode: $local_answer"; exit 1; }
 fi
 [ -n "$answer" ] || exit 1
+http_answer=$(curl -sf -X POST -H 'Content-Type: application/json' \
+  "http://127.0.0.1:$http_port/v1/meshes/terrain:findShortestPath" \
+  -d '{"from": {"vertex": 0}, "to": {"vertex": 4224}}' |
+  /usr/bin/python3 -c 'import json, sys; print(json.load(sys.stdin)["distance"])')
+echo "the same path over HTTP/JSON: $http_answer"
+[ -n "$http_answer" ] || { docker logs "$container" | tail -5; exit 1; }
 
 step "docker stop"
 start=$(date +%s)

@@ -3,6 +3,7 @@
 # an nginx gateway that routes by the x-mesh-id metadata (deploy/gateway/nginx.conf.template).
 #
 #   deploy/local-cluster.sh start DIR [N]   # prints the gateway address; state and logs in DIR
+#                                           # (DIR/gateway-http-address: its HTTP/JSON port)
 #   deploy/local-cluster.sh stop DIR        # stops exactly the processes `start` launched
 #
 # Env: GEODEXD (default build/server/geodexd), NGINX (default nginx from PATH or /usr/sbin).
@@ -29,24 +30,34 @@ wait_for_port() {  # wait_for_port LOG -> prints the port geodexd reports
   return 1
 }
 
+http_port_of() {  # http_port_of LOG -> the HTTP/JSON port geodexd reports (logged before the gRPC one)
+  sed -n 's|.*HTTP/JSON API on http://[0-9.]*:\([0-9]*\)/.*|\1|p' "$1" | head -1
+}
+
 case "$cmd" in
   start)
     n="${3:-3}"
     mkdir -p "$dir/gateway"
     : >"$dir/pids"
     upstreams=""
+    http_upstreams=""
+    gateway_port=$(free_port)
+    gateway_http_port=$(free_port)
     for i in $(seq 0 $((n - 1))); do
-      "$geodexd" --listen 127.0.0.1:0 --data-dir "$dir/replica-$i/data" --metrics_listen "" \
+      "$geodexd" --listen 127.0.0.1:0 --http_listen 127.0.0.1:0 \
+        --http_grpc_target "127.0.0.1:$gateway_port" --data-dir "$dir/replica-$i/data" --metrics_listen "" \
         --replica_name "replica-$i" --pool-threads 1 --shutdown_grace_seconds 5 \
         >"$dir/replica-$i.log" 2>&1 &
       echo "replica-$i $!" >>"$dir/pids"
       port=$(wait_for_port "$dir/replica-$i.log")
       echo "replica-$i 127.0.0.1:$port" >>"$dir/replicas"
       upstreams+="    server 127.0.0.1:$port max_fails=1 fail_timeout=30s;"$'\n'
+      http_upstreams+="    server 127.0.0.1:$(http_port_of "$dir/replica-$i.log") max_fails=1 fail_timeout=30s;"$'\n'
     done
-    gateway_port=$(free_port)
     sed -e "s|@PREFIX@|$dir/gateway|g" -e "s|@LISTEN@|127.0.0.1:$gateway_port|" \
-      "$here/gateway/nginx.conf.template" | awk -v u="$upstreams" '{ if ($0 == "@UPSTREAMS@") printf "%s", u; else print }' \
+      -e "s|@HTTP_LISTEN@|127.0.0.1:$gateway_http_port|" "$here/gateway/nginx.conf.template" |
+      awk -v u="$upstreams" -v h="$http_upstreams" \
+        '{ if ($0 == "@UPSTREAMS@") printf "%s", u; else if ($0 == "@HTTP_UPSTREAMS@") printf "%s", h; else print }' \
       >"$dir/gateway/nginx.conf"
     "$nginx" -p "$dir/gateway" -c "$dir/gateway/nginx.conf" -g 'daemon off;' \
       >"$dir/gateway/stdout.log" 2>&1 &
@@ -58,6 +69,7 @@ case "$cmd" in
       sleep 0.1
     done
     echo "127.0.0.1:$gateway_port" >"$dir/gateway-address"
+    echo "127.0.0.1:$gateway_http_port" >"$dir/gateway-http-address"
     cat "$dir/gateway-address"
     ;;
   stop)

@@ -11,7 +11,9 @@
 #include "geodex/mesh_id.h"
 #include "geodex/mesh_io.h"
 #include "geodex/samples.h"
+#include "grpcpp/create_channel.h"
 #include "grpcpp/ext/proto_server_reflection_plugin.h"
+#include "grpcpp/security/credentials.h"
 #include "grpcpp/security/server_credentials.h"
 #include "grpcpp/server_builder.h"
 #include "listen_address.h"
@@ -187,8 +189,11 @@ absl::StatusOr<std::unique_ptr<GeodexServer>> GeodexServer::Start(const ServerOp
     http.tls_key_file = options.tls_key_file;
     grpc::ChannelArguments arguments;
     arguments.SetMaxReceiveMessageSize(-1);  // answers are bounded by the server's own limits
-    absl::StatusOr<std::unique_ptr<HttpEdge>> edge =
-        HttpEdge::Start(http, s->server_->InProcessChannel(arguments));
+    absl::StatusOr<std::unique_ptr<HttpEdge>> edge = HttpEdge::Start(
+        http, http.grpc_target.empty()
+                  ? s->server_->InProcessChannel(arguments)
+                  : grpc::CreateCustomChannel(http.grpc_target, grpc::InsecureChannelCredentials(),
+                                              arguments));
     if (!edge.ok()) return edge.status();
     s->http_ = *std::move(edge);
   }
@@ -265,7 +270,7 @@ void GeodexServer::Shutdown(absl::Time deadline) {
   shut_down_ = true;
   health_->Shutdown();  // NOT_SERVING; Watch streams end now, not at the deadline
   server_->Shutdown(absl::ToChronoTime(deadline));
-  if (http_ != nullptr) http_->Stop();  // its calls are over: the server's are
+  if (http_ != nullptr) http_->Stop();          // its calls are over: the server's are
   if (promoter_ != nullptr) promoter_->Stop();  // a background solve is cancelled, not awaited
 }
 

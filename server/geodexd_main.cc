@@ -43,6 +43,9 @@ ABSL_FLAG(uint64_t, http_max_response_bytes, uint64_t{64} << 20,
 ABSL_FLAG(std::vector<std::string>, http_allowed_hosts, {},
           "Host names the HTTP port answers besides localhost, 127.0.0.1 and [::1], when no "
           "bearer tokens are on (comma-separated; * = any: only behind a proxy that checks Host)");
+ABSL_FLAG(std::string, http_grpc_target, "",
+          "Where HTTP calls go: empty = this geodexd; HOST:PORT = a gateway's gRPC port, so HTTP "
+          "calls are routed by mesh as gRPC calls are (deploy/gateway)");
 ABSL_FLAG(std::string, http_cors_origin, "",
           "Origin allowed to call the HTTP port from a browser (CORS; * = any; empty = none)");
 ABSL_FLAG(std::string, replica_name, "",
@@ -163,6 +166,7 @@ int main(int argc, char** argv) {
   options.http.max_response_bytes = absl::GetFlag(FLAGS_http_max_response_bytes);
   options.http.allowed_hosts = absl::GetFlag(FLAGS_http_allowed_hosts);
   options.http.cors_origin = absl::GetFlag(FLAGS_http_cors_origin);
+  options.http.grpc_target = absl::GetFlag(FLAGS_http_grpc_target);
   if (options.replica_name.empty()) {
     char host[256] = {};
     if (gethostname(host, sizeof host - 1) == 0) options.replica_name = host;

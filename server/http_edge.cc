@@ -56,7 +56,8 @@ class GenericCall {
     std::vector<grpc::Slice> slices;
     if (!buffer.Dump(&slices).ok()) return false;
     bytes->clear();
-    for (const grpc::Slice& s : slices) bytes->append(reinterpret_cast<const char*>(s.begin()), s.size());
+    for (const grpc::Slice& s : slices)
+      bytes->append(reinterpret_cast<const char*>(s.begin()), s.size());
     return true;
   }
   grpc::Status Finish() {
@@ -102,12 +103,17 @@ absl::Status ValidateHttpEdgeOptions(const HttpEdgeOptions& options) {
   if (options.listen.empty()) return absl::OkStatus();
   if (absl::Status s = ValidateListenAddress(options.listen, "http_listen"); !s.ok()) return s;
   if (absl::StartsWith(options.listen, "unix") || absl::StartsWith(options.listen, "[")) {
-    return absl::InvalidArgumentError(absl::StrCat(
-        "--http_listen=", options.listen, ": the HTTP port takes an IPv4 HOST:PORT"));
+    return absl::InvalidArgumentError(
+        absl::StrCat("--http_listen=", options.listen, ": the HTTP port takes an IPv4 HOST:PORT"));
   }
   if (options.threads < 1 || options.threads > kMaxHttpThreads) {
-    return absl::InvalidArgumentError(absl::StrCat("--http_threads=", options.threads,
-                                                   ": from 1 to ", kMaxHttpThreads));
+    return absl::InvalidArgumentError(
+        absl::StrCat("--http_threads=", options.threads, ": from 1 to ", kMaxHttpThreads));
+  }
+  if (!options.grpc_target.empty()) {
+    if (absl::Status s = ValidateListenAddress(options.grpc_target, "http_grpc_target"); !s.ok()) {
+      return s;
+    }
   }
   if (options.max_response_bytes < 1024) {
     return absl::InvalidArgumentError(absl::StrCat(
@@ -131,12 +137,18 @@ absl::StatusOr<std::unique_ptr<HttpEdge>> HttpEdge::Start(const HttpEdgeOptions&
   const std::string ports = absl::StrCat(host.empty() ? "" : host + ":", port, tls ? "s" : "");
   const std::string threads = absl::StrCat(options.threads);
   // No document_root: nothing but the handler below answers, and no file is ever served.
-  const char* settings[] = {"listening_ports",    ports.c_str(),
-                            "num_threads",        threads.c_str(),
-                            "request_timeout_ms", "30000",
-                            "enable_keep_alive",  "yes",
-                            "keep_alive_timeout_ms", "5000",
-                            "ssl_protocol_version", "4",  // TLS 1.2 and later
+  const char* settings[] = {"listening_ports",
+                            ports.c_str(),
+                            "num_threads",
+                            threads.c_str(),
+                            "request_timeout_ms",
+                            "30000",
+                            "enable_keep_alive",
+                            "yes",
+                            "keep_alive_timeout_ms",
+                            "5000",
+                            "ssl_protocol_version",
+                            "4",  // TLS 1.2 and later
                             nullptr};
   mg_callbacks callbacks{};
   callbacks.log_message = [](const mg_connection*, const char* message) {
@@ -162,8 +174,8 @@ absl::StatusOr<std::unique_ptr<HttpEdge>> HttpEdge::Start(const HttpEdgeOptions&
       return absl::UnavailableError(
           absl::StrCat("--http_listen=", options.listen, ": address in use; choose another port"));
     }
-    return absl::UnavailableError(absl::StrCat("--http_listen=", options.listen,
-                                               ": cannot listen", tls ? " (or serve TLS)" : ""));
+    return absl::UnavailableError(absl::StrCat("--http_listen=", options.listen, ": cannot listen",
+                                               tls ? " (or serve TLS)" : ""));
   }
   mg_set_request_handler(edge->context_, "/", &HttpEdge::Handle, edge.get());
   mg_server_port bound[4];
@@ -190,14 +202,18 @@ int HttpEdge::Serve(mg_connection* connection) {
   const std::string origin = Header(connection, "Origin");
   const bool cors = !options_.cors_origin.empty() && !origin.empty() &&
                     (options_.cors_origin == "*" || origin == options_.cors_origin);
+  std::string replica;  // the x-geodex-replica the call answered with: which replica served it
   auto send_head = [&](int status, const std::string& media_type, int64_t length) {
-    std::string head = absl::StrCat("HTTP/1.1 ", status, " ",
-                                    mg_get_response_code_text(connection, status),
-                                    "\r\nContent-Type: ", media_type,
-                                    "\r\nCache-Control: no-store\r\nX-Content-Type-Options: nosniff\r\n");
-    if (cors) absl::StrAppend(&head, "Access-Control-Allow-Origin: ", origin, "\r\nVary: Origin\r\n");
-    absl::StrAppend(&head, length >= 0 ? absl::StrCat("Content-Length: ", length, "\r\n")
-                                       : std::string("Transfer-Encoding: chunked\r\n"),
+    std::string head =
+        absl::StrCat("HTTP/1.1 ", status, " ", mg_get_response_code_text(connection, status),
+                     "\r\nContent-Type: ", media_type,
+                     "\r\nCache-Control: no-store\r\nX-Content-Type-Options: nosniff\r\n");
+    if (!replica.empty()) absl::StrAppend(&head, "X-Geodex-Replica: ", replica, "\r\n");
+    if (cors)
+      absl::StrAppend(&head, "Access-Control-Allow-Origin: ", origin, "\r\nVary: Origin\r\n");
+    absl::StrAppend(&head,
+                    length >= 0 ? absl::StrCat("Content-Length: ", length, "\r\n")
+                                : std::string("Transfer-Encoding: chunked\r\n"),
                     "\r\n");
     mg_write(connection, head.data(), head.size());
   };
@@ -217,26 +233,28 @@ int HttpEdge::Serve(mg_connection* connection) {
   if (!options_.tokens) {
     const std::string host = HostName(Header(connection, "Host"));
     const bool local = host == "localhost" || host == "127.0.0.1" || host == "[::1]";
-    const bool allowed =
-        std::any_of(options_.allowed_hosts.begin(), options_.allowed_hosts.end(),
-                    [&](const std::string& a) { return a == "*" || absl::AsciiStrToLower(a) == host; });
+    const bool allowed = std::any_of(
+        options_.allowed_hosts.begin(), options_.allowed_hosts.end(),
+        [&](const std::string& a) { return a == "*" || absl::AsciiStrToLower(a) == host; });
     if (!local && !allowed) {
-      return refuse(grpc::Status(grpc::StatusCode::PERMISSION_DENIED,
-                                 absl::StrCat("Host ", host.empty() ? "(none)" : host,
-                                              ": not this server's; add it to --http_allowed_hosts")));
+      return refuse(
+          grpc::Status(grpc::StatusCode::PERMISSION_DENIED,
+                       absl::StrCat("Host ", host.empty() ? "(none)" : host,
+                                    ": not this server's; add it to --http_allowed_hosts")));
     }
   }
   const std::string method = info->request_method;
   if (method == "OPTIONS") {  // a CORS preflight
     if (!cors) {
       return refuse(grpc::Status(grpc::StatusCode::PERMISSION_DENIED,
-                                 "cross-origin requests are off (--http_cors_origin)"), 403);
+                                 "cross-origin requests are off (--http_cors_origin)"),
+                    403);
     }
-    const std::string head = absl::StrCat(
-        "HTTP/1.1 204 No Content\r\nAccess-Control-Allow-Origin: ", origin,
-        "\r\nVary: Origin\r\nAccess-Control-Allow-Methods: GET, POST, DELETE"
-        "\r\nAccess-Control-Allow-Headers: Content-Type, Authorization, grpc-timeout"
-        "\r\nAccess-Control-Max-Age: 600\r\nContent-Length: 0\r\n\r\n");
+    const std::string head =
+        absl::StrCat("HTTP/1.1 204 No Content\r\nAccess-Control-Allow-Origin: ", origin,
+                     "\r\nVary: Origin\r\nAccess-Control-Allow-Methods: GET, POST, DELETE"
+                     "\r\nAccess-Control-Allow-Headers: Content-Type, Authorization, grpc-timeout"
+                     "\r\nAccess-Control-Max-Age: 600\r\nContent-Length: 0\r\n\r\n");
     mg_write(connection, head.data(), head.size());
     return 204;
   }
@@ -248,7 +266,8 @@ int HttpEdge::Serve(mg_connection* connection) {
   request.content_type = Header(connection, "Content-Type");
   request.accept = Header(connection, "Accept");
   request.content_length = info->content_length;
-  const bool upload = method == "POST" && (request.path == "/v1/meshes" || request.path == "/v1/meshes/");
+  const bool upload =
+      method == "POST" && (request.path == "/v1/meshes" || request.path == "/v1/meshes/");
   if (!upload && method == "POST") {  // the JSON body, bounded
     if (info->content_length > static_cast<int64_t>(options_.max_body_bytes)) {
       return refuse(grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
@@ -272,10 +291,9 @@ int HttpEdge::Serve(mg_connection* connection) {
   absl::StatusOr<HttpCall> routed = RouteHttpRequest(request);
   if (!routed.ok()) {
     const absl::StatusCode code = routed.status().code();
-    return refuse(EdgeStatus(routed.status()), code == absl::StatusCode::kUnimplemented ? 405
-                                               : code == absl::StatusCode::kFailedPrecondition
-                                                   ? 415
-                                                   : 0);
+    return refuse(EdgeStatus(routed.status()), code == absl::StatusCode::kUnimplemented        ? 405
+                                               : code == absl::StatusCode::kFailedPrecondition ? 415
+                                                                                               : 0);
   }
   const HttpCall& call = *routed;
 
@@ -293,6 +311,7 @@ int HttpEdge::Serve(mg_connection* connection) {
   if (const std::string auth = Header(connection, "Authorization"); !auth.empty()) {
     context.AddMetadata("authorization", auth);
   }
+  if (!call.mesh_key.empty()) context.AddMetadata("x-mesh-id", call.mesh_key);
 
   GenericCall rpc(channel_.get(), &context, call.grpc_method);
   bool writing = rpc.Write(call.request);
@@ -304,12 +323,22 @@ int HttpEdge::Serve(mg_connection* connection) {
     }
   }
   rpc.WritesDone();
+  auto note_replica = [&] {  // valid once the call's initial metadata arrived
+    const auto& metadata = context.GetServerInitialMetadata();
+    const auto found = metadata.find("x-geodex-replica");
+    if (found == metadata.end()) return;
+    replica.assign(found->second.data(), found->second.size());
+    replica.erase(std::remove_if(replica.begin(), replica.end(),
+                                 [](char c) { return c == '\r' || c == '\n'; }),
+                  replica.end());
+  };
 
   HttpAnswerBuilder answer(call, options_.max_response_bytes);
   bool streaming = false;  // headers sent: the answer goes out in chunks
   std::string message, out;
   absl::Status assembled;
   while (rpc.Read(&message)) {
+    if (replica.empty()) note_replica();
     if (!assembled.ok()) continue;  // drain what the cancelled call still sends
     assembled = answer.Add(message, &out);
     if (!assembled.ok()) {
@@ -325,6 +354,7 @@ int HttpEdge::Serve(mg_connection* connection) {
     }
   }
   const grpc::Status status = rpc.Finish();
+  if (replica.empty()) note_replica();
   if (streaming) {  // NDJSON: an error is the stream's last line
     if (!status.ok() || !assembled.ok()) {
       const std::string line = absl::StrCat(

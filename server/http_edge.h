@@ -35,6 +35,10 @@ struct HttpEdgeOptions {
   std::string cors_origin;                  // --http_cors_origin ("" = no CORS)
   bool tokens = false;                      // bearer tokens on: Host is not checked
   std::string tls_cert_file, tls_key_file;  // HTTPS when given (geodexd's --tls_cert/--tls_key)
+  // --http_grpc_target: where the calls go. "" = this server, in-process; HOST:PORT = a gateway's
+  // gRPC port (plaintext), so that HTTP calls are routed by mesh exactly as gRPC calls are (each
+  // carries its mesh as x-mesh-id; deploy/gateway).
+  std::string grpc_target;
 };
 inline constexpr size_t kMaxHttpThreads = 256;
 

@@ -53,7 +53,8 @@ std::string PercentDecode(absl::string_view in) {
   for (size_t i = 0; i < in.size(); ++i) {
     if (in[i] == '+') {
       out += ' ';
-    } else if (in[i] == '%' && i + 2 < in.size() && std::isxdigit(static_cast<unsigned char>(in[i + 1])) &&
+    } else if (in[i] == '%' && i + 2 < in.size() &&
+               std::isxdigit(static_cast<unsigned char>(in[i + 1])) &&
                std::isxdigit(static_cast<unsigned char>(in[i + 2]))) {
       int value = 0;
       (void)absl::SimpleHexAtoi(in.substr(i + 1, 2), &value);
@@ -103,7 +104,8 @@ absl::Status SetFieldsFromQuery(const std::map<std::string, std::string>& params
         continue;
       }
       pb::Value& leaf = (*at->mutable_fields())[field->name()];
-      if (field->cpp_type() == pb::FieldDescriptor::CPPTYPE_BOOL && (value == "true" || value == "false")) {
+      if (field->cpp_type() == pb::FieldDescriptor::CPPTYPE_BOOL &&
+          (value == "true" || value == "false")) {
         leaf.set_bool_value(value == "true");
       } else {
         leaf.set_string_value(value);  // numbers as strings: the JSON mapping accepts both
@@ -154,8 +156,8 @@ absl::StatusOr<HttpCall> RouteHttpRequest(const HttpRequest& request) {
         "/v1/meshes/{id}:{method})"));
   };
   auto wrong_method = [&](const char* allowed) {
-    return absl::UnimplementedError(absl::StrCat(request.method, " ", QuoteInput(request.path),
-                                                 ": use ", allowed));
+    return absl::UnimplementedError(
+        absl::StrCat(request.method, " ", QuoteInput(request.path), ": use ", allowed));
   };
   if (!absl::StartsWith(request.path, kCollection)) return no_route();
   std::string rest = request.path.substr(sizeof(kCollection) - 1);
@@ -167,7 +169,8 @@ absl::StatusOr<HttpCall> RouteHttpRequest(const HttpRequest& request) {
   for (absl::string_view pair : absl::StrSplit(request.query, '&', absl::SkipEmpty())) {
     const size_t eq = pair.find('=');
     const std::string key = PercentDecode(pair.substr(0, eq));
-    const std::string value = eq == absl::string_view::npos ? "" : PercentDecode(pair.substr(eq + 1));
+    const std::string value =
+        eq == absl::string_view::npos ? "" : PercentDecode(pair.substr(eq + 1));
     if (key == "timeout") {
       absl::StatusOr<double> seconds = ParseTimeoutSeconds(value, false, "query parameter timeout");
       if (!seconds.ok()) return seconds.status();
@@ -175,8 +178,8 @@ absl::StatusOr<HttpCall> RouteHttpRequest(const HttpRequest& request) {
       continue;
     }
     if (!params.emplace(key, value).second) {
-      return absl::InvalidArgumentError(absl::StrCat("query parameter ", QuoteInput(key),
-                                                     ": given twice"));
+      return absl::InvalidArgumentError(
+          absl::StrCat("query parameter ", QuoteInput(key), ": given twice"));
     }
   }
 
@@ -229,8 +232,11 @@ absl::StatusOr<HttpCall> RouteHttpRequest(const HttpRequest& request) {
     const pb::FieldDescriptor* metadata = method->input_type()->FindFieldByName("metadata");
     pb::Message* fields = message->GetReflection()->MutableMessage(message.get(), metadata);
     if (absl::Status set = SetFieldsFromQuery(params, fields); !set.ok()) return set;
+    call.mesh_key = fields->GetReflection()->GetString(
+        *fields, fields->GetDescriptor()->FindFieldByName("expected_mesh_id"));
     if (request.content_length >= 0) {  // the server refuses an upload over its limit up front
-      fields->GetReflection()->SetUInt64(fields, fields->GetDescriptor()->FindFieldByName("total_bytes"),
+      fields->GetReflection()->SetUInt64(fields,
+                                         fields->GetDescriptor()->FindFieldByName("total_bytes"),
                                          static_cast<uint64_t>(request.content_length));
     }
     call.upload = true;
@@ -250,8 +256,8 @@ absl::StatusOr<HttpCall> RouteHttpRequest(const HttpRequest& request) {
     if (pb::util::Status parsed = pb::util::JsonStringToMessage(body, message.get(), options);
         !parsed.ok()) {
       return absl::InvalidArgumentError(
-          absl::StrCat("body: not a ", method->input_type()->full_name(), " in JSON: ",
-                       QuoteInput(parsed.message().as_string())));
+          absl::StrCat("body: not a ", method->input_type()->full_name(),
+                       " in JSON: ", QuoteInput(parsed.message().as_string())));
     }
   } else if (absl::Status set = SetFieldsFromQuery(params, message.get()); !set.ok()) {
     return set;
@@ -261,11 +267,12 @@ absl::StatusOr<HttpCall> RouteHttpRequest(const HttpRequest& request) {
     const std::string name = absl::StrCat("meshes/", mesh);
     const std::string given = message->GetReflection()->GetString(*message, field);
     if (!given.empty() && given != name && given != mesh) {
-      return absl::InvalidArgumentError(absl::StrCat("body: ", field->json_name(), " ",
-                                                     QuoteInput(given),
-                                                     " differs from the path's mesh; leave it out"));
+      return absl::InvalidArgumentError(
+          absl::StrCat("body: ", field->json_name(), " ", QuoteInput(given),
+                       " differs from the path's mesh; leave it out"));
     }
     message->GetReflection()->SetString(message.get(), field, name);
+    call.mesh_key = mesh;
   }
   call.request = message->SerializeAsString();
   if (method->name() == "ExportGis") {
@@ -279,8 +286,8 @@ absl::StatusOr<HttpCall> RouteHttpRequest(const HttpRequest& request) {
 
 std::string UploadChunkMessage(const HttpCall& call, const std::string& bytes) {
   std::unique_ptr<pb::Message> message = NewMessage(call.method->input_type());
-  message->GetReflection()->SetString(
-      message.get(), call.method->input_type()->FindFieldByName("chunk"), bytes);
+  message->GetReflection()->SetString(message.get(),
+                                      call.method->input_type()->FindFieldByName("chunk"), bytes);
   return message->SerializeAsString();
 }
 
@@ -410,9 +417,9 @@ grpc::Status EdgeStatus(const absl::Status& status) { return ToGrpcStatus(status
 absl::StatusOr<double> ParseTimeoutSeconds(const std::string& text, bool grpc_form,
                                            const std::string& what) {
   auto bad = [&] {
-    return absl::InvalidArgumentError(absl::StrCat(
-        what, " ", QuoteInput(text), ": not a duration (",
-        grpc_form ? "gRPC's form: 30S, 500m, 2M" : "30s, 1.5s, 500ms, 2m", ")"));
+    return absl::InvalidArgumentError(
+        absl::StrCat(what, " ", QuoteInput(text), ": not a duration (",
+                     grpc_form ? "gRPC's form: 30S, 500m, 2M" : "30s, 1.5s, 500ms, 2m", ")"));
   };
   double seconds = 0;
   if (grpc_form) {

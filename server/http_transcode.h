@@ -6,7 +6,8 @@
 // stays the one source of truth (docs/service.md, "HTTP/JSON"):
 //   GET    /v1/meshes                      ListMeshes (query parameters: the request's fields)
 //   POST   /v1/meshes                      CreateMesh: the body is the file; the metadata's fields
-//                                          (display_name, format, dem.step, ...) as query parameters
+//                                          (display_name, format, dem.step, ...) as query
+//                                          parameters
 //   GET    /v1/meshes/{id}                 GetMesh
 //   DELETE /v1/meshes/{id}                 DeleteMesh
 //   POST   /v1/meshes/{id}:{rpc}           any other method, lowerCamelCase (":findShortestPath");
@@ -31,12 +32,12 @@ namespace geodex::server {
 
 // What the edge needs of an HTTP request (the body only for JSON routes: uploads stream theirs).
 struct HttpRequest {
-  std::string method;        // "GET", "POST", ...
-  std::string path;          // URL-decoded path, without the query
-  std::string query;         // raw query string (percent-encoded), without '?'
-  std::string content_type;  // the Content-Type header ("" when absent)
-  std::string accept;        // the Accept header
-  std::string body;          // the JSON body (not for uploads)
+  std::string method;           // "GET", "POST", ...
+  std::string path;             // URL-decoded path, without the query
+  std::string query;            // raw query string (percent-encoded), without '?'
+  std::string content_type;     // the Content-Type header ("" when absent)
+  std::string accept;           // the Accept header
+  std::string body;             // the JSON body (not for uploads)
   int64_t content_length = -1;  // an upload's size when the request states it
 };
 
@@ -55,6 +56,9 @@ struct HttpCall {
   std::string request;      // the serialized request (for an upload, its first message)
   HttpAnswer answer = HttpAnswer::kJson;
   double timeout_seconds = 0;  // from ?timeout= (0: none asked)
+  // The mesh the call is about, as gRPC clients send it in x-mesh-id for a gateway: the path's
+  // mesh, or an upload's expected_mesh_id ("" when neither).
+  std::string mesh_key;
 };
 
 // The route of a request: NotFound for no route (naming the path), InvalidArgument for a body or

@@ -62,6 +62,34 @@ for k in $(seq 0 11); do
     fi
   done <"$tmp/cluster/replicas"
 done
+# HTTP/JSON through the gateway's HTTP port: a mesh asked by its id reaches the replica gRPC uses
+# (X-Geodex-Replica), and the answer is the one local mode gives.
+gw_http=$(cat "$tmp/cluster/gateway-http-address")
+for k in 0 3 7; do
+  f="$tmp/mesh$k.off"
+  id=$("$GEODEX" --server "$gw" mesh get "$f" 2>/dev/null | cut -f1)
+  id=${id#meshes/}
+  curl -s -D "$tmp/http_headers.txt" -o "$tmp/http_path.json" -X POST \
+    -H 'Content-Type: application/json' "http://$gw_http/v1/meshes/$id:findShortestPath" \
+    -d '{"from": {"vertex": 0}, "to": {"vertex": 20}}'
+  http_replica=$(sed -n 's/^X-Geodex-Replica: \([^\r]*\).*/\1/p' "$tmp/http_headers.txt" | tr -d '\r')
+  check "mesh$k over HTTP: answered by its gRPC owner ${owner[$k]} (got $http_replica)" \
+    test "$http_replica" = "${owner[$k]}"
+  local_length=$("$GEODEX" path "$f" --from 0 --to 20 --format json |
+    /usr/bin/python3 -c 'import json,sys; print(repr(json.load(sys.stdin)["length_m"]))')
+  http_length=$(/usr/bin/python3 -c 'import json,sys; print(repr(json.load(open(sys.argv[1]))["distance"]))' "$tmp/http_path.json")
+  check "mesh$k over HTTP: the local length ($local_length = $http_length)" test "$local_length" = "$http_length"
+done
+# An HTTP upload naming its id lands on the replica its queries go to.
+f="$tmp/mesh11.off"
+id=$("$GEODEX" --server "$gw" mesh get "$f" 2>/dev/null | cut -f1)
+id=${id#meshes/}
+curl -s -D "$tmp/http_headers.txt" -o /dev/null -X POST -H 'Content-Type: application/octet-stream' \
+  --data-binary @"$f" "http://$gw_http/v1/meshes?expected_mesh_id=$id&display_name=http11"
+http_replica=$(sed -n 's/^X-Geodex-Replica: \([^\r]*\).*/\1/p' "$tmp/http_headers.txt" | tr -d '\r')
+check "an HTTP upload with its expected_mesh_id reaches ${owner[11]} (got $http_replica)" \
+  test "$http_replica" = "${owner[11]}"
+
 used=$(printf '%s\n' "${owner[@]}" | sort -u | wc -l)
 check "the 12 meshes are spread over at least 2 replicas (got $used)" test "$used" -ge 2
 

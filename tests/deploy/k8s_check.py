@@ -80,9 +80,21 @@ check(pod["spec"]["securityContext"].get("runAsNonRoot") is True, "geodexd may r
 pdb = by_kind["PodDisruptionBudget"]["geodex"]
 check(pdb["spec"]["selector"]["matchLabels"].items() <= labels.items(), "PDB selects no geodexd pod")
 conf = by_kind["ConfigMap"]["geodex-gateway"]["data"]["nginx.conf"]
-upstreams = re.findall(r"server\s+([\w.-]+):(\d+)", conf)
-expected = [(f"geodex-{i}.{sts['spec']['serviceName']}", "50051") for i in range(sts["spec"]["replicas"])]
-check(upstreams == expected, f"gateway upstreams {upstreams} != the StatefulSet's pods {expected}")
+def upstream(name):
+    block = re.search(r"upstream\s+" + name + r"\s*\{([^}]*)\}", conf)
+    return re.findall(r"server\s+([\w.-]+):(\d+)", block.group(1)) if block else []
+pods = [f"geodex-{i}.{sts['spec']['serviceName']}" for i in range(sts["spec"]["replicas"])]
+expected = [(pod, "50051") for pod in pods]
+check(upstream("geodex") == expected, f"gateway upstreams {upstream('geodex')} != the StatefulSet's pods {expected}")
+# HTTP/JSON: the replicas' HTTP ports, whose calls come back to the gateway's gRPC Service.
+http_port = flags.get("http_listen", ":").rsplit(":", 1)[1]
+check(upstream("geodex_http") == [(pod, http_port) for pod in pods],
+      f"gateway HTTP upstreams {upstream('geodex_http')} != the pods' --http_listen port {http_port}")
+check(any(p["containerPort"] == int(http_port or 0) for p in container["ports"]),
+      "no container port for --http_listen")
+gateway_svc = by_kind["Service"]["geodex-gateway"]
+check(flags.get("http_grpc_target") == f"geodex-gateway:{[p['port'] for p in gateway_svc['spec']['ports'] if p['name'] == 'grpc'][0]}",
+      "--http_grpc_target is not the gateway's gRPC Service")
 check("hash $http_x_mesh_id consistent" in conf, "gateway does not hash x-mesh-id consistently")
 check(re.search(r"client_max_body_size\s+(\d+)m", conf) and
       int(re.search(r"client_max_body_size\s+(\d+)m", conf).group(1)) * 2**20 >=

@@ -139,8 +139,9 @@ class HttpEdgeTest : public testing::ServerFixture {
   }
   // Uploads the DEM over HTTP as "hills" (step 1); returns its mesh resource.
   v1::Mesh UploadHills() {
-    HttpReply reply = Http(port_, "POST", "/v1/meshes?display_name=hills&format=MESH_FORMAT_GEOTIFF&dem.step=1",
-                           dem_, {{"Content-Type", "image/tiff"}});
+    HttpReply reply =
+        Http(port_, "POST", "/v1/meshes?display_name=hills&format=MESH_FORMAT_GEOTIFF&dem.step=1",
+             dem_, {{"Content-Type", "image/tiff"}});
     EXPECT_EQ(reply.status, 200) << reply.body;
     return FromJson<v1::Mesh>(reply.body);
   }
@@ -151,7 +152,9 @@ class HttpEdgeTest : public testing::ServerFixture {
 };
 
 TEST_F(HttpEdgeTest, ListsAnUploadedDemAndFindsThePathTheGrpcCallFinds) {
-  StartHttp();
+  ServerOptions options;
+  options.replica_name = "replica-7";
+  StartHttp(options);
   const v1::Mesh uploaded = UploadHills();
   EXPECT_TRUE(uploaded.has_terrain());
   EXPECT_EQ(uploaded.display_name(), "hills");
@@ -169,6 +172,7 @@ TEST_F(HttpEdgeTest, ListsAnUploadedDemAndFindsThePathTheGrpcCallFinds) {
   HttpReply path = Http(port_, "POST", "/v1/meshes/hills:findShortestPath", body, kJson);
   ASSERT_EQ(path.status, 200) << path.body;
   const auto over_http = FromJson<v1::FindShortestPathResponse>(path.body);
+  EXPECT_EQ(path.headers["x-geodex-replica"], "replica-7");  // which replica answered
 
   v1::FindShortestPathRequest request = FromJson<v1::FindShortestPathRequest>(body);
   request.set_mesh("meshes/hills");
@@ -181,7 +185,8 @@ TEST_F(HttpEdgeTest, ListsAnUploadedDemAndFindsThePathTheGrpcCallFinds) {
 
   // The mesh by id too, percent-encoded or not; and GET of one mesh.
   const std::string id = uploaded.name().substr(7);
-  HttpReply by_id = Http(port_, "POST", absl::StrCat("/v1/meshes/", id, ":findShortestPath"), body, kJson);
+  HttpReply by_id =
+      Http(port_, "POST", absl::StrCat("/v1/meshes/", id, ":findShortestPath"), body, kJson);
   EXPECT_EQ(FromJson<v1::FindShortestPathResponse>(by_id.body).distance(), over_http.distance());
   HttpReply get = Http(port_, "GET", "/v1/meshes/h%69lls");
   ASSERT_EQ(get.status, 200) << get.body;
@@ -193,12 +198,14 @@ TEST_F(HttpEdgeTest, ErrorsAreGoogleRpcStatusJsonWithTheirHttpCodes) {
   UploadHills();
   auto error_of = [](const HttpReply& reply) { return FromJson<google::rpc::Status>(reply.body); };
 
-  HttpReply malformed = Http(port_, "POST", "/v1/meshes/hills:findShortestPath", R"({"from": )", kJson);
+  HttpReply malformed =
+      Http(port_, "POST", "/v1/meshes/hills:findShortestPath", R"({"from": )", kJson);
   EXPECT_EQ(malformed.status, 400);
   EXPECT_EQ(error_of(malformed).code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_TRUE(Contains(error_of(malformed).message(), "body")) << malformed.body;
 
-  HttpReply unknown_field = Http(port_, "POST", "/v1/meshes/hills:findShortestPath", R"({"form": {}})", kJson);
+  HttpReply unknown_field =
+      Http(port_, "POST", "/v1/meshes/hills:findShortestPath", R"({"form": {}})", kJson);
   EXPECT_EQ(unknown_field.status, 400);
   EXPECT_TRUE(Contains(error_of(unknown_field).message(), "form")) << unknown_field.body;
 
@@ -222,9 +229,9 @@ TEST_F(HttpEdgeTest, ErrorsAreGoogleRpcStatusJsonWithTheirHttpCodes) {
   EXPECT_TRUE(Contains(error_of(bad_vertex).message(), "from")) << bad_vertex.body;
 
   // Unreachable is FAILED_PRECONDITION: 400 by the convention.
-  HttpReply far = Http(port_, "POST", "/v1/meshes/hills:findShortestPath",
-                       R"({"from": {"vertex": 0}, "to": {"vertex": 1199}, "options": {"maxDistance": 1}})",
-                       kJson);
+  HttpReply far = Http(
+      port_, "POST", "/v1/meshes/hills:findShortestPath",
+      R"({"from": {"vertex": 0}, "to": {"vertex": 1199}, "options": {"maxDistance": 1}})", kJson);
   EXPECT_EQ(far.status, 400) << far.body;
   EXPECT_EQ(error_of(far).code(), grpc::StatusCode::FAILED_PRECONDITION);
 
@@ -234,17 +241,21 @@ TEST_F(HttpEdgeTest, ErrorsAreGoogleRpcStatusJsonWithTheirHttpCodes) {
   EXPECT_EQ(Http(port_, "PUT", "/v1/meshes").status, 405);
   // Media types: a form or text/plain body (what a cross-site page can post) is refused.
   EXPECT_EQ(Http(port_, "POST", "/v1/meshes/hills:findShortestPath", "{}",
-                 {{"Content-Type", "text/plain"}}).status, 415);
+                 {{"Content-Type", "text/plain"}})
+                .status,
+            415);
   EXPECT_EQ(Http(port_, "POST", "/v1/meshes", dem_,
-                 {{"Content-Type", "application/x-www-form-urlencoded"}}).status, 415);
+                 {{"Content-Type", "application/x-www-form-urlencoded"}})
+                .status,
+            415);
   // Query parameters: unknown ones and JSON routes' are refused, naming them.
   HttpReply bogus = Http(port_, "GET", "/v1/meshes?bogus=1");
   EXPECT_EQ(bogus.status, 400);
   EXPECT_TRUE(Contains(error_of(bogus).message(), "bogus"));
   EXPECT_EQ(Http(port_, "GET", "/v1/meshes?pageSize=2").status, 200);
   // A mesh in the body that is not the path's.
-  HttpReply two_meshes = Http(port_, "POST", "/v1/meshes/hills:locatePoints",
-                              R"({"mesh": "meshes/other"})", kJson);
+  HttpReply two_meshes =
+      Http(port_, "POST", "/v1/meshes/hills:locatePoints", R"({"mesh": "meshes/other"})", kJson);
   EXPECT_EQ(two_meshes.status, 400);
 }
 
@@ -289,9 +300,9 @@ TEST_F(HttpEdgeTest, StreamsAreAssembledOrSentAsNdjsonAndFilesComeWhole) {
   EXPECT_EQ(values, grpc_field.distances.size());
 
   // ExportGis: the file itself, with its media type.
-  HttpReply geojson = Http(port_, "POST", "/v1/meshes/hills:exportGis",
-                           R"({"product": "GIS_PRODUCT_ISOCHRONES", "sources": [{"vertex": 17}], "count": 4})",
-                           kJson);
+  HttpReply geojson = Http(
+      port_, "POST", "/v1/meshes/hills:exportGis",
+      R"({"product": "GIS_PRODUCT_ISOCHRONES", "sources": [{"vertex": 17}], "count": 4})", kJson);
   ASSERT_EQ(geojson.status, 200) << geojson.body.substr(0, 300);
   EXPECT_EQ(geojson.headers["content-type"], "application/geo+json");
   EXPECT_TRUE(Contains(geojson.body, "\"FeatureCollection\""));
@@ -306,8 +317,8 @@ TEST_F(HttpEdgeTest, LimitsAndDeadlinesApplyAsOverGrpc) {
   options.samples = true;
   StartHttp(options);
   // An upload over --max_upload_bytes: refused, naming the flag (total_bytes from Content-Length).
-  HttpReply upload = Http(port_, "POST", "/v1/meshes?display_name=hills", dem_,
-                          {{"Content-Type", "image/tiff"}});
+  HttpReply upload =
+      Http(port_, "POST", "/v1/meshes?display_name=hills", dem_, {{"Content-Type", "image/tiff"}});
   EXPECT_EQ(upload.status, 429) << upload.body;
   EXPECT_TRUE(Contains(upload.body, "max_upload_bytes")) << upload.body;
 
@@ -318,13 +329,18 @@ TEST_F(HttpEdgeTest, LimitsAndDeadlinesApplyAsOverGrpc) {
   auto headers = kJson;
   headers["Accept"] = "application/x-ndjson";  // not bounded: the suggested way
   EXPECT_EQ(Http(port_, "POST", "/v1/meshes/sphere:computeDistanceField",
-                 R"({"sources": [{"vertex": 0}]})", headers).status, 200);
+                 R"({"sources": [{"vertex": 0}]})", headers)
+                .status,
+            200);
 
   headers = kJson;
-  headers["grpc-timeout"] = "1n";
-  HttpReply late = Http(port_, "POST", "/v1/meshes/sphere:computeDistanceMatrix",
-                        R"({"sources": [{"vertex": 0}], "targets": [{"vertex": 5}]})", headers);
-  EXPECT_EQ(late.status, 504) << late.body;
+  // A Tobler field on the terrain sample takes about 2 s: a 100 ms deadline ends it.
+  headers["grpc-timeout"] = "100m";
+  HttpReply late = Http(
+      port_, "POST", "/v1/meshes/terrain:computeDistanceField",
+      R"({"sources": [{"vertex": 0}], "options": {"travel": {"speedModel": "SPEED_MODEL_TOBLER", "epsilon": 0.02}}})",
+      headers);
+  EXPECT_EQ(late.status, 504) << late.body.substr(0, 200);
   EXPECT_EQ(FromJson<google::rpc::Status>(late.body).code(), grpc::StatusCode::DEADLINE_EXCEEDED);
   EXPECT_EQ(Http(port_, "GET", "/v1/meshes?timeout=soon").status, 400);
   EXPECT_EQ(Http(port_, "GET", "/v1/meshes?timeout=30s").status, 200);
@@ -376,11 +392,13 @@ TEST_F(HttpEdgeTest, TokensAreCheckedAsOverGrpc) {
   StartHttp(options);
   HttpReply anonymous = Http(port_, "GET", "/v1/meshes");
   EXPECT_EQ(anonymous.status, 401);
-  EXPECT_EQ(FromJson<google::rpc::Status>(anonymous.body).code(), grpc::StatusCode::UNAUTHENTICATED);
+  EXPECT_EQ(FromJson<google::rpc::Status>(anonymous.body).code(),
+            grpc::StatusCode::UNAUTHENTICATED);
   EXPECT_EQ(Http(port_, "GET", "/v1/meshes", "", {{"Authorization", "Bearer wrong"}}).status, 401);
   // With tokens on, a proxy's Host is fine: the token is what is checked.
   EXPECT_EQ(Http(port_, "GET", "/v1/meshes", "",
-                 {{"Authorization", "Bearer s3cret"}, {"Host", "geodex.example"}}).status,
+                 {{"Authorization", "Bearer s3cret"}, {"Host", "geodex.example"}})
+                .status,
             200);
 }
 
@@ -388,10 +406,10 @@ TEST(HttpTranscodeTest, RoutesFollowTheServiceDescriptor) {
   HttpRequest request;
   request.method = "POST";
   request.content_type = "application/json; charset=utf-8";
-  for (const char* verb : {"findShortestPath", "findShortestPaths", "computeDistanceField",
-                           "computeDistanceMatrix", "estimateDistances", "locatePoints",
-                           "computeIsolines", "computeVoronoi", "computeDelaunay", "exportGis",
-                           "deriveMesh", "getMeshGeometry"}) {
+  for (const char* verb :
+       {"findShortestPath", "findShortestPaths", "computeDistanceField", "computeDistanceMatrix",
+        "estimateDistances", "locatePoints", "computeIsolines", "computeVoronoi", "computeDelaunay",
+        "exportGis", "deriveMesh", "getMeshGeometry"}) {
     request.path = absl::StrCat("/v1/meshes/m1:", verb);
     absl::StatusOr<HttpCall> call = RouteHttpRequest(request);
     ASSERT_TRUE(call.ok()) << verb << ": " << call.status();
