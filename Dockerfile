@@ -15,7 +15,7 @@
 FROM debian:bookworm AS build
 WORKDIR /src
 COPY scripts/install-deps.sh scripts/install-deps.sh
-RUN bash scripts/install-deps.sh && rm -rf /var/lib/apt/lists/*
+RUN GEODEX_NO_BROWSER=1 bash scripts/install-deps.sh && rm -rf /var/lib/apt/lists/*
 COPY . .
 ARG GEODEX_TESTS=OFF
 RUN cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DGEODEX_BUILD_BENCH=OFF \

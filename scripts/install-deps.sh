@@ -41,7 +41,14 @@ packages=(
   curl
   # TLS tests make a self-signed certificate
   openssl
+  # the map page of geodexd's HTTP port: Leaflet (BSD-2-Clause), built into the binary
+  libjs-leaflet
 )
+# The map page's browser test (tests/server/map_page_test.py): headless Chromium driven by Selenium.
+# GEODEX_NO_BROWSER=1 leaves them out (the Docker image's build stage runs no tests of it).
+if [ -z "${GEODEX_NO_BROWSER:-}" ]; then
+  packages+=(chromium chromium-driver python3-selenium)
+fi
 
 # Skip apt entirely when everything is already there (fast re-runs).
 missing=()

@@ -14,6 +14,7 @@
 #include "grpcpp/support/byte_buffer.h"
 #include "http_transcode.h"
 #include "listen_address.h"
+#include "map_assets.h"
 #include "spdlog/spdlog.h"
 
 namespace geodex::server {
@@ -203,12 +204,14 @@ int HttpEdge::Serve(mg_connection* connection) {
   const bool cors = !options_.cors_origin.empty() && !origin.empty() &&
                     (options_.cors_origin == "*" || origin == options_.cors_origin);
   std::string replica;  // the x-geodex-replica the call answered with: which replica served it
+  std::string extra_headers;
   auto send_head = [&](int status, const std::string& media_type, int64_t length) {
     std::string head =
         absl::StrCat("HTTP/1.1 ", status, " ", mg_get_response_code_text(connection, status),
                      "\r\nContent-Type: ", media_type,
                      "\r\nCache-Control: no-store\r\nX-Content-Type-Options: nosniff\r\n");
     if (!replica.empty()) absl::StrAppend(&head, "X-Geodex-Replica: ", replica, "\r\n");
+    head += extra_headers;
     if (cors)
       absl::StrAppend(&head, "Access-Control-Allow-Origin: ", origin, "\r\nVary: Origin\r\n");
     absl::StrAppend(&head,
@@ -257,6 +260,19 @@ int HttpEdge::Serve(mg_connection* connection) {
                      "\r\nAccess-Control-Max-Age: 600\r\nContent-Length: 0\r\n\r\n");
     mg_write(connection, head.data(), head.size());
     return 204;
+  }
+
+  // The map page and its files (map_assets.h): only what is built in, never a file from disk.
+  const std::string path = info->local_uri != nullptr ? info->local_uri : "";
+  if ((method == "GET" || method == "HEAD") && !absl::StartsWith(path, "/v1/")) {
+    for (const MapAsset& asset : MapAssets()) {
+      if (path != asset.path) continue;
+      // The page loads only its own files; Leaflet sets inline styles; the hillshade is a data URL.
+      extra_headers =
+          "Content-Security-Policy: default-src 'self'; img-src 'self' data: blob:; "
+          "style-src 'self' 'unsafe-inline'; frame-ancestors 'none'\r\n";
+      return send({200, MapAssetMediaType(path), std::string(asset.bytes)});
+    }
   }
 
   HttpRequest request;
