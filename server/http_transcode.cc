@@ -138,6 +138,49 @@ const pb::FieldDescriptor* MeshField(const pb::Descriptor* type) {
   return nullptr;
 }
 
+// With Accept: application/geo+json, the geometry methods answer as ExportGis does (RFC 7946
+// GeoJSON): the request becomes the ExportGisRequest of the same points, levels and options.
+struct GeoJsonProduct {
+  const char* method;
+  const char* product;
+};
+constexpr GeoJsonProduct kGeoJsonProducts[] = {
+    {"ComputeIsolines", "GIS_PRODUCT_ISOCHRONES"}, {"ComputeVoronoi", "GIS_PRODUCT_VORONOI"},
+    {"ComputeDelaunay", "GIS_PRODUCT_DELAUNAY"},   {"FindShortestPath", "GIS_PRODUCT_PATH"},
+    {"EstimateDistances", "GIS_PRODUCT_POINTS"},
+};
+
+absl::StatusOr<std::unique_ptr<pb::Message>> AsExportGis(const pb::Message& request,
+                                                         const char* product) {
+  pb::Struct fields;
+  std::string json;
+  if (!pb::util::MessageToJsonString(request, &json).ok() ||
+      !pb::util::JsonStringToMessage(json, &fields).ok()) {
+    return absl::InternalError("a request that does not print as JSON");
+  }
+  pb::Struct gis;
+  auto& out = *gis.mutable_fields();
+  for (const auto& [name, value] : fields.fields()) {
+    if (name == "from") {
+      *out["sources"].mutable_list_value()->add_values() = value;
+    } else if (name == "to") {
+      *out["points"].mutable_list_value()->add_values() = value;
+    } else if (name == "mesh" || name == "sources" || name == "points" || name == "levels" ||
+               name == "count" || name == "options" || name == "maxSnap") {
+      out[name] = value;
+    }  // the rest (statistics, modes, directions) has no GeoJSON form
+  }
+  out["product"].set_string_value(product);
+  const pb::MethodDescriptor* export_gis = Service().FindMethodByName("ExportGis");
+  std::unique_ptr<pb::Message> message = NewMessage(export_gis->input_type());
+  json.clear();  // (MessageToJsonString appends)
+  if (!pb::util::MessageToJsonString(gis, &json).ok() ||
+      !pb::util::JsonStringToMessage(json, message.get()).ok()) {
+    return absl::InternalError("an ExportGisRequest that does not parse");
+  }
+  return message;
+}
+
 }  // namespace
 
 bool IsUploadMediaType(const std::string& content_type) {
@@ -273,6 +316,18 @@ absl::StatusOr<HttpCall> RouteHttpRequest(const HttpRequest& request) {
     }
     message->GetReflection()->SetString(message.get(), field, name);
     call.mesh_key = mesh;
+  }
+  if (absl::StrContains(absl::AsciiStrToLower(request.accept), "application/geo+json")) {
+    for (const GeoJsonProduct& geo : kGeoJsonProducts) {
+      if (method->name() != geo.method) continue;
+      absl::StatusOr<std::unique_ptr<pb::Message>> gis = AsExportGis(*message, geo.product);
+      if (!gis.ok()) return gis.status();
+      message = *std::move(gis);
+      method = service.FindMethodByName("ExportGis");
+      call.method = method;
+      call.grpc_method = absl::StrCat("/", service.full_name(), "/", method->name());
+      break;
+    }
   }
   call.request = message->SerializeAsString();
   if (method->name() == "ExportGis") {

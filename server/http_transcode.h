@@ -15,7 +15,9 @@
 //                                          `mesh` (or `name`) taken from the path
 // Answers are the response message's JSON (lowerCamelCase names, every field printed); a streamed
 // answer is assembled into one message (or sent as NDJSON, one message a line, when the request
-// accepts application/x-ndjson); ExportGis answers the file itself with its media type. Errors are
+// accepts application/x-ndjson); ExportGis answers the file itself with its media type, and so do
+// isolines, Voronoi, Delaunay, a path and point distances asked with Accept: application/geo+json
+// (as the ExportGis product of the same request: RFC 7946 GeoJSON). Errors are
 // google.rpc.Status JSON with the HTTP code the convention maps the gRPC code to.
 
 #include <cstddef>

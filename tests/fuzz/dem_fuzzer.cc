@@ -32,7 +32,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (!dem.ok()) return 0;
   absl::StatusOr<Dem> stored = Dem::FromMesh(dem->mesh(), dem->info());
   if (!stored.ok()) {
-    fprintf(stderr, "STORED: %s\n", std::string(stored.status().message()).c_str());
+    // On stdout: scripts/fuzz.sh closes the target's stderr (-close_fd_mask=2), and the reason is
+    // what a report needs.
+    printf("STORED: %s (step %u, z tolerance %g)\n", std::string(stored.status().message()).c_str(),
+           options.step, options.z_tolerance);
+    fflush(stdout);
     __builtin_trap();
   }  // a mesh the reader made must come back
   const auto& gt = dem->info().geotransform;

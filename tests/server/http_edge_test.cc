@@ -16,6 +16,7 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_split.h"
 #include "gdal_priv.h"
+#include "google/protobuf/struct.pb.h"
 #include "google/protobuf/util/json_util.h"
 #include "http_transcode.h"
 #include "ogr_spatialref.h"
@@ -307,6 +308,33 @@ TEST_F(HttpEdgeTest, StreamsAreAssembledOrSentAsNdjsonAndFilesComeWhole) {
   EXPECT_EQ(geojson.headers["content-type"], "application/geo+json");
   EXPECT_TRUE(Contains(geojson.body, "\"FeatureCollection\""));
   EXPECT_GT(geojson.body.size(), 1024u);  // more than one message's worth
+
+  // Accept: application/geo+json turns a geometry method's answer into ExportGis's GeoJSON.
+  headers = kJson;
+  headers["Accept"] = "application/geo+json";
+  HttpReply isochrones =
+      Http(port_, "POST", "/v1/meshes/hills:computeIsolines",
+           R"({"sources": [{"vertex": 17}], "levels": [50, 100, 150]})", headers);
+  ASSERT_EQ(isochrones.status, 200) << isochrones.body.substr(0, 300);
+  EXPECT_EQ(isochrones.headers["content-type"], "application/geo+json");
+  google::protobuf::Struct collection = FromJson<google::protobuf::Struct>(isochrones.body);
+  EXPECT_EQ(collection.fields().at("type").string_value(), "FeatureCollection");
+  EXPECT_EQ(collection.fields().at("features").list_value().values_size(), 3);
+  const std::string path_body = R"({"from": {"vertex": 17}, "to": {"vertex": 1000}})";
+  HttpReply line = Http(port_, "POST", "/v1/meshes/hills:findShortestPath", path_body, headers);
+  ASSERT_EQ(line.status, 200) << line.body.substr(0, 300);
+  const auto feature = FromJson<google::protobuf::Struct>(line.body)
+                           .fields()
+                           .at("features")
+                           .list_value()
+                           .values(0)
+                           .struct_value();
+  EXPECT_EQ(feature.fields().at("geometry").struct_value().fields().at("type").string_value(),
+            "LineString");
+  const double length_m =
+      feature.fields().at("properties").struct_value().fields().at("length_m").number_value();
+  HttpReply plain = Http(port_, "POST", "/v1/meshes/hills:findShortestPath", path_body, kJson);
+  EXPECT_NEAR(length_m, FromJson<v1::FindShortestPathResponse>(plain.body).distance(), 1e-9);
 }
 
 TEST_F(HttpEdgeTest, LimitsAndDeadlinesApplyAsOverGrpc) {
