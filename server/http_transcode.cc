@@ -2,15 +2,16 @@
 
 #include <cctype>
 #include <cmath>
+#include <functional>
 #include <map>
 
 #include "absl/strings/ascii.h"
 #include "absl/strings/match.h"
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_cat.h"
+#include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
 #include "absl/time/time.h"
-#include "google/protobuf/struct.pb.h"
 #include "google/protobuf/util/json_util.h"
 #include "google/rpc/status.pb.h"
 #include "status_convert.h"
@@ -76,15 +77,36 @@ const pb::FieldDescriptor* FindField(const pb::Descriptor* type, const std::stri
   return nullptr;
 }
 
+// A JSON string literal (RFC 8259 escapes).
+std::string JsonQuote(const std::string& text) {
+  std::string out = "\"";
+  for (unsigned char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += static_cast<char>(c);
+    } else if (c < 0x20) {
+      out += absl::StrFormat("\\u%04x", c);
+    } else {
+      out += static_cast<char>(c);
+    }
+  }
+  return out + "\"";
+}
+
 // Query parameters (but `timeout`) set the request's scalar fields: "page_size=10",
-// "dem.step=2". A google.protobuf.Struct is built from them and read by the JSON parser, so a
-// value is checked exactly as the same value in a body would be.
+// "dem.step=2". They are written as a JSON object and read by the JSON parser, so a value is
+// checked exactly as the same value in a body would be. (No google.protobuf.Struct here: its map's
+// inline code crashed under ThreadSanitizer with Debian's uninstrumented libprotobuf.)
 absl::Status SetFieldsFromQuery(const std::map<std::string, std::string>& params,
                                 pb::Message* request) {
-  pb::Struct root;
+  struct Node {
+    std::string json;                    // a leaf's value
+    std::map<std::string, Node> fields;  // an object's members
+  };
+  Node root;
   for (const auto& [key, value] : params) {
     const pb::Descriptor* type = request->GetDescriptor();
-    pb::Struct* at = &root;
+    Node* at = &root;
     const std::vector<std::string> parts = absl::StrSplit(key, '.');
     for (size_t i = 0; i < parts.size(); ++i) {
       const pb::FieldDescriptor* field = FindField(type, parts[i]);
@@ -97,28 +119,28 @@ absl::Status SetFieldsFromQuery(const std::map<std::string, std::string>& params
         return absl::InvalidArgumentError(absl::StrCat(
             "query parameter ", key, ": not a single value; send it in the JSON body"));
       }
+      at = &at->fields[field->name()];
       if (i + 1 < parts.size()) {
-        pb::Value& child = (*at->mutable_fields())[field->name()];
-        at = child.mutable_struct_value();
         type = field->message_type();
         continue;
       }
-      pb::Value& leaf = (*at->mutable_fields())[field->name()];
-      if (field->cpp_type() == pb::FieldDescriptor::CPPTYPE_BOOL &&
-          (value == "true" || value == "false")) {
-        leaf.set_bool_value(value == "true");
-      } else {
-        leaf.set_string_value(value);  // numbers as strings: the JSON mapping accepts both
-      }
+      // Numbers as strings: the JSON mapping accepts both; booleans as the literals.
+      const bool literal = field->cpp_type() == pb::FieldDescriptor::CPPTYPE_BOOL &&
+                           (value == "true" || value == "false");
+      at->json = literal ? value : JsonQuote(value);
     }
   }
-  std::string json;
-  if (!pb::util::MessageToJsonString(root, &json).ok()) {
-    return absl::InvalidArgumentError("query parameters: not valid UTF-8");
-  }
+  std::function<std::string(const Node&)> write = [&](const Node& node) {
+    if (node.fields.empty()) return node.json.empty() ? std::string("{}") : node.json;
+    std::string out = "{";
+    for (const auto& [name, child] : node.fields) {
+      absl::StrAppend(&out, out.size() > 1 ? "," : "", JsonQuote(name), ":", write(child));
+    }
+    return out + "}";
+  };
   pb::util::JsonParseOptions options;
   options.ignore_unknown_fields = false;
-  if (pb::util::Status parsed = pb::util::JsonStringToMessage(json, request, options);
+  if (pb::util::Status parsed = pb::util::JsonStringToMessage(write(root), request, options);
       !parsed.ok()) {
     return absl::InvalidArgumentError(
         absl::StrCat("query parameters: ", QuoteInput(parsed.message().as_string())));
@@ -150,35 +172,54 @@ constexpr GeoJsonProduct kGeoJsonProducts[] = {
     {"EstimateDistances", "GIS_PRODUCT_POINTS"},
 };
 
-absl::StatusOr<std::unique_ptr<pb::Message>> AsExportGis(const pb::Message& request,
-                                                         const char* product) {
-  pb::Struct fields;
-  std::string json;
-  if (!pb::util::MessageToJsonString(request, &json).ok() ||
-      !pb::util::JsonStringToMessage(json, &fields).ok()) {
-    return absl::InternalError("a request that does not print as JSON");
+// The ExportGisRequest of a geometry request: its mesh, sources (or `from`), points (or `to`),
+// levels, count, options and max_snap, copied field by field (by reflection).
+std::unique_ptr<pb::Message> AsExportGis(const pb::Message& request, const char* product) {
+  const pb::Descriptor* gis_type = Service().FindMethodByName("ExportGis")->input_type();
+  std::unique_ptr<pb::Message> gis = NewMessage(gis_type);
+  const pb::Reflection& in = *request.GetReflection();
+  const pb::Reflection& out = *gis->GetReflection();
+  for (const auto& [from, to] :
+       std::vector<std::pair<std::string, std::string>>{{"mesh", "mesh"},
+                                                        {"sources", "sources"},
+                                                        {"from", "sources"},
+                                                        {"points", "points"},
+                                                        {"to", "points"},
+                                                        {"levels", "levels"},
+                                                        {"count", "count"},
+                                                        {"options", "options"},
+                                                        {"max_snap", "max_snap"}}) {
+    const pb::FieldDescriptor* src = request.GetDescriptor()->FindFieldByName(from);
+    const pb::FieldDescriptor* dst = gis_type->FindFieldByName(to);
+    if (src == nullptr || dst == nullptr) continue;
+    if (src->is_repeated()) {
+      for (int k = 0; k < in.FieldSize(request, src); ++k) {
+        if (src->cpp_type() == pb::FieldDescriptor::CPPTYPE_MESSAGE) {
+          out.AddMessage(gis.get(), dst)->CopyFrom(in.GetRepeatedMessage(request, src, k));
+        } else {  // levels
+          out.AddDouble(gis.get(), dst, in.GetRepeatedDouble(request, src, k));
+        }
+      }
+    } else if (src->cpp_type() == pb::FieldDescriptor::CPPTYPE_MESSAGE) {
+      if (!in.HasField(request, src)) continue;
+      if (dst->is_repeated()) {  // from, to: the one source, the one point
+        out.AddMessage(gis.get(), dst)->CopyFrom(in.GetMessage(request, src));
+      } else {
+        out.MutableMessage(gis.get(), dst)->CopyFrom(in.GetMessage(request, src));
+      }
+    } else if (src->cpp_type() == pb::FieldDescriptor::CPPTYPE_STRING) {
+      out.SetString(gis.get(), dst, in.GetString(request, src));
+    } else if (src->cpp_type() == pb::FieldDescriptor::CPPTYPE_INT32) {
+      out.SetInt32(gis.get(), dst, in.GetInt32(request, src));
+    } else if (src->cpp_type() == pb::FieldDescriptor::CPPTYPE_DOUBLE &&
+               (!src->has_presence() || in.HasField(request, src))) {
+      out.SetDouble(gis.get(), dst, in.GetDouble(request, src));
+    }
   }
-  pb::Struct gis;
-  auto& out = *gis.mutable_fields();
-  for (const auto& [name, value] : fields.fields()) {
-    if (name == "from") {
-      *out["sources"].mutable_list_value()->add_values() = value;
-    } else if (name == "to") {
-      *out["points"].mutable_list_value()->add_values() = value;
-    } else if (name == "mesh" || name == "sources" || name == "points" || name == "levels" ||
-               name == "count" || name == "options" || name == "maxSnap") {
-      out[name] = value;
-    }  // the rest (statistics, modes, directions) has no GeoJSON form
-  }
-  out["product"].set_string_value(product);
-  const pb::MethodDescriptor* export_gis = Service().FindMethodByName("ExportGis");
-  std::unique_ptr<pb::Message> message = NewMessage(export_gis->input_type());
-  json.clear();  // (MessageToJsonString appends)
-  if (!pb::util::MessageToJsonString(gis, &json).ok() ||
-      !pb::util::JsonStringToMessage(json, message.get()).ok()) {
-    return absl::InternalError("an ExportGisRequest that does not parse");
-  }
-  return message;
+  out.SetEnumValue(
+      gis.get(), gis_type->FindFieldByName("product"),
+      gis_type->FindFieldByName("product")->enum_type()->FindValueByName(product)->number());
+  return gis;
 }
 
 }  // namespace
@@ -320,9 +361,7 @@ absl::StatusOr<HttpCall> RouteHttpRequest(const HttpRequest& request) {
   if (absl::StrContains(absl::AsciiStrToLower(request.accept), "application/geo+json")) {
     for (const GeoJsonProduct& geo : kGeoJsonProducts) {
       if (method->name() != geo.method) continue;
-      absl::StatusOr<std::unique_ptr<pb::Message>> gis = AsExportGis(*message, geo.product);
-      if (!gis.ok()) return gis.status();
-      message = *std::move(gis);
+      message = AsExportGis(*message, geo.product);
       method = service.FindMethodByName("ExportGis");
       call.method = method;
       call.grpc_method = absl::StrCat("/", service.full_name(), "/", method->name());

@@ -16,7 +16,6 @@
 #include "absl/strings/numbers.h"
 #include "absl/strings/str_split.h"
 #include "gdal_priv.h"
-#include "google/protobuf/struct.pb.h"
 #include "google/protobuf/util/json_util.h"
 #include "http_transcode.h"
 #include "ogr_spatialref.h"
@@ -317,22 +316,21 @@ TEST_F(HttpEdgeTest, StreamsAreAssembledOrSentAsNdjsonAndFilesComeWhole) {
            R"({"sources": [{"vertex": 17}], "levels": [50, 100, 150]})", headers);
   ASSERT_EQ(isochrones.status, 200) << isochrones.body.substr(0, 300);
   EXPECT_EQ(isochrones.headers["content-type"], "application/geo+json");
-  google::protobuf::Struct collection = FromJson<google::protobuf::Struct>(isochrones.body);
-  EXPECT_EQ(collection.fields().at("type").string_value(), "FeatureCollection");
-  EXPECT_EQ(collection.fields().at("features").list_value().values_size(), 3);
+  // (Read as text: google.protobuf.Struct's map code crashes under ThreadSanitizer with Debian's
+  // uninstrumented libprotobuf.)
+  EXPECT_TRUE(Contains(isochrones.body, "\"FeatureCollection\""));
+  size_t features = 0;
+  for (size_t at = 0; (at = isochrones.body.find("\"Feature\"", at)) != std::string::npos; ++at) {
+    ++features;
+  }
+  EXPECT_EQ(features, 3u);  // one per level
   const std::string path_body = R"({"from": {"vertex": 17}, "to": {"vertex": 1000}})";
   HttpReply line = Http(port_, "POST", "/v1/meshes/hills:findShortestPath", path_body, headers);
   ASSERT_EQ(line.status, 200) << line.body.substr(0, 300);
-  const auto feature = FromJson<google::protobuf::Struct>(line.body)
-                           .fields()
-                           .at("features")
-                           .list_value()
-                           .values(0)
-                           .struct_value();
-  EXPECT_EQ(feature.fields().at("geometry").struct_value().fields().at("type").string_value(),
-            "LineString");
-  const double length_m =
-      feature.fields().at("properties").struct_value().fields().at("length_m").number_value();
+  EXPECT_TRUE(Contains(line.body, "\"LineString\"")) << line.body.substr(0, 300);
+  const size_t key = line.body.find("\"length_m\":");
+  ASSERT_NE(key, std::string::npos) << line.body.substr(0, 300);
+  const double length_m = std::strtod(line.body.c_str() + key + 11, nullptr);
   HttpReply plain = Http(port_, "POST", "/v1/meshes/hills:findShortestPath", path_body, kJson);
   EXPECT_NEAR(length_m, FromJson<v1::FindShortestPathResponse>(plain.body).distance(), 1e-9);
 }
