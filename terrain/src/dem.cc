@@ -303,6 +303,12 @@ absl::StatusOr<Dem> Dem::ReadDataset(GDALDataset& dataset, const std::string& pa
     if (std::min(std::abs(gt[1]), std::abs(gt[5])) < 1e-7) {
       return bad("cells finer than 1e-7 degrees (about a centimetre)");
     }
+    // A prime meridian far from Greenwich (found by dem_fuzzer: 1.1e119 degrees) swallows every
+    // longitude's digits: the cells collapse onto one meridian and the mesh cannot be mapped back.
+    if (const double meridian = file_crs.GetPrimeMeridian(); !(std::abs(meridian) <= 180)) {
+      return bad(absl::StrFormat(
+          "a prime meridian %.9g degrees from Greenwich: at most 180 either way", meridian));
+    }
     // The grid must be longitudes and latitudes: at most a turn wide, its rows within the poles
     // (its centre alone, wrapped by PROJ, could pass with cells a million degrees wide).
     const double degrees = DegreesPerUnit(info.file_crs_wkt);

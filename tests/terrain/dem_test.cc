@@ -615,5 +615,17 @@ TEST_F(DemTest, LongitudeLatitudeGridPastATurnOrAPoleIsRefused) {
   }
 }
 
+// Found by dem_fuzzer (CI, 2026-11-28; again on 2026-11-29): a geographic CRS whose prime meridian
+// is 1.1e119 degrees east read, but every longitude lost its digits to the meridian, the cells
+// fell on one line and the stored mesh did not come back (Dem::FromMesh: "vertex 0 is not at a
+// cell centre"). It is refused, naming the meridian.
+TEST_F(DemTest, AGeographicCrsWithAFarPrimeMeridianIsRefused) {
+  const std::string path = TestDataPath("far_prime_meridian.tif");
+  absl::StatusOr<Dem> dem = Dem::Read(path);
+  ASSERT_FALSE(dem.ok());
+  EXPECT_EQ(dem.status().code(), absl::StatusCode::kInvalidArgument) << dem.status();
+  EXPECT_NE(dem.status().message().find("prime meridian"), std::string::npos) << dem.status();
+}
+
 }  // namespace
 }  // namespace geodex::terrain
