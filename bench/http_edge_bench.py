@@ -5,7 +5,7 @@ the time) asked CALLS times through each, alternating blocks of 50, from Python 
 keep-alive and json, against the geodex package over gRPC). Prints the median latency of each and
 their ratio, and checks both answers agree to 1e-12.
 
-usage: PYTHONPATH=build/python http_edge_bench.py GEODEXD [CALLS]   (starts its own geodexd on
+usage: PYTHONPATH=client/python:build/python http_edge_bench.py GEODEXD [CALLS]   (starts its own geodexd on
 127.0.0.1, ports it picks; stops it)
 """
 import http.client
@@ -61,7 +61,7 @@ def run(grpc_port, http_port, calls):
 
     with geodex.GeodexClient("127.0.0.1:" + grpc_port, timeout=60, wait_for_ready=True) as client:
         def over_grpc():
-            return client.shortest_path("terrain", vertex(0), vertex(4224)).distance
+            return client.shortest_path("terrain", vertex(0), vertex(4224)).length_m
 
         a, b = over_http(), over_grpc()  # warm: the field is solved once and cached
         assert abs(a - b) <= 1e-12 * max(1.0, abs(b)), (a, b)
