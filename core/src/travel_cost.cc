@@ -262,7 +262,7 @@ absl::StatusOr<TravelPointSolver> TravelPointSolver::Create(
   const WeightedSurface::Limits limits{weighted->max_distance, weighted->cancel};
   // Several weights: regions built for these points, not a shared graph (the exact engine inside
   // each region answers a matrix in a fraction of the graph's search; SharesTravelSurface).
-  const bool several = RegionsServeFields(*weighted) && !RegionsServe(*weighted);
+  const bool several = RegionsServeSeveralWeights(*weighted);
   if (!several) {
     if (std::shared_ptr<const WeightedSurface> shared = SharedGraph(mesh, options, *weighted)) {
       return TravelPointSolver(*options.travel, std::move(shared), nullptr, limits);
@@ -328,7 +328,7 @@ absl::StatusOr<PathsQueryResult> ComputeTravelPaths(const TriangleMesh& mesh,
   // A constant speed: the regions, as for fields, so a path's time is the field's at its end
   // (one weight: the exact engine's surface, shared when the caller has it; several: the regions
   // built around the path's ends). A slope speed: the graph.
-  const bool several = RegionsServeFields(*weighted) && !RegionsServe(*weighted);
+  const bool several = RegionsServeSeveralWeights(*weighted);
   const std::shared_ptr<const WeightedSurface> shared =
       several ? nullptr : SharedGraph(mesh, options, *weighted);
   if (shared != nullptr) {

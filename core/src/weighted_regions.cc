@@ -452,6 +452,10 @@ bool RegionsServe(const WeightedOptions& options) {
 
 bool RegionsServeFields(const WeightedOptions& options) { return options.slope_cost == nullptr; }
 
+bool RegionsServeSeveralWeights(const WeightedOptions& options) {
+  return RegionsServeFields(options) && !RegionsServe(options);
+}
+
 RegionSurface::RegionSurface(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 RegionSurface::~RegionSurface() = default;
 

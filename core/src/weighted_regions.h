@@ -30,10 +30,12 @@ bool OneFiniteWeight(const std::vector<double>& weights);
 // Whether a whole field with `options` is solved by regions: any weights without a slope cost.
 // With several weights the answers keep the graph's bound and are never above it (the boundary
 // points are the graph's; inside a region propagation is exact), in 2.7x the exact field's time
-// on the target case (docs/performance.md). Times at points and matrices use them too
-// (TravelPointSolver); paths with several weights stay on the graph: a path cannot yet be traced
-// back through a boundary point.
+// on the target case (docs/performance.md). Times at points, matrices and paths use them too
+// (TravelPointSolver, ComputeTravelPaths; a path is traced back through the boundary points).
 bool RegionsServeFields(const WeightedOptions& options);
+// Whether `options` has several weights and no slope cost: the regions answer, built around the
+// query's own points, never a surface shared between queries (only one weight's is shared).
+bool RegionsServeSeveralWeights(const WeightedOptions& options);
 
 // The union mesh and its links for one mesh and one set of options (already validated), built
 // once for many queries (a matrix's rows); immutable, CostsAt may run on many threads at once.
