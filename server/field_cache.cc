@@ -20,7 +20,7 @@ std::string FieldCacheKey(const std::string& mesh_id, const std::vector<SurfaceP
   return mesh_id + SolveKey(sources, options);
 }
 
-std::string TravelGraphKey(const std::string& mesh_id, const GeodesicOptions& options) {
+std::string TravelSurfaceKey(const std::string& mesh_id, const GeodesicOptions& options) {
   return "travel graph|" + mesh_id + TravelCostKey(options);  // (a field's key starts with the id)
 }
 

@@ -11,8 +11,8 @@
 // reader. Thread-safe.
 //
 // The same budget holds travel graphs (the weighted engine's Steiner points for one mesh and one
-// constant-speed travel cost, core's BuildTravelGraph), keyed by TravelGraphKey: the travel paths,
-// times at points and matrices on a mesh with one cost layer share one graph instead of each
+// constant-speed travel cost, core's BuildTravelSurface), keyed by TravelSurfaceKey: the travel
+// paths, times at points and matrices on a mesh with one cost layer share one graph instead of each
 // building its own.
 
 #include <cstdint>
@@ -36,7 +36,7 @@ std::string FieldCacheKey(const std::string& mesh_id, const std::vector<SurfaceP
                           const GeodesicOptions& options);
 
 // The key of a travel graph: mesh id and the travel cost as FieldCacheKey keys it (no sources).
-std::string TravelGraphKey(const std::string& mesh_id, const GeodesicOptions& options);
+std::string TravelSurfaceKey(const std::string& mesh_id, const GeodesicOptions& options);
 
 // Memory a cached field occupies.
 uint64_t FieldBytes(const DistanceField& field);

@@ -130,7 +130,7 @@ absl::StatusOr<DistanceMatrix> SolveMatrixRows(const QueryEnv& env, const Stored
   for (size_t r : missing) rest.push_back(sources[r]);
   MatrixOptions matrix_options;
   matrix_options.solver = solver;
-  ShareTravelGraph(env, mesh, &matrix_options.solver);
+  ShareTravelSurface(env, mesh, &matrix_options.solver);
   matrix_options.k_nearest = k_nearest;
   if (env.pool != nullptr) {
     // Rows beyond the calling worker's go to the shared pool, behind work already queued; a

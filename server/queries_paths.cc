@@ -73,7 +73,7 @@ absl::Status RunFindShortestPath(const QueryEnv& env, const v1::FindShortestPath
   if (env.quick) return SolveLaneNeeded();
   PathQueryOptions options;
   options.solver = *solver;
-  ShareTravelGraph(env, **mesh, &options.solver);
+  ShareTravelSurface(env, **mesh, &options.solver);
   absl::StatusOr<PathQueryResult> result = ComputeShortestPath(*(*mesh)->mesh, *from, *to, options);
   if (result.ok()) {
     env.counters->solves.fetch_add(1, std::memory_order_relaxed);
@@ -139,7 +139,7 @@ absl::Status RunFindShortestPaths(const QueryEnv& env, const v1::FindShortestPat
   }
   PathQueryOptions options;
   options.solver = *solver;
-  ShareTravelGraph(env, **mesh, &options.solver);
+  ShareTravelSurface(env, **mesh, &options.solver);
   SolveStats total;
   for (size_t g = 0; g < groups.size(); ++g) {
     std::vector<SurfacePoint> targets;
@@ -212,7 +212,7 @@ absl::Status RunEstimateDistances(const QueryEnv& env, const v1::EstimateDistanc
     }
   }
   if (exact) {
-    if (!request.want_directions()) ShareTravelGraph(env, **mesh, &*solver);
+    if (!request.want_directions()) ShareTravelSurface(env, **mesh, &*solver);
     PointQuery query{*std::move(sources), *std::move(points), *solver, request.want_directions()};
     absl::StatusOr<PointValues> values = ComputePointValues(tm, query);
     if (!values.ok()) return NameSolveError(values.status(), "points");

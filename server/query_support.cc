@@ -132,16 +132,16 @@ absl::StatusOr<GeodesicOptions> Options(const QueryEnv& env, const StoredMesh& m
   return out;
 }
 
-void ShareTravelGraph(const QueryEnv& env, const StoredMesh& mesh, GeodesicOptions* options) {
+void ShareTravelSurface(const QueryEnv& env, const StoredMesh& mesh, GeodesicOptions* options) {
   if (!options->travel.has_value() || IsDirectional(*options->travel) || !env.cache->enabled()) {
     return;
   }
   if (!SharesTravelSurface(*options->travel)) return;
-  const std::string key = TravelGraphKey(mesh.id, *options);
+  const std::string key = TravelSurfaceKey(mesh.id, *options);
   std::shared_ptr<const WeightedSurface> graph = env.cache->FindGraph(key, *mesh.mesh);
   if (graph == nullptr) {
     absl::StatusOr<std::shared_ptr<const WeightedSurface>> built =
-        BuildTravelGraph(*mesh.mesh, *options);
+        BuildTravelSurface(*mesh.mesh, *options);
     if (!built.ok() || *built == nullptr) return;
     // The graph refers to the mesh: its owner keeps the mesh alive as long as the graph lives.
     struct Held {

@@ -45,13 +45,13 @@ void SnapsToProto(const PointSnaps& snaps, Response* out) {
 absl::StatusOr<GeodesicOptions> Options(const QueryEnv& env, const StoredMesh& mesh,
                                         const v1::SolverOptions& options);
 // A constant-speed, one-weight travel cost's surface (the exact engine's on the passable faces,
-// core's BuildTravelGraph) from the result cache (TravelGraphKey), or built and cached, set in
+// core's BuildTravelSurface) from the result cache (TravelSurfaceKey), or built and cached, set in
 // options->travel->graph: the travel paths, times at points and matrices on one mesh with one
 // cost layer then share it; it takes any point. Nothing without a travel cost, with the cache off,
 // or where core shares nothing (SharesTravelSurface): several weights run on regions built around
 // each query's points, a slope-dependent speed on its own graph. A surface that cannot be built is
 // left to the query, whose solve names the error. Solve-lane work (it may build).
-void ShareTravelGraph(const QueryEnv& env, const StoredMesh& mesh, GeodesicOptions* options);
+void ShareTravelSurface(const QueryEnv& env, const StoredMesh& mesh, GeodesicOptions* options);
 // What an answer's travel_epsilon says: 0 for exact metres, else the epsilon the solve uses
 // (set, or the speed model's default).
 inline double TravelEpsilon(const GeodesicOptions& options) {

@@ -231,7 +231,7 @@ std::shared_ptr<const WeightedSurface> SharedGraph(const TriangleMesh& mesh,
 
 }  // namespace
 
-absl::StatusOr<std::shared_ptr<const WeightedSurface>> BuildTravelGraph(
+absl::StatusOr<std::shared_ptr<const WeightedSurface>> BuildTravelSurface(
     const TriangleMesh& mesh, const GeodesicOptions& options) {
   absl::StatusOr<WeightedOptions> weighted = WeightedOptionsFor(mesh, options);
   if (!weighted.ok()) return weighted.status();

@@ -170,7 +170,7 @@ void ExpectSamePaths(const TriangleMesh& mesh, const SurfacePoint& from,
   }
 }
 
-// Several weights share nothing (BuildTravelGraph gives null: paths, point values and matrices
+// Several weights share nothing (BuildTravelSurface gives null: paths, point values and matrices
 // run on regions built around their own points, the fields' engine). A Steiner graph of the
 // same cost handed to queries in TravelCost::graph anyway is not read: every path, point value and
 // matrix entry is bit for bit what a query building its own gives, under the query's own limits
@@ -183,7 +183,7 @@ TEST(TravelCostTest, ASharedGraphAnswersAsEachQuerysOwn) {
   for (uint32_t f = 0; f < mesh.face_count(); f += 3) (*weights)[f] = 2.5;
   GeodesicOptions own = Travel(3.6, 0.05);
   own.travel->face_weight = weights;
-  absl::StatusOr<std::shared_ptr<const WeightedSurface>> nothing = BuildTravelGraph(mesh, own);
+  absl::StatusOr<std::shared_ptr<const WeightedSurface>> nothing = BuildTravelSurface(mesh, own);
   ASSERT_TRUE(nothing.ok()) << nothing.status();
   EXPECT_EQ(*nothing, nullptr);
   absl::StatusOr<WeightedOptions> weighted = WeightedOptionsFor(mesh, own);
@@ -271,13 +271,13 @@ TEST(TravelCostTest, ASharedGraphAnswersAsEachQuerysOwn) {
   GeodesicOptions tobler = own;
   tobler.travel->speed_model = SpeedModel::kTobler;
   tobler.travel->speed_kmh = 0;
-  absl::StatusOr<std::shared_ptr<const WeightedSurface>> none = BuildTravelGraph(mesh, tobler);
+  absl::StatusOr<std::shared_ptr<const WeightedSurface>> none = BuildTravelSurface(mesh, tobler);
   ASSERT_TRUE(none.ok()) << none.status();
   EXPECT_EQ(*none, nullptr);
 }
 
-// One weight (the exact engine, no graph): BuildTravelGraph wraps the exact engine's surface to be
-// shared the same way; a query handed it answers bit for bit as one building its own, and it
+// One weight (the exact engine, no graph): BuildTravelSurface wraps the exact engine's surface to
+// be shared the same way; a query handed it answers bit for bit as one building its own, and it
 // serves only queries of the same weights and window budget.
 TEST(TravelCostTest, ASharedOneWeightSurfaceAnswersAsEachQuerysOwn) {
   const TriangleMesh mesh = SquarePlane(8, 80, 0.2);
@@ -285,7 +285,7 @@ TEST(TravelCostTest, ASharedOneWeightSurfaceAnswersAsEachQuerysOwn) {
   std::vector<double> weights(mesh.face_count(), 2.0);
   weights[7] = kInf;
   own.travel->face_weight = std::make_shared<std::vector<double>>(std::move(weights));
-  absl::StatusOr<std::shared_ptr<const WeightedSurface>> surface = BuildTravelGraph(mesh, own);
+  absl::StatusOr<std::shared_ptr<const WeightedSurface>> surface = BuildTravelSurface(mesh, own);
   ASSERT_TRUE(surface.ok()) << surface.status();
   ASSERT_NE(*surface, nullptr);
   EXPECT_EQ((*surface)->steiner_points(), 0u);

@@ -429,7 +429,7 @@ TEST_F(TravelServiceTest, OneWeightSurfaceIsSharedAsAGraphIs) {
   absl::StatusOr<std::shared_ptr<const StoredMesh>> stored = server_->store().Get("hills");
   ASSERT_TRUE(stored.ok()) << stored.status();
   std::shared_ptr<const WeightedSurface> surface =
-      server_->cache().FindGraph(TravelGraphKey((*stored)->id, one), *(*stored)->mesh);
+      server_->cache().FindGraph(TravelSurfaceKey((*stored)->id, one), *(*stored)->mesh);
   ASSERT_NE(surface, nullptr);
   EXPECT_EQ(surface->steiner_points(), 0u);
 }
@@ -523,11 +523,11 @@ TEST_F(TravelServiceTest, TravelQueriesShareOneGraphPerCost) {
   // A graph keeps its mesh alive, so its entry counts the mesh's memory as well as its own.
   absl::StatusOr<std::shared_ptr<const StoredMesh>> stored = server_->store().Get("hills");
   ASSERT_TRUE(stored.ok()) << stored.status();
-  const std::string key = TravelGraphKey((*stored)->id, one);
+  const std::string key = TravelSurfaceKey((*stored)->id, one);
   std::shared_ptr<const WeightedSurface> graph = server_->cache().FindGraph(key, *(*stored)->mesh);
   ASSERT_NE(graph, nullptr);
   EXPECT_EQ(&graph->mesh(), (*stored)->mesh.get());
-  const std::string finer_key = TravelGraphKey((*stored)->id, finer);
+  const std::string finer_key = TravelSurfaceKey((*stored)->id, finer);
   std::shared_ptr<const WeightedSurface> finer_graph =
       server_->cache().FindGraph(finer_key, *(*stored)->mesh);
   ASSERT_NE(finer_graph, nullptr);

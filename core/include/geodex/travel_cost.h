@@ -63,9 +63,9 @@ struct TravelCost {
   // 0 = unlimited; else a solve needing more Steiner points fails with ResourceExhausted
   // (Limit::kSteinerPoints) before allocating them.
   uint64_t max_steiner_points = 0;
-  // The weighted engine's graph for this mesh and these options, built once (BuildTravelGraph) and
-  // shared by many queries: paths, times at points and matrices then skip building their own. It
-  // is used only where it is the graph they would build (WeightedSurface::Serves: the same mesh
+  // The weighted engine's graph for this mesh and these options, built once (BuildTravelSurface)
+  // and shared by many queries: paths, times at points and matrices then skip building their own.
+  // It is used only where it is the graph they would build (WeightedSurface::Serves: the same mesh
   // object, epsilon and weights), so a stale one costs a build, never a wrong answer. Not part of
   // the cost: caches key on the fields above.
   std::shared_ptr<const WeightedSurface> graph;
@@ -130,7 +130,7 @@ inline const char* SpeedModelName(SpeedModel model) {
 // Null where nothing is shared (SharesTravelSurface): several weights run on regions built around
 // each query's points, a slope-dependent speed on a graph that follows each query's sources.
 // Errors: as the queries' (the options).
-absl::StatusOr<std::shared_ptr<const WeightedSurface>> BuildTravelGraph(
+absl::StatusOr<std::shared_ptr<const WeightedSurface>> BuildTravelSurface(
     const TriangleMesh& mesh, const GeodesicOptions& options);
 
 // Whether paths, times at points and matrices under `travel` read a surface shared through

@@ -190,7 +190,7 @@ class WeightedSurface {
                                                const std::vector<SurfacePoint>& anchors = {});
   // The surface of one weight, answered by the exact engine (core's RegionSurface: every passable
   // face weighs the same, so no Steiner point is needed), wrapped to be shared and cached as a
-  // graph is (BuildTravelGraph): CostsAt and Paths answer from it, steiner_points() is 0.
+  // graph is (BuildTravelSurface): CostsAt and Paths answer from it, steiner_points() is 0.
   static WeightedSurface OnRegions(const TriangleMesh& mesh, WeightedOptions options,
                                    std::shared_ptr<const RegionSurface> regions);
   WeightedSurface(WeightedSurface&&) noexcept;
