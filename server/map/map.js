@@ -60,7 +60,7 @@
     if (!speed) return {};
     if (speed === 'tobler') return {travel: {speedModel: 'SPEED_MODEL_TOBLER'}};
     var kmh = parseFloat(speed.split(':')[1]);
-    return {travel: {speedKmh: kmh}};
+    return {travel: {speed_kmh: kmh}};
   }
 
   function unit() { return speedSelect.value ? 's' : 'm'; }

@@ -173,6 +173,9 @@ TEST_F(HttpEdgeTest, ListsAnUploadedDemAndFindsThePathTheGrpcCallFinds) {
   ASSERT_EQ(path.status, 200) << path.body;
   const auto over_http = FromJson<v1::FindShortestPathResponse>(path.body);
   EXPECT_EQ(path.headers["x-geodex-replica"], "replica-7");  // which replica answered
+  // A unit suffix reads as written (json_name), not lengthM.
+  EXPECT_TRUE(Contains(path.body, "\"length_m\":")) << path.body.substr(0, 200);
+  EXPECT_FALSE(Contains(path.body, "lengthM"));
 
   v1::FindShortestPathRequest request = FromJson<v1::FindShortestPathRequest>(body);
   request.set_mesh("meshes/hills");
