@@ -12,6 +12,7 @@
 #include "absl/strings/str_format.h"
 #include "absl/strings/str_split.h"
 #include "absl/time/time.h"
+#include "geodex/gis_formats.h"
 #include "google/protobuf/util/json_util.h"
 #include "google/rpc/status.pb.h"
 #include "status_convert.h"
@@ -77,21 +78,7 @@ const pb::FieldDescriptor* FindField(const pb::Descriptor* type, const std::stri
   return nullptr;
 }
 
-// A JSON string literal (RFC 8259 escapes).
-std::string JsonQuote(const std::string& text) {
-  std::string out = "\"";
-  for (unsigned char c : text) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += static_cast<char>(c);
-    } else if (c < 0x20) {
-      out += absl::StrFormat("\\u%04x", c);
-    } else {
-      out += static_cast<char>(c);
-    }
-  }
-  return out + "\"";
-}
+using terrain::JsonQuoted;  // a JSON string literal (RFC 8259 escapes), as the GIS files write
 
 // Query parameters (but `timeout`) set the request's scalar fields: "page_size=10",
 // "dem.step=2". They are written as a JSON object and read by the JSON parser, so a value is
@@ -127,14 +114,14 @@ absl::Status SetFieldsFromQuery(const std::map<std::string, std::string>& params
       // Numbers as strings: the JSON mapping accepts both; booleans as the literals.
       const bool literal = field->cpp_type() == pb::FieldDescriptor::CPPTYPE_BOOL &&
                            (value == "true" || value == "false");
-      at->json = literal ? value : JsonQuote(value);
+      at->json = literal ? value : JsonQuoted(value);
     }
   }
   std::function<std::string(const Node&)> write = [&](const Node& node) {
     if (node.fields.empty()) return node.json.empty() ? std::string("{}") : node.json;
     std::string out = "{";
     for (const auto& [name, child] : node.fields) {
-      absl::StrAppend(&out, out.size() > 1 ? "," : "", JsonQuote(name), ":", write(child));
+      absl::StrAppend(&out, out.size() > 1 ? "," : "", JsonQuoted(name), ":", write(child));
     }
     return out + "}";
   };
