@@ -39,9 +39,10 @@ path_text=$(./build/client/geodex --server "$server" path terrain --from 0 --to 
 printf '%s\n' "$path_text" | head -n 4
 if curl -sf "http://$http/v1/meshes?pageSize=1" >/dev/null 2>&1; then
   echo "--- the same path over HTTP/JSON: curl -X POST http://$http/v1/meshes/terrain:findShortestPath"
-  curl -sf -X POST -H 'Content-Type: application/json' \
-    "http://$http/v1/meshes/terrain:findShortestPath" -d '{"from": {"vertex": 0}, "to": {"vertex": 4224}}' |
-    head -c 120
+  # (Into a variable first: `curl | head` could fail curl on a closed pipe, and pipefail is on.)
+  http_answer=$(curl -sf -X POST -H 'Content-Type: application/json' \
+    "http://$http/v1/meshes/terrain:findShortestPath" -d '{"from": {"vertex": 0}, "to": {"vertex": 4224}}')
+  printf '%s' "${http_answer:0:120}"
   echo " ..."
   echo "--- HTTP/JSON API on http://$http/v1/meshes (docs/service.md, \"HTTP/JSON\")"
 fi
