@@ -27,14 +27,10 @@ RUN cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DGEODEX_BUILD_BENCH
     fi
 
 FROM debian:bookworm
-# (civetweb, the HTTP/JSON port's server, loads OpenSSL as libssl.so for --http_listen with TLS:
-# the unversioned names point at libssl3's libraries.)
 RUN apt-get update \
  && apt-get install -y --no-install-recommends libgrpc++1.51 libprotobuf32 libabsl20220623 \
       libspdlog1.10 libprometheus-cpp-pull1.0 libprometheus-cpp-core1.0 libcivetweb1 libpng16-16 zlib1g libssl3 libgdal32 libgeos-c1v5 \
  && rm -rf /var/lib/apt/lists/* \
- && for lib in ssl crypto; do ln -s "$(ls /usr/lib/*/lib$lib.so.3)" /usr/local/lib/lib$lib.so; done \
- && ldconfig \
  && groupadd --system --gid 10001 geodex \
  && useradd --system --uid 10001 --gid geodex --home-dir /data --shell /usr/sbin/nologin geodex \
  && mkdir /data && chown geodex:geodex /data

@@ -48,6 +48,13 @@ absl::Status ValidateServerOptions(const ServerOptions& options) {
         "--auth_token_file without --tls_cert/--tls_key would send bearer tokens in plaintext; "
         "serve TLS, or pass --allow_plaintext_tokens when a TLS-terminating proxy is in front");
   }
+  if (!options.http.listen.empty() && !options.tls_cert_file.empty() &&
+      !options.allow_plaintext_tokens) {
+    return absl::InvalidArgumentError(
+        "--http_listen with --tls_cert: the HTTP/JSON port serves plaintext only; put a "
+        "TLS-terminating proxy in front of it and pass --allow_plaintext_tokens, or leave "
+        "--http_listen off");
+  }
   if (options.queue_capacity > kMaxQueueCapacity) {
     return absl::InvalidArgumentError(
         absl::StrCat("--queue_capacity=", options.queue_capacity, ": at most ", kMaxQueueCapacity));
@@ -185,8 +192,6 @@ absl::StatusOr<std::unique_ptr<GeodexServer>> GeodexServer::Start(const ServerOp
     HttpEdgeOptions http = options.http;
     http.max_body_bytes = static_cast<uint64_t>(options.max_receive_message_bytes);
     http.tokens = s->authenticated_;
-    http.tls_cert_file = options.tls_cert_file;
-    http.tls_key_file = options.tls_key_file;
     grpc::ChannelArguments arguments;
     arguments.SetMaxReceiveMessageSize(-1);  // answers are bounded by the server's own limits
     absl::StatusOr<std::unique_ptr<HttpEdge>> edge = HttpEdge::Start(

@@ -235,8 +235,8 @@ int main(int argc, char** argv) {
   }
   if ((*server)->http_port() != 0) {
     const std::string& listen = options.http.listen;
-    spdlog::info("HTTP/JSON API on {}://{}:{}/v1/meshes", (*server)->tls() ? "https" : "http",
-                 listen.substr(0, listen.rfind(':')), (*server)->http_port());
+    spdlog::info("HTTP/JSON API on http://{}:{}/v1/meshes", listen.substr(0, listen.rfind(':')),
+                 (*server)->http_port());
   }
   if ((*server)->authenticated() && !(*server)->tls()) {
     spdlog::warn(

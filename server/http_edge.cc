@@ -1,7 +1,5 @@
 #include "http_edge.h"
 
-#include <openssl/ssl.h>
-
 #include <algorithm>
 
 #include "absl/strings/ascii.h"
@@ -129,13 +127,12 @@ absl::StatusOr<std::unique_ptr<HttpEdge>> HttpEdge::Start(const HttpEdgeOptions&
   std::unique_ptr<HttpEdge> edge(new HttpEdge());
   edge->options_ = options;
   edge->channel_ = std::move(channel);
-  const bool tls = !options.tls_cert_file.empty();
-  mg_init_library(tls ? MG_FEATURES_TLS : 0);
+  mg_init_library(0);
 
   std::string host = options.listen.substr(0, options.listen.rfind(':'));
   const std::string port = options.listen.substr(options.listen.rfind(':') + 1);
   if (host == "localhost") host = "127.0.0.1";
-  const std::string ports = absl::StrCat(host.empty() ? "" : host + ":", port, tls ? "s" : "");
+  const std::string ports = absl::StrCat(host.empty() ? "" : host + ":", port);
   const std::string threads = absl::StrCat(options.threads);
   // No document_root: nothing but the handler below answers, and no file is ever served.
   const char* settings[] = {"listening_ports",
@@ -150,26 +147,12 @@ absl::StatusOr<std::unique_ptr<HttpEdge>> HttpEdge::Start(const HttpEdgeOptions&
                             "5000",
                             "tcp_nodelay",  // chunks (NDJSON) leave as they are written
                             "1",
-                            "ssl_protocol_version",
-                            "4",  // TLS 1.2 and later
                             nullptr};
   mg_callbacks callbacks{};
   callbacks.log_message = [](const mg_connection*, const char* message) {
     spdlog::warn("http: {}", message);
     return 1;
   };
-  if (tls) {
-    // The certificate and key files geodexd's gRPC port uses, set on civetweb's OpenSSL context.
-    callbacks.init_ssl = [](void* ssl_context, void* user) {
-      const HttpEdgeOptions& o = static_cast<HttpEdge*>(user)->options_;
-      auto* ctx = static_cast<SSL_CTX*>(ssl_context);
-      const bool ok =
-          SSL_CTX_use_certificate_chain_file(ctx, o.tls_cert_file.c_str()) == 1 &&
-          SSL_CTX_use_PrivateKey_file(ctx, o.tls_key_file.c_str(), SSL_FILETYPE_PEM) == 1 &&
-          SSL_CTX_check_private_key(ctx) == 1;
-      return ok ? 1 : -1;
-    };
-  }
   edge->context_ = mg_start(&callbacks, edge.get(), settings);
   if (edge->context_ == nullptr) {
     mg_exit_library();
@@ -177,8 +160,8 @@ absl::StatusOr<std::unique_ptr<HttpEdge>> HttpEdge::Start(const HttpEdgeOptions&
       return absl::UnavailableError(
           absl::StrCat("--http_listen=", options.listen, ": address in use; choose another port"));
     }
-    return absl::UnavailableError(absl::StrCat("--http_listen=", options.listen, ": cannot listen",
-                                               tls ? " (or serve TLS)" : ""));
+    return absl::UnavailableError(
+        absl::StrCat("--http_listen=", options.listen, ": cannot listen"));
   }
   mg_set_request_handler(edge->context_, "/", &HttpEdge::Handle, edge.get());
   mg_server_port bound[4];

@@ -10,8 +10,10 @@
 // Safe by default: without bearer tokens a request's Host must name this machine (localhost,
 // 127.0.0.1, [::1]) or one of --http_allowed_hosts, so a web page cannot reach geodex through DNS
 // rebinding; a POST needs a JSON (or, for uploads, a file) media type, which a cross-site form
-// cannot send; CORS is off unless --http_cors_origin names an origin. With --tls_cert the port
-// speaks HTTPS with the same certificate.
+// cannot send; CORS is off unless --http_cors_origin names an origin. The port speaks plaintext
+// HTTP only: Debian's civetweb 1.15 loads OpenSSL at run time and its TLS connections were reset
+// (its own `civetweb` binary too), so next to --tls_cert the port needs a TLS-terminating proxy
+// in front (geodex_server.cc refuses it otherwise).
 
 #include <cstdint>
 #include <memory>
@@ -27,14 +29,13 @@ struct mg_connection;
 namespace geodex::server {
 
 struct HttpEdgeOptions {
-  std::string listen;                       // HOST:PORT (port 0: a free one); "" = no HTTP port
-  size_t threads = 4;                       // --http_threads: connections served at once
-  uint64_t max_body_bytes = 4 << 20;        // a JSON body (--max_receive_message_bytes)
-  uint64_t max_response_bytes = 64 << 20;   // --http_max_response_bytes: an assembled answer
-  std::vector<std::string> allowed_hosts;   // --http_allowed_hosts ("*": any)
-  std::string cors_origin;                  // --http_cors_origin ("" = no CORS)
-  bool tokens = false;                      // bearer tokens on: Host is not checked
-  std::string tls_cert_file, tls_key_file;  // HTTPS when given (geodexd's --tls_cert/--tls_key)
+  std::string listen;                      // HOST:PORT (port 0: a free one); "" = no HTTP port
+  size_t threads = 4;                      // --http_threads: connections served at once
+  uint64_t max_body_bytes = 4 << 20;       // a JSON body (--max_receive_message_bytes)
+  uint64_t max_response_bytes = 64 << 20;  // --http_max_response_bytes: an assembled answer
+  std::vector<std::string> allowed_hosts;  // --http_allowed_hosts ("*": any)
+  std::string cors_origin;                 // --http_cors_origin ("" = no CORS)
+  bool tokens = false;                     // bearer tokens on: Host is not checked
   // --http_grpc_target: where the calls go. "" = this server, in-process; HOST:PORT = a gateway's
   // gRPC port (plaintext), so that HTTP calls are routed by mesh exactly as gRPC calls are (each
   // carries its mesh as x-mesh-id; deploy/gateway).
@@ -53,7 +54,6 @@ class HttpEdge {
   ~HttpEdge();  // Stop()
 
   int port() const { return port_; }
-  bool tls() const { return !options_.tls_cert_file.empty(); }
   // Stops accepting and waits for the requests being served (their calls end with the server's).
   void Stop();
 

@@ -431,6 +431,23 @@ TEST_F(HttpEdgeTest, TokensAreCheckedAsOverGrpc) {
             200);
 }
 
+// The HTTP port is plaintext (http_edge.h): next to a TLS gRPC port it needs a TLS-terminating
+// proxy, said with --allow_plaintext_tokens; otherwise geodexd refuses to start, naming the flags.
+TEST(HttpEdgeOptionsTest, PlaintextHttpNextToTlsNeedsAProxy) {
+  ServerOptions options;
+  options.http.listen = "127.0.0.1:0";
+  options.tls_cert_file = "cert.pem";
+  options.tls_key_file = "key.pem";
+  const absl::Status refused = ValidateServerOptions(options);
+  EXPECT_EQ(refused.code(), absl::StatusCode::kInvalidArgument);
+  EXPECT_TRUE(Contains(std::string(refused.message()), "--http_listen")) << refused;
+  EXPECT_TRUE(Contains(std::string(refused.message()), "--allow_plaintext_tokens")) << refused;
+  options.allow_plaintext_tokens = true;
+  EXPECT_TRUE(ValidateServerOptions(options).ok());
+  options.http.threads = 0;
+  EXPECT_TRUE(Contains(std::string(ValidateServerOptions(options).message()), "--http_threads"));
+}
+
 TEST(HttpTranscodeTest, RoutesFollowTheServiceDescriptor) {
   HttpRequest request;
   request.method = "POST";
