@@ -57,14 +57,17 @@ constexpr char kRenderHelp[] =
       automatically (z up; 800x600); on a DEM a scale bar at the bottom left. The default view,
       auto, is the one of iso and the six axis views that shows the most sources, then the most
       of the lines.
-      .ply and .gltf write the coloured mesh for 3D viewers instead.
+      .ply and .gltf write the coloured mesh for 3D viewers instead. With --speed (and the
+      other travel flags) a travel-time map: the bar in s, or min from 10 minutes on.
 )";
 
 int RunRender(Backend& backend, const Args& args) {
   std::string error;
+  // "lambda" etc.: the solver's flags, which also admit the travel flags (kTravelFlags): with
+  // --speed the picture is a travel-time map.
   if (!CheckKnown(args,
                   {"sources", "isolines", "levels", "voronoi", "delaunay", "path", "output", "view",
-                   "size", "max-snap"},
+                   "size", "max-snap", "lambda", "lambda-scale", "max-distance", "max-windows"},
                   &error)) {
     return Fail(kExitUsage, error);
   }
@@ -105,6 +108,8 @@ int RunRender(Backend& backend, const Args& args) {
   }
   if (!GetLevels(args, "isolines", &levels, &error)) return Fail(kExitUsage, error);
   const bool isolines = levels.count > 0 || !levels.levels.empty();
+  GeodesicOptions solver;  // --speed, --friction, --lambda, ... (a travel-time map with --speed)
+  if (!GetSolverFlags(args, &solver, &error)) return Fail(kExitUsage, error);
   const bool voronoi = args.options.count("voronoi") > 0,
              delaunay = args.options.count("delaunay") > 0;
 
@@ -119,6 +124,7 @@ int RunRender(Backend& backend, const Args& args) {
     }
   }
   if (int code = OpenMesh(backend, args, positional[0], MeshBuildOptions{})) return code;
+  if (int code = ResolveTravelWeights(backend, args, &solver)) return code;
   sources = ParseSpec(&backend, "sources", args.options.at("sources"));  // map points onto the DEM
   if (!sources.ok()) return FailQuery(sources.status());
   if (!path_spec.empty()) {
@@ -139,27 +145,28 @@ int RunRender(Backend& backend, const Args& args) {
 
   // A local backend solves the field once and derives the layers from it.
   Layers layers;
-  absl::StatusOr<const DistanceField*> field = backend.Field({*sources, {}, false});
+  absl::StatusOr<const DistanceField*> field = backend.Field({*sources, solver, false});
   if (!field.ok()) return FailQuery(field.status());
   layers.field = *field;
   if (isolines) {
-    absl::StatusOr<Isolines> iso = backend.ComputeIsolines({*sources, GeodesicOptions{}, levels});
+    absl::StatusOr<Isolines> iso = backend.ComputeIsolines({*sources, solver, levels});
     if (!iso.ok()) return FailQuery(iso.status());
     layers.isolines = *std::move(iso);
   }
   if (voronoi) {
-    absl::StatusOr<VoronoiDiagram> v = backend.ComputeVoronoi({*sources, GeodesicOptions{}});
+    absl::StatusOr<VoronoiDiagram> v = backend.ComputeVoronoi({*sources, solver});
     if (!v.ok()) return FailQuery(v.status());
     layers.voronoi = *std::move(v);
   }
   if (delaunay) {
-    absl::StatusOr<DelaunayTriangulation> d =
-        backend.ComputeDelaunay({*sources, GeodesicOptions{}});
+    absl::StatusOr<DelaunayTriangulation> d = backend.ComputeDelaunay({*sources, solver});
     if (!d.ok()) return FailQuery(d.status());
     layers.delaunay = *std::move(d);
   }
   if (!ends.empty()) {
-    absl::StatusOr<PathQueryResult> p = backend.Path({ends[0], ends[1], PathQueryOptions{}});
+    PathQueryOptions path_options;
+    path_options.solver = solver;
+    absl::StatusOr<PathQueryResult> p = backend.Path({ends[0], ends[1], path_options});
     if (!p.ok()) return FailQuery(p.status());
     layers.path = *std::move(p);
   }
@@ -169,6 +176,10 @@ int RunRender(Backend& backend, const Args& args) {
   if (backend.Terrain() != nullptr) {  // a DEM is in metres, and gets a scale bar
     scene.units = "m";
     scene.scale_bar = true;
+  }
+  if (solver.travel.has_value()) {
+    scene.units = "s";  // a travel-time map: the bar and the isoline labels in s, or min
+    scene.caption = "travel time";
   }
   scene.vertex_colors = render::FieldColors(layers.field->distance);
   for (double d : layers.field->distance) {

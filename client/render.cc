@@ -260,7 +260,8 @@ const uint8_t* Glyph(char c) {
       {'n', {0, 0, 22, 25, 17, 17, 17}},   {'s', {0, 0, 14, 16, 14, 1, 30}},
       {'t', {8, 8, 28, 8, 8, 9, 6}},       {'u', {0, 0, 17, 17, 17, 19, 13}},
       {'(', {2, 4, 8, 8, 8, 4, 2}},        {')', {8, 4, 2, 2, 2, 4, 8}},
-      {'k', {16, 16, 18, 20, 24, 20, 18}},
+      {'k', {16, 16, 18, 20, 24, 20, 18}}, {'r', {0, 0, 22, 25, 16, 16, 16}},
+      {'v', {0, 0, 17, 17, 17, 10, 4}},    {'l', {12, 4, 4, 4, 4, 4, 14}},
   };
   for (const auto& [ch, rows] : kFont) {
     if (ch == c) return rows.data();
@@ -315,6 +316,10 @@ NiceScale NiceTicks(double max_value, const std::string& units, int most) {
     out.units = "km";
     out.divisor = 1000;
   }
+  if (units == "s" && max_value >= 600) {  // and minutes from 10 minutes on
+    out.units = "min";
+    out.divisor = 60;
+  }
   const double top = max_value / out.divisor;
   if (!(top > 0) || !std::isfinite(top)) return out;
   // The smallest step of 1, 2 or 5 times a power of ten that puts at most `most` ticks above 0.
@@ -337,10 +342,15 @@ NiceScale NiceTicks(double max_value, const std::string& units, int most) {
 }
 
 std::string NiceLabel(double value, const std::string& units) {
-  std::string unit = units == "m" ? "m" : "";  // mesh units go unnamed on the picture
+  // Mesh units go unnamed on the picture.
+  std::string unit = units == "m" || units == "s" ? units : "";
   if (units == "m" && std::abs(value) >= 2000) {
     unit = "km";
     value /= 1000;
+  }
+  if (units == "s" && std::abs(value) >= 600) {
+    unit = "min";
+    value /= 60;
   }
   // Three significant digits, no exponent.
   const int digits = std::clamp(
@@ -357,8 +367,9 @@ namespace {
 
 // The colour bar in the right strip: the map from 0 (bottom) to max (top), ticks at round values
 // (1, 2 or 5 times a power of ten; km from 2 km on a DEM) whose labels always fit in the strip
-// (drawn smaller when needed), the caption "distance" and the units.
-void DrawColorBar(Image* image, double max_distance, const std::string& units) {
+// (drawn smaller when needed), the caption ("distance", "travel time") and the units.
+void DrawColorBar(Image* image, double max_distance, const std::string& units,
+                  const std::string& caption) {
   const int x0 = image->width - kColorBarWidth + 8, bar = 16;
   const int top = static_cast<int>(0.15 * image->height),
             bottom = static_cast<int>(0.85 * image->height);
@@ -387,7 +398,7 @@ void DrawColorBar(Image* image, double max_distance, const std::string& units) {
       label.pop_back();  // never past the edge
     Text(image, x0 + bar + 9, y - 7 * text_scale / 2, label, text_scale);
   }
-  Text(image, x0 - 4, top - 40, "distance", 2);
+  Text(image, x0 - 4, top - 40, caption, TextWidth(caption, 2) <= kColorBarWidth - 4 ? 2 : 1);
   Text(image, x0 - 4, top - 22, "(" + scale.units + ")", 1);
 }
 
@@ -505,7 +516,7 @@ Image Render(const Scene& scene, View view, int width, int height) {
     TextBackground(&image, x, y, text, 1);
     Text(&image, x, y, text, 1);
   }
-  if (bar) DrawColorBar(&image, scene.max_distance, scene.units);
+  if (bar) DrawColorBar(&image, scene.max_distance, scene.units, scene.caption);
   if (scene.scale_bar) DrawScaleBar(&image, project, mesh_width);
   return image;
 }

@@ -44,12 +44,14 @@ struct Scene {
   // The colour bar at the right (when max_distance > 0 and the image is at least kColorBarMinWidth
   // wide): the colour map from 0 (bottom) to max_distance (top), labelled, with `units`.
   double max_distance = 0;
-  std::string units = "mesh units";
-  bool scale_bar = false;  // a round length at the bottom left (a DEM: metres)
+  std::string units = "mesh units";  // "m" on a DEM; "s" on a travel-time map (min from 10 min)
+  std::string caption = "distance";  // above the colour bar ("travel time")
+  bool scale_bar = false;            // a round length at the bottom left (a DEM: metres)
 };
 
 // Round values for a colour bar or a scale: ticks at 0, s, 2s, ... <= max_value with s 1, 2 or 5
-// times a power of ten and at most `most` ticks above 0; on "m" from 2 km on, in km. Labels have
+// times a power of ten and at most `most` ticks above 0; on "m" from 2 km on, in km; on "s" from
+// 10 minutes on, in min. Labels have
 // no exponent (but for values beyond 1e9) and as many decimals as the step needs.
 struct NiceScale {
   std::string units;

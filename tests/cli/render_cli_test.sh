@@ -118,6 +118,28 @@ check "server started" test -n "$geodexd_port"
 check "remote render: exit 0" test $? -eq 0
 check "remote render: same bytes as local" cmp -s "$tmp/all.png" "$tmp/remote.png"
 
+# A travel-time map (--speed): at 7.2 km/h every time is half the distance, so the colours of the
+# mesh are the distance map's exactly (both run from 0 to their largest value); the colour bar's
+# strip differs (its caption says travel time, its labels seconds). A friction map changes them.
+"$GEODEX" render sample:terrain --sources 0 --view top --output "$tmp/dist.png"
+"$GEODEX" render sample:terrain --sources 0 --view top --speed constant:7.2 --output "$tmp/time.png"
+check "render --speed exits 0" test $? -eq 0
+check "travel-time map: the mesh's colours are the distance map's, the legend is not" \
+  /usr/bin/python3 - "$tmp/dist.png" "$tmp/time.png" "$PROBE" <<'PY'
+import importlib.util, sys
+spec = importlib.util.spec_from_file_location("probe", sys.argv[3]); probe = importlib.util.module_from_spec(spec); spec.loader.exec_module(probe)
+w, h, a = probe.read_png(sys.argv[1])
+_, _, b = probe.read_png(sys.argv[2])
+mesh = lambda rows: [bytes(r[:3 * (w - 112)]) for r in rows]
+strip = lambda rows: [bytes(r[3 * (w - 112):]) for r in rows]
+sys.exit(0 if mesh(a) == mesh(b) and strip(a) != strip(b) else 1)
+PY
+"$GEODEX" render sample:terrain --sources 0 --view top --speed constant:7.2 --cost-epsilon 0.5 \
+  --face-weights <(/usr/bin/python3 -c 'print("\n".join("1" if f < 4096 else "3" for f in range(8192)))') \
+  --output "$tmp/weighted.png"
+check "render --face-weights exits 0" test $? -eq 0
+check "weights change the travel-time map" test "$(cmp -s "$tmp/time.png" "$tmp/weighted.png"; echo $?)" = 1
+
 # Bad arguments.
 for bad in "--size 5x5" "--view sideways" "--isolines 1"; do
   # shellcheck disable=SC2086
