@@ -14,6 +14,7 @@
 #include "listen_address.h"
 #include "map_assets.h"
 #include "spdlog/spdlog.h"
+#include "status_convert.h"
 
 namespace geodex::server {
 namespace {
@@ -265,14 +266,12 @@ int HttpEdge::Serve(mg_connection* connection) {
 
   HttpRequest request;
   request.method = method;
-  request.path = info->local_uri != nullptr ? info->local_uri : "";
+  request.path = path;
   request.query = info->query_string != nullptr ? info->query_string : "";
   request.content_type = Header(connection, "Content-Type");
   request.accept = Header(connection, "Accept");
   request.content_length = info->content_length;
-  const bool upload =
-      method == "POST" && (request.path == "/v1/meshes" || request.path == "/v1/meshes/");
-  if (!upload && method == "POST") {  // the JSON body, bounded
+  if (method == "POST" && !IsUploadRequest(method, path)) {  // the JSON body, bounded
     if (info->content_length > static_cast<int64_t>(options_.max_body_bytes)) {
       return refuse(grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
                                  absl::StrCat("body of ", info->content_length,
@@ -295,9 +294,10 @@ int HttpEdge::Serve(mg_connection* connection) {
   absl::StatusOr<HttpCall> routed = RouteHttpRequest(request);
   if (!routed.ok()) {
     const absl::StatusCode code = routed.status().code();
-    return refuse(EdgeStatus(routed.status()), code == absl::StatusCode::kUnimplemented        ? 405
-                                               : code == absl::StatusCode::kFailedPrecondition ? 415
-                                                                                               : 0);
+    return refuse(ToGrpcStatus(routed.status()), code == absl::StatusCode::kUnimplemented ? 405
+                                                 : code == absl::StatusCode::kFailedPrecondition
+                                                     ? 415
+                                                     : 0);
   }
   const HttpCall& call = *routed;
 
@@ -305,7 +305,7 @@ int HttpEdge::Serve(mg_connection* connection) {
   double timeout = call.timeout_seconds;
   if (const std::string header = Header(connection, "grpc-timeout"); !header.empty()) {
     absl::StatusOr<double> seconds = ParseTimeoutSeconds(header, true, "header grpc-timeout");
-    if (!seconds.ok()) return refuse(EdgeStatus(seconds.status()));
+    if (!seconds.ok()) return refuse(ToGrpcStatus(seconds.status()));
     timeout = timeout > 0 ? std::min(timeout, *seconds) : *seconds;
   }
   if (timeout > 0) {
@@ -362,13 +362,13 @@ int HttpEdge::Serve(mg_connection* connection) {
   if (streaming) {  // NDJSON: an error is the stream's last line
     if (!status.ok() || !assembled.ok()) {
       const std::string line = absl::StrCat(
-          "{\"error\": ", ErrorJson(status.ok() ? EdgeStatus(assembled) : status), "}\n");
+          "{\"error\": ", ErrorJson(status.ok() ? ToGrpcStatus(assembled) : status), "}\n");
       mg_send_chunk(connection, line.data(), line.size());
     }
     mg_send_chunk(connection, "", 0);
     return status.ok() ? 200 : HttpStatusOf(status.error_code());
   }
-  if (!assembled.ok()) return refuse(EdgeStatus(assembled));
+  if (!assembled.ok()) return refuse(ToGrpcStatus(assembled));
   if (!status.ok()) return refuse(status);
   return send({200, answer.media_type(), answer.Finish()});
 }

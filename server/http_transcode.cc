@@ -1,7 +1,6 @@
 #include "http_transcode.h"
 
 #include <cctype>
-#include <cmath>
 #include <functional>
 #include <map>
 
@@ -211,6 +210,10 @@ std::unique_ptr<pb::Message> AsExportGis(const pb::Message& request, const char*
 
 }  // namespace
 
+bool IsUploadRequest(const std::string& method, const std::string& path) {
+  return method == "POST" && (path == kCollection || path == absl::StrCat(kCollection, "/"));
+}
+
 bool IsUploadMediaType(const std::string& content_type) {
   const std::string type = BareMediaType(content_type);
   return !type.empty() && type.find('/') != std::string::npos && type != "text/plain" &&
@@ -259,7 +262,7 @@ absl::StatusOr<HttpCall> RouteHttpRequest(const HttpRequest& request) {
   if (rest.empty()) {  // the collection
     if (request.method == "GET") {
       method = service.FindMethodByName("ListMeshes");
-    } else if (request.method == "POST") {
+    } else if (IsUploadRequest(request.method, request.path)) {
       method = service.FindMethodByName("CreateMesh");
     } else {
       return wrong_method("GET (list) or POST (upload)");
@@ -492,8 +495,6 @@ std::string ErrorJson(const grpc::Status& status) {
   }
   return json;
 }
-
-grpc::Status EdgeStatus(const absl::Status& status) { return ToGrpcStatus(status); }
 
 absl::StatusOr<double> ParseTimeoutSeconds(const std::string& text, bool grpc_form,
                                            const std::string& what) {

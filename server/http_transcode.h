@@ -69,6 +69,10 @@ struct HttpCall {
 // take (415). The path's mesh becomes the request's `mesh` (or `name`): "meshes/{id}".
 absl::StatusOr<HttpCall> RouteHttpRequest(const HttpRequest& request);
 
+// Whether the request is an upload (POST of the collection): its body is the file, streamed into
+// CreateMesh, not a JSON body read whole before routing.
+bool IsUploadRequest(const std::string& method, const std::string& path);
+
 // Whether a Content-Type is one an upload's body may have: anything but the types a browser form
 // can post without a CORS preflight (text/plain, forms), so no web page can upload behind a user's
 // back.
@@ -108,10 +112,6 @@ std::string MessageToHttpJson(const google::protobuf::Message& message);
 // carries.
 int HttpStatusOf(grpc::StatusCode code);
 std::string ErrorJson(const grpc::Status& status);
-
-// The gRPC status of an edge-level refusal (a route, a media type, a header): the code, and the
-// message naming what was wrong.
-grpc::Status EdgeStatus(const absl::Status& status);
 
 // A duration in gRPC's grpc-timeout form ("30S", "500m", "2M": the header) or absl's ("30s",
 // "1.5s", "2m": the query parameter); InvalidArgument naming `what` otherwise, or for zero.
